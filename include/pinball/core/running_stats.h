@@ -1,0 +1,36 @@
+#pragma once
+// Incremental mean and variance (Welford's update, thesis App. A done stably).
+
+#include <cstdint>
+
+namespace pinball {
+
+/// Running sample statistics in O(1) memory.
+class RunningStats {
+ public:
+  /// Adds one sample.
+  void add(double x);
+
+  /// Number of samples added.
+  std::int64_t count() const { return n_; }
+  /// Sample mean (0 with no samples).
+  double mean() const { return mean_; }
+  /// Unbiased sample variance (0 with fewer than two samples).
+  double variance() const { return n_ > 1 ? m2_ / static_cast<double>(n_ - 1) : 0.0; }
+  /// Sample standard deviation.
+  double stddev() const;
+  /// Half-width of the normal-approximation 95 % confidence interval of the mean.
+  double ci95_half_width() const;
+  /// Smallest and largest sample (0 with no samples).
+  double min() const { return min_; }
+  double max() const { return max_; }
+
+ private:
+  std::int64_t n_ = 0;
+  double mean_ = 0.0;
+  double m2_ = 0.0;
+  double min_ = 0.0;
+  double max_ = 0.0;
+};
+
+}  // namespace pinball
