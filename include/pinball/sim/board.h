@@ -1,0 +1,144 @@
+#pragma once
+// The static description of a pinball table (thesis 3.2): obstacles, flippers,
+// launcher, sensors and the constants of the game. Built once by the board
+// loader and never changed while a game runs; everything that changes lives in
+// GameState. Units: metres, seconds, radians, board frame (origin bottom-left
+// of the playfield, +x right, +y up the table).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pinball/core/geometry.h"
+
+namespace pinball::sim {
+
+/// Primitive shape of an obstacle or sensor (thesis 3.2.3).
+enum class ShapeKind : std::uint8_t {
+  kLine,    ///< directed segment p0 -> p1; reflects only on the side of its normal
+  kCircle,  ///< circle of radius_m around p0; radius 0 is a point
+};
+
+/// Geometry of one primitive: the hot data the collision search reads.
+struct Shape {
+  ShapeKind kind = ShapeKind::kLine;  ///< line or circle
+  Vec2 p0 = Vec2::Zero();             ///< line start X1, or circle centre (m)
+  Vec2 p1 = Vec2::Zero();             ///< line end X2 (m); unused for circles
+  Vec2 normal = Vec2::Zero();         ///< line unit normal, left of p0 -> p1; unused for circles
+  double radius_m = 0.0;              ///< circle radius (m); 0 for points and lines
+};
+
+/// What happens when the ball strikes (or, for sensors, enters) something.
+struct Action {
+  double score = 0.0;                ///< points per hit or entry
+  double kick_mps = 0.0;             ///< speed added along the contact normal on a hit (active bumper)
+  double contact_score_per_s = 0.0;  ///< points per second while the ball touches it (left passage)
+  bool eats_ball = false;            ///< ball eater: the ball is lost (drain, thesis 3.2.3)
+};
+
+/// A reflecting obstacle: shape, reflectivity and action (thesis 3.2.3).
+struct Obstacle {
+  double rho = 1.0;       ///< reflectivity: normal speed out = rho x normal speed in; > 1 kicks
+  Action action;          ///< score, kick, eat
+  bool visible = true;    ///< visibility at the start of a game (thesis 3.4); hidden ones are not hit
+  int bank = -1;          ///< index into Board::banks when it is a flag of a bank, else -1
+  std::string name;       ///< for traces and errors: the file's name= or "<kind>@<line>"
+  int source_line = 0;    ///< line of the board file it came from; the shapes of one line are one
+                          ///< object (a flag made of a wall falls whole); 0 (built in code): its own object
+};
+
+/// Kind of a non-reflecting sensor (thesis 3.4).
+enum class SensorKind : std::uint8_t {
+  kProximity,  ///< fires when the ball touches its shape; does not reflect
+  kHole,       ///< fires when the ball's centre enters the circle (the ball falls in)
+};
+
+/// A proximity sensor or a hole. Fires once per entry.
+struct Sensor {
+  SensorKind kind = SensorKind::kProximity;  ///< proximity or hole
+  Shape shape;                               ///< line or circle (holes: circle)
+  Action action;                             ///< score, eat
+  bool has_kickout = false;                  ///< hole that ejects the ball instead of eating it
+  Vec2 kickout_mps = Vec2::Zero();           ///< velocity the ball leaves a hole with (m/s)
+  std::string name;                          ///< for traces and errors
+  int source_line = 0;                       ///< line of the board file it came from
+};
+
+/// A bank of flags (drop targets, thesis 3.4): each flag hides when hit; when
+/// all are hidden the bank pays its bonus and all reappear.
+struct Bank {
+  std::string name;          ///< as declared in the file
+  double bonus = 0.0;        ///< points when the last flag falls
+  std::vector<int> members;  ///< indices into Board::obstacles
+};
+
+/// Which way a flipper points from its pivot.
+enum class Side : std::uint8_t { kLeft, kRight };
+
+/// A flipper (thesis 3.2.4): a segment of length_m rotating about the pivot,
+/// with an end point at each end. theta is the elevation of the flipper above
+/// the horizontal, measured the same way for both sides: a left flipper points
+/// along (cos θ, sin θ), a right one along (−cos θ, sin θ). θ_min is the rest
+/// ("down") stop, θ_max the energised ("up") stop; positive θ̇ raises it.
+struct Flipper {
+  Side side = Side::kLeft;     ///< left flippers point right, right flippers point left
+  Vec2 pivot = Vec2::Zero();   ///< pivot point (m)
+  double length_m = 0.0;       ///< pivot to tip (m)
+  double theta_min_rad = 0.0;  ///< down stop (rad)
+  double theta_max_rad = 0.0;  ///< up stop (rad)
+  double omega_rad_s = 0.0;    ///< θ̇₀: angular speed while moving (rad/s), > 0
+  double rho = 1.0;            ///< reflectivity of the flipper's three obstacles
+  double mu = 0.0;             ///< moment factor μ: imparted speed = l_moment·μ·θ̇ (dimensionless)
+  std::string name;            ///< for traces and errors
+  int source_line = 0;         ///< line of the board file it came from
+};
+
+/// The plunger (thesis 3.2.2, 3.3.1).
+struct Launcher {
+  Vec2 position = Vec2::Zero();  ///< where the ball sits in the chute before a launch (m)
+  double pull = 1.0;             ///< default pull fraction P_val in (0, 1]
+  double noise_max = 0.03;       ///< launch speed is P·(1 − R)·speed_max with R ~ U[0, noise_max]
+};
+
+/// Ball constants (thesis 3.2.1).
+struct BallSpec {
+  double radius_m = 0.0135;     ///< ball radius (m)
+  double speed_max_mps = 5.0;   ///< speed clamp (m/s): stands in for friction
+};
+
+/// The whole static table.
+struct Board {
+  std::string source;            ///< file it was loaded from (for messages)
+  double width_m = 0.51;         ///< playfield width (m)
+  double height_m = 1.07;        ///< playfield height (m)
+  BallSpec ball;                 ///< ball radius and speed clamp
+  double gravity_mps2 = 1.11;    ///< component of g along the table, pointing −y (m/s²)
+  double dt_s = 0.0005;          ///< default time step of the thesis stepper (s)
+  int balls_per_game = 3;        ///< balls before the game resets
+  Launcher launcher;             ///< plunger
+  std::vector<Shape> shapes;     ///< reflecting obstacles' geometry (hot)
+  std::vector<Obstacle> obstacles;  ///< reflecting obstacles' attributes, same index as shapes (cold)
+  std::vector<Sensor> sensors;   ///< proximity sensors and holes
+  std::vector<Flipper> flippers; ///< flippers, in file order
+  std::vector<Bank> banks;       ///< banks of flags
+};
+
+/// Unit vector from pivot to tip at elevation theta_rad.
+Vec2 flipper_direction(const Flipper& f, double theta_rad);
+
+/// Unit normal of the flipper's upper face at theta_rad: the direction the
+/// face moves when θ increases.
+Vec2 flipper_up_normal(const Flipper& f, double theta_rad);
+
+/// Tip position at theta_rad (m).
+Vec2 flipper_tip(const Flipper& f, double theta_rad);
+
+/// The largest time step for which a flipper moving at its θ̇₀ cannot jump
+/// over the ball: l·sin(θ̇₀·dt/2) < r (thesis 3.3.3). Infinite with no flippers.
+double max_stable_dt_s(const Board& board);
+
+/// Throws std::invalid_argument naming the flipper if dt_s violates
+/// l·sin(θ̇₀·dt/2) < r for any flipper.
+void check_flipper_time_step(const Board& board, double dt_s);
+
+}  // namespace pinball::sim

@@ -1,0 +1,35 @@
+#pragma once
+// Draws a board and, optionally, a game state into an OpenCV image: for
+// `pinball render`, `pinball sim --video`, and people checking a board file.
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "pinball/sim/board.h"
+#include "pinball/sim/game_state.h"
+
+namespace pinball::sim {
+
+/// How to draw.
+struct RenderOptions {
+  double px_per_m = 800.0;   ///< scale: 800 px/m draws the 0.51 x 1.07 m table at about 430 x 880 px
+  int margin_px = 12;        ///< border around the playfield
+  bool draw_normals = false; ///< draw each line's normal as a short tick (debugging one-sided lines)
+  bool draw_hud = true;      ///< score, balls and time in the top-left corner (needs a state)
+};
+
+/// Image size (width, height in px) that render_board produces for `board`.
+cv::Size render_size(const Board& board, const RenderOptions& options);
+
+/// Board point (m) to image pixel (u right, v down) under `options`.
+cv::Point2d board_to_pixel(const Board& board, const RenderOptions& options, const Vec2& p_board);
+
+/// Draws the board; with a state also draws flippers at their angles, hidden
+/// flags greyed out, the ball and the HUD. Returns an 8-bit BGR image.
+cv::Mat render_board(const Board& board, const GameState* state, const RenderOptions& options);
+
+/// Writes an image as PNG. Throws std::runtime_error naming the path on failure.
+void write_png(const cv::Mat& image, const std::string& path);
+
+}  // namespace pinball::sim

@@ -1,0 +1,37 @@
+#pragma once
+// Writes rendered frames to an AVI with OpenCV's MJPG encoder.
+
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace pinball::sim {
+
+/// An open AVI file receiving frames of one fixed size.
+class VideoRecorder {
+ public:
+  /// Opens `path` for frames of `frame_size` at `fps`. Throws
+  /// std::runtime_error naming the path when the file cannot be opened.
+  VideoRecorder(const std::string& path, double fps, cv::Size frame_size);
+  VideoRecorder(const VideoRecorder&) = delete;             ///< one writer, one owner
+  VideoRecorder& operator=(const VideoRecorder&) = delete;
+
+  /// Appends a frame; it must be 8-bit BGR of the size given at open
+  /// (throws std::invalid_argument otherwise).
+  void write(const cv::Mat& frame_bgr);
+
+  /// Frames written so far.
+  int frames_written() const { return frames_; }
+
+  /// Finishes the file (also done by the destructor).
+  void close();
+
+ private:
+  std::string path_;
+  cv::Size size_;
+  cv::VideoWriter writer_;
+  int frames_ = 0;
+};
+
+}  // namespace pinball::sim

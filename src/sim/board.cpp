@@ -1,0 +1,51 @@
+#include "pinball/sim/board.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace pinball::sim {
+
+Vec2 flipper_direction(const Flipper& f, double theta_rad) {
+  const double c = std::cos(theta_rad);
+  const double s = std::sin(theta_rad);
+  return f.side == Side::kLeft ? Vec2{c, s} : Vec2{-c, s};
+}
+
+Vec2 flipper_up_normal(const Flipper& f, double theta_rad) {
+  // d/dθ of the direction: the way every point of the flipper moves as θ grows.
+  const double c = std::cos(theta_rad);
+  const double s = std::sin(theta_rad);
+  return f.side == Side::kLeft ? Vec2{-s, c} : Vec2{s, c};
+}
+
+Vec2 flipper_tip(const Flipper& f, double theta_rad) {
+  return f.pivot + f.length_m * flipper_direction(f, theta_rad);
+}
+
+double max_stable_dt_s(const Board& board) {
+  double dt = std::numeric_limits<double>::infinity();
+  for (const Flipper& f : board.flippers) {
+    if (f.length_m <= board.ball.radius_m) continue;  // any step is safe
+    dt = std::min(dt, 2.0 * std::asin(board.ball.radius_m / f.length_m) / f.omega_rad_s);
+  }
+  return dt;
+}
+
+void check_flipper_time_step(const Board& board, double dt_s) {
+  for (const Flipper& f : board.flippers) {
+    const double half_sweep = f.omega_rad_s * dt_s / 2.0;
+    // sin is only monotonic up to π/2; beyond it the sweep is certainly too large.
+    const double chord = half_sweep >= M_PI / 2.0 ? f.length_m : f.length_m * std::sin(half_sweep);
+    if (!(chord < board.ball.radius_m)) {
+      std::ostringstream msg;
+      msg << "flipper '" << f.name << "': l*sin(omega*dt/2) = " << chord << " m is not below the ball radius "
+          << board.ball.radius_m << " m at dt = " << dt_s << " s (largest stable dt is " << max_stable_dt_s(board)
+          << " s)";
+      throw std::invalid_argument(msg.str());
+    }
+  }
+}
+
+}  // namespace pinball::sim

@@ -1,0 +1,30 @@
+#include "pinball/sim/oracle_policy.h"
+
+#include <limits>
+
+namespace pinball::sim {
+
+void oracle_spastic_policy(const Board& board, GameState& state, double reach_factor) {
+  int nearest = -1;
+  double nearest_d = std::numeric_limits<double>::infinity();
+  if (state.ball_in_play) {
+    for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+      const Flipper& f = board.flippers[i];
+      const double d = distance_point_segment(state.ball.position_m, f.pivot, flipper_tip(f, f.theta_min_rad));
+      if (d < nearest_d) {
+        nearest_d = d;
+        nearest = static_cast<int>(i);
+      }
+    }
+  }
+  // Falling balls only: a ball cradled on a raised flipper is let go, so it
+  // rolls down and is flipped again instead of resting there forever.
+  constexpr double kFallingSpeed_mps = 0.05;
+  const bool in_reach = nearest >= 0 && nearest_d <= reach_factor * board.ball.radius_m &&
+                        state.ball.velocity_mps.y() < -kFallingSpeed_mps;
+  for (std::size_t i = 0; i < state.flippers.size(); ++i) {
+    state.flippers[i].energized = in_reach && static_cast<int>(i) == nearest;
+  }
+}
+
+}  // namespace pinball::sim

@@ -1,0 +1,327 @@
+#include "pinball/sim/thesis_stepper.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "pinball/sim/collision.h"
+#include "pinball/sim/penetration.h"
+
+namespace pinball::sim {
+namespace {
+
+// A flipper push that would leave the ball deeper than this in a wall stalls
+// the flipper instead (the ball is jammed; a real coil stalls too).
+constexpr double kStallDepth_m = 1e-9;
+
+// Contacts resolved within one step before the rest of the step is dropped
+// (a ball wedged between two surfaces would otherwise bounce without end).
+constexpr int kMaxContactsPerStep = 4;
+
+void clamp_speed(Vec2& v, double speed_max) {
+  const double s2 = v.squaredNorm();
+  if (s2 > speed_max * speed_max) v *= speed_max / std::sqrt(s2);
+}
+
+}  // namespace
+
+ThesisStepper::ThesisStepper(const Board& board, ThesisStepperOptions options) : board_(board), options_(options) {
+  if (options_.dt_s == 0.0) options_.dt_s = board.dt_s;
+  if (!(options_.dt_s > 0.0) || !std::isfinite(options_.dt_s)) {
+    throw std::invalid_argument("time step must be a positive number of seconds");
+  }
+  check_flipper_time_step(board, options_.dt_s);
+  // Within one step the centre moves at most speed_max·dt, and a contact
+  // counts within contact_tolerance of the surface.
+  reach_m_ = board.ball.radius_m + board.ball.speed_max_mps * options_.dt_s + options_.contact_tolerance_m +
+             options_.separation_m;
+  const double cell_m = std::max(reach_m_, 1e-3);
+  obstacle_grid_ = UniformGrid(board.shapes, reach_m_, cell_m);
+  sensor_shapes_.reserve(board.sensors.size());
+  for (const Sensor& s : board.sensors) sensor_shapes_.push_back(s.shape);
+  sensor_grid_ = UniformGrid(sensor_shapes_, reach_m_, cell_m);
+  all_obstacles_.resize(board.shapes.size());
+  std::iota(all_obstacles_.begin(), all_obstacles_.end(), 0);
+  all_sensors_.resize(board.sensors.size());
+  std::iota(all_sensors_.begin(), all_sensors_.end(), 0);
+  has_contact_score_ = std::any_of(board.obstacles.begin(), board.obstacles.end(),
+                                   [](const Obstacle& o) { return o.action.contact_score_per_s > 0.0; });
+}
+
+std::span<const std::int32_t> ThesisStepper::obstacle_candidates(const Vec2& p) const {
+  return options_.use_grid ? obstacle_grid_.candidates(p) : std::span<const std::int32_t>(all_obstacles_);
+}
+
+StepEvents ThesisStepper::step(GameState& state) const {
+  StepEvents events;
+  update_flippers(state, events);
+  if (state.ball_in_play) move_ball(state, events);
+  if (state.rising_flags > 0) raise_flags(state);
+  state.time_s += options_.dt_s;
+  ++state.steps;
+  return events;
+}
+
+void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const {
+  const double dt = options_.dt_s;
+  const double r = board_.ball.radius_m;
+  for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
+    const Flipper& f = board_.flippers[i];
+    FlipperState& fs = state.flippers[i];
+    if (fs.energized && !fs.was_energized) ++state.flips;
+    fs.was_energized = fs.energized;
+    const double omega = fs.energized ? f.omega_rad_s : -f.omega_rad_s;
+    const double theta_old = fs.theta_rad;
+    const double theta_new = std::clamp(theta_old + dt * omega, f.theta_min_rad, f.theta_max_rad);
+    if (theta_new == theta_old) {  // resting on a stop
+      fs.omega_rad_s = 0.0;
+      continue;
+    }
+    fs.theta_rad = theta_new;
+    fs.omega_rad_s = omega;
+    if (!state.ball_in_play) continue;
+
+    // Sweep test (thesis 3.3.3): did the moving face pass into the ball?
+    Vec2& p = state.ball.position_m;
+    const Vec2 rel = p - f.pivot;
+    if (rel.squaredNorm() > (f.length_m + r) * (f.length_m + r)) continue;
+    const double front = omega > 0.0 ? 1.0 : -1.0;  // the face that moves toward the ball
+    if (front * rel.dot(flipper_up_normal(f, theta_old)) < 0.0) continue;  // ball behind: face moves away
+    const Vec2 dir = flipper_direction(f, theta_new);
+    const Vec2 n_face = front * flipper_up_normal(f, theta_new);
+    const double along = rel.dot(dir);
+    if (along <= 0.0) continue;  // the pivot does not move
+    Vec2 pushed, normal, contact;
+    if (along < f.length_m) {
+      const double s = rel.dot(n_face);
+      if (s >= r) continue;
+      normal = n_face;
+      pushed = p + (r + options_.separation_m - s) * n_face;  // out the front even if the centre was crossed
+      contact = f.pivot + along * dir;
+    } else {
+      contact = f.pivot + f.length_m * dir;
+      const Vec2 away = p - contact;
+      const double dist = away.norm();
+      if (dist >= r) continue;
+      normal = dist > 0.0 ? Vec2(away / dist) : n_face;
+      pushed = contact + (r + options_.separation_m) * normal;
+    }
+    if (obstacle_penetration_m(board_, state, obstacle_candidates(pushed), pushed) > kStallDepth_m) {
+      fs.theta_rad = theta_old;  // jammed against a wall: the flipper stalls
+      fs.omega_rad_s = 0.0;
+      events.flags |= StepEvents::kFlipperStall;
+      events.flipper = static_cast<std::int32_t>(i);
+      continue;
+    }
+    p = pushed;
+    state.ball.velocity_mps = flipper_response(f, theta_new, omega, contact, normal, state.ball.velocity_mps);
+    events.flags |= StepEvents::kFlipperPush;
+    events.flipper = static_cast<std::int32_t>(i);
+  }
+}
+
+void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
+  const double dt = options_.dt_s;
+  const double r = board_.ball.radius_m;
+  Vec2& p = state.ball.position_m;
+  Vec2& v = state.ball.velocity_mps;
+  const Vec2 start = p;
+
+  // Semi-implicit Euler: the new velocity first, clamped, then used for the
+  // collision search and the move (thesis eq. 3.1–3.2).
+  v.y() -= dt * board_.gravity_mps2;
+  clamp_speed(v, board_.ball.speed_max_mps);
+
+  // Earliest time of impact over every candidate on the new velocity. After
+  // a contact the rest of the step continues from the contact with the new
+  // velocity (docs/physics.md: the thesis drops it, which stops a ball
+  // sliding along a wall dead); after kMaxContactsPerStep the rest is dropped.
+  const auto candidates = obstacle_candidates(start);
+  const double flipper_reach = r + board_.ball.speed_max_mps * dt + options_.separation_m;
+  double remaining = dt;
+  for (int contact = 0; contact < kMaxContactsPerStep; ++contact) {
+    Contact best;
+    best.t_s = INFINITY;
+    std::int32_t hit_obstacle = -1;
+    std::int32_t hit_flipper = -1;
+    Contact c;
+    for (const std::int32_t i : candidates) {
+      if (state.visible[i] != kVisible) continue;
+      if (shape_time_of_impact(board_.shapes[i], p, v, r, remaining, c) && c.t_s < best.t_s) {
+        best = c;
+        hit_obstacle = i;
+      }
+    }
+    for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
+      const Flipper& f = board_.flippers[i];
+      const double theta = state.flippers[i].theta_rad;
+      if ((start - f.pivot).squaredNorm() > std::pow(f.length_m + flipper_reach, 2)) continue;
+      // The flipper is a two-sided segment with a point at each end (thesis 3.2.4).
+      const bool face = line_time_of_impact(flipper_face(f, theta, p), p, v, r, remaining, c);
+      if (face && c.t_s < best.t_s) {
+        best = c;
+        hit_obstacle = -1;
+        hit_flipper = static_cast<std::int32_t>(i);
+      }
+      for (const Vec2& end : {flipper_tip(f, theta), f.pivot}) {
+        if (circle_time_of_impact(end, 0.0, p, v, r, remaining, c) && c.t_s < best.t_s) {
+          best = c;
+          hit_obstacle = -1;
+          hit_flipper = static_cast<std::int32_t>(i);
+        }
+      }
+    }
+    if (hit_obstacle < 0 && hit_flipper < 0) {
+      p += remaining * v;
+      break;
+    }
+    // Stop short of contact by the separation, measured along the normal, so
+    // the move never enters any other surface (thesis 3.3.2, fn. 3).
+    const double approach = -v.dot(best.normal);
+    const double t_move = std::max(0.0, best.t_s - options_.separation_m / approach);
+    p += t_move * v;
+    remaining -= t_move;
+    if (hit_obstacle >= 0) {
+      apply_obstacle_hit(state, hit_obstacle, best.normal, events);
+    } else {
+      const Flipper& f = board_.flippers[hit_flipper];
+      const FlipperState& fs = state.flippers[hit_flipper];
+      v = flipper_response(f, fs.theta_rad, fs.omega_rad_s, best.point, best.normal, v);
+      events.flags |= StepEvents::kHitFlipper;
+      events.flipper = hit_flipper;
+    }
+    // Kicks may exceed the clamp; the rest of this step must stay within the
+    // broadphase's reach, so the clamp applies at once.
+    clamp_speed(v, board_.ball.speed_max_mps);
+    if (!state.ball_in_play) return;  // eaten by the obstacle's action
+  }
+
+  update_sensors(state, start, events);
+  if (!state.ball_in_play) return;
+  update_contacts(state, candidates, events);
+
+  const double margin = 2.0 * r;
+  if (p.x() < -margin || p.y() < -margin || p.x() > board_.width_m + margin || p.y() > board_.height_m + margin) {
+    events.flags |= StepEvents::kLeftTable;
+    lose_ball(state, events);
+  }
+}
+
+void ThesisStepper::apply_obstacle_hit(GameState& state, std::int32_t index, const Vec2& normal,
+                                       StepEvents& events) const {
+  const Obstacle& o = board_.obstacles[index];
+  Vec2& v = state.ball.velocity_mps;
+  v = reflect(v, normal, o.rho);
+  v += o.action.kick_mps * normal;
+  events.flags |= StepEvents::kHitObstacle;
+  events.obstacle = index;
+  state.score += o.action.score;
+  events.score_gained += o.action.score;
+  if (o.bank >= 0) {
+    // A flag falls (every shape of its statement); when the whole bank is
+    // down it pays and resets (thesis 3.4).
+    const Bank& bank = board_.banks[o.bank];
+    for (const std::int32_t m : bank.members) {
+      const bool same_flag = m == index || (o.source_line > 0 && board_.obstacles[m].source_line == o.source_line);
+      if (same_flag) state.visible[m] = kHidden;
+    }
+    const bool all_down = std::none_of(bank.members.begin(), bank.members.end(),
+                                       [&](std::int32_t m) { return state.visible[m] != kHidden; });
+    if (all_down) {
+      // A flag never rises into the ball: it waits until the ball has left.
+      for (const std::int32_t m : bank.members) {
+        state.visible[m] = kRising;
+        ++state.rising_flags;
+      }
+      raise_flags(state);
+      state.score += bank.bonus;
+      events.score_gained += bank.bonus;
+      events.flags |= StepEvents::kBankComplete;
+    }
+  }
+  if (o.action.eats_ball) lose_ball(state, events);
+}
+
+void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvents& events) const {
+  const double r = board_.ball.radius_m;
+  const auto candidates = options_.use_grid ? sensor_grid_.candidates(from) : std::span<const std::int32_t>(all_sensors_);
+  for (const std::int32_t i : candidates) {
+    const Sensor& sensor = board_.sensors[i];
+    const Vec2& to = state.ball.position_m;
+    // Swept over the whole move so that a fast ball cannot skip a sensor.
+    bool touched = false;
+    bool inside = false;
+    const Shape& shape = sensor.shape;
+    if (sensor.kind == SensorKind::kHole) {
+      touched = distance_point_segment(shape.p0, from, to) <= shape.radius_m;
+      inside = (to - shape.p0).norm() <= shape.radius_m;
+    } else if (shape.kind == ShapeKind::kLine) {
+      touched = distance_segment_segment(from, to, shape.p0, shape.p1) <= r;
+      inside = distance_point_segment(to, shape.p0, shape.p1) <= r;
+    } else {
+      touched = distance_point_segment(shape.p0, from, to) <= r + shape.radius_m;
+      inside = (to - shape.p0).norm() <= r + shape.radius_m;
+    }
+    const bool entered = touched && !state.sensor_inside[i];
+    state.sensor_inside[i] = inside ? 1 : 0;
+    if (!entered) continue;
+    if (events.sensor < 0) events.sensor = i;
+    events.flags |= StepEvents::kSensor;
+    state.score += sensor.action.score;
+    events.score_gained += sensor.action.score;
+    if (sensor.action.eats_ball) {
+      lose_ball(state, events);
+      return;
+    }
+    if (sensor.has_kickout) {
+      state.ball.position_m = shape.p0;
+      state.ball.velocity_mps = sensor.kickout_mps;
+      state.sensor_inside[i] = 1;
+    }
+  }
+}
+
+void ThesisStepper::update_contacts(GameState& state, std::span<const std::int32_t> candidates,
+                                    StepEvents& events) const {
+  const double r = board_.ball.radius_m;
+  const double touch = r + options_.contact_tolerance_m;
+  const Vec2& p = state.ball.position_m;
+  for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
+    const Flipper& f = board_.flippers[i];
+    state.flippers[i].ball_contact =
+        distance_point_segment(p, f.pivot, flipper_tip(f, state.flippers[i].theta_rad)) <= touch;
+  }
+  if (!has_contact_score_) return;
+  for (const std::int32_t i : candidates) {
+    const double rate = board_.obstacles[i].action.contact_score_per_s;
+    if (rate <= 0.0 || state.visible[i] != kVisible) continue;
+    if (distance_to_shape(board_.shapes[i], p) <= touch) {
+      state.score += rate * options_.dt_s;
+      events.score_gained += rate * options_.dt_s;
+    }
+  }
+}
+
+void ThesisStepper::raise_flags(GameState& state) const {
+  const double clear_m = board_.ball.radius_m + options_.separation_m;
+  for (const Bank& bank : board_.banks) {
+    for (const std::int32_t m : bank.members) {
+      if (state.visible[m] != kRising) continue;
+      if (state.ball_in_play && distance_to_shape(board_.shapes[m], state.ball.position_m) < clear_m) continue;
+      state.visible[m] = kVisible;
+      --state.rising_flags;
+    }
+  }
+}
+
+void ThesisStepper::lose_ball(GameState& state, StepEvents& events) const {
+  events.flags |= StepEvents::kBallLost;
+  state.ball_in_play = false;
+  state.balls_left = std::max(0, state.balls_left - 1);
+  state.ball.position_m = board_.launcher.position;
+  state.ball.velocity_mps = Vec2::Zero();
+  for (auto& f : state.flippers) f.ball_contact = false;
+}
+
+}  // namespace pinball::sim

@@ -1,0 +1,89 @@
+#include "pinball/sim/board.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "test_boards.h"
+
+namespace pinball::sim {
+namespace {
+
+using testing::add_flipper;
+using testing::empty_board;
+
+TEST(FlipperGeometry, DirectionAtZeroAndUpNormal) {
+  Board b = empty_board();
+  add_flipper(b, Side::kLeft, {0.1, 0.2});
+  add_flipper(b, Side::kRight, {0.4, 0.2});
+  const Flipper& left = b.flippers[0];
+  const Flipper& right = b.flippers[1];
+  EXPECT_EQ(flipper_direction(left, 0.0), Vec2(1.0, 0.0));
+  EXPECT_EQ(flipper_direction(right, 0.0), Vec2(-1.0, 0.0));
+  EXPECT_EQ(flipper_up_normal(left, 0.0), Vec2(0.0, 1.0));
+  EXPECT_EQ(flipper_up_normal(right, 0.0), Vec2(0.0, 1.0));
+  for (double theta : {-0.6, -0.2, 0.3, 0.7}) {
+    for (const Flipper* f : {&left, &right}) {
+      const Vec2 d = flipper_direction(*f, theta);
+      const Vec2 n = flipper_up_normal(*f, theta);
+      EXPECT_NEAR(d.norm(), 1.0, 1e-15);
+      EXPECT_NEAR(n.norm(), 1.0, 1e-15);
+      EXPECT_NEAR(d.dot(n), 0.0, 1e-15);
+      EXPECT_GT(n.y(), 0.0);                        // the upper face points up the table
+      EXPECT_NEAR(d.y(), std::sin(theta), 1e-15);   // elevation is the same for both sides
+      // The up normal is the direction the flipper's points move as theta grows.
+      const double h = 1e-6;
+      const Vec2 dd = (flipper_direction(*f, theta + h) - flipper_direction(*f, theta - h)) / (2.0 * h);
+      EXPECT_NEAR((dd - n).norm(), 0.0, 1e-9);
+    }
+    EXPECT_GT(flipper_direction(left, theta).x(), 0.0);
+    EXPECT_LT(flipper_direction(right, theta).x(), 0.0);
+  }
+  EXPECT_NEAR((flipper_tip(left, 0.5) - (left.pivot + 0.076 * Vec2{std::cos(0.5), std::sin(0.5)})).norm(), 0.0,
+              1e-15);
+  EXPECT_NEAR((flipper_tip(right, -0.5) - (right.pivot + 0.076 * Vec2{-std::cos(0.5), -std::sin(0.5)})).norm(), 0.0,
+              1e-15);
+}
+
+TEST(MaxStableDt, FormulaAndSmallestOverFlippers) {
+  Board b = empty_board();
+  EXPECT_EQ(max_stable_dt_s(b), std::numeric_limits<double>::infinity());
+  add_flipper(b, Side::kLeft, {0.1, 0.2}, 0.076, -0.5, 0.5, 33.0);
+  const double r = b.ball.radius_m;
+  const double dt1 = 2.0 * std::asin(r / 0.076) / 33.0;
+  EXPECT_NEAR(max_stable_dt_s(b), dt1, 1e-15);
+  // At that step the tip's chord equals the radius.
+  EXPECT_NEAR(0.076 * std::sin(33.0 * dt1 / 2.0), r, 1e-15);
+  add_flipper(b, Side::kRight, {0.4, 0.2}, 0.1, -0.5, 0.5, 40.0);  // longer and faster: the binding one
+  const double dt2 = 2.0 * std::asin(r / 0.1) / 40.0;
+  ASSERT_LT(dt2, dt1);
+  EXPECT_NEAR(max_stable_dt_s(b), dt2, 1e-15);
+  // A flipper shorter than the ball radius imposes no limit.
+  Board c = empty_board();
+  add_flipper(c, Side::kLeft, {0.1, 0.2}, 0.01, -0.5, 0.5, 1000.0);
+  EXPECT_EQ(max_stable_dt_s(c), std::numeric_limits<double>::infinity());
+}
+
+TEST(CheckFlipperTimeStep, ThrowsAboveTheLimitNamingTheFlipper) {
+  Board b = empty_board();
+  add_flipper(b, Side::kLeft, {0.1, 0.2}, 0.076, -0.5, 0.5, 33.0);
+  b.flippers[0].name = "lefty";
+  const double dt_max = max_stable_dt_s(b);
+  EXPECT_NO_THROW(check_flipper_time_step(b, 0.99 * dt_max));
+  EXPECT_NO_THROW(check_flipper_time_step(b, 1e-6));
+  EXPECT_THROW(check_flipper_time_step(b, 1.01 * dt_max), std::invalid_argument);
+  // A sweep past a half turn (sin no longer monotonic) is refused too.
+  EXPECT_THROW(check_flipper_time_step(b, 4.0 * M_PI / 33.0), std::invalid_argument);
+  try {
+    check_flipper_time_step(b, 2.0 * dt_max);
+    FAIL() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("lefty"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pinball::sim

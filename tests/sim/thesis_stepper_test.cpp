@@ -1,0 +1,677 @@
+#include "pinball/sim/thesis_stepper.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include "pinball/sim/collision.h"
+#include "pinball/sim/penetration.h"
+#include "test_boards.h"
+
+namespace pinball::sim {
+namespace {
+
+using namespace pinball::sim::testing;
+
+constexpr double kR = 0.0135;
+
+TEST(ThesisStepper, FreeFlightIsSemiImplicitEuler) {
+  const double g = 1.11;
+  const double dt = 5e-4;
+  Board b = empty_board(10.0, 10.0, g, dt);
+  const ThesisStepper stepper(b);
+  const Vec2 p0{2.0, 5.0};
+  const Vec2 v0{0.3, 1.2};
+  GameState s = state_with_ball(b, p0, v0);
+  for (int n = 1; n <= 4000; ++n) {
+    const StepEvents ev = stepper.step(s);
+    ASSERT_EQ(ev.flags, 0u);
+    const double nn = n;
+    const double x = p0.x() + v0.x() * nn * dt;
+    const double y = p0.y() + v0.y() * nn * dt - g * dt * dt * nn * (nn + 1.0) / 2.0;
+    ASSERT_NEAR(s.ball.position_m.x(), x, 1e-12) << n;
+    ASSERT_NEAR(s.ball.position_m.y(), y, 1e-12) << n;
+    ASSERT_NEAR(s.ball.velocity_mps.y(), v0.y() - g * nn * dt, 1e-12) << n;
+    // Against the true parabola the error is exactly g·dt·t/2 (below it).
+    const double t = nn * dt;
+    const double y_true = p0.y() + v0.y() * t - 0.5 * g * t * t;
+    ASSERT_NEAR(y_true - s.ball.position_m.y(), g * dt * t / 2.0, 1e-12) << n;
+    ASSERT_NEAR(s.time_s, t, 1e-12);
+  }
+  EXPECT_EQ(s.steps, 4000u);
+  EXPECT_TRUE(s.ball_in_play);
+}
+
+TEST(ThesisStepper, BallOutOfPlayDoesNotMove) {
+  Board b = empty_board();
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.5, 0.5}, {1.0, 1.0});
+  s.ball_in_play = false;
+  stepper.step(s);
+  EXPECT_EQ(s.ball.position_m, Vec2(0.5, 0.5));
+  EXPECT_EQ(s.steps, 1u);
+}
+
+TEST(ThesisStepper, ReflectionOffHorizontalLineScalesNormalSpeedByRho) {
+  for (double rho : {0.5, 1.0, 1.5}) {
+    Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+    const int floor = add_line(b, {0.0, 0.2}, {1.0, 0.2}, rho);
+    const ThesisStepper stepper(b);
+    const double vx = 0.7;
+    const double vy = -2.0;
+    GameState s = state_with_ball(b, {0.3, 0.26}, {vx, vy});
+    bool hit = false;
+    for (int i = 0; i < 200 && !hit; ++i) {
+      const Vec2 before = s.ball.position_m;
+      const StepEvents ev = stepper.step(s);
+      if (ev.has(StepEvents::kHitObstacle)) {
+        hit = true;
+        EXPECT_EQ(ev.obstacle, floor);
+        EXPECT_NEAR(s.ball.velocity_mps.y(), -rho * vy, 1e-14) << rho;
+        EXPECT_NEAR(s.ball.velocity_mps.x(), vx, 1e-14) << rho;
+        // The ball moved to one separation short of the surface (along the
+        // normal), reflected, and spent the rest of the step on the new
+        // velocity (docs/physics.md: the step continues after a contact).
+        const double dt = stepper.dt_s();
+        const double y_contact = 0.2 + kR + stepper.options().separation_m;
+        const double t_move = (before.y() - y_contact) / -vy;
+        ASSERT_GT(t_move, 0.0);
+        ASSERT_LT(t_move, dt);
+        EXPECT_NEAR(s.ball.position_m.y(), y_contact + (dt - t_move) * (-rho * vy), 1e-12);
+        EXPECT_NEAR(s.ball.position_m.x(), before.x() + vx * dt, 1e-12);
+      } else {
+        EXPECT_EQ(s.ball.velocity_mps, Vec2(vx, vy));
+      }
+    }
+    ASSERT_TRUE(hit) << rho;
+    for (int i = 0; i < 50; ++i) stepper.step(s);
+    EXPECT_NEAR(s.ball.velocity_mps.y(), -rho * vy, 1e-14);
+    EXPECT_GT(s.ball.position_m.y(), 0.2 + kR);
+  }
+}
+
+TEST(ThesisStepper, ReflectionUsesVelocityAfterGravityUpdate) {
+  const double g = 9.81;
+  const double dt = 1e-3;
+  Board b = empty_board(1.0, 1.0, g, dt);
+  add_line(b, {0.0, 0.0}, {1.0, 0.0}, 0.5);
+  const ThesisStepper stepper(b);
+  // Reaches the line within the first step: incoming vy = -1 - g·dt.
+  GameState s = state_with_ball(b, {0.5, kR + 5e-4}, {0.0, -1.0});
+  const StepEvents ev = stepper.step(s);
+  ASSERT_TRUE(ev.has(StepEvents::kHitObstacle));
+  EXPECT_NEAR(s.ball.velocity_mps.y(), 0.5 * (1.0 + g * dt), 1e-14);
+}
+
+TEST(ThesisStepper, BallBouncesUpOffTheTipOfAVerticalWall) {
+  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  add_wall(b, {0.5, 0.0}, {0.5, 0.3}, 1.0);
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.5, 0.4}, {0.0, -1.0});
+  bool hit = false;
+  for (int i = 0; i < 400; ++i) {
+    const StepEvents ev = stepper.step(s);
+    ASSERT_LT(max_penetration_m(b, s), 1e-6);
+    if (ev.has(StepEvents::kHitObstacle) && !hit) {
+      hit = true;
+      EXPECT_EQ(b.shapes[ev.obstacle].kind, ShapeKind::kCircle);  // the end point, not the faces
+      EXPECT_GT(s.ball.velocity_mps.y(), 0.9);
+      EXPECT_NEAR(s.ball.velocity_mps.x(), 0.0, 1e-12);
+    }
+    ASSERT_GT(s.ball.position_m.y(), 0.3 + kR - 1e-6) << "fell past the tip at step " << i;
+  }
+  EXPECT_TRUE(hit);
+  EXPECT_GT(s.ball.position_m.y(), 0.3);
+}
+
+TEST(ThesisStepper, BallLeftOfTheTipBouncesLeft) {
+  for (double side : {-1.0, 1.0}) {
+    Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+    add_wall(b, {0.5, 0.0}, {0.5, 0.3}, 1.0);
+    const ThesisStepper stepper(b);
+    GameState s = state_with_ball(b, {0.5 + side * 0.004, 0.4}, {0.0, -1.0});
+    for (int i = 0; i < 600; ++i) {
+      stepper.step(s);
+      ASSERT_LT(max_penetration_m(b, s), 1e-6);
+      // Never on the wrong side of the wall.
+      if (s.ball.position_m.y() < 0.3) {
+        ASSERT_GT(side * (s.ball.position_m.x() - 0.5), kR - 1e-6);
+      }
+    }
+    EXPECT_GT(side * s.ball.velocity_mps.x(), 0.2);
+    EXPECT_GT(side * (s.ball.position_m.x() - 0.5), 0.05);
+  }
+}
+
+TEST(ThesisStepper, BallBehindOneSidedLinePassesThrough) {
+  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  add_line(b, {0.0, 0.5}, {1.0, 0.5}, 1.0);  // normal +y: hit from above only
+  const ThesisStepper stepper(b);
+  const Vec2 v{0.2, 1.5};
+  GameState s = state_with_ball(b, {0.4, 0.4}, v);
+  for (int i = 0; i < 200; ++i) {
+    const StepEvents ev = stepper.step(s);
+    ASSERT_FALSE(ev.has(StepEvents::kHitObstacle));
+  }
+  EXPECT_EQ(s.ball.velocity_mps, v);
+  EXPECT_NEAR(s.ball.position_m.y(), 0.4 + 1.5 * 200 * 5e-4, 1e-12);
+  EXPECT_GT(s.ball.position_m.y(), 0.5 + kR);
+}
+
+TEST(ThesisStepper, SpeedClampHoldsEveryStep) {
+  Board b = empty_board(1.0, 50.0, 9.81, 5e-4);
+  b.ball.speed_max_mps = 2.0;
+  add_line(b, {0.0, 0.0}, {1.0, 0.0}, 1.0);
+  add_line(b, {1.0, 0.0}, {1.0, 50.0}, 1.0);
+  add_line(b, {0.0, 50.0}, {0.0, 0.0}, 1.0);
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.5, 45.0}, {3.0 * 2.0 * 0.6, -3.0 * 2.0 * 0.8});
+  double max_speed_seen = 0.0;
+  for (int i = 0; i < 60000; ++i) {  // 30 s: falls 45 m at the clamp, then bounces
+    stepper.step(s);
+    const double speed = s.ball.velocity_mps.norm();
+    ASSERT_LE(speed, 2.0 + 1e-12) << "step " << i;
+    max_speed_seen = std::max(max_speed_seen, speed);
+  }
+  EXPECT_GT(max_speed_seen, 2.0 - 1e-9);  // it did reach the clamp
+  EXPECT_TRUE(s.ball_in_play);
+}
+
+TEST(LaunchBall, SpeedWithinNoiseBand) {
+  Board b = empty_board();
+  b.ball.speed_max_mps = 5.0;
+  b.launcher.noise_max = 0.03;
+  GameState s = make_game_state(b, 17);
+  const double pull = 0.9;
+  const double hi = pull * b.ball.speed_max_mps;
+  const double lo = pull * (1.0 - b.launcher.noise_max) * b.ball.speed_max_mps;
+  double vmin = INFINITY;
+  double vmax = -INFINITY;
+  for (int i = 0; i < 1000; ++i) {
+    s.ball.position_m = {0.1, 0.1};
+    launch_ball(b, s, pull);
+    ASSERT_TRUE(s.ball_in_play);
+    ASSERT_EQ(s.ball.position_m, b.launcher.position);
+    ASSERT_EQ(s.ball.velocity_mps.x(), 0.0);
+    const double vy = s.ball.velocity_mps.y();
+    ASSERT_GE(vy, lo - 1e-12);
+    ASSERT_LE(vy, hi + 1e-12);
+    vmin = std::min(vmin, vy);
+    vmax = std::max(vmax, vy);
+  }
+  // 1000 uniform draws: the extremes lie within 1 % of the band from its ends
+  // unless something has gone wrong (probability 0.99^1000 = 4e-5 each).
+  EXPECT_LT(vmin - lo, 0.01 * (hi - lo));
+  EXPECT_LT(hi - vmax, 0.01 * (hi - lo));
+}
+
+// A ball falling onto a horizontal line at y = 0.2 with the given action.
+struct DropOnLine {
+  explicit DropOnLine(Action action, double rho = 1.0) : board(empty_board(1.0, 1.0, 0.0, 5e-4)) {
+    line = add_line(board, {0.0, 0.2}, {1.0, 0.2}, rho, action);
+  }
+  Board board;
+  int line = -1;
+};
+
+TEST(ThesisStepperActions, KickAddsSpeedAlongNormal) {
+  Action a;
+  a.kick_mps = 1.25;
+  DropOnLine d(a, 0.8);
+  const ThesisStepper stepper(d.board);
+  GameState s = state_with_ball(d.board, {0.5, 0.25}, {0.3, -1.0});
+  for (int i = 0; i < 200; ++i) {
+    if (stepper.step(s).has(StepEvents::kHitObstacle)) break;
+  }
+  EXPECT_NEAR(s.ball.velocity_mps.y(), 0.8 * 1.0 + 1.25, 1e-14);
+  EXPECT_NEAR(s.ball.velocity_mps.x(), 0.3, 1e-14);
+}
+
+TEST(ThesisStepperActions, ScoreEachHit) {
+  Action a;
+  a.score = 50.0;
+  DropOnLine d(a, 1.0);
+  Board& b = d.board;
+  add_line(b, {1.0, 0.5}, {0.0, 0.5}, 1.0);  // ceiling (normal -y), no score
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.5, 0.35}, {0.0, -1.0});
+  int hits = 0;
+  double gained = 0.0;
+  for (int i = 0; i < 4000; ++i) {  // 2 s: period of a round trip is 2·(0.3 - 2r) / 1 = 0.546 s
+    const StepEvents ev = stepper.step(s);
+    if (ev.has(StepEvents::kHitObstacle) && ev.obstacle == d.line) ++hits;
+    gained += ev.score_gained;
+  }
+  EXPECT_EQ(hits, 4);
+  EXPECT_EQ(s.score, 50.0 * hits);
+  EXPECT_EQ(gained, s.score);
+}
+
+TEST(ThesisStepperActions, EatsBallEndsIt) {
+  Action a;
+  a.eats_ball = true;
+  DropOnLine d(a);
+  const ThesisStepper stepper(d.board);
+  GameState s = state_with_ball(d.board, {0.5, 0.25}, {0.0, -1.0});
+  ASSERT_EQ(s.balls_left, 3);
+  bool lost = false;
+  for (int i = 0; i < 200 && !lost; ++i) lost = stepper.step(s).has(StepEvents::kBallLost);
+  EXPECT_TRUE(lost);
+  EXPECT_FALSE(s.ball_in_play);
+  EXPECT_EQ(s.balls_left, 2);
+  EXPECT_EQ(s.ball.position_m, d.board.launcher.position);
+  const Vec2 rest = s.ball.position_m;
+  stepper.step(s);
+  EXPECT_EQ(s.ball.position_m, rest);  // out of play: does not move
+}
+
+TEST(ThesisStepperActions, LeavingTheTableLosesTheBall) {
+  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.5, 0.5}, {0.0, -3.0});
+  StepEvents last;
+  for (int i = 0; i < 1000 && s.ball_in_play; ++i) last = stepper.step(s);
+  EXPECT_FALSE(s.ball_in_play);
+  EXPECT_TRUE(last.has(StepEvents::kLeftTable));
+  EXPECT_TRUE(last.has(StepEvents::kBallLost));
+  EXPECT_EQ(s.balls_left, 2);
+}
+
+TEST(ThesisStepperActions, BankFlagsHideAndReappearWithBonus) {
+  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  Action flag_action;
+  flag_action.score = 10.0;
+  const int f0 = add_line(b, {0.1, 0.2}, {0.3, 0.2}, 1.0, flag_action, "flag0");
+  const int f1 = add_line(b, {0.6, 0.2}, {0.8, 0.2}, 1.0, flag_action, "flag1");
+  b.obstacles[f0].bank = 0;
+  b.obstacles[f1].bank = 0;
+  // Each flag is its own statement of the board file (a flag falls as a whole statement).
+  b.obstacles[f0].source_line = 11;
+  b.obstacles[f1].source_line = 12;
+  Bank bank;
+  bank.name = "bank";
+  bank.bonus = 500.0;
+  bank.members = {f0, f1};
+  b.banks.push_back(bank);
+  const ThesisStepper stepper(b);
+  GameState s = make_game_state(b, 1);
+  s.ball_in_play = true;
+
+  auto drop_at = [&](double x) {
+    s.ball.position_m = {x, 0.3};
+    s.ball.velocity_mps = {0.0, -1.0};
+    for (int i = 0; i < 400; ++i) {
+      const StepEvents ev = stepper.step(s);
+      if (ev.flags != 0) return ev;
+    }
+    return StepEvents{};
+  };
+
+  StepEvents ev = drop_at(0.2);
+  ASSERT_TRUE(ev.has(StepEvents::kHitObstacle));
+  EXPECT_EQ(ev.obstacle, f0);
+  EXPECT_FALSE(ev.has(StepEvents::kBankComplete));
+  EXPECT_EQ(s.visible[f0], 0);
+  EXPECT_EQ(s.visible[f1], 1);
+  EXPECT_EQ(s.score, 10.0);
+  // A hidden flag is not hit: the ball falls through where it was.
+  s.ball.position_m = {0.2, 0.3};
+  s.ball.velocity_mps = {0.0, -1.0};
+  for (int i = 0; i < 400; ++i) ASSERT_FALSE(stepper.step(s).has(StepEvents::kHitObstacle));
+  EXPECT_LT(s.ball.position_m.y(), 0.2);
+
+  ev = drop_at(0.7);
+  ASSERT_TRUE(ev.has(StepEvents::kHitObstacle));
+  EXPECT_EQ(ev.obstacle, f1);
+  EXPECT_TRUE(ev.has(StepEvents::kBankComplete));
+  EXPECT_EQ(s.visible[f0], 1);
+  EXPECT_EQ(s.visible[f1], 1);
+  EXPECT_EQ(s.score, 10.0 + 10.0 + 500.0);
+  EXPECT_EQ(ev.score_gained, 510.0);
+}
+
+TEST(ThesisStepperSensors, ProximityFiresOncePerEntryWithoutChangingVelocity) {
+  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  Sensor sensor;
+  sensor.kind = SensorKind::kProximity;
+  sensor.shape.kind = ShapeKind::kCircle;
+  sensor.shape.p0 = {0.5, 0.5};
+  sensor.shape.radius_m = 0.03;
+  sensor.action.score = 7.0;
+  b.sensors.push_back(sensor);
+  const ThesisStepper stepper(b);
+  const Vec2 v{1.0, 0.0};
+  GameState s = state_with_ball(b, {0.3, 0.51}, v);
+  int fired = 0;
+  int steps_inside = 0;
+  for (int i = 0; i < 800; ++i) {  // passes the sensor, 0.4 m in 0.4 s
+    const StepEvents ev = stepper.step(s);
+    if (ev.has(StepEvents::kSensor)) {
+      ++fired;
+      EXPECT_EQ(ev.sensor, 0);
+    }
+    steps_inside += s.sensor_inside[0];
+    ASSERT_EQ(s.ball.velocity_mps, v);
+  }
+  EXPECT_EQ(fired, 1);
+  EXPECT_GT(steps_inside, 50);  // it was inside for many steps but fired once
+  EXPECT_EQ(s.score, 7.0);
+  // Coming back is a new entry.
+  s.ball.velocity_mps = -v;
+  for (int i = 0; i < 800; ++i) fired += stepper.step(s).has(StepEvents::kSensor) ? 1 : 0;
+  EXPECT_EQ(fired, 2);
+  EXPECT_EQ(s.score, 14.0);
+}
+
+TEST(ThesisStepperSensors, FastBallCannotSkipALineSensor) {
+  Board b = empty_board(1.0, 1.0, 0.0, 1e-3);
+  b.ball.speed_max_mps = 50.0;
+  Sensor sensor;
+  sensor.kind = SensorKind::kProximity;
+  sensor.shape.kind = ShapeKind::kLine;
+  sensor.shape.p0 = {0.5, 0.0};
+  sensor.shape.p1 = {0.5, 1.0};
+  sensor.shape.normal = {-1.0, 0.0};
+  b.sensors.push_back(sensor);
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.2137, 0.5}, {40.0, 0.0});  // 4 cm per step, past the 2.7 cm band
+  int fired = 0;
+  for (int i = 0; i < 15; ++i) fired += stepper.step(s).has(StepEvents::kSensor) ? 1 : 0;
+  EXPECT_EQ(fired, 1);
+}
+
+TEST(ThesisStepperSensors, HoleWithKickoutPlacesBallAtCentre) {
+  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  Sensor hole;
+  hole.kind = SensorKind::kHole;
+  hole.shape.kind = ShapeKind::kCircle;
+  hole.shape.p0 = {0.5, 0.5};
+  hole.shape.radius_m = 0.01;
+  hole.action.score = 100.0;
+  hole.has_kickout = true;
+  hole.kickout_mps = {-0.8, 1.5};
+  b.sensors.push_back(hole);
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.3, 0.505}, {1.0, 0.0});
+  int fired = 0;
+  bool checked = false;
+  for (int i = 0; i < 1000; ++i) {
+    const StepEvents ev = stepper.step(s);
+    if (ev.has(StepEvents::kSensor)) {
+      ++fired;
+      if (!checked) {
+        checked = true;
+        EXPECT_EQ(s.ball.position_m, hole.shape.p0);
+        EXPECT_EQ(s.ball.velocity_mps, hole.kickout_mps);
+        EXPECT_TRUE(s.ball_in_play);
+        EXPECT_EQ(s.score, 100.0);
+      }
+    }
+  }
+  EXPECT_EQ(fired, 1);  // the kicked-out ball leaves without re-entering
+  EXPECT_TRUE(checked);
+  EXPECT_LT(s.ball.position_m.x(), 0.5 - 0.1);
+}
+
+TEST(ThesisStepperSensors, HoleWithoutKickoutEatsBall) {
+  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  Sensor hole;
+  hole.kind = SensorKind::kHole;
+  hole.shape.kind = ShapeKind::kCircle;
+  hole.shape.p0 = {0.5, 0.5};
+  hole.shape.radius_m = 0.01;
+  hole.action.eats_ball = true;
+  b.sensors.push_back(hole);
+  const ThesisStepper stepper(b);
+  // Passing 15 mm from the centre: the ball's edge overlaps but its centre never enters.
+  GameState miss = state_with_ball(b, {0.3, 0.515}, {1.0, 0.0});
+  for (int i = 0; i < 800; ++i) ASSERT_FALSE(stepper.step(miss).has(StepEvents::kSensor));
+  GameState s = state_with_ball(b, {0.3, 0.505}, {1.0, 0.0});
+  bool lost = false;
+  for (int i = 0; i < 800 && !lost; ++i) lost = stepper.step(s).has(StepEvents::kBallLost);
+  EXPECT_TRUE(lost);
+  EXPECT_FALSE(s.ball_in_play);
+  EXPECT_EQ(s.balls_left, 2);
+}
+
+TEST(ThesisStepperActions, ContactScoreAccumulatesWhileRolling) {
+  Board b = empty_board(2.0, 1.0, 1.11, 5e-4);
+  Action a;
+  a.contact_score_per_s = 40.0;
+  add_line(b, {0.0, 0.1}, {2.0, 0.1}, 0.5, a);
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.2, 0.1 + kR + 1e-6}, {0.3, 0.0});
+  const int n = 4000;  // 2 s, rolls 0.6 m
+  for (int i = 0; i < n; ++i) stepper.step(s);
+  EXPECT_NEAR(s.score, 40.0 * n * 5e-4, 1e-9);
+  // Away from the line: nothing.
+  GameState far = state_with_ball(b, {0.2, 0.6}, {0.3, 0.0});
+  for (int i = 0; i < 100; ++i) stepper.step(far);
+  EXPECT_EQ(far.score, 0.0);
+}
+
+// A ball in resting contact with a line must keep its tangential motion:
+// sliding along a flat floor, and sliding down a slope under gravity. The
+// speed clamp stands in for friction, so over a short run the motion along
+// the surface is that of a frictionless slide (thesis eq. 3.1-3.2 between
+// contacts, the reflection only touching the normal component).
+TEST(ThesisStepperResting, BallSlidesAlongFlatLine) {
+  Board b = empty_board(2.0, 1.0, 1.11, 5e-4);
+  add_line(b, {0.0, 0.1}, {2.0, 0.1}, 0.5);
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.2, 0.1 + kR + 1e-6}, {0.3, 0.0});
+  const int n = 4000;  // 2 s
+  for (int i = 0; i < n; ++i) {
+    stepper.step(s);
+    ASSERT_LT(max_penetration_m(b, s), 1e-6);
+  }
+  EXPECT_NEAR(s.ball.velocity_mps.x(), 0.3, 1e-12);
+  // The ball's velocity says 0.3 m/s along the floor, so its position must follow.
+  EXPECT_NEAR(s.ball.position_m.x(), 0.2 + 0.3 * n * 5e-4, 1e-3);
+}
+
+TEST(ThesisStepperResting, BallSlidesDownSlope) {
+  const double a = 20.0 * M_PI / 180.0;
+  const double g = 1.11;
+  Board b = empty_board(3.0, 3.0, g, 5e-4);
+  const Vec2 p0{0.1, 2.0};
+  const Vec2 p1{2.9, 2.0 - 2.8 * std::tan(a)};
+  add_line(b, p0, p1, 0.5);
+  const ThesisStepper stepper(b);
+  const Vec2 along = (p1 - p0).normalized();
+  const Vec2 start = p0 + 0.2 * along + (kR + 1e-6) * b.shapes[0].normal;
+  GameState s = state_with_ball(b, start, Vec2::Zero());
+  const int n = 2000;  // 1 s: a frictionless slide covers g·sin(a)·t²/2 = 0.19 m
+  for (int i = 0; i < n; ++i) {
+    stepper.step(s);
+    ASSERT_LT(max_penetration_m(b, s), 1e-6);
+  }
+  const double t = n * 5e-4;
+  const double expected = 0.5 * g * std::sin(a) * t * t;
+  EXPECT_NEAR((s.ball.position_m - start).dot(along), expected, 0.05 * expected);
+  // Its velocity must match the distance it covered: speed ~ g·sin(a)·t.
+  EXPECT_NEAR(s.ball.velocity_mps.dot(along), g * std::sin(a) * t, 0.05 * g * std::sin(a) * t);
+}
+
+// --- Flippers ---------------------------------------------------------------
+
+struct FlipperBoard {
+  FlipperBoard(double gravity = 0.0, double theta_min = -0.5) : board(empty_board(1.0, 1.0, gravity, 5e-4)) {
+    add_flipper(board, Side::kLeft, {0.3, 0.3}, 0.076, theta_min, 0.5, 33.0, 0.5, 1.0);
+  }
+  Board board;
+};
+
+TEST(ThesisStepperFlippers, EnergisedRisesAtOmegaAndStops) {
+  FlipperBoard fb;
+  const Flipper& f = fb.board.flippers[0];
+  const ThesisStepper stepper(fb.board);
+  GameState s = make_game_state(fb.board, 1);
+  const double dt = stepper.dt_s();
+  s.flippers[0].energized = true;
+  const int n_up = static_cast<int>(std::ceil((f.theta_max_rad - f.theta_min_rad) / (f.omega_rad_s * dt)));
+  for (int n = 1; n <= n_up + 20; ++n) {
+    stepper.step(s);
+    const double expected = std::min(f.theta_min_rad + n * f.omega_rad_s * dt, f.theta_max_rad);
+    ASSERT_NEAR(s.flippers[0].theta_rad, expected, 1e-12) << n;
+    if (n <= n_up) {
+      ASSERT_EQ(s.flippers[0].omega_rad_s, f.omega_rad_s) << n;
+    } else {
+      ASSERT_EQ(s.flippers[0].omega_rad_s, 0.0) << n;
+    }
+  }
+  EXPECT_EQ(s.flippers[0].theta_rad, f.theta_max_rad);
+  EXPECT_EQ(s.flips, 1u);
+  s.flippers[0].energized = false;
+  for (int n = 1; n <= n_up + 20; ++n) {
+    stepper.step(s);
+    const double expected = std::max(f.theta_max_rad - n * f.omega_rad_s * dt, f.theta_min_rad);
+    ASSERT_NEAR(s.flippers[0].theta_rad, expected, 1e-12) << n;
+    if (n <= n_up) {
+      ASSERT_EQ(s.flippers[0].omega_rad_s, -f.omega_rad_s) << n;
+    }
+  }
+  EXPECT_EQ(s.flippers[0].theta_rad, f.theta_min_rad);
+  EXPECT_EQ(s.flippers[0].omega_rad_s, 0.0);
+  EXPECT_EQ(s.flips, 1u);
+}
+
+// Speed of a ball that starts at rest on the upper face at `arm` from the pivot
+// after the flipper fires (no gravity, no obstacles).
+double launch_speed(double arm) {
+  FlipperBoard fb;
+  const Flipper& f = fb.board.flippers[0];
+  const ThesisStepper stepper(fb.board);
+  const double theta = f.theta_min_rad;
+  const Vec2 p = f.pivot + arm * flipper_direction(f, theta) + (kR + 1e-6) * flipper_up_normal(f, theta);
+  GameState s = state_with_ball(fb.board, p, Vec2::Zero());
+  s.flippers[0].energized = true;
+  bool pushed = false;
+  for (int i = 0; i < 100; ++i) {
+    const StepEvents ev = stepper.step(s);
+    pushed = pushed || ev.has(StepEvents::kFlipperPush) || ev.has(StepEvents::kHitFlipper);
+    EXPECT_LT(max_penetration_m(fb.board, s), 1e-6);
+  }
+  EXPECT_TRUE(pushed);
+  return s.ball.velocity_mps.norm();
+}
+
+TEST(ThesisStepperFlippers, BallNearTipLaunchedFasterThanNearPivot) {
+  const double near_pivot = launch_speed(0.02);
+  const double middle = launch_speed(0.045);
+  const double near_tip = launch_speed(0.07);
+  EXPECT_GT(middle, near_pivot);
+  EXPECT_GT(near_tip, middle);
+  // The first push imparts mu·omega·arm; later pushes can only add.
+  EXPECT_GE(near_pivot, 1.0 * 33.0 * 0.02 * 0.99);
+  EXPECT_GE(near_tip, 1.0 * 33.0 * 0.07 * 0.99);
+}
+
+TEST(ThesisStepperFlippers, ContactSensorWhenBallRestsOnFlipper) {
+  FlipperBoard fb(1.11, 0.0);  // horizontal at rest
+  const Flipper& f = fb.board.flippers[0];
+  const ThesisStepper stepper(fb.board);
+  GameState s = state_with_ball(fb.board, f.pivot + Vec2{0.04, kR + 1e-6}, Vec2::Zero());
+  for (int i = 0; i < 2000; ++i) {
+    stepper.step(s);
+    ASSERT_TRUE(s.flippers[0].ball_contact) << "step " << i;
+    ASSERT_LT(max_penetration_m(fb.board, s), 1e-6);
+  }
+  EXPECT_NEAR(s.ball.position_m.x(), f.pivot.x() + 0.04, 1e-9);
+  // Far from it: no contact.
+  GameState away = state_with_ball(fb.board, f.pivot + Vec2{0.04, 0.1}, Vec2::Zero());
+  stepper.step(away);
+  EXPECT_FALSE(away.flippers[0].ball_contact);
+}
+
+TEST(ThesisStepperFlippers, FallingFlipperDoesNotPushBallAbove) {
+  FlipperBoard fb(0.0);
+  const Flipper& f = fb.board.flippers[0];
+  const ThesisStepper stepper(fb.board);
+  const double theta = f.theta_max_rad;
+  const Vec2 p = f.pivot + 0.05 * flipper_direction(f, theta) + (kR + 1e-6) * flipper_up_normal(f, theta);
+  GameState s = state_with_ball(fb.board, p, Vec2::Zero());
+  s.flippers[0].theta_rad = theta;
+  for (int i = 0; i < 100; ++i) {  // a full stroke takes 1 / (33 * 5e-4) = 61 steps
+    const StepEvents ev = stepper.step(s);
+    ASSERT_FALSE(ev.has(StepEvents::kFlipperPush));
+  }
+  EXPECT_EQ(s.ball.position_m, p);
+  EXPECT_EQ(s.ball.velocity_mps, Vec2(Vec2::Zero()));
+  EXPECT_EQ(s.flippers[0].theta_rad, f.theta_min_rad);
+}
+
+// --- Grid on / off ----------------------------------------------------------
+
+TEST(ThesisStepper, GridOnAndOffAreBitIdentical) {
+  const Board b = box_with_bumpers_and_flippers();
+  ThesisStepperOptions on;
+  on.use_grid = true;
+  ThesisStepperOptions off;
+  off.use_grid = false;
+  const ThesisStepper a(b, on);
+  const ThesisStepper c(b, off);
+  GameState sa = state_with_ball(b, {0.25, 0.95}, {1.3, -0.4});
+  GameState sc = sa;
+  int hits = 0;
+  int pushes = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const bool up = (i / 300) % 2 == 1;
+    for (auto& f : sa.flippers) f.energized = up;
+    for (auto& f : sc.flippers) f.energized = up;
+    const StepEvents ea = a.step(sa);
+    const StepEvents ec = c.step(sc);
+    ASSERT_EQ(ea.flags, ec.flags) << "step " << i;
+    ASSERT_EQ(ea.obstacle, ec.obstacle) << "step " << i;
+    ASSERT_EQ(std::memcmp(sa.ball.position_m.data(), sc.ball.position_m.data(), sizeof(double) * 2), 0)
+        << "step " << i;
+    ASSERT_EQ(std::memcmp(sa.ball.velocity_mps.data(), sc.ball.velocity_mps.data(), sizeof(double) * 2), 0)
+        << "step " << i;
+    ASSERT_EQ(sa.score, sc.score);
+    hits += ea.has(StepEvents::kHitObstacle) ? 1 : 0;
+    pushes += (ea.has(StepEvents::kFlipperPush) || ea.has(StepEvents::kHitFlipper)) ? 1 : 0;
+    if (!sa.ball_in_play) {
+      // Should not happen in a closed box; restart to keep the comparison going.
+      ADD_FAILURE() << "ball lost at step " << i;
+      break;
+    }
+  }
+  EXPECT_GT(hits, 20);  // the run really exercised collisions
+  // The grid really prunes: the largest cell lists fewer than all obstacles.
+  EXPECT_LT(a.obstacle_grid().max_candidates(), b.shapes.size());
+  EXPECT_EQ(c.obstacle_candidates({0.25, 0.5}).size(), b.shapes.size());
+  EXPECT_GT(pushes, 0);  // and the flippers
+}
+
+// --- Constructor -------------------------------------------------------------
+
+TEST(ThesisStepper, ConstructorChecksTimeStep) {
+  Board b = box_with_bumpers_and_flippers();
+  const double dt_max = max_stable_dt_s(b);
+  ASSERT_TRUE(std::isfinite(dt_max));
+  // Violates l·sin(omega·dt/2) < r.
+  const double dt_bad = 1.01 * dt_max;
+  ASSERT_GE(b.flippers[0].length_m * std::sin(b.flippers[0].omega_rad_s * dt_bad / 2.0), b.ball.radius_m);
+  ThesisStepperOptions o;
+  o.dt_s = dt_bad;
+  EXPECT_THROW(ThesisStepper(b, o), std::invalid_argument);
+  o.dt_s = 0.99 * dt_max;
+  EXPECT_NO_THROW(ThesisStepper(b, o));
+  // The board's dt is taken when the option is 0; a bad board dt throws too.
+  b.dt_s = 2.0 * dt_max;
+  EXPECT_THROW(ThesisStepper{b}, std::invalid_argument);
+  o.dt_s = -1e-3;
+  EXPECT_THROW(ThesisStepper(b, o), std::invalid_argument);
+  o.dt_s = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(ThesisStepper(b, o), std::invalid_argument);
+  b.dt_s = 1e-4;
+  const ThesisStepper ok(b);
+  EXPECT_EQ(ok.dt_s(), 1e-4);
+}
+
+}  // namespace
+}  // namespace pinball::sim

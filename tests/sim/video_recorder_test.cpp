@@ -1,0 +1,147 @@
+#include "pinball/sim/video_recorder.h"
+
+#include <filesystem>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "pinball/sim/board.h"
+#include "pinball/sim/game_state.h"
+#include "pinball/sim/renderer.h"
+
+namespace pinball::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh, empty directory under the system temp directory, removed at the end of each test.
+class VideoRecorderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::random_device rd;
+    dir_ = fs::temp_directory_path() / ("pinball_video_test_" + std::to_string(rd()) + std::to_string(rd()));
+    ASSERT_TRUE(fs::create_directory(dir_));
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+// Frame i: a grey level that changes from frame to frame, with a white square moving right.
+cv::Mat test_frame(cv::Size size, int i) {
+  cv::Mat f(size, CV_8UC3, cv::Scalar(20 + 10 * i, 40, 60));
+  cv::rectangle(f, cv::Rect{4 + 6 * i, 10, 12, 12}, cv::Scalar(255, 255, 255), cv::FILLED);
+  return f;
+}
+
+TEST_F(VideoRecorderTest, WritesFramesThatVideoCaptureReadsBack) {
+  const cv::Size size{160, 120};
+  const int n = 10;
+  const std::string file = path("frames.avi");
+  {
+    VideoRecorder rec(file, 25.0, size);
+    for (int i = 0; i < n; ++i) {
+      rec.write(test_frame(size, i));
+      EXPECT_EQ(rec.frames_written(), i + 1);
+    }
+    rec.close();
+    rec.close();  // closing twice is harmless
+    EXPECT_EQ(rec.frames_written(), n);
+  }
+  ASSERT_TRUE(fs::exists(file));
+  EXPECT_GT(fs::file_size(file), 0u);
+
+  cv::VideoCapture cap(file);
+  ASSERT_TRUE(cap.isOpened());
+  EXPECT_EQ(static_cast<int>(cap.get(cv::CAP_PROP_FRAME_WIDTH)), size.width);
+  EXPECT_EQ(static_cast<int>(cap.get(cv::CAP_PROP_FRAME_HEIGHT)), size.height);
+  int read = 0;
+  cv::Mat frame;
+  while (cap.read(frame)) {
+    ASSERT_EQ(frame.size(), size);
+    ASSERT_EQ(frame.type(), CV_8UC3);
+    // MJPG is lossy, but each frame should be close to the one written.
+    const cv::Mat expected = test_frame(size, read);
+    EXPECT_LT(cv::norm(frame, expected, cv::NORM_L1) / (size.area() * 3.0), 8.0) << "frame " << read;
+    ++read;
+  }
+  EXPECT_EQ(read, n);
+}
+
+TEST_F(VideoRecorderTest, RecordsRenderedBoardFrames) {
+  Board b;
+  Shape s;
+  s.p0 = Vec2{0.1, 0.5};
+  s.p1 = Vec2{0.4, 0.5};
+  s.normal = Vec2{0.0, 1.0};
+  b.shapes.push_back(s);
+  b.obstacles.emplace_back();
+  RenderOptions o;
+  o.px_per_m = 300.0;
+  GameState state = make_game_state(b, 1);
+  state.ball_in_play = true;
+  const cv::Size size = render_size(b, o);
+  const std::string file = path("board.avi");
+  {
+    VideoRecorder rec(file, 30.0, size);
+    for (int i = 0; i < 5; ++i) {
+      state.ball.position_m = Vec2{0.1 + 0.05 * i, 0.3};
+      state.time_s = i / 30.0;
+      rec.write(render_board(b, &state, o));
+    }
+  }  // the destructor finishes the file
+  cv::VideoCapture cap(file);
+  ASSERT_TRUE(cap.isOpened());
+  cv::Mat frame;
+  int read = 0;
+  while (cap.read(frame)) {
+    EXPECT_EQ(frame.size(), size);
+    ++read;
+  }
+  EXPECT_EQ(read, 5);
+}
+
+TEST_F(VideoRecorderTest, WrongFrameSizeOrTypeThrows) {
+  const cv::Size size{64, 48};
+  VideoRecorder rec(path("bad.avi"), 10.0, size);
+  EXPECT_THROW(rec.write(cv::Mat(cv::Size{48, 64}, CV_8UC3, cv::Scalar::all(0))), std::invalid_argument);
+  EXPECT_THROW(rec.write(cv::Mat(size, CV_8UC1, cv::Scalar::all(0))), std::invalid_argument);
+  EXPECT_THROW(rec.write(cv::Mat(size, CV_32FC3, cv::Scalar::all(0))), std::invalid_argument);
+  EXPECT_THROW(rec.write(cv::Mat()), std::invalid_argument);
+  EXPECT_EQ(rec.frames_written(), 0);
+  rec.write(cv::Mat(size, CV_8UC3, cv::Scalar::all(0)));
+  EXPECT_EQ(rec.frames_written(), 1);
+}
+
+TEST_F(VideoRecorderTest, WriteAfterCloseThrows) {
+  const cv::Size size{64, 48};
+  VideoRecorder rec(path("closed.avi"), 10.0, size);
+  rec.close();
+  EXPECT_THROW(rec.write(cv::Mat(size, CV_8UC3, cv::Scalar::all(0))), std::logic_error);
+  EXPECT_EQ(rec.frames_written(), 0);
+}
+
+TEST_F(VideoRecorderTest, UnopenablePathThrowsNamingIt) {
+  const std::string file = path("no_such_dir/out.avi");
+  try {
+    VideoRecorder rec(file, 25.0, cv::Size{64, 48});
+    FAIL() << "VideoRecorder opened " << file;
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(VideoRecorderTest, RejectsBadFpsAndSize) {
+  EXPECT_THROW(VideoRecorder(path("a.avi"), 0.0, cv::Size{64, 48}), std::invalid_argument);
+  EXPECT_THROW(VideoRecorder(path("b.avi"), 25.0, cv::Size{0, 48}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pinball::sim
