@@ -1,0 +1,147 @@
+#include "speed_bench.h"
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+#include "pinball/sim/ball_runner.h"
+#include "pinball/sim/oracle_policy.h"
+#include "pinball/sim/state_hash.h"
+#include "pinball/sim/thesis_stepper.h"
+
+namespace pinball::bench {
+
+sim::Board with_far_obstacles(const sim::Board& board, int copies) {
+  sim::Board crowded = board;
+  const double stride_m = board.width_m + 0.5;  // well beyond the ball's reach
+  const std::size_t n = board.shapes.size();
+  crowded.shapes.reserve(n * (copies + 1));
+  crowded.obstacles.reserve(n * (copies + 1));
+  for (int k = 1; k <= copies; ++k) {
+    const Vec2 shift{k * stride_m, 0.0};
+    for (std::size_t i = 0; i < n; ++i) {
+      sim::Shape s = board.shapes[i];
+      s.p0 += shift;
+      s.p1 += shift;
+      sim::Obstacle o = board.obstacles[i];
+      o.bank = -1;
+      o.name += "+far" + std::to_string(k);
+      crowded.shapes.push_back(s);
+      crowded.obstacles.push_back(o);
+    }
+  }
+  return crowded;
+}
+
+namespace {
+
+struct Timed {
+  double seconds = 0.0;
+  double mean_candidates = 0.0;
+  std::uint64_t hash = 0;
+  std::uint64_t steps = 0;
+};
+
+// Plays balls with the spastic policy until `steps` steps have run.
+Timed run_once(const sim::ThesisStepper& stepper, std::uint64_t steps, std::uint64_t seed) {
+  const sim::Board& board = stepper.board();
+  sim::GameState state = sim::make_game_state(board, seed);
+  sim::BallLimits limits;
+  limits.max_ball_time_s = 60.0;
+  std::uint64_t candidates = 0;
+  const auto start = std::chrono::steady_clock::now();
+  while (state.steps < steps) {
+    sim::play_ball(stepper, state, limits,
+                   [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+                   [&](const sim::GameState&, const sim::StepEvents&) {});
+  }
+  const auto stop = std::chrono::steady_clock::now();
+  // Candidate counts come from a second, untimed pass so they cost nothing above.
+  sim::GameState replay = sim::make_game_state(board, seed);
+  while (replay.steps < std::min<std::uint64_t>(steps, 200'000)) {
+    sim::play_ball(stepper, replay, limits,
+                   [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+                   [&](const sim::GameState& s, const sim::StepEvents&) {
+                     candidates += stepper.obstacle_candidates(s.ball.position_m).size();
+                   });
+  }
+  Timed t;
+  t.seconds = std::chrono::duration<double>(stop - start).count();
+  t.mean_candidates = static_cast<double>(candidates) / static_cast<double>(std::max<std::uint64_t>(replay.steps, 1));
+  t.hash = sim::hash_state(state);
+  t.steps = state.steps;
+  return t;
+}
+
+SpeedRun measure(const std::string& name, const sim::Board& board, bool use_grid, const SpeedBenchOptions& options,
+                 const std::function<void(const std::string&)>& progress) {
+  sim::ThesisStepperOptions so;
+  so.use_grid = use_grid;
+  const sim::ThesisStepper stepper(board, so);
+  std::vector<double> times;
+  SpeedRun run;
+  run.name = name;
+  run.use_grid = use_grid;
+  run.obstacles = board.shapes.size();
+  for (int i = 0; i < std::max(1, options.repeats); ++i) {
+    const Timed t = run_once(stepper, options.steps, options.seed);
+    times.push_back(t.seconds);
+    run.mean_candidates = t.mean_candidates;
+    run.final_hash = t.hash;
+    run.steps = t.steps;  // play_ball finishes its ball, so a run may pass `steps` a little
+  }
+  std::sort(times.begin(), times.end());
+  run.median_s = times[times.size() / 2];
+  run.steps_per_s = static_cast<double>(run.steps) / run.median_s;
+  if (progress) {
+    std::ostringstream line;
+    line << name << ": " << run.steps << " steps, median " << run.median_s << " s, " << run.steps_per_s
+         << " steps/s";
+    progress(line.str());
+  }
+  return run;
+}
+
+}  // namespace
+
+SpeedReport run_speed_bench(const sim::Board& board, const SpeedBenchOptions& options,
+                            const std::function<void(const std::string&)>& progress) {
+  SpeedReport report;
+  report.board = board.source;
+  report.dt_s = board.dt_s;
+  const sim::Board crowded = with_far_obstacles(board, options.crowd_factor);
+  report.runs.push_back(measure("grid", board, true, options, progress));
+  report.runs.push_back(measure("linear", board, false, options, progress));
+  report.runs.push_back(measure("grid_crowded", crowded, true, options, progress));
+  report.runs.push_back(measure("linear_crowded", crowded, false, options, progress));
+  const SpeedRun& grid = report.runs[0];
+  const SpeedRun& linear = report.runs[1];
+  const SpeedRun& grid_crowded = report.runs[2];
+  report.grid_speedup = grid.steps_per_s / linear.steps_per_s;
+  report.crowded_cost_ratio = (grid_crowded.median_s / static_cast<double>(grid_crowded.steps)) /
+                              (grid.median_s / static_cast<double>(grid.steps));
+  report.grid_matches_linear = grid.final_hash == linear.final_hash && grid.steps == linear.steps;
+  return report;
+}
+
+nlohmann::json to_json(const SpeedReport& report) {
+  nlohmann::json runs = nlohmann::json::array();
+  for (const SpeedRun& r : report.runs) {
+    runs.push_back({{"name", r.name},
+                    {"use_grid", r.use_grid},
+                    {"obstacles", r.obstacles},
+                    {"steps", r.steps},
+                    {"median_s", r.median_s},
+                    {"steps_per_s", r.steps_per_s},
+                    {"mean_candidates_per_step", r.mean_candidates}});
+  }
+  return {{"benchmark", "speed"},
+          {"board", report.board},
+          {"dt_s", report.dt_s},
+          {"runs", runs},
+          {"grid_speedup", report.grid_speedup},
+          {"crowded_cost_ratio", report.crowded_cost_ratio},
+          {"grid_matches_linear", report.grid_matches_linear}};
+}
+
+}  // namespace pinball::bench

@@ -1,0 +1,57 @@
+#pragma once
+// The `pinball` subcommands. Each has an argument struct filled by CLI11 and a
+// run function that reports on `out` (one JSON object with --json) and shows
+// progress on `err`. Bad input throws; main turns it into a one-line message.
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace pinball::cli {
+
+/// `pinball sim`
+struct SimArgs {
+  std::string board;             ///< board file
+  std::string policy = "none";   ///< none | spastic
+  int balls = 1;                 ///< balls to play
+  std::uint64_t seed = 1;        ///< launch noise seed
+  std::string stepper = "thesis";///< integrator
+  double dt_s = 0.0;             ///< time step override (0: the board's)
+  double max_ball_time_s = 300.0;///< cut a ball still in play after this
+  std::string trace;             ///< CSV trace path, or empty
+  std::string video;             ///< AVI path, or empty
+  double video_fps = 60.0;       ///< video frame rate (simulated time)
+  bool json = false;             ///< one JSON object on stdout
+};
+CLI::App* add_sim_command(CLI::App& app, SimArgs& args);
+int run_sim(const SimArgs& args, std::ostream& out, std::ostream& err);
+
+/// `pinball render`
+struct RenderArgs {
+  std::string board;          ///< board file
+  std::string out;            ///< PNG path
+  double px_per_m = 800.0;    ///< scale
+  bool normals = false;       ///< draw line normals
+  bool json = false;          ///< one JSON object on stdout
+};
+CLI::App* add_render_command(CLI::App& app, RenderArgs& args);
+int run_render(const RenderArgs& args, std::ostream& out, std::ostream& err);
+
+/// `pinball bench`
+struct BenchArgs {
+  std::string which;                                 ///< speed (more kinds land with later issues)
+  std::string board = "boards/mit1993.board";        ///< board to measure on
+  std::uint64_t steps = 2'000'000;                   ///< steps per timed run
+  int repeats = 3;                                   ///< timed runs per configuration
+  bool json = false;                                 ///< one JSON object on stdout
+};
+CLI::App* add_bench_command(CLI::App& app, BenchArgs& args);
+int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& err);
+
+/// Parses argv and runs the chosen subcommand; returns the exit code
+/// (0 success, 1 bad input or failure, 2 bad usage).
+int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
+}  // namespace pinball::cli

@@ -1,0 +1,40 @@
+#include <exception>
+#include <ostream>
+
+#include "commands.h"
+
+namespace pinball::cli {
+
+int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app{"pinball: simulator and tools of the pinball controller (see README.md)", "pinball"};
+  app.require_subcommand(1);
+  SimArgs sim;
+  RenderArgs render;
+  BenchArgs bench;
+  CLI::App* sim_cmd = add_sim_command(app, sim);
+  CLI::App* render_cmd = add_render_command(app, render);
+  CLI::App* bench_cmd = add_bench_command(app, bench);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    out << app.help();
+    return 0;
+  } catch (const CLI::CallForAllHelp&) {
+    out << app.help("", CLI::AppFormatMode::All);
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    err << "pinball: " << e.what() << " (try --help)\n";
+    return 2;
+  }
+  try {
+    if (sim_cmd->parsed()) return run_sim(sim, out, err);
+    if (render_cmd->parsed()) return run_render(render, out, err);
+    if (bench_cmd->parsed()) return run_bench(bench, out, err);
+  } catch (const std::exception& e) {
+    err << "pinball: " << e.what() << "\n";
+    return 1;
+  }
+  return 2;
+}
+
+}  // namespace pinball::cli

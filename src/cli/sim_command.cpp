@@ -1,0 +1,140 @@
+// `pinball sim BOARD`: plays N balls on the embedded simulator and reports the
+// mean score per ball (95 % interval), mean ball time and steps per second.
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <ostream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "pinball/core/running_stats.h"
+#include "pinball/sim/ball_runner.h"
+#include "pinball/sim/board_loader.h"
+#include "pinball/sim/oracle_policy.h"
+#include "pinball/sim/renderer.h"
+#include "pinball/sim/state_hash.h"
+#include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/video_recorder.h"
+#include "trace_writer.h"
+
+namespace pinball::cli {
+
+CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
+  CLI::App* cmd = app.add_subcommand("sim", "play balls on the embedded simulator and report the scores");
+  cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--policy", a.policy, "who flips: none, or spastic (flip the nearer flipper whenever the ball is in reach)")
+      ->check(CLI::IsMember({"none", "spastic"}));
+  cmd->add_option("--balls", a.balls, "balls to play")->check(CLI::Range(1, 100'000'000));
+  cmd->add_option("--seed", a.seed, "random seed (launch noise); same seed, same results");
+  cmd->add_option("--stepper", a.stepper, "integrator: thesis (fixed-step, Ch. 3)")
+      ->check(CLI::IsMember({"thesis"}));
+  cmd->add_option("--dt", a.dt_s, "time step in seconds (default: the board's)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball still in play is cut")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--trace", a.trace, "write every step to this CSV (t,x,y,vx,vy,event)");
+  cmd->add_option("--video", a.video, "write an MJPG AVI of the play to this file");
+  cmd->add_option("--video-fps", a.video_fps, "video frames per simulated second")->check(CLI::Range(1.0, 1000.0));
+  cmd->add_flag("--json", a.json, "print one JSON object instead of text");
+  return cmd;
+}
+
+int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
+  const sim::Board board = sim::load_board(a.board);
+  sim::ThesisStepperOptions options;
+  options.dt_s = a.dt_s;
+  const sim::ThesisStepper stepper(board, options);
+  sim::GameState state = sim::make_game_state(board, a.seed);
+
+  std::optional<TraceWriter> trace;
+  if (!a.trace.empty()) trace.emplace(a.trace);
+  std::unique_ptr<sim::VideoRecorder> video;
+  sim::RenderOptions render_options;
+  double next_frame_s = 0.0;
+  if (!a.video.empty()) {
+    video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(board, render_options));
+  }
+
+  const bool spastic = a.policy == "spastic";
+  sim::BallLimits limits;
+  limits.max_ball_time_s = a.max_ball_time_s;
+  RunningStats score;
+  RunningStats ball_time;
+  std::uint64_t steps = 0;
+  int cut = 0;
+  int left_table = 0;
+  std::uint64_t run_hash = sim::hash_state(state);
+  const auto start = std::chrono::steady_clock::now();
+  auto last_progress = start;
+
+  for (int ball = 0; ball < a.balls; ++ball) {
+    const sim::BallResult r = sim::play_ball(
+        stepper, state, limits,
+        [&](sim::GameState& s) {
+          if (spastic) sim::oracle_spastic_policy(board, s);
+        },
+        [&](const sim::GameState& s, const sim::StepEvents& e) {
+          if (trace) trace->write(board, s, e);
+          if (video && s.time_s >= next_frame_s) {
+            video->write(sim::render_board(board, &s, render_options));
+            next_frame_s += 1.0 / a.video_fps;
+          }
+        });
+    score.add(r.score);
+    ball_time.add(r.duration_s);
+    steps += r.steps;
+    cut += r.cut ? 1 : 0;
+    left_table += r.left_table ? 1 : 0;
+    run_hash = sim::hash_combine_state(run_hash, state);
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_progress > std::chrono::seconds(2) || ball + 1 == a.balls) {
+      err << "sim: " << ball + 1 << "/" << a.balls << " balls, mean score " << score.mean() << "\n";
+      last_progress = now;
+    }
+  }
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (trace) trace->close();
+  if (video) video->close();
+
+  const double steps_per_s = wall_s > 0.0 ? static_cast<double>(steps) / wall_s : 0.0;
+  char hash_hex[17];
+  std::snprintf(hash_hex, sizeof(hash_hex), "%016llx", static_cast<unsigned long long>(run_hash));
+  if (a.json) {
+    nlohmann::json j = {
+        {"board", a.board},
+        {"policy", a.policy},
+        {"stepper", a.stepper},
+        {"seed", a.seed},
+        {"dt_s", stepper.dt_s()},
+        {"balls", a.balls},
+        {"mean_score_per_ball", score.mean()},
+        {"score_ci95_half_width", score.ci95_half_width()},
+        {"score_stddev", score.stddev()},
+        {"max_score", score.max()},
+        {"mean_ball_time_s", ball_time.mean()},
+        {"balls_cut_at_time_limit", cut},
+        {"balls_left_table", left_table},
+        {"steps", steps},
+        {"state_hash", hash_hex},
+        {"wall_time_s", wall_s},
+        {"steps_per_s", steps_per_s},
+    };
+    out << j.dump(2) << "\n";
+  } else {
+    out << "board            " << a.board << " (policy " << a.policy << ", stepper " << a.stepper << ", dt "
+        << stepper.dt_s() << " s, seed " << a.seed << ")\n"
+        << "balls            " << a.balls << " (" << cut << " cut at " << a.max_ball_time_s << " s, " << left_table
+        << " left the table)\n"
+        << "score per ball   " << score.mean() << " +/- " << score.ci95_half_width() << " (95 % interval), max "
+        << score.max() << "\n"
+        << "mean ball time   " << ball_time.mean() << " s\n"
+        << "steps            " << steps << " in " << wall_s << " s wall = " << steps_per_s << " steps/s\n"
+        << "state hash       " << hash_hex << "\n";
+  }
+  return 0;
+}
+
+}  // namespace pinball::cli

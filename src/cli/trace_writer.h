@@ -1,0 +1,38 @@
+#pragma once
+// `pinball sim --trace FILE.csv`: one row per step, t,x,y,vx,vy,event, with
+// every double printed round-trip exact so that equal runs give equal files.
+
+#include <cstdio>
+#include <string>
+
+#include "pinball/sim/board.h"
+#include "pinball/sim/game_state.h"
+#include "pinball/sim/thesis_stepper.h"
+
+namespace pinball::cli {
+
+/// Names what happened in a step, '|'-separated ("hit:wall@12|sensor:lane"),
+/// or an empty string for plain flight.
+std::string describe_events(const sim::Board& board, const sim::StepEvents& events);
+
+/// A CSV trace file.
+class TraceWriter {
+ public:
+  /// Creates the file and writes the header. Throws std::runtime_error naming the path.
+  explicit TraceWriter(const std::string& path);
+  ~TraceWriter();
+  TraceWriter(const TraceWriter&) = delete;
+  TraceWriter& operator=(const TraceWriter&) = delete;
+
+  /// Appends one row for the state after a step.
+  void write(const sim::Board& board, const sim::GameState& state, const sim::StepEvents& events);
+
+  /// Flushes and closes; throws std::runtime_error if the data could not be written.
+  void close();
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace pinball::cli

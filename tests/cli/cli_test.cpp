@@ -1,0 +1,156 @@
+// The `pinball` command as users and scripts run it: JSON on stdout, one-line
+// errors, exit codes, and the same seed giving the same output to the bit.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("pinball_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  CommandResult run(const std::string& args) {
+    const fs::path err = dir_ / "stderr.txt";
+    const std::string cmd = std::string("cd " PINBALL_SOURCE_DIR " && " PINBALL_EXE " ") + args + " 2>" + err.string();
+    CommandResult r;
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    char buf[4096];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
+    const int status = ::pclose(pipe);
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.err = slurp(err);
+    return r;
+  }
+
+  fs::path dir_;
+};
+
+int count_lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+TEST_F(Cli, SimJsonReportsEveryFigure) {
+  const CommandResult r = run("sim boards/mit1993.board --policy spastic --balls 5 --seed 3 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("balls"), 5);
+  for (const char* key : {"mean_score_per_ball", "score_ci95_half_width", "mean_ball_time_s", "steps_per_s",
+                          "steps", "state_hash", "balls_cut_at_time_limit"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_GT(j.at("mean_score_per_ball").get<double>(), 0.0);
+  EXPECT_GT(j.at("steps_per_s").get<double>(), 0.0);
+  EXPECT_NE(r.err.find("5/5 balls"), std::string::npos) << "progress goes to stderr";
+}
+
+TEST_F(Cli, SameSeedGivesTheSameTraceAndScores) {
+  const std::string a = (dir_ / "a.csv").string();
+  const std::string b = (dir_ / "b.csv").string();
+  const CommandResult ra = run("sim boards/mit1993.board --policy spastic --balls 3 --seed 9 --json --trace " + a);
+  const CommandResult rb = run("sim boards/mit1993.board --policy spastic --balls 3 --seed 9 --json --trace " + b);
+  ASSERT_EQ(ra.exit_code, 0) << ra.err;
+  ASSERT_EQ(rb.exit_code, 0) << rb.err;
+  const std::string ta = slurp(a);
+  EXPECT_GT(count_lines(ta), 1000);
+  EXPECT_EQ(ta.rfind("t,x,y,vx,vy,event\n", 0), 0u);
+  EXPECT_NE(ta.find("launch"), std::string::npos);
+  EXPECT_NE(ta.find("lost"), std::string::npos);
+  EXPECT_EQ(ta, slurp(b));
+  auto ja = nlohmann::json::parse(ra.out);
+  auto jb = nlohmann::json::parse(rb.out);
+  for (auto* j : {&ja, &jb}) {
+    j->erase("wall_time_s");
+    j->erase("steps_per_s");
+  }
+  EXPECT_EQ(ja, jb);
+  const CommandResult rc = run("sim boards/mit1993.board --policy spastic --balls 3 --seed 10 --json");
+  EXPECT_NE(nlohmann::json::parse(rc.out).at("state_hash"), ja.at("state_hash"));
+}
+
+TEST_F(Cli, BadBoardFileIsOneLineNamingFileAndLine) {
+  const fs::path bad = dir_ / "bad.board";
+  std::ofstream(bad) << "pinball-board 1\nsize 0.5 1\ncirle 0.1 0.1 0.01\n";
+  const CommandResult r = run("sim " + bad.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(bad.string() + ":3:"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("cirle"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+TEST_F(Cli, BadArgumentsExitWithUsageError) {
+  for (const char* args : {"sim boards/mit1993.board --balls 0", "sim boards/mit1993.board --policy wild",
+                           "sim no/such.board", "sim boards/mit1993.board --dt -1", "frobnicate"}) {
+    const CommandResult r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_EQ(count_lines(r.err), 1) << args << ": " << r.err;
+  }
+}
+
+TEST_F(Cli, TimeStepThatBreaksTheFlipperConditionIsRefused) {
+  const CommandResult r = run("sim boards/mit1993.board --dt 0.02");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("l*sin(omega*dt/2)"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, RenderWritesAPng) {
+  const fs::path png = dir_ / "board.png";
+  const CommandResult r = run("render boards/mit1993.board --out " + png.string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j.at("width_px").get<int>(), 100);
+  ASSERT_TRUE(fs::exists(png));
+  EXPECT_EQ(slurp(png).substr(1, 3), "PNG");
+}
+
+TEST_F(Cli, VideoRecordsFrames) {
+  const fs::path avi = dir_ / "play.avi";
+  const CommandResult r = run("sim boards/mit1993.board --balls 1 --max-ball-time 2 --video " + avi.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(avi));
+  EXPECT_GT(fs::file_size(avi), 10'000u);
+}
+
+TEST_F(Cli, BenchSpeedJson) {
+  const CommandResult r = run("bench speed --steps 20000 --repeats 1 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("runs").size(), 4u);
+  EXPECT_TRUE(j.at("grid_matches_linear").get<bool>());
+  EXPECT_GT(j.at("grid_speedup").get<double>(), 0.0);
+}
+
+}  // namespace
