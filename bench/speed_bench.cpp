@@ -61,7 +61,8 @@ Timed run_once(const sim::ThesisStepper& stepper, std::uint64_t steps, std::uint
   while (replay.steps < std::min<std::uint64_t>(steps, 200'000)) {
     sim::play_ball(stepper, replay, limits,
                    [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
-                   [&](const sim::GameState& s, const sim::StepEvents&) {
+                   [&](const sim::GameState& s, const sim::StepEvents& e) {
+                     if (e.has(sim::StepEvents::kLaunch)) return;  // not a step
                      candidates += stepper.obstacle_candidates(s.ball.position_m).size();
                    });
   }
