@@ -7,6 +7,29 @@
 
 namespace pinball::sim {
 
+Shape make_line_shape(const Vec2& p0, const Vec2& p1) {
+  Shape s;
+  s.kind = ShapeKind::kLine;
+  s.p0 = p0;
+  s.p1 = p1;
+  s.normal = perp_left(p1 - p0).normalized();
+  return s;
+}
+
+Shape make_circle_shape(const Vec2& centre, double radius_m) {
+  Shape s;
+  s.kind = ShapeKind::kCircle;
+  s.p0 = centre;
+  s.p1 = centre;
+  s.radius_m = radius_m;
+  return s;
+}
+
+double distance_to_shape(const Shape& shape, const Vec2& p) {
+  if (shape.kind == ShapeKind::kLine) return distance_point_segment(p, shape.p0, shape.p1);
+  return (p - shape.p0).norm() - shape.radius_m;
+}
+
 Vec2 flipper_direction(const Flipper& f, double theta_rad) {
   const double c = std::cos(theta_rad);
   const double s = std::sin(theta_rad);

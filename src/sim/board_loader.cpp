@@ -142,7 +142,10 @@ class Reader {
         fail("unknown attribute '" + std::string(args_[first + names.size()]) + "'");
       }
       std::string list;
-      for (const std::string_view n : names) list += (list.empty() ? "" : " ") + std::string(n);
+      for (const std::string_view n : names) {
+        if (!list.empty()) list += ' ';
+        list += n;
+      }
       fail("expected " + std::to_string(names.size()) + " number" + (names.size() == 1 ? "" : "s") + " (" + list +
            "), got " + std::to_string(got));
     }
@@ -194,28 +197,6 @@ class Reader {
   std::vector<std::string_view> args_;
   std::vector<Attribute> attributes_;
 };
-
-Shape make_line(const Vec2& p0, const Vec2& p1) {
-  Shape s;
-  s.kind = ShapeKind::kLine;
-  s.p0 = p0;
-  s.p1 = p1;
-  s.normal = perp_left(p1 - p0).normalized();
-  return s;
-}
-
-Shape make_circle(const Vec2& centre, double radius_m) {
-  Shape s;
-  s.kind = ShapeKind::kCircle;
-  s.p0 = centre;
-  s.radius_m = radius_m;
-  return s;
-}
-
-/// Distance from `p` to the nearest point of `s`, whatever its side (negative inside a circle).
-double distance_to_shape(const Vec2& p, const Shape& s) {
-  return s.kind == ShapeKind::kLine ? distance_point_segment(p, s.p0, s.p1) : (p - s.p0).norm() - s.radius_m;
-}
 
 class Loader {
  public:
@@ -298,7 +279,8 @@ class Loader {
 
   /// units/angles: a single word, before any length or angle.
   std::string_view unit_word(const Reader& r, std::string_view a, std::string_view b) {
-    const std::string choices = "'" + std::string(a) + "' or '" + std::string(b) + "'";
+    std::string choices = "'";  // built piecewise: GCC 12 warns falsely on "literal" + std::string
+    choices.append(a).append("' or '").append(b).append("'");
     if (r.arg_count() != 1) r.fail("expected one word, " + choices + ", got " + std::to_string(r.arg_count()));
     if (r.arg(0) != a && r.arg(0) != b) r.fail("expected " + choices + ", got '" + std::string(r.arg(0)) + "'");
     if (first_dimensioned_line_ != 0) {
@@ -422,27 +404,27 @@ class Loader {
 
   void line(const Reader& r) {
     const auto [p0, p1] = segment(r, 0);
-    add(make_line(p0, p1), obstacle_attributes(r));
+    add(make_line_shape(p0, p1), obstacle_attributes(r));
   }
 
   void wall(const Reader& r) {
     const auto [p0, p1] = segment(r, 0);
     const Obstacle o = obstacle_attributes(r);
-    add(make_line(p0, p1), o);
-    add(make_line(p1, p0), o);
-    add(make_circle(p0, 0.0), o);
-    add(make_circle(p1, 0.0), o);
+    add(make_line_shape(p0, p1), o);
+    add(make_line_shape(p1, p0), o);
+    add(make_circle_shape(p0, 0.0), o);
+    add(make_circle_shape(p1, 0.0), o);
   }
 
   void point(const Reader& r) {
     const auto v = r.numbers(0, {"X", "Y"});
-    add(make_circle(Vec2{v[0], v[1]} * length_scale_, 0.0), obstacle_attributes(r));
+    add(make_circle_shape(Vec2{v[0], v[1]} * length_scale_, 0.0), obstacle_attributes(r));
   }
 
   void circle(const Reader& r) {
     const auto v = r.numbers(0, {"X", "Y", "R"});
     r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
-    add(make_circle(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_), obstacle_attributes(r));
+    add(make_circle_shape(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_), obstacle_attributes(r));
   }
 
   /// Vertices in file units, checked for zero-length edges (closed: also last -> first).
@@ -463,10 +445,10 @@ class Loader {
     const Obstacle o = obstacle_attributes(r);
     const bool two_sided = r.flag("two-sided");
     for (std::size_t i = 0; i + 1 < v.size(); ++i) {
-      add(make_line(v[i] * length_scale_, v[i + 1] * length_scale_), o);
-      if (two_sided) add(make_line(v[i + 1] * length_scale_, v[i] * length_scale_), o);
+      add(make_line_shape(v[i] * length_scale_, v[i + 1] * length_scale_), o);
+      if (two_sided) add(make_line_shape(v[i + 1] * length_scale_, v[i] * length_scale_), o);
     }
-    for (const Vec2& p : v) add(make_circle(p * length_scale_, 0.0), o);
+    for (const Vec2& p : v) add(make_circle_shape(p * length_scale_, 0.0), o);
   }
 
   void polygon(const Reader& r) {
@@ -478,9 +460,9 @@ class Loader {
     if (twice_area > 0.0) std::reverse(v.begin(), v.end());
     const Obstacle o = obstacle_attributes(r);
     for (std::size_t i = 0; i < v.size(); ++i) {
-      add(make_line(v[i] * length_scale_, v[(i + 1) % v.size()] * length_scale_), o);
+      add(make_line_shape(v[i] * length_scale_, v[(i + 1) % v.size()] * length_scale_), o);
     }
-    for (const Vec2& p : v) add(make_circle(p * length_scale_, 0.0), o);
+    for (const Vec2& p : v) add(make_circle_shape(p * length_scale_, 0.0), o);
   }
 
   // ---- flippers and sensors ----
@@ -515,11 +497,11 @@ class Loader {
     const std::string_view shape = r.arg_count() > 0 ? r.arg(0) : std::string_view{};
     if (shape == "line") {
       const auto [p0, p1] = segment(r, 1);
-      s.shape = make_line(p0, p1);
+      s.shape = make_line_shape(p0, p1);
     } else if (shape == "circle") {
       const auto v = r.numbers(1, {"X", "Y", "R"});
       r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
-      s.shape = make_circle(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_);
+      s.shape = make_circle_shape(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_);
     } else {
       r.fail("field SHAPE must be 'line' or 'circle', got '" + std::string(shape) + "'");
     }
@@ -532,7 +514,7 @@ class Loader {
     const auto v = r.numbers(0, {"X", "Y", "R"});
     r.require(v[2] > 0, "field R (radius)", "> 0", v[2]);
     s.kind = SensorKind::kHole;
-    s.shape = make_circle(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_);
+    s.shape = make_circle_shape(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_);
     const bool eat = r.flag("eat");
     if (eat == r.flag("kickout")) r.fail("needs exactly one of 'eat' or 'kickout=VX,VY'");
     if (!eat) {
@@ -593,7 +575,7 @@ class Loader {
                            " m, ball radius " + fmt(r) + " m)");
     };
     for (std::size_t i = 0; i < board_.shapes.size(); ++i) {
-      const double d = distance_to_shape(p, board_.shapes[i]);
+      const double d = distance_to_shape(board_.shapes[i], p);
       if (d < r) overlap("'" + board_.obstacles[i].name + "'", d);
     }
     for (const Flipper& f : board_.flippers) {

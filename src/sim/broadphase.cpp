@@ -28,11 +28,6 @@ double distance_shape_box(const Shape& s, const Vec2& lo, const Vec2& hi) {
 
 }  // namespace
 
-double distance_to_shape(const Shape& shape, const Vec2& p) {
-  if (shape.kind == ShapeKind::kLine) return distance_point_segment(p, shape.p0, shape.p1);
-  return (p - shape.p0).norm() - shape.radius_m;
-}
-
 UniformGrid::UniformGrid(std::span<const Shape> shapes, double reach_m, double cell_m) {
   if (!(reach_m >= 0.0) || !(cell_m > 0.0)) throw std::invalid_argument("UniformGrid: reach must be >= 0, cell > 0");
   if (shapes.empty()) {

@@ -16,17 +16,7 @@ using testing::empty_board;
 
 constexpr double kR = 0.0135;
 
-Shape line_shape(const Vec2& p0, const Vec2& p1) {
-  Shape s;
-  s.kind = ShapeKind::kLine;
-  s.p0 = p0;
-  s.p1 = p1;
-  s.normal = perp_left(p1 - p0).normalized();
-  return s;
-}
-
-// A horizontal line y = 0 from x = 0 to x = 1, normal +y.
-Shape floor_line() { return line_shape({0.0, 0.0}, {1.0, 0.0}); }
+Shape floor_line() { return make_line_shape({0.0, 0.0}, {1.0, 0.0}); }
 
 TEST(LineTimeOfImpact, FallingBallHitsAtHeightMinusRadiusOverSpeed) {
   const Shape line = floor_line();
@@ -50,7 +40,7 @@ TEST(LineTimeOfImpact, FallingBallHitsAtHeightMinusRadiusOverSpeed) {
 TEST(LineTimeOfImpact, SlantedLine) {
   // Line through the origin at 30 degrees; ball on its normal at distance d moving straight at it.
   const double a = std::numbers::pi / 6.0;
-  const Shape line = line_shape({0.0, 0.0}, {std::cos(a), std::sin(a)});
+  const Shape line = make_line_shape({0.0, 0.0}, {std::cos(a), std::sin(a)});
   const Vec2 n = line.normal;
   const Vec2 foot = 0.5 * Vec2{std::cos(a), std::sin(a)};
   const double d = 0.3;
@@ -73,7 +63,7 @@ TEST(LineTimeOfImpact, BackSidePassesThrough) {
   // Below it and moving down (away from the back): nothing either.
   EXPECT_FALSE(line_time_of_impact(floor_line(), {0.4, -0.005}, {0.0, -1.0}, kR, 1.0, c));
   // The reversed line (normal -y) is hit by the ball from below.
-  const Shape back = line_shape({1.0, 0.0}, {0.0, 0.0});
+  const Shape back = make_line_shape({1.0, 0.0}, {0.0, 0.0});
   ASSERT_TRUE(line_time_of_impact(back, {0.4, -0.2}, {0.0, 1.0}, kR, 1.0, c));
   EXPECT_NEAR(c.t_s, 0.2 - kR, 1e-15);
   EXPECT_NEAR(c.normal.y(), -1.0, 1e-15);

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "pinball/core/rng.h"
+#include "pinball/sim/ball_runner.h"
+#include "pinball/sim/board_loader.h"
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "test_boards.h"
@@ -291,6 +293,29 @@ TEST(StiffCases, MillionRandomSteps) {
   }
   EXPECT_GT(events, 1000);
   EXPECT_GT(relaunches, 0);
+}
+
+// The "a million random steps on the full table": the thesis board,
+// flippers pressed at random, balls relaunched as they drain.
+TEST(StiffCases, MillionRandomStepsOnTheThesisTable) {
+  const Board b = load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const ThesisStepper stepper(b);
+  GameState s = make_game_state(b, 99);
+  Rng rng(4242);
+  long lost = 0;
+  for (long i = 0; i < 1000000; ++i) {
+    if (!s.ball_in_play) {
+      begin_ball(b, s, rng.uniform(0.5, 1.0));
+      ++lost;
+    }
+    if (rng.uniform01() < 0.02) {
+      for (auto& fs : s.flippers) fs.energized = rng.uniform01() < 0.5;
+    }
+    const StepEvents ev = stepper.step(s);
+    ASSERT_FALSE(ev.has(StepEvents::kLeftTable)) << "step " << i;
+    ASSERT_TRUE(invariants_hold(b, s, i));
+  }
+  EXPECT_GE(lost, 2) << "balls drain under random flipping, so relaunches are covered too";
 }
 
 }  // namespace

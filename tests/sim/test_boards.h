@@ -24,12 +24,7 @@ inline Obstacle obstacle_with_rho(double rho) {
 /// Adds a one-sided line p0 -> p1 (normal = unit left perpendicular of p1 - p0); returns its index.
 inline int add_line(Board& board, const Vec2& p0, const Vec2& p1, double rho = 1.0, Action action = {},
                     const std::string& name = "line") {
-  Shape s;
-  s.kind = ShapeKind::kLine;
-  s.p0 = p0;
-  s.p1 = p1;
-  s.normal = perp_left(p1 - p0).normalized();
-  s.radius_m = 0.0;
+  const Shape s = make_line_shape(p0, p1);
   Obstacle o = obstacle_with_rho(rho);
   o.action = action;
   o.name = name;
@@ -41,12 +36,7 @@ inline int add_line(Board& board, const Vec2& p0, const Vec2& p1, double rho = 1
 /// Adds a circle of radius_m (0: a point) around c; returns its index.
 inline int add_circle(Board& board, const Vec2& c, double radius_m, double rho = 1.0, Action action = {},
                       const std::string& name = "circle") {
-  Shape s;
-  s.kind = ShapeKind::kCircle;
-  s.p0 = c;
-  s.p1 = c;
-  s.normal = Vec2::Zero();
-  s.radius_m = radius_m;
+  const Shape s = make_circle_shape(c, radius_m);
   Obstacle o = obstacle_with_rho(rho);
   o.action = action;
   o.name = name;

@@ -123,6 +123,16 @@ struct Board {
   std::vector<Bank> banks;       ///< banks of flags
 };
 
+/// A line shape from p0 to p1 whose normal points to the left of p0 -> p1.
+Shape make_line_shape(const Vec2& p0, const Vec2& p1);
+
+/// A circle shape around `centre` (radius 0: a point).
+Shape make_circle_shape(const Vec2& centre, double radius_m);
+
+/// Distance from a point p to a shape's surface (lines: to the segment,
+/// either side; circles: to the rim, negative inside).
+double distance_to_shape(const Shape& shape, const Vec2& p);
+
 /// Unit vector from pivot to tip at elevation theta_rad.
 Vec2 flipper_direction(const Flipper& f, double theta_rad);
 

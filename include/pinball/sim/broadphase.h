@@ -49,8 +49,4 @@ class UniformGrid {
   std::vector<std::int32_t> entries_;
 };
 
-/// Distance from a ball centre p to a shape's surface (lines: to the segment,
-/// either side; circles: to the rim, negative inside).
-double distance_to_shape(const Shape& shape, const Vec2& p);
-
 }  // namespace pinball::sim
