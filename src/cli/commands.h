@@ -9,6 +9,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pinball/track/camera_model.h"
+
 namespace pinball::cli {
 
 /// `pinball sim`
@@ -23,6 +25,8 @@ struct SimArgs {
   std::string trace;             ///< CSV trace path, or empty
   std::string video;             ///< AVI path, or empty
   double video_fps = 60.0;       ///< video frame rate (simulated time)
+  track::CameraModelConfig camera;  ///< the camera the spastic player sees through
+  double reach_m = 0.02;         ///< spastic: flip when the projected impact is this close (m)
   bool json = false;             ///< one JSON object on stdout
 };
 CLI::App* add_sim_command(CLI::App& app, SimArgs& args);
@@ -38,6 +42,17 @@ struct RenderArgs {
 };
 CLI::App* add_render_command(CLI::App& app, RenderArgs& args);
 int run_render(const RenderArgs& args, std::ostream& out, std::ostream& err);
+
+/// `pinball track`
+struct TrackArgs {
+  std::string board;           ///< board file (flipper geometry)
+  std::string observations;    ///< observation CSV
+  double gravity_mps2 = -1.0;  ///< calibrated g; negative: the board's
+  double sigma_m = 0.0;        ///< observation noise; 0: the default camera's
+  bool json = false;           ///< one JSON object on stdout
+};
+CLI::App* add_track_command(CLI::App& app, TrackArgs& args);
+int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 
 /// `pinball bench`
 struct BenchArgs {

@@ -11,9 +11,11 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   SimArgs sim;
   RenderArgs render;
   BenchArgs bench;
+  TrackArgs track;
   CLI::App* sim_cmd = add_sim_command(app, sim);
   CLI::App* render_cmd = add_render_command(app, render);
   CLI::App* bench_cmd = add_bench_command(app, bench);
+  CLI::App* track_cmd = add_track_command(app, track);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -30,6 +32,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
     if (sim_cmd->parsed()) return run_sim(sim, out, err);
     if (render_cmd->parsed()) return run_render(render, out, err);
     if (bench_cmd->parsed()) return run_bench(bench, out, err);
+    if (track_cmd->parsed()) return run_track(track, out, err);
   } catch (const std::exception& e) {
     err << "pinball: " << e.what() << "\n";
     return 1;

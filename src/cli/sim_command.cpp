@@ -13,7 +13,7 @@
 #include "pinball/core/running_stats.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/board_loader.h"
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/control/simulated_player.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -25,8 +25,21 @@ namespace pinball::cli {
 CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
   CLI::App* cmd = app.add_subcommand("sim", "play balls on the embedded simulator and report the scores");
   cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--policy", a.policy, "who flips: none, or spastic (flip the nearer flipper whenever the ball is in reach)")
+  cmd->add_option("--policy", a.policy,
+                  "who flips: none, or spastic (flip the flipper the tracker's projection names whenever the "
+                  "ball is within --reach of impact; sees the ball only through the camera model)")
       ->check(CLI::IsMember({"none", "spastic"}));
+  cmd->add_option("--reach", a.reach_m, "spastic: flip when the projected impact is this close (m)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--fps", a.camera.fps, "camera model: frames per second")->check(CLI::Range(1.0, 10000.0));
+  cmd->add_option("--m-per-px", a.camera.m_per_px, "camera model: metres per pixel on the table")
+      ->check(CLI::Range(1e-5, 0.1));
+  cmd->add_option("--noise-px", a.camera.noise_px, "camera model: centroid noise, standard deviation (px)")
+      ->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--latency", a.camera.latency_s, "camera model: exposure to delivery (s)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--drop", a.camera.drop_probability, "camera model: probability a frame is lost")
+      ->check(CLI::Range(0.0, 0.99));
   cmd->add_option("--balls", a.balls, "balls to play")->check(CLI::Range(1, 100'000'000));
   cmd->add_option("--seed", a.seed, "random seed (launch noise); same seed, same results");
   cmd->add_option("--stepper", a.stepper, "integrator: thesis (fixed-step, Ch. 3)")
@@ -58,7 +71,12 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(board, render_options));
   }
 
-  const bool spastic = a.policy == "spastic";
+  std::optional<control::SimulatedSpasticPlayer> spastic;
+  if (a.policy == "spastic") {
+    control::SpasticConfig spastic_config;
+    spastic_config.reach_m = a.reach_m;
+    spastic.emplace(board, a.camera, spastic_config, a.seed ^ 0x5DEECE66Dull);
+  }
   sim::BallLimits limits;
   limits.max_ball_time_s = a.max_ball_time_s;
   RunningStats score;
@@ -66,6 +84,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   std::uint64_t steps = 0;
   int cut = 0;
   int left_table = 0;
+  std::uint64_t flips = 0;
   std::uint64_t run_hash = sim::hash_state(state);
   const auto start = std::chrono::steady_clock::now();
   auto last_progress = start;
@@ -74,7 +93,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     const sim::BallResult r = sim::play_ball(
         stepper, state, limits,
         [&](sim::GameState& s) {
-          if (spastic) sim::oracle_spastic_policy(board, s);
+          if (spastic) spastic->act(s);
         },
         [&](const sim::GameState& s, const sim::StepEvents& e) {
           if (trace) trace->write(board, s, e);
@@ -86,6 +105,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     score.add(r.score);
     ball_time.add(r.duration_s);
     steps += r.steps;
+    flips += static_cast<std::uint64_t>(r.flips);
     cut += r.cut ? 1 : 0;
     left_table += r.left_table ? 1 : 0;
     run_hash = sim::hash_combine_state(run_hash, state);
@@ -110,6 +130,13 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"seed", a.seed},
         {"dt_s", stepper.dt_s()},
         {"balls", a.balls},
+        {"camera",
+         {{"fps", a.camera.fps},
+          {"m_per_px", a.camera.m_per_px},
+          {"noise_px", a.camera.noise_px},
+          {"latency_s", a.camera.latency_s},
+          {"drop_probability", a.camera.drop_probability}}},
+        {"flips", flips},
         {"mean_score_per_ball", score.mean()},
         {"score_ci95_half_width", score.ci95_half_width()},
         {"score_stddev", score.stddev()},
@@ -130,7 +157,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         << " left the table)\n"
         << "score per ball   " << score.mean() << " +/- " << score.ci95_half_width() << " (95 % interval), max "
         << score.max() << "\n"
-        << "mean ball time   " << ball_time.mean() << " s\n"
+        << "mean ball time   " << ball_time.mean() << " s, " << flips << " flips\n"
         << "steps            " << steps << " in " << wall_s << " s wall = " << steps_per_s << " steps/s\n"
         << "state hash       " << hash_hex << "\n";
   }

@@ -1,0 +1,23 @@
+#pragma once
+// Observation files: CSV with header t,x,y (s, m, board frame), optionally
+// followed by left_contact,right_contact (0/1 flipper contact sensors).
+
+#include <string>
+#include <vector>
+
+#include "pinball/track/observation.h"
+
+namespace pinball::track {
+
+/// One row of an observation file.
+struct ObservationRow {
+  Observation observation;    ///< t, x, y
+  ContactSensors contacts;    ///< all false when the file has no contact columns
+};
+
+/// Reads a whole file. Throws std::runtime_error "file:line: what is wrong"
+/// (bad header, missing or non-finite number, contact not 0/1, time going
+/// backwards) and returns nothing partial.
+std::vector<ObservationRow> read_observations_csv(const std::string& path);
+
+}  // namespace pinball::track

@@ -1,0 +1,58 @@
+#pragma once
+// The trajectory projection (thesis 4.1.3): where and how the ball will meet
+// the 'V' of the down flippers if they stayed down, computed from a fitted
+// trajectory; and the special projection for a ball rolling on a flipper
+// (4.1.2). Every degenerate case gives a defined answer, never NaN.
+
+#include <cstdint>
+
+#include "pinball/track/flipper_geometry.h"
+#include "pinball/track/trajectory_fit.h"
+
+namespace pinball::track {
+
+/// Why there is no projection.
+enum class NoProjection : std::uint8_t {
+  kNone = 0,          ///< there is a projection
+  kTooFewPoints,      ///< fewer than 3 usable observations on the current trajectory
+  kOutsideCritical,   ///< ball above the critical area (not worth computing)
+  kBelowFlippers,     ///< ball already below the flipper lines
+  kNoImpact,          ///< the trajectory never meets the 'V' in the future
+  kNumerical,         ///< the numbers came out non-finite (never seen; guarded)
+};
+
+/// Name of a NoProjection value for CSV and JSON ("none", "too_few_points", ...).
+const char* to_string(NoProjection reason);
+
+/// The trajectory projection (f, s, θ, h, d) plus its time (thesis 4.1).
+struct TrajectoryProjection {
+  bool valid = false;            ///< a projection exists (reason == kNone)
+  NoProjection reason = NoProjection::kTooFewPoints;  ///< why not, when not valid
+  int flipper = kLeftFlipper;    ///< f_impact: the flipper line the ball meets
+  double speed_mps = 0.0;        ///< s_impact: speed at impact (m/s)
+  double angle_rad = 0.0;        ///< θ_impact: slope of the velocity at impact, in [−π/2, π/2]
+  double h = 0.0;                ///< h_impact: 0 at the pivot, 1 at the tip, h_apex at the V's centre
+  double d_m = 0.0;              ///< d_impact: distance from the ball now to the impact point (m)
+  double t_impact_s = 0.0;       ///< time from the newest observation to impact (s)
+  double t_observation_s = 0.0;  ///< time of the newest observation (s)
+  Vec2 impact_point = Vec2::Zero();  ///< where (m)
+  bool hittable = false;         ///< impact on the 'V' (0 <= h <= h_apex): the controller acts on these only
+  bool rolling = false;          ///< the rolling-ball projection of 4.1.2
+};
+
+/// Projects a fitted trajectory onto the 'V' (thesis eq. 4.6–4.11): the
+/// nearest future meeting with either flipper line between its pivot and the
+/// apex. `fit` must be valid.
+TrajectoryProjection project_trajectory(const TrajectoryFit& fit, const FlipperGeometry& geometry);
+
+/// The projection for a ball rolling on flipper `rolling_on` (thesis 4.1.2):
+/// heading for the V's centre (h = h_apex) of the other flipper, at
+/// `speed_mps`, at the angle of the down flipper it rolls on.
+TrajectoryProjection rolling_projection(const FlipperGeometry& geometry, int rolling_on, const Vec2& p_now,
+                                        double speed_mps, double t_now_s);
+
+/// Folds a direction angle into [−π/2, π/2] (the thesis's tan⁻¹(ẏ/ẋ)
+/// without a division: a vertical fall is −π/2 exactly).
+double fold_to_half_plane(double angle_rad);
+
+}  // namespace pinball::track

@@ -1,0 +1,84 @@
+#pragma once
+// The ball tracker (thesis Ch. 4, 5.2.5): turns timestamped observations into
+// trajectory projections and launch events. A plain class: no threads, no
+// I/O; fixed-size buffers, so update() never allocates.
+
+#include <array>
+#include <cstddef>
+
+#include "pinball/track/camera_model.h"
+#include "pinball/track/flipper_geometry.h"
+#include "pinball/track/launch_detector.h"
+#include "pinball/track/observation.h"
+#include "pinball/track/projection.h"
+#include "pinball/track/trajectory_fit.h"
+
+namespace pinball::track {
+
+/// Tracker settings.
+struct TrackerConfig {
+  double g_mps2 = 1.11;               ///< calibrated gravity along the table (m/s²)
+  double window_distance_m = 0.038;   ///< d: fit over the first n with |B_n − B_0| >= d (half a flipper)
+  double rolling_epsilon_m = 0.0076;  ///< ε: rolling speed from the first point this far back (10 % of a flipper)
+  double sigma_m = 0.0007;            ///< standard deviation of one observed coordinate (m)
+  double critical_y_m = 0.5;          ///< projections only while the ball is below this y (m)
+  int max_window = 64;                ///< at most this many points in a fit
+  bool chi2_flush = true;             ///< drop the points before a collision at once (4.1.1)
+  LaunchDetectorConfig launch;        ///< launch detection
+};
+
+/// Defaults for a board and a camera: g from the board, d and ε from the
+/// flipper length, σ from the camera, the critical area 0.35 m above the pivots.
+TrackerConfig default_tracker_config(const sim::Board& board, const CameraModelConfig& camera);
+
+/// Everything one update produced.
+struct TrackerOutput {
+  TrajectoryProjection projection;  ///< the projection (valid or with its reason)
+  TrajectoryFit fit;                ///< the fit behind it (invalid when rolling or too few points)
+  LaunchEvent launch;               ///< launch / loss / entry events of this update
+  int window = 0;                   ///< observations in the fit
+  bool flushed = false;             ///< the χ² test dropped points from before a collision
+};
+
+/// Stateful tracker for one ball at a time.
+class Tracker {
+ public:
+  Tracker(const FlipperGeometry& geometry, const TrackerConfig& config);
+
+  /// Adds one observation (in time order) with the flipper contact sensors
+  /// read at the same time, and returns the new projection.
+  const TrackerOutput& update(const Observation& observation, const ContactSensors& contacts);
+
+  /// Forgets the ball (call when a ball is lost or a new one is launched).
+  void reset();
+
+  /// The geometry and settings in use.
+  const FlipperGeometry& geometry() const { return geometry_; }
+  const TrackerConfig& config() const { return config_; }
+  /// Observations currently kept (the trajectory since the last break).
+  std::size_t history_size() const { return size_; }
+  /// Collisions detected by the χ² test since construction.
+  std::size_t flushes() const { return flushes_; }
+
+ private:
+  static constexpr std::size_t kHistory = 512;
+
+  const Observation& back(std::size_t i) const { return history_[(head_ + size_ - 1 - i) % kHistory]; }
+  void keep_newest(std::size_t n);
+  std::span<const Observation> newest(std::size_t n);
+  std::size_t window_length() const;
+  double rolling_speed() const;
+
+  FlipperGeometry geometry_;
+  TrackerConfig config_;
+  LaunchDetector launch_;
+  std::array<Observation, kHistory> history_{};
+  std::size_t head_ = 0;
+  std::size_t size_ = 0;
+  std::array<Observation, kHistory> scratch_{};
+  bool was_rolling_ = false;
+  std::size_t flushes_ = 0;
+  TrackerOutput out_;
+};
+
+}  // namespace pinball::track

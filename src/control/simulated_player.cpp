@@ -1,0 +1,40 @@
+#include "pinball/control/simulated_player.h"
+
+namespace pinball::control {
+
+SimulatedSpasticPlayer::SimulatedSpasticPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
+                                               const SpasticConfig& spastic, std::uint64_t seed)
+    : board_(board),
+      camera_(camera, seed),
+      tracker_(track::flipper_geometry_from_board(board), track::default_tracker_config(board, camera)),
+      spastic_(spastic) {
+  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+    board_index_[board.flippers[i].side == sim::Side::kLeft ? track::kLeftFlipper : track::kRightFlipper] =
+        static_cast<int>(i);
+  }
+}
+
+void SimulatedSpasticPlayer::act(sim::GameState& state) {
+  if (!state.ball_in_play) {
+    if (ball_was_in_play_) {  // the ball is gone: forget it
+      tracker_.reset();
+      camera_.reset(state.time_s);
+      spastic_.reset(energized_);
+    }
+    ball_was_in_play_ = false;
+  } else {
+    ball_was_in_play_ = true;
+    camera_.expose(state.time_s, state.ball.position_m);
+    track::Observation obs;
+    while (camera_.deliver(state.time_s, obs)) {
+      const track::ContactSensors contacts{state.flippers[board_index_[track::kLeftFlipper]].ball_contact,
+                                           state.flippers[board_index_[track::kRightFlipper]].ball_contact};
+      last_ = tracker_.update(obs, contacts);
+      spastic_.update(last_, state.time_s, energized_);
+      ++observations_;
+    }
+  }
+  for (int f = 0; f < 2; ++f) state.flippers[board_index_[f]].energized = energized_[f];
+}
+
+}  // namespace pinball::control

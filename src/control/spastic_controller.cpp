@@ -1,0 +1,25 @@
+#include "pinball/control/spastic_controller.h"
+
+namespace pinball::control {
+
+void SpasticController::reset(std::array<bool, 2>& energized) {
+  energized = {false, false};
+  held_since_s_ = {0.0, 0.0};
+}
+
+void SpasticController::update(const track::TrackerOutput& out, double now_s, std::array<bool, 2>& energized) {
+  if (out.launch.launched || out.launch.lost) {
+    reset(energized);
+    return;
+  }
+  for (int f = 0; f < 2; ++f) {
+    if (energized[f] && now_s - held_since_s_[f] > config_.max_hold_s) energized[f] = false;
+  }
+  const track::TrajectoryProjection& p = out.projection;
+  if (p.valid && p.hittable && p.d_m <= config_.reach_m && !energized[p.flipper]) {
+    energized[p.flipper] = true;
+    held_since_s_[p.flipper] = now_s;
+  }
+}
+
+}  // namespace pinball::control

@@ -1,0 +1,47 @@
+#include "pinball/track/flipper_geometry.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace pinball::track {
+
+FlipperGeometry make_flipper_geometry(const FlipperLine& left, const FlipperLine& right) {
+  FlipperGeometry g;
+  g.lines = {left, right};
+  const Vec2 fl = left.axis();
+  const Vec2 fr = right.axis();
+  const double denom = cross(fl, fr);
+  if (!(std::abs(denom) > 1e-12 * fl.norm() * fr.norm())) {
+    throw std::invalid_argument("flipper lines are parallel: they form no 'V'");
+  }
+  // left.pivot + hl·fl = right.pivot + hr·fr
+  const Vec2 d = right.pivot - left.pivot;
+  const double hl = cross(d, fr) / denom;
+  const double hr = cross(d, fl) / denom;
+  if (!(hl > 0.0 && hr > 0.0)) throw std::invalid_argument("flipper lines meet behind a pivot: they form no 'V'");
+  g.apex = left.pivot + hl * fl;
+  g.h_apex = {hl, hr};
+  return g;
+}
+
+FlipperGeometry flipper_geometry_from_board(const sim::Board& board) {
+  const sim::Flipper* left = nullptr;
+  const sim::Flipper* right = nullptr;
+  for (const sim::Flipper& f : board.flippers) {
+    const sim::Flipper*& slot = f.side == sim::Side::kLeft ? left : right;
+    if (slot) throw std::invalid_argument("board '" + board.source + "' has more than one flipper on a side");
+    slot = &f;
+  }
+  if (!left || !right) throw std::invalid_argument("board '" + board.source + "' needs a left and a right flipper");
+  return make_flipper_geometry({left->pivot, sim::flipper_tip(*left, left->theta_min_rad)},
+                               {right->pivot, sim::flipper_tip(*right, right->theta_min_rad)});
+}
+
+bool above_flippers(const FlipperGeometry& g, const Vec2& p) {
+  // Left flipper points right: "above" is to its left. The right one points left.
+  const FlipperLine& l = g.lines[kLeftFlipper];
+  const FlipperLine& r = g.lines[kRightFlipper];
+  return cross(l.axis(), p - l.pivot) > 0.0 && cross(r.axis(), p - r.pivot) < 0.0;
+}
+
+}  // namespace pinball::track

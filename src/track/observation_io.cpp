@@ -1,0 +1,91 @@
+#include "pinball/track/observation_io.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string_view>
+
+namespace pinball::track {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, int line, const std::string& what) {
+  std::ostringstream msg;
+  msg << path << ":" << line << ": " << what;
+  throw std::runtime_error(msg.str());
+}
+
+std::vector<std::string_view> split(std::string_view s) {
+  std::vector<std::string_view> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = s.find(',', start);
+    std::string_view field = s.substr(start, comma == std::string_view::npos ? s.npos : comma - start);
+    while (!field.empty() && (field.front() == ' ' || field.front() == '\t')) field.remove_prefix(1);
+    while (!field.empty() && (field.back() == ' ' || field.back() == '\t' || field.back() == '\r')) field.remove_suffix(1);
+    out.push_back(field);
+    if (comma == std::string_view::npos) return out;
+    start = comma + 1;
+  }
+}
+
+double number(const std::string& path, int line, std::string_view field, const char* name) {
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), v);
+  if (ec != std::errc() || end != field.data() + field.size() || !std::isfinite(v)) {
+    fail(path, line, std::string("column '") + name + "' is not a finite number: '" + std::string(field) + "'");
+  }
+  return v;
+}
+
+}  // namespace
+
+std::vector<ObservationRow> read_observations_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open observation file");
+  std::string text;
+  int line_no = 0;
+  bool has_contacts = false;
+  std::vector<ObservationRow> rows;
+  while (std::getline(in, text)) {
+    ++line_no;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    if (line_no == 1) {
+      const auto header = split(text);
+      const bool plain = header.size() == 3 && header[0] == "t" && header[1] == "x" && header[2] == "y";
+      has_contacts = header.size() == 5 && header[0] == "t" && header[1] == "x" && header[2] == "y" &&
+                     header[3] == "left_contact" && header[4] == "right_contact";
+      if (!plain && !has_contacts) {
+        fail(path, line_no, "header must be 't,x,y' or 't,x,y,left_contact,right_contact', got '" + text + "'");
+      }
+      continue;
+    }
+    if (text.find_first_not_of(" \t") == std::string::npos) continue;  // blank line
+    const auto f = split(text);
+    const std::size_t want = has_contacts ? 5 : 3;
+    if (f.size() != want) {
+      fail(path, line_no, "expected " + std::to_string(want) + " columns, got " + std::to_string(f.size()));
+    }
+    ObservationRow row;
+    row.observation.t_s = number(path, line_no, f[0], "t");
+    row.observation.p_board = {number(path, line_no, f[1], "x"), number(path, line_no, f[2], "y")};
+    if (has_contacts) {
+      for (int k = 0; k < 2; ++k) {
+        if (f[3 + k] != "0" && f[3 + k] != "1") {
+          fail(path, line_no, std::string("column '") + (k == 0 ? "left_contact" : "right_contact") +
+                                  "' must be 0 or 1, got '" + std::string(f[3 + k]) + "'");
+        }
+      }
+      row.contacts = {f[3] == "1", f[4] == "1"};
+    }
+    if (!rows.empty() && !(row.observation.t_s > rows.back().observation.t_s)) {
+      fail(path, line_no, "time must increase from row to row");
+    }
+    rows.push_back(row);
+  }
+  if (line_no == 0) fail(path, 1, "empty file: expected the header 't,x,y'");
+  return rows;
+}
+
+}  // namespace pinball::track

@@ -1,0 +1,134 @@
+#include "pinball/track/tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace pinball::track {
+
+TrackerConfig default_tracker_config(const sim::Board& board, const CameraModelConfig& camera) {
+  TrackerConfig c;
+  c.g_mps2 = board.gravity_mps2;
+  double length = 0.0;
+  double pivot_y = 0.0;
+  for (const sim::Flipper& f : board.flippers) {
+    length = std::max(length, f.length_m);
+    pivot_y = std::max(pivot_y, f.pivot.y());
+  }
+  if (length > 0.0) {
+    c.window_distance_m = 0.5 * length;
+    c.rolling_epsilon_m = 0.1 * length;
+  }
+  c.sigma_m = observation_sigma_m(camera);
+  c.critical_y_m = pivot_y + 0.35;
+  return c;
+}
+
+Tracker::Tracker(const FlipperGeometry& geometry, const TrackerConfig& config)
+    : geometry_(geometry), config_(config), launch_(flipper_ellipse(geometry), config.launch) {
+  if (!(config.window_distance_m > 0.0) || !(config.rolling_epsilon_m > 0.0) || !(config.sigma_m > 0.0) ||
+      config.max_window < 3 || config.max_window > static_cast<int>(kHistory) || !std::isfinite(config.g_mps2)) {
+    throw std::invalid_argument(
+        "tracker: window distance, rolling epsilon and sigma must be > 0, max_window in [3, 512], g finite");
+  }
+}
+
+void Tracker::reset() {
+  head_ = 0;
+  size_ = 0;
+  was_rolling_ = false;
+  launch_.reset();
+  out_ = TrackerOutput{};
+}
+
+void Tracker::keep_newest(std::size_t n) {
+  n = std::min(n, size_);
+  head_ = (head_ + size_ - n) % kHistory;
+  size_ = n;
+}
+
+std::span<const Observation> Tracker::newest(std::size_t n) {
+  n = std::min(n, size_);
+  for (std::size_t i = 0; i < n; ++i) scratch_[i] = back(n - 1 - i);  // oldest first
+  return {scratch_.data(), n};
+}
+
+std::size_t Tracker::window_length() const {
+  // Thesis eq. 4.5: the first n with |B_n − B_0| >= d, so slow balls use many
+  // points and fast ones few; all we have if none is that far yet.
+  const Vec2& b0 = back(0).p_board;
+  const std::size_t limit = std::min<std::size_t>(size_, static_cast<std::size_t>(config_.max_window));
+  for (std::size_t n = 1; n < limit; ++n) {
+    if ((back(n).p_board - b0).norm() >= config_.window_distance_m) return n + 1;
+  }
+  return limit;
+}
+
+double Tracker::rolling_speed() const {
+  // Thesis 4.1.2: distance to the first point at least ε back, over the time between.
+  const Vec2& b0 = back(0).p_board;
+  for (std::size_t n = 1; n < size_; ++n) {
+    const double dist = (back(n).p_board - b0).norm();
+    if (dist >= config_.rolling_epsilon_m) {
+      const double dt = back(0).t_s - back(n).t_s;
+      return dt > 0.0 ? dist / dt : 0.0;
+    }
+  }
+  return 0.0;
+}
+
+const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensors& contacts) {
+  if (size_ > 0 && !(obs.t_s > back(0).t_s)) {
+    // Out of order or repeated frame: ignore it, keep the last answer.
+    out_.launch = LaunchEvent{};
+    return out_;
+  }
+  if (size_ == kHistory) keep_newest(kHistory - 1);
+  history_[(head_ + size_) % kHistory] = obs;
+  ++size_;
+
+  out_ = TrackerOutput{};
+  const bool rolling = contacts.left || contacts.right;
+  if (!rolling && was_rolling_) keep_newest(1);  // rolling points are no parabola
+  was_rolling_ = rolling;
+
+  if (rolling) {
+    const int on = contacts.left ? kLeftFlipper : kRightFlipper;
+    out_.projection = rolling_projection(geometry_, on, obs.p_board, rolling_speed(), obs.t_s);
+    out_.launch = launch_.update(obs.p_board, false, 0.0, true);
+    return out_;
+  }
+
+  if (obs.p_board.y() > config_.critical_y_m) {
+    out_.projection.reason = NoProjection::kOutsideCritical;
+    out_.projection.t_observation_s = obs.t_s;
+    out_.launch = launch_.update(obs.p_board, false, 0.0, false);
+    return out_;
+  }
+
+  std::size_t n = window_length();
+  TrajectoryFit fit = fit_fixed_gravity(newest(n), config_.g_mps2, config_.sigma_m);
+  if (config_.chi2_flush && fit.valid && fit.chi2 > chi2_threshold(fit.dof)) {
+    // The newest points left the old parabola: keep the longest run of newest
+    // points that fits, and drop the rest at once (thesis 4.1.1's proposal).
+    std::size_t good = 1;
+    for (std::size_t m = 3; m <= n; ++m) {
+      const TrajectoryFit trial = fit_fixed_gravity(newest(m), config_.g_mps2, config_.sigma_m);
+      if (!trial.valid || trial.chi2 > chi2_threshold(trial.dof)) break;
+      good = m;
+    }
+    keep_newest(good);
+    out_.flushed = true;
+    ++flushes_;
+    n = good;
+    fit = fit_fixed_gravity(newest(n), config_.g_mps2, config_.sigma_m);
+  }
+  out_.fit = fit;
+  out_.window = static_cast<int>(std::min(n, size_));
+  out_.projection = fit.valid ? project_trajectory(fit, geometry_) : TrajectoryProjection{};
+  out_.projection.t_observation_s = obs.t_s;
+  out_.launch = launch_.update(obs.p_board, fit.valid, fit.v_ref.y(), false);
+  return out_;
+}
+
+}  // namespace pinball::track
