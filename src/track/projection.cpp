@@ -24,6 +24,12 @@ double fold_to_half_plane(double angle_rad) {
   return angle_rad;
 }
 
+double slope_angle(const Vec2& v) {
+  constexpr double kHalfPi = std::numbers::pi / 2.0;
+  if (std::abs(v.x()) <= 1e-9 * std::abs(v.y())) return v.y() < 0.0 ? -kHalfPi : kHalfPi;
+  return fold_to_half_plane(std::atan2(v.y(), v.x()));
+}
+
 namespace {
 
 TrajectoryProjection none(NoProjection reason, double t_s) {
@@ -68,7 +74,7 @@ TrajectoryProjection project_trajectory(const TrajectoryFit& fit, const FlipperG
       best.reason = NoProjection::kNone;
       best.flipper = f;
       best.speed_mps = v.norm();
-      best.angle_rad = fold_to_half_plane(std::atan2(v.y(), v.x()));
+      best.angle_rad = slope_angle(v);
       best.h = h;
       best.d_m = (at - p0).norm();
       best.t_impact_s = tau;
@@ -93,7 +99,7 @@ TrajectoryProjection rolling_projection(const FlipperGeometry& g, int rolling_on
   p.h = g.h_apex[other];
   p.impact_point = g.apex;
   p.speed_mps = std::isfinite(speed_mps) ? speed_mps : 0.0;
-  p.angle_rad = fold_to_half_plane(std::atan2(axis.y(), axis.x()));
+  p.angle_rad = slope_angle(axis);
   p.d_m = (g.apex - p_now).norm();
   // A ball at rest on the flipper never arrives: say so with an infinite wait
   // capped to a large finite number, so consumers never see inf or NaN.

@@ -153,4 +153,40 @@ TEST_F(Cli, BenchSpeedJson) {
   EXPECT_GT(j.at("grid_speedup").get<double>(), 0.0);
 }
 
+TEST_F(Cli, TrackPrintsOneProjectionPerObservation) {
+  // A ball falling straight onto the left flipper of the thesis table, seen at 200 fps.
+  const fs::path obs = dir_ / "obs.csv";
+  {
+    std::ofstream f(obs);
+    f << "t,x,y\n";
+    for (int i = 0; i < 40; ++i) {
+      const double t = i * 0.005;
+      f << t << "," << 0.21 << "," << 0.40 - 1.0 * t - 0.5 * 1.11 * t * t << "\n";
+    }
+  }
+  const CommandResult r = run("track --board boards/mit1993.board --observations " + obs.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("t,valid,flipper,speed,angle,h,d,t_impact,rolling\n", 0), 0u);
+  EXPECT_EQ(count_lines(r.out), 41);
+  EXPECT_NE(r.out.find(",1,left,"), std::string::npos) << r.out;
+
+  const CommandResult j = run("track --board boards/mit1993.board --json --observations " + obs.string());
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  const auto report = nlohmann::json::parse(j.out);
+  ASSERT_EQ(report.at("projections").size(), 40u);
+  const auto& last_valid = report.at("projections").at(20);
+  EXPECT_TRUE(last_valid.at("valid").get<bool>());
+  EXPECT_EQ(last_valid.at("flipper"), "left");
+  EXPECT_NEAR(last_valid.at("angle_rad").get<double>(), -1.5707963267948966, 1e-9) << "a vertical fall";
+}
+
+TEST_F(Cli, TrackRejectsABadObservationFileNamingTheLine) {
+  const fs::path obs = dir_ / "bad.csv";
+  std::ofstream(obs) << "t,x,y\n0,0.1,0.2\n0.01,0.1,abc\n";
+  const CommandResult r = run("track --board boards/mit1993.board --observations " + obs.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(obs.string() + ":3: column 'y'"), std::string::npos) << r.err;
+}
+
 }  // namespace

@@ -52,7 +52,12 @@ TrajectoryProjection rolling_projection(const FlipperGeometry& geometry, int rol
                                         double speed_mps, double t_now_s);
 
 /// Folds a direction angle into [−π/2, π/2] (the thesis's tan⁻¹(ẏ/ẋ)
-/// without a division: a vertical fall is −π/2 exactly).
+/// without a division).
 double fold_to_half_plane(double angle_rad);
+
+/// The slope angle of a velocity, in [−π/2, π/2]: fold_to_half_plane(atan2(vy, vx)),
+/// except that a velocity within 1e-9 rad of vertical is exactly −π/2 falling
+/// and +π/2 rising, whatever the sign of a round-off vx.
+double slope_angle(const Vec2& v);
 
 }  // namespace pinball::track
