@@ -27,9 +27,11 @@ TrackerConfig default_tracker_config(const sim::Board& board, const CameraModelC
 Tracker::Tracker(const FlipperGeometry& geometry, const TrackerConfig& config)
     : geometry_(geometry), config_(config), launch_(flipper_ellipse(geometry), config.launch) {
   if (!(config.window_distance_m > 0.0) || !(config.rolling_epsilon_m > 0.0) || !(config.sigma_m > 0.0) ||
-      config.max_window < 3 || config.max_window > static_cast<int>(kHistory) || !std::isfinite(config.g_mps2)) {
+      config.max_window < 3 || config.max_window > static_cast<int>(kHistory) || config.min_window < 0 ||
+      config.min_window > config.max_window || !std::isfinite(config.g_mps2)) {
     throw std::invalid_argument(
-        "tracker: window distance, rolling epsilon and sigma must be > 0, max_window in [3, 512], g finite");
+        "tracker: window distance, rolling epsilon and sigma must be > 0, max_window in [3, 512], "
+        "min_window in [0, max_window], g finite");
   }
 }
 
@@ -56,10 +58,14 @@ std::span<const Observation> Tracker::newest(std::size_t n) {
 std::size_t Tracker::window_length() const {
   // Thesis eq. 4.5: the first n with |B_n − B_0| >= d, so slow balls use many
   // points and fast ones few; all we have if none is that far yet.
+  // A floor of min_window points keeps fast balls from being fitted on a
+  // handful of points (docs/results.md: the thesis rule alone misses the h
+  // target at 2 mm/px); the χ² flush keeps the floor from spanning collisions.
   const Vec2& b0 = back(0).p_board;
   const std::size_t limit = std::min<std::size_t>(size_, static_cast<std::size_t>(config_.max_window));
+  const std::size_t floor = std::min<std::size_t>(limit, static_cast<std::size_t>(std::max(config_.min_window, 0)));
   for (std::size_t n = 1; n < limit; ++n) {
-    if ((back(n).p_board - b0).norm() >= config_.window_distance_m) return n + 1;
+    if ((back(n).p_board - b0).norm() >= config_.window_distance_m) return std::max(n + 1, floor);
   }
   return limit;
 }
@@ -109,13 +115,19 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
   std::size_t n = window_length();
   TrajectoryFit fit = fit_fixed_gravity(newest(n), config_.g_mps2, config_.sigma_m);
   if (config_.chi2_flush && fit.valid && fit.chi2 > chi2_threshold(fit.dof)) {
-    // The newest points left the old parabola: keep the longest run of newest
-    // points that fits, and drop the rest at once (thesis 4.1.1's proposal).
+    // The newest points left the old parabola (thesis 4.1.1's proposal): find
+    // the fewest newest points whose removal leaves the older ones fitting one
+    // parabola; those are after the collision, so drop everything before them
+    // at once. (Fitting short runs of newest points instead would not work: a
+    // 3- or 4-point fit absorbs the kink and keeps stale points.)
     std::size_t good = 1;
-    for (std::size_t m = 3; m <= n; ++m) {
-      const TrajectoryFit trial = fit_fixed_gravity(newest(m), config_.g_mps2, config_.sigma_m);
-      if (!trial.valid || trial.chi2 > chi2_threshold(trial.dof)) break;
-      good = m;
+    for (std::size_t m = 1; m + 3 <= n; ++m) {
+      const std::span<const Observation> window = newest(n);
+      const TrajectoryFit older = fit_fixed_gravity(window.first(n - m), config_.g_mps2, config_.sigma_m);
+      if (older.valid && older.chi2 <= chi2_threshold(older.dof)) {
+        good = m;
+        break;
+      }
     }
     keep_newest(good);
     out_.flushed = true;

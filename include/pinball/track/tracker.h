@@ -22,6 +22,7 @@ struct TrackerConfig {
   double rolling_epsilon_m = 0.0076;  ///< ε: rolling speed from the first point this far back (10 % of a flipper)
   double sigma_m = 0.0007;            ///< standard deviation of one observed coordinate (m)
   double critical_y_m = 0.5;          ///< projections only while the ball is below this y (m)
+  int min_window = 24;                ///< at least this many points when the trajectory has them (0: the thesis rule alone)
   int max_window = 64;                ///< at most this many points in a fit
   bool chi2_flush = true;             ///< drop the points before a collision at once (4.1.1)
   LaunchDetectorConfig launch;        ///< launch detection

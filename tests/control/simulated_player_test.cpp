@@ -1,0 +1,154 @@
+#include "pinball/control/simulated_player.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "pinball/sim/ball_runner.h"
+#include "pinball/sim/board_loader.h"
+#include "pinball/sim/thesis_stepper.h"
+
+namespace pinball::control {
+namespace {
+
+constexpr int kBalls = 20;
+
+const sim::Board& mit1993() {
+  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  return board;
+}
+
+sim::BallLimits limits() {
+  sim::BallLimits l;
+  l.max_ball_time_s = 30.0;  // keeps the suite quick; a cut ball still counts its score
+  return l;
+}
+
+struct Totals {
+  double score = 0.0;
+  long flips = 0;
+  std::uint64_t observations = 0;
+  double time_s = 0.0;
+};
+
+// One ball per seed, seeds 1..kBalls, with the tracked spastic player.
+Totals play_tracked(const track::CameraModelConfig& camera) {
+  const sim::ThesisStepper stepper(mit1993());
+  Totals t;
+  for (int seed = 1; seed <= kBalls; ++seed) {
+    sim::GameState s = sim::make_game_state(mit1993(), static_cast<std::uint64_t>(seed));
+    SimulatedSpasticPlayer player(mit1993(), camera, SpasticConfig{}, static_cast<std::uint64_t>(seed));
+    const sim::BallResult r = sim::play_ball(
+        stepper, s, limits(), [&](sim::GameState& st) { player.act(st); },
+        [](const sim::GameState&, const sim::StepEvents&) {});
+    t.score += r.score;
+    t.flips += r.flips;
+    t.observations += player.observations();
+    t.time_s += r.duration_s;
+  }
+  return t;
+}
+
+// The same balls with nobody at the buttons.
+Totals play_idle() {
+  const sim::ThesisStepper stepper(mit1993());
+  Totals t;
+  for (int seed = 1; seed <= kBalls; ++seed) {
+    sim::GameState s = sim::make_game_state(mit1993(), static_cast<std::uint64_t>(seed));
+    const sim::BallResult r = sim::play_ball(
+        stepper, s, limits(), [](sim::GameState&) {}, [](const sim::GameState&, const sim::StepEvents&) {});
+    t.score += r.score;
+    t.flips += r.flips;
+    t.time_s += r.duration_s;
+  }
+  return t;
+}
+
+TEST(SimulatedSpasticPlayer, FlipsAndScoresMoreThanDoingNothing) {
+  const Totals idle = play_idle();
+  EXPECT_EQ(idle.flips, 0);
+  const Totals tracked = play_tracked(track::CameraModelConfig{});
+  EXPECT_GT(tracked.flips, kBalls);  // more than one flip a ball on average
+  EXPECT_GT(tracked.score / kBalls, idle.score / kBalls);
+  EXPECT_GT(tracked.time_s, idle.time_s);  // it keeps balls alive
+  // Every frame of the camera reached the tracker: about 200 a second of play.
+  EXPECT_NEAR(static_cast<double>(tracked.observations), 200.0 * tracked.time_s, 0.05 * 200.0 * tracked.time_s);
+  RecordProperty("idle_mean_score", std::to_string(idle.score / kBalls));
+  RecordProperty("tracked_mean_score", std::to_string(tracked.score / kBalls));
+}
+
+TEST(SimulatedSpasticPlayer, StillWorksWithLatencyAndNoise) {
+  track::CameraModelConfig camera;
+  camera.latency_s = 0.010;
+  camera.noise_px = 1.0;
+  const Totals idle = play_idle();
+  const Totals tracked = play_tracked(camera);
+  EXPECT_GT(tracked.flips, kBalls);
+  EXPECT_GT(tracked.score / kBalls, idle.score / kBalls);
+}
+
+TEST(SimulatedSpasticPlayer, SeesTheBallOnlyThroughTheCamera) {
+  // Two identical players: one acts on the true state, the other on a copy
+  // whose velocity (which no camera measures) is NaN. Their commands must
+  // agree at every step: nothing but the position reaches the tracker.
+  const sim::ThesisStepper stepper(mit1993());
+  track::CameraModelConfig camera;
+  camera.latency_s = 0.010;
+  for (int seed = 1; seed <= 3; ++seed) {
+    sim::GameState s = sim::make_game_state(mit1993(), static_cast<std::uint64_t>(seed));
+    SimulatedSpasticPlayer truth(mit1993(), camera, SpasticConfig{}, 7);
+    SimulatedSpasticPlayer blind(mit1993(), camera, SpasticConfig{}, 7);
+    long steps = 0;
+    long disagreements = 0;
+    long energized_steps = 0;
+    sim::GameState shadow = s;
+    sim::play_ball(
+        stepper, s, limits(),
+        [&](sim::GameState& st) {
+          shadow = st;
+          shadow.ball.velocity_mps = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+          shadow.score = -1.0;
+          truth.act(st);
+          blind.act(shadow);
+          ++steps;
+          for (std::size_t f = 0; f < st.flippers.size(); ++f) {
+            if (st.flippers[f].energized != shadow.flippers[f].energized) ++disagreements;
+            if (st.flippers[f].energized) ++energized_steps;
+          }
+        },
+        [](const sim::GameState&, const sim::StepEvents&) {});
+    EXPECT_EQ(disagreements, 0) << "seed " << seed;
+    EXPECT_GT(steps, 1000);
+    EXPECT_GT(energized_steps, 0) << "seed " << seed;  // it did play
+    EXPECT_EQ(truth.observations(), blind.observations());
+    EXPECT_EQ(truth.last_output().projection.h, blind.last_output().projection.h);
+  }
+}
+
+TEST(SimulatedSpasticPlayer, BallOutOfPlayReleasesTheFlippersAndSeesNothing) {
+  const sim::Board& b = mit1993();
+  sim::GameState s = sim::make_game_state(b, 1);
+  SimulatedSpasticPlayer player(b, track::CameraModelConfig{}, SpasticConfig{}, 1);
+  ASSERT_FALSE(s.ball_in_play);
+  for (auto& f : s.flippers) f.energized = true;
+  for (int i = 0; i < 100; ++i) {
+    player.act(s);
+    s.time_s += b.dt_s;
+  }
+  EXPECT_EQ(player.observations(), 0u);
+  for (const auto& f : s.flippers) EXPECT_FALSE(f.energized);
+}
+
+TEST(SimulatedSpasticPlayer, BadSettingsThrow) {
+  track::CameraModelConfig bad;
+  bad.fps = 0.0;
+  EXPECT_THROW(SimulatedSpasticPlayer(mit1993(), bad, SpasticConfig{}, 1), std::invalid_argument);
+  sim::Board one = mit1993();
+  one.flippers.pop_back();
+  EXPECT_THROW(SimulatedSpasticPlayer(one, track::CameraModelConfig{}, SpasticConfig{}, 1), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pinball::control
