@@ -1,0 +1,163 @@
+#pragma once
+// The host side of the CAN link: the controller calls fire/release/release_all,
+// which only enqueue and return (no socket I/O, no allocation, no lock); the
+// bus's own thread sends the frames, the heartbeat at its period, runs the
+// session (Hello, Configure, running, bus-off recovery) and tracks the board's
+// Status and Faults. On any failure it makes the coils safe first (ReleaseAll)
+// and counts. Without start(), poll_once(now) runs one iteration on the
+// caller's clock (the simulator's lockstep and deterministic tests).
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <thread>
+
+#include "pinball/firmware/can_transport.h"
+#include "pinball/firmware/codec.h"
+
+namespace pinball::firmware {
+
+class FrameLog;
+
+/// Settings of a DriverBus; checked by the constructor.
+struct DriverBusOptions {
+  std::uint8_t board_id = 0;                          ///< board to talk to, 0..15
+  int driver_count = 2;                               ///< drivers used (flipper i = driver i), 1..8
+  std::array<DriverConfig, kMaxDrivers> drivers{};    ///< per-driver timings and caps
+  double heartbeat_period_s = 0.02;                   ///< heartbeat period (s)
+  double watchdog_timeout_s = 0.1;                    ///< board switches all off after this silence (s); >= 3 periods
+  double reply_timeout_s = 0.05;                      ///< resend Hello / Configure after this (s)
+  double status_timeout_s = 0.25;                     ///< no Status for this long: restart the session (s)
+  double bus_off_holdoff_s = 0.1;                     ///< wait after bus-off before reopening (s)
+  FrameLog* log = nullptr;                            ///< optional candump log of every frame (borrowed)
+};
+
+/// Session state.
+enum class BusState : std::uint8_t {
+  kStopped = 0,   ///< not started
+  kHandshake,     ///< Hello sent, waiting for HelloAck
+  kConfiguring,   ///< Configure sent, waiting for a Status with every driver configured
+  kRunning,       ///< commands flow
+  kBusOff,        ///< the controller went bus-off: waiting to reopen
+};
+
+/// Counters (monotonic).
+struct DriverBusCounters {
+  std::uint64_t fires = 0;             ///< fire() calls accepted into the queue
+  std::uint64_t releases = 0;          ///< release() calls accepted into the queue
+  std::uint64_t release_alls = 0;      ///< release_all() calls
+  std::uint64_t queue_full = 0;        ///< commands refused because the queue was full
+  std::uint64_t dropped_not_running = 0;  ///< commands discarded because the session was not running
+  std::uint64_t frames_sent = 0;       ///< frames sent successfully
+  std::uint64_t tx_failures = 0;       ///< sends that failed (each followed by a ReleaseAll attempt)
+  std::uint64_t heartbeats = 0;        ///< heartbeats sent
+  std::uint64_t hellos = 0;            ///< Hello frames sent
+  std::uint64_t sessions = 0;          ///< times the session reached kRunning
+  std::uint64_t rx_frames = 0;         ///< frames received and decoded
+  std::uint64_t rx_bad = 0;            ///< frames received that failed to decode
+  std::uint64_t version_mismatch = 0;  ///< HelloAck with another protocol version
+  std::uint64_t statuses = 0;          ///< Status frames received
+  std::uint64_t faults = 0;            ///< Fault frames received
+  std::uint64_t watchdog_faults = 0;   ///< of which the board's watchdog expired
+  std::uint64_t hold_cap_faults = 0;   ///< of which a hold cap tripped
+  std::uint64_t error_frames = 0;      ///< controller error frames
+  std::uint64_t bus_off = 0;           ///< bus-off events
+  std::uint64_t reconnects = 0;        ///< transport reopened after bus-off
+  std::uint64_t status_timeouts = 0;   ///< sessions restarted for lack of Status
+};
+
+/// The board's last Status as the host saw it.
+struct BoardView {
+  bool valid = false;   ///< a Status has arrived in this session
+  Status status;        ///< its content
+};
+
+/// The host side of the link to one driver board.
+class DriverBus {
+ public:
+  /// Borrows `transport`. Throws std::invalid_argument naming the bad option.
+  DriverBus(CanTransport& transport, DriverBusOptions options);
+  /// Stops the thread (switching every coil off first).
+  ~DriverBus();
+  DriverBus(const DriverBus&) = delete;
+  DriverBus& operator=(const DriverBus&) = delete;
+
+  /// Starts the bus thread (steady clock). Throws std::logic_error if running.
+  void start();
+  /// Sends ReleaseAll, then stops the thread. Safe to call twice.
+  void stop();
+  /// Stops the thread without sending anything, as a crashed or hung host
+  /// would (for fault-injection tests: the board's watchdog must act).
+  void simulate_hang();
+
+  /// Pulse then hold flipper i. Never blocks; false when refused (bad index, queue full).
+  bool fire(int flipper);
+  /// Release flipper i. Never blocks; false when refused.
+  bool release(int flipper);
+  /// Release every flipper; takes priority over queued commands. Never blocks.
+  void release_all();
+
+  /// One iteration at time `now_s` (s, any monotonic clock): receive, run the
+  /// session, send commands and the heartbeat. For use without start().
+  void poll_once(double now_s);
+
+  /// Session state.
+  BusState state() const { return state_.load(std::memory_order_acquire); }
+  /// Counters so far.
+  DriverBusCounters counters() const;
+  /// The board's last Status (lock-free snapshot).
+  BoardView board() const;
+  /// The options in force.
+  const DriverBusOptions& options() const { return options_; }
+
+  /// Commands that fit in the queue between two bus iterations.
+  static constexpr int kQueueSize = 64;
+
+ private:
+  enum class Op : std::uint8_t { kFire, kRelease };
+  struct Command {
+    Op op;
+    std::uint8_t driver;
+  };
+
+  bool push(Op op, int flipper);
+  void run();
+  void wake();
+  bool send(const Payload& p, double now_s);
+  void bump(std::uint64_t DriverBusCounters::*field, std::uint64_t n = 1);
+  void make_safe(double now_s);
+  void begin_session(double now_s);
+  void on_message(const Message& m, double now_s);
+  void on_error_frame(const CanFrame& f, double now_s);
+  void set_state(BusState s) { state_.store(s, std::memory_order_release); }
+
+  CanTransport& transport_;
+  DriverBusOptions options_;
+  std::atomic<BusState> state_{BusState::kStopped};
+
+  // Single-producer (controller) / single-consumer (bus thread) ring.
+  std::array<Command, kQueueSize> queue_{};
+  std::atomic<std::uint32_t> head_{0};
+  std::atomic<std::uint32_t> tail_{0};
+  std::atomic<bool> release_all_pending_{false};
+
+  // Bus-thread state.
+  std::uint16_t seq_ = 0;
+  double last_heartbeat_s_ = -1e300;
+  double last_request_s_ = -1e300;
+  double last_status_s_ = 0.0;
+  double bus_off_s_ = 0.0;
+  std::uint8_t board_drivers_ = 0;
+
+  std::atomic<std::uint64_t> status_word_{0};  // bit 63: valid; then the Status fields
+  struct AtomicCounters;
+  std::unique_ptr<AtomicCounters> counters_;
+
+  std::thread thread_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> hang_{false};
+  int wake_fd_ = -1;
+};
+
+}  // namespace pinball::firmware

@@ -1,0 +1,233 @@
+#include "pinball/firmware/driver_bus.h"
+
+#include <gtest/gtest.h>
+#include <linux/can/error.h>
+
+#include <chrono>
+#include <thread>
+
+#include "board_harness.h"
+#include "pinball/firmware/faulty_link.h"
+
+namespace pinball::firmware {
+namespace {
+
+// DriverBus on a virtual clock (poll_once) against the reference board.
+class DriverBusTest : public testing::BoardTest {
+ protected:
+  DriverBusOptions bus_options() {
+    DriverBusOptions o;
+    o.driver_count = 2;
+    o.heartbeat_period_s = 0.02;
+    o.watchdog_timeout_s = 0.1;
+    for (int d = 0; d < 2; ++d) monitor_.set_caps(d, testing::caps_of(o.drivers[static_cast<std::size_t>(d)]));
+    return o;
+  }
+  // Runs host and board in lockstep for `seconds` in 1 ms ticks.
+  void run(DriverBus& bus, double seconds, bool host_alive = true) {
+    const int ticks = static_cast<int>(seconds * 1000.0 + 0.5);
+    for (int k = 0; k < ticks; ++k) {
+      t_ += 0.001;
+      if (host_alive) bus.poll_once(t_);
+      board_.service(*link_, t_);
+    }
+  }
+};
+
+TEST_F(DriverBusTest, SessionReachesRunningAndFireReleaseMoveTheCoil) {
+  DriverBus bus(*host_, bus_options());
+  run(bus, 0.05);
+  ASSERT_EQ(bus.state(), BusState::kRunning);
+  EXPECT_TRUE(board_.configured(0) && board_.configured(1));
+  EXPECT_TRUE(board_.armed());
+  EXPECT_TRUE(bus.fire(0));
+  run(bus, 0.002);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kPulse);
+  run(bus, 0.05);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kHold);
+  EXPECT_TRUE(bus.board().valid);
+  EXPECT_EQ(bus.board().status.coil(0), CoilState::kHold);
+  EXPECT_TRUE(bus.release(0));
+  run(bus, 0.002);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  EXPECT_FALSE(bus.fire(2));  // only 2 flippers
+  EXPECT_FALSE(bus.fire(-1));
+  const DriverBusCounters c = bus.counters();
+  EXPECT_EQ(c.sessions, 1u);
+  EXPECT_GE(c.heartbeats, 4u);
+  EXPECT_GT(c.statuses, 5u);
+  EXPECT_EQ(c.rx_bad, 0u);
+}
+
+TEST_F(DriverBusTest, HeartbeatLossMidHoldSwitchesEverythingOffWithinTheTimeout) {
+  DriverBus bus(*host_, bus_options());
+  run(bus, 0.05);
+  bus.fire(0);
+  bus.fire(1);
+  run(bus, 0.1);
+  ASSERT_EQ(board_.coil(0).state, CoilState::kHold);
+  const double hang_at = t_;
+  run(bus, 0.2, /*host_alive=*/false);  // the host hangs
+  for (int d = 0; d < 2; ++d) {
+    EXPECT_EQ(board_.coil(d).state, CoilState::kOff);
+    EXPECT_LE(board_.coil(d).since_s, hang_at + 0.1 + 1e-9);
+  }
+  EXPECT_EQ(board_.counters().watchdog_trips, 1u);
+  // The host comes back: it sees the fault, and the board takes commands again after a heartbeat.
+  run(bus, 0.05);
+  EXPECT_GE(bus.counters().watchdog_faults, 1u);
+  bus.fire(0);
+  run(bus, 0.002);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kPulse);
+}
+
+TEST_F(DriverBusTest, BusOffIsRecoveredWithANewSession) {
+  DriverBus bus(*host_, bus_options());
+  run(bus, 0.05);
+  bus.fire(0);
+  run(bus, 0.05);
+  ASSERT_EQ(board_.coil(0).state, CoilState::kHold);
+  ASSERT_EQ(link_->send(make_error_frame(CAN_ERR_BUSOFF)), TxStatus::kOk);  // the controller reports bus-off
+  run(bus, 0.002);
+  EXPECT_EQ(bus.state(), BusState::kBusOff);
+  bus.fire(0);  // accepted into the queue, dropped while bus-off (counted)
+  run(bus, 0.3);
+  EXPECT_EQ(bus.state(), BusState::kRunning);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);  // off: the watchdog or the recovery's ReleaseAll
+  const DriverBusCounters c = bus.counters();
+  EXPECT_EQ(c.bus_off, 1u);
+  EXPECT_EQ(c.reconnects, 1u);
+  EXPECT_EQ(c.sessions, 2u);
+  EXPECT_GE(c.dropped_not_running, 1u);
+  bus.fire(1);
+  run(bus, 0.002);
+  EXPECT_EQ(board_.coil(1).state, CoilState::kPulse);
+}
+
+TEST_F(DriverBusTest, WorksThroughALossyLink) {
+  FaultyLinkOptions o;
+  o.drop_p = 0.05;
+  o.duplicate_p = 0.05;
+  o.delay_p = 0.05;
+  o.corrupt_p = 0.05;
+  o.seed = 3;
+  FaultyLink lossy(*host_, o);
+  DriverBus bus(lossy, bus_options());
+  run(bus, 0.2);
+  ASSERT_EQ(bus.state(), BusState::kRunning);
+  int on = 0;
+  for (int i = 0; i < 20; ++i) {
+    bus.fire(i % 2);
+    run(bus, 0.003);
+    on += board_.coil(i % 2).state != CoilState::kOff;
+    bus.release(i % 2);
+    run(bus, 0.02);
+  }
+  EXPECT_GE(on, 14);  // most commands get through
+  EXPECT_GT(board_.counters().bad_frames, 0u);
+  EXPECT_GT(lossy.fault_counters().dropped, 0u);
+}
+
+TEST_F(DriverBusTest, ReleaseAllDiscardsQueuedFires) {
+  DriverBus bus(*host_, bus_options());
+  run(bus, 0.05);
+  bus.fire(0);
+  bus.fire(1);
+  bus.release_all();
+  run(bus, 0.002);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  EXPECT_EQ(board_.coil(1).state, CoilState::kOff);
+  EXPECT_EQ(board_.counters().fires_accepted, 0u);
+}
+
+TEST_F(DriverBusTest, StatusSilenceRestartsTheSession) {
+  DriverBus bus(*host_, bus_options());
+  run(bus, 0.05);
+  ASSERT_EQ(bus.state(), BusState::kRunning);
+  for (int k = 0; k < 300; ++k) {  // the board stops talking (its replies are lost)
+    t_ += 0.001;
+    bus.poll_once(t_);
+    CanFrame f;
+    while (link_->receive(f, 0) == RxStatus::kFrame) {
+    }
+  }
+  EXPECT_NE(bus.state(), BusState::kRunning);
+  EXPECT_GE(bus.counters().status_timeouts, 1u);
+  run(bus, 0.1);
+  EXPECT_EQ(bus.state(), BusState::kRunning);
+}
+
+TEST_F(DriverBusTest, FireNeverBlocksAndCountsAFullQueue) {
+  DriverBus bus(*host_, bus_options());  // not started: nobody drains the queue
+  const auto start = std::chrono::steady_clock::now();
+  int accepted = 0;
+  for (int i = 0; i < 10'000; ++i) accepted += bus.fire(i % 2);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(accepted, DriverBus::kQueueSize);
+  EXPECT_EQ(bus.counters().queue_full, 10'000u - DriverBus::kQueueSize);
+  EXPECT_LT(s, 0.5);
+}
+
+TEST(DriverBusOptions, BadConfigurationThrowsWithTheFieldName) {
+  auto [a, b] = StreamTransport::make_pair();
+  DriverBusOptions o;
+  o.heartbeat_period_s = 0.05;  // watchdog 0.1 < 3 periods
+  try {
+    DriverBus bus(*a, o);
+    FAIL() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("watchdog_timeout_s"), std::string::npos) << e.what();
+  }
+  o = {};
+  o.drivers[1].pulse_ms = 90;  // above max_pulse_ms
+  EXPECT_THROW(DriverBus(*a, o), std::invalid_argument);
+  o = {};
+  o.driver_count = 9;
+  EXPECT_THROW(DriverBus(*a, o), std::invalid_argument);
+}
+
+// The real thread on the steady clock: fire, then the host hangs mid-hold.
+TEST_F(DriverBusTest, ThreadedHeartbeatKeepsTheBoardAliveUntilTheHostHangs) {
+  DriverBus bus(*host_, bus_options());
+  auto steady = [] { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); };
+  auto serve_until = [&](double until, auto done) {
+    while (steady() < until) {
+      CanFrame f;
+      if (link_->receive(f, 1) == RxStatus::kFrame) board_.on_frame(f, t_ = steady());
+      board_.service(*link_, t_ = steady());
+      if (done()) return true;
+    }
+    return false;
+  };
+  t_ = steady();
+  board_.advance(t_);
+  bus.start();
+  ASSERT_TRUE(serve_until(t_ + 1.0, [&] { return bus.state() == BusState::kRunning; }));
+  bus.fire(0);
+  ASSERT_TRUE(serve_until(t_ + 0.5, [&] { return board_.coil(0).state == CoilState::kHold; }));
+  // Held well past the watchdog timeout: the heartbeat thread keeps it alive.
+  serve_until(t_ + 0.3, [] { return false; });
+  EXPECT_EQ(board_.coil(0).state, CoilState::kHold);
+  EXPECT_EQ(board_.counters().watchdog_trips, 0u);
+  bus.simulate_hang();
+  const double hang_at = steady();
+  ASSERT_TRUE(serve_until(hang_at + 0.5, [&] { return board_.coil(0).state == CoilState::kOff; }));
+  EXPECT_LE(board_.coil(0).since_s - hang_at, 0.1 + 0.005);
+  EXPECT_EQ(board_.counters().watchdog_trips, 1u);
+}
+
+TEST_F(DriverBusTest, StopSwitchesEveryCoilOff) {
+  DriverBus bus(*host_, bus_options());
+  run(bus, 0.05);
+  bus.fire(0);
+  run(bus, 0.05);
+  ASSERT_EQ(board_.coil(0).state, CoilState::kHold);
+  bus.start();
+  bus.stop();
+  board_.service(*link_, t_ += 0.001);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  EXPECT_EQ(board_.counters().watchdog_trips, 0u);
+}
+
+}  // namespace
+}  // namespace pinball::firmware
