@@ -4,22 +4,67 @@
 
 #include "commands.h"
 #include "pinball/sim/board_loader.h"
+#include "latency_bench.h"
 #include "speed_bench.h"
+#include "tracker_bench.h"
 
 namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
-  CLI::App* cmd = app.add_subcommand("bench", "run a benchmark (speed)");
-  cmd->add_option("kind", a.which, "which benchmark: speed")->required()->check(CLI::IsMember({"speed"}));
+  CLI::App* cmd = app.add_subcommand("bench", "run a benchmark (speed, tracker, latency)");
+  cmd->add_option("kind", a.which, "which benchmark: speed, tracker, latency")
+      ->required()
+      ->check(CLI::IsMember({"speed", "tracker", "latency"}));
   cmd->add_option("--board", a.board, "board file")->check(CLI::ExistingFile);
   cmd->add_option("--steps", a.steps, "steps per timed run")->check(CLI::Range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
+  cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
+      ->check(CLI::Range(10, 1'000'000));
+  cmd->add_option("--seed", a.seed, "tracker: seed for approaches and camera noise");
+  cmd->add_flag("--quick", a.quick, "tracker: 100 approaches, the target camera only");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
 
+namespace {
+
+int run_tracker(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+  bench::TrackerBenchOptions options = a.quick ? bench::quick_tracker_bench_options() : bench::TrackerBenchOptions{};
+  if (!a.quick) options.approaches = a.approaches;
+  options.seed = a.seed;
+  const bench::TrackerReport report = bench::run_tracker_bench(
+      board, options, [&](const std::string& line) { err << "bench tracker: " << line << "\n"; });
+  if (a.json) {
+    out << bench::to_json(report).dump(2) << "\n";
+  } else {
+    out << bench::to_text(report);
+  }
+  return 0;
+}
+
+int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
+  const bench::LatencyReport r = bench::run_latency_bench(
+      bench::LatencyBenchOptions{}, [&](const std::string& line) { err << "bench latency: " << line << "\n"; });
+  if (a.json) {
+    out << bench::to_json(r).dump(2) << "\n";
+    return 0;
+  }
+  out << "fire() to coil output over the stream transport, " << r.samples << " samples\n"
+      << "  p50 " << r.fire_to_coil_p50_us << " us, p99 " << r.fire_to_coil_p99_us << " us, max "
+      << r.fire_to_coil_max_us << " us; longest fire() call " << r.fire_call_max_us << " us\n"
+      << "  baseline raw 16-byte write+read: p50 " << r.raw_p50_us << " us, p99 " << r.raw_p99_us << " us ("
+      << r.stack_overhead_ratio << "x)\n"
+      << "encode+decode per frame " << r.encode_decode_ns << " ns (copy baseline " << r.copy_baseline_ns << " ns)\n"
+      << "coil safety violations " << r.coil_violations << "\n";
+  return 0;
+}
+
+}  // namespace
+
 int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
+  if (a.which == "latency") return run_latency(a, out, err);
   const sim::Board board = sim::load_board(a.board);
+  if (a.which == "tracker") return run_tracker(a, board, out, err);
   bench::SpeedBenchOptions options;
   options.steps = a.steps;
   options.repeats = a.repeats;
