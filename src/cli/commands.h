@@ -27,6 +27,8 @@ struct SimArgs {
   double video_fps = 60.0;       ///< video frame rate (simulated time)
   track::CameraModelConfig camera;  ///< the camera the spastic player sees through
   double reach_m = 0.02;         ///< spastic: flip when the projected impact is this close (m)
+  std::string actuation = "direct";  ///< direct | can: flipper commands through the CAN path
+  double actuation_delay_s = 0.004;  ///< can: solenoid rise before the flipper moves (s)
   bool json = false;             ///< one JSON object on stdout
 };
 CLI::App* add_sim_command(CLI::App& app, SimArgs& args);

@@ -13,6 +13,7 @@
 #include "pinball/core/running_stats.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/board_loader.h"
+#include "pinball/control/can_flipper_drive.h"
 #include "pinball/control/simulated_player.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/sim/state_hash.h"
@@ -40,6 +41,12 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--drop", a.camera.drop_probability, "camera model: probability a frame is lost")
       ->check(CLI::Range(0.0, 0.99));
+  cmd->add_option("--actuation", a.actuation,
+                  "how commands reach the flippers: direct, or can (DriverBus, CAN frames, the virtual "
+                  "driver board and the solenoid delay)")
+      ->check(CLI::IsMember({"direct", "can"}));
+  cmd->add_option("--actuation-delay", a.actuation_delay_s, "can: solenoid rise before the flipper moves (s)")
+      ->check(CLI::Range(0.0, 0.1));
   cmd->add_option("--balls", a.balls, "balls to play")->check(CLI::Range(1, 100'000'000));
   cmd->add_option("--seed", a.seed, "random seed (launch noise); same seed, same results");
   cmd->add_option("--stepper", a.stepper, "integrator: thesis (fixed-step, Ch. 3)")
@@ -77,6 +84,8 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     spastic_config.reach_m = a.reach_m;
     spastic.emplace(board, a.camera, spastic_config, a.seed ^ 0x5DEECE66Dull);
   }
+  std::optional<control::CanFlipperDrive> can_drive;
+  if (a.actuation == "can") can_drive.emplace(board, a.actuation_delay_s);
   sim::BallLimits limits;
   limits.max_ball_time_s = a.max_ball_time_s;
   RunningStats score;
@@ -94,6 +103,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         stepper, state, limits,
         [&](sim::GameState& s) {
           if (spastic) spastic->act(s);
+          if (can_drive) can_drive->apply(s);
         },
         [&](const sim::GameState& s, const sim::StepEvents& e) {
           if (trace) trace->write(board, s, e);
@@ -137,6 +147,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
           {"latency_s", a.camera.latency_s},
           {"drop_probability", a.camera.drop_probability}}},
         {"flips", flips},
+        {"actuation", a.actuation},
         {"mean_score_per_ball", score.mean()},
         {"score_ci95_half_width", score.ci95_half_width()},
         {"score_stddev", score.stddev()},
@@ -151,7 +162,8 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     };
     out << j.dump(2) << "\n";
   } else {
-    out << "board            " << a.board << " (policy " << a.policy << ", stepper " << a.stepper << ", dt "
+    out << "board            " << a.board << " (policy " << a.policy << ", actuation " << a.actuation
+        << ", stepper " << a.stepper << ", dt "
         << stepper.dt_s() << " s, seed " << a.seed << ")\n"
         << "balls            " << a.balls << " (" << cut << " cut at " << a.max_ball_time_s << " s, " << left_table
         << " left the table)\n"

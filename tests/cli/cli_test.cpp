@@ -100,6 +100,14 @@ TEST_F(Cli, SameSeedGivesTheSameTraceAndScores) {
   EXPECT_NE(nlohmann::json::parse(rc.out).at("state_hash"), ja.at("state_hash"));
 }
 
+TEST_F(Cli, FlipsCanGoThroughTheCanPath) {
+  const CommandResult r = run("sim boards/mit1993.board --policy spastic --balls 3 --actuation can --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("actuation"), "can");
+  EXPECT_GT(j.at("flips").get<int>(), 0);
+}
+
 TEST_F(Cli, BadBoardFileIsOneLineNamingFileAndLine) {
   const fs::path bad = dir_ / "bad.board";
   std::ofstream(bad) << "pinball-board 1\nsize 0.5 1\ncirle 0.1 0.1 0.01\n";
