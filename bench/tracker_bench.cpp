@@ -40,18 +40,6 @@ constexpr std::size_t kTwoPoint = 1;
 constexpr std::size_t kFreeG = 2;
 constexpr std::array<const char*, 3> kMethodNames{"tracker", "two_point", "free_g"};
 
-// A parabola through p with velocity v at t_ref_s, as a fit the projection reads.
-track::TrajectoryFit exact_fit(const Vec2& p, const Vec2& v, double g_mps2, double t_ref_s = 0.0) {
-  track::TrajectoryFit fit;
-  fit.valid = true;
-  fit.t_ref_s = t_ref_s;
-  fit.p_ref = p;
-  fit.v_ref = v;
-  fit.g_mps2 = g_mps2;
-  fit.points = 3;
-  return fit;
-}
-
 bool touches_board(const sim::Board& board, const Vec2& p) {
   const double r = board.ball.radius_m;
   // Every obstacle, hidden ones too: an approach must be free flight whatever the flags do.
@@ -68,7 +56,7 @@ enum class Verdict { kKept, kNoImpact, kTooShort, kObstacle };
 
 Verdict judge_approach(const sim::Board& board, const track::FlipperGeometry& geometry,
                        const TrackerBenchOptions& options, const Vec2& p, const Vec2& v, TrackerApproach& out) {
-  const track::TrajectoryFit fit = exact_fit(p, v, board.gravity_mps2);
+  const track::TrajectoryFit fit = track::exact_trajectory(p, v, board.gravity_mps2, 0.0);
   const track::TrajectoryProjection truth = track::project_trajectory(fit, geometry);
   if (!truth.valid || !truth.hittable) return Verdict::kNoImpact;
   if (truth.d_m < options.min_start_distance_m) return Verdict::kTooShort;
@@ -183,7 +171,7 @@ void observe(const TrackerApproach& a, const track::CameraModelConfig& camera, s
              double sample_dt_s, std::vector<track::Observation>& out) {
   out.clear();
   track::CameraModel cam(camera, seed);
-  const track::TrajectoryFit exact = exact_fit(a.p0, a.v0, a.g_mps2);
+  const track::TrajectoryFit exact = track::exact_trajectory(a.p0, a.v0, a.g_mps2, 0.0);
   track::Observation o;
   for (std::size_t k = 0;; ++k) {
     const double t = static_cast<double>(k) * sample_dt_s;
@@ -194,7 +182,7 @@ void observe(const TrackerApproach& a, const track::CameraModelConfig& camera, s
 }
 
 double remaining_distance(const TrackerApproach& a, double t_s) {
-  const Vec2 p = exact_fit(a.p0, a.v0, a.g_mps2).position_at(t_s);
+  const Vec2 p = track::exact_trajectory(a.p0, a.v0, a.g_mps2, 0.0).position_at(t_s);
   return (p - a.truth.impact_point).norm();
 }
 
@@ -234,7 +222,7 @@ TrackerSetting run_setting(const sim::Board& board, const track::FlipperGeometry
         const double dt = o.t_s - prev.t_s;
         Vec2 v = (o.p_board - prev.p_board) / dt;
         v.y() -= 0.5 * config.g_mps2 * dt;  // the chord's velocity is the one half a frame back
-        two_point = track::project_trajectory(exact_fit(o.p_board, v, config.g_mps2, o.t_s), geometry);
+        two_point = track::project_trajectory(track::exact_trajectory(o.p_board, v, config.g_mps2, o.t_s), geometry);
         // The same points the tracker fitted (approaches are collision-free,
         // so its window is the newest out.window observations).
         const std::size_t n = static_cast<std::size_t>(out.window);

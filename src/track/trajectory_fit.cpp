@@ -15,7 +15,26 @@ bool usable(std::span<const Observation> obs) {
   return obs.size() >= 3 && std::abs(obs.back().t_s - obs.front().t_s) > kMinTimeSpan_s;
 }
 
+// Point count, degrees of freedom and χ² of a solved fit over its observations.
+void finish(TrajectoryFit& fit, std::span<const Observation> obs, int parameters, double sigma_m) {
+  fit.points = static_cast<int>(obs.size());
+  fit.dof = 2 * fit.points - parameters;
+  double chi2 = 0.0;
+  for (const Observation& o : obs) chi2 += (o.p_board - fit.position_at(o.t_s)).squaredNorm();
+  fit.chi2 = sigma_m > 0.0 ? chi2 / (sigma_m * sigma_m) : 0.0;
+}
+
 }  // namespace
+
+TrajectoryFit exact_trajectory(const Vec2& p_ref, const Vec2& v_ref, double g_mps2, double t_ref_s) {
+  TrajectoryFit fit;
+  fit.valid = true;
+  fit.t_ref_s = t_ref_s;
+  fit.p_ref = p_ref;
+  fit.v_ref = v_ref;
+  fit.g_mps2 = g_mps2;
+  return fit;
+}
 
 TrajectoryFit fit_fixed_gravity(std::span<const Observation> obs, double g_mps2, double sigma_m) {
   TrajectoryFit fit;
@@ -47,11 +66,7 @@ TrajectoryFit fit_fixed_gravity(std::span<const Observation> obs, double g_mps2,
   fit.p_ref = {cx(0), cy(0)};
   fit.v_ref = {cx(1), cy(1)};
   fit.g_mps2 = g_mps2;
-  fit.points = static_cast<int>(obs.size());
-  fit.dof = 2 * fit.points - 4;
-  double chi2 = 0.0;
-  for (const Observation& o : obs) chi2 += (o.p_board - fit.position_at(o.t_s)).squaredNorm();
-  fit.chi2 = sigma_m > 0.0 ? chi2 / (sigma_m * sigma_m) : 0.0;
+  finish(fit, obs, 4, sigma_m);
   return fit;
 }
 
@@ -83,11 +98,7 @@ TrajectoryFit fit_free_gravity(std::span<const Observation> obs, double sigma_m)
   fit.p_ref = {cx(0), cy(0)};
   fit.v_ref = {cx(1), cy(1)};
   fit.g_mps2 = cy(2);
-  fit.points = static_cast<int>(obs.size());
-  fit.dof = 2 * fit.points - 5;
-  double chi2 = 0.0;
-  for (const Observation& o : obs) chi2 += (o.p_board - fit.position_at(o.t_s)).squaredNorm();
-  fit.chi2 = sigma_m > 0.0 ? chi2 / (sigma_m * sigma_m) : 0.0;
+  finish(fit, obs, 5, sigma_m);
   return fit;
 }
 

@@ -20,15 +20,7 @@ constexpr double kPi = std::numbers::pi;
 FlipperGeometry hand_v() { return make_flipper_geometry({{-1.0, 0.0}, {-0.5, -0.5}}, {{1.0, 0.0}, {0.5, -0.5}}); }
 
 TrajectoryFit fit_of(const Vec2& p, const Vec2& v, double g, double t_ref_s = 10.0) {
-  TrajectoryFit f;
-  f.valid = true;
-  f.t_ref_s = t_ref_s;
-  f.p_ref = p;
-  f.v_ref = v;
-  f.g_mps2 = g;
-  f.points = 10;
-  f.dof = 16;
-  return f;
+  return exact_trajectory(p, v, g, t_ref_s);
 }
 
 void expect_finite(const TrajectoryProjection& p) {

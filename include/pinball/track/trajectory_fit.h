@@ -31,6 +31,10 @@ struct TrajectoryFit {
   Vec2 velocity_at(double t_s) const { return {v_ref.x(), v_ref.y() - g_mps2 * (t_s - t_ref_s)}; }
 };
 
+/// A known parabola as a fit (exact truth, or a predictor's guess): passes
+/// through p_ref with velocity v_ref at t_ref_s under g_mps2.
+TrajectoryFit exact_trajectory(const Vec2& p_ref, const Vec2& v_ref, double g_mps2, double t_ref_s);
+
 /// Fits with g fixed (4 parameters). `observations` oldest first; needs at
 /// least 3 points with distinct times; sigma_m scales the χ².
 TrajectoryFit fit_fixed_gravity(std::span<const Observation> observations, double g_mps2, double sigma_m);
