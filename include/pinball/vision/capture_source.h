@@ -1,0 +1,70 @@
+#pragma once
+// A real camera (V4L2 device) or a video file through OpenCV's VideoCapture.
+// Frames come out gray, stamped with the steady clock when the grab returned
+// and, when the backend has one, the driver's own timestamp (V4L2 buffer time,
+// or the file's presentation time). Gaps in the timestamps longer than 1.5
+// frame periods count as dropped frames and advance the sequence number.
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "pinball/vision/frame_source.h"
+
+namespace pinball::vision {
+
+/// What to open and how to ask for it.
+struct CaptureConfig {
+  std::string source;          ///< "0" (V4L2 index), "/dev/video0" (V4L2 path) or a video file path
+  int width_px = 640;          ///< requested width (devices; 0 leaves the driver's)
+  int height_px = 480;         ///< requested height (devices; 0 leaves the driver's)
+  double fps = 200.0;          ///< requested frame rate (devices; 0 leaves the driver's); a file's own rate is used
+  std::string fourcc;          ///< requested pixel format, e.g. "GREY", "YUYV", "MJPG" (devices; empty: the driver's)
+  double exposure = -1.0;      ///< manual exposure in the driver's units (V4L2: 100 µs steps); < 0 leaves auto
+  int buffers = 2;             ///< driver buffer count (devices; fewer: less latency, more drops); 0 leaves it
+};
+
+/// True when `source` names a V4L2 device (a number or a /dev/ path) rather than a file.
+bool is_device_source(const std::string& source);
+
+/// OpenCV capture of a device or a file.
+class CaptureSource final : public FrameSource {
+ public:
+  /// Opens the source. Throws std::runtime_error naming it when it cannot be
+  /// opened (no such device, no such file, not a video, no frames).
+  explicit CaptureSource(const CaptureConfig& config);
+  CaptureSource(const CaptureSource&) = delete;             ///< one owner of the device
+  CaptureSource& operator=(const CaptureSource&) = delete;
+
+  /// Blocks until the next frame (devices) or decodes the next one (files).
+  /// False at the end of a file or on a failed grab (counted).
+  bool read(Frame& out) override;
+
+  /// True after a file's last frame was read.
+  bool at_end() const { return at_end_; }
+  /// True when the source is a device rather than a file.
+  bool is_device() const { return is_device_; }
+
+  cv::Size frame_size() const override { return size_; }
+  double fps() const override { return fps_; }
+  FrameSourceCounters counters() const override { return counters_; }
+  std::string describe() const override;
+
+ private:
+  CaptureConfig config_;
+  bool is_device_ = false;
+  cv::VideoCapture capture_;
+  cv::Mat raw_;
+  cv::Size size_;
+  double fps_ = 0.0;
+  bool at_end_ = false;
+  bool have_last_ = false;
+  double last_stamp_s_ = 0.0;
+  std::uint64_t sequence_ = 0;
+  FrameSourceCounters counters_;
+};
+
+}  // namespace pinball::vision

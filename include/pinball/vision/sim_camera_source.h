@@ -1,0 +1,185 @@
+#pragma once
+// A camera made of the simulator: it is fed the simulator's state every step
+// and renders grayscale frames at its own frame rate, as a camera bolted over
+// the table would see them: the playfield drawing, clutter and lamps, the
+// ball with shading and motion blur over the exposure, plastics that hide it,
+// an optional glare patch, sensor noise, all seen through a perspective
+// homography. The static scene is rendered once at construction; a frame
+// costs one copy, the ball patch and the noise. Deterministic by seed.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pinball/core/geometry.h"
+#include "pinball/core/rng.h"
+#include "pinball/sim/board.h"
+#include "pinball/sim/game_state.h"
+#include "pinball/vision/camera_homography.h"
+#include "pinball/vision/frame_source.h"
+
+namespace pinball::vision {
+
+/// A piece of plastic above the playfield that hides the ball beneath it.
+struct SimPlastic {
+  std::vector<Vec2> polygon_board;  ///< convex outline in the board frame (m)
+  double gray = 95.0;               ///< its brightness (0..255)
+  double opacity = 1.0;             ///< 1: opaque; less lets some of the floor through
+};
+
+/// An additive bright patch (a reflection of a room light in the glass).
+struct SimGlare {
+  bool enabled = false;             ///< draw it at all
+  Vec2 centre_board{0.20, 0.35};    ///< centre (m, board frame)
+  double sigma_m = 0.03;            ///< Gaussian size on the table (m); the patch spans ±3σ
+  double peak_gray = 150.0;         ///< brightness added at the centre (gray levels)
+  double toggle_probability = 0.0;  ///< per frame: chance it switches on/off (0: always on)
+};
+
+/// Every setting of the simulated camera.
+struct SimCameraConfig {
+  int width_px = 640;               ///< image width (px)
+  int height_px = 480;              ///< image height (px)
+  double fps = 200.0;               ///< frames per second
+  double exposure_s = 0.002;        ///< shutter open time (s): motion blur spans the ball's travel over it
+  double first_exposure_s = 0.0;    ///< simulated time the first exposure starts (s)
+  CameraView view;                  ///< where the camera sits (perspective)
+  int supersample = 2;              ///< the static scene is drawn at this multiple of the image scale, then warped
+  double floor_gain = 0.6;          ///< playfield drawing brightness: gray = gain · drawing + offset
+  double floor_offset = 20.0;       ///< see floor_gain (gray levels)
+  int clutter_shapes = 80;          ///< playfield art: random shapes drawn on the table
+  double clutter_contrast = 28.0;   ///< their brightness offset, up to ± this (gray levels)
+  double ball_gray = 215.0;         ///< ball body brightness (gray levels)
+  double ball_limb_darkening = 0.35;///< brightness lost at the ball's rim (fraction)
+  double highlight_gray = 255.0;    ///< specular highlight peak
+  Vec2 highlight_offset{-0.3, 0.3}; ///< highlight centre from the ball centre, in ball radii (board frame)
+  double highlight_sigma = 0.22;    ///< highlight size, in ball radii
+  int lamps = 14;                   ///< playfield lamps: half small round lamps, half long arrow inserts
+  double lamp_delta_gray = 110.0;   ///< brightness a lit lamp adds
+  double lamp_toggle_probability = 0.03;  ///< per lamp per frame: chance it switches
+  std::vector<SimPlastic> plastics = default_plastics();  ///< occluders (board frame)
+  SimGlare glare;                   ///< glare patch (off by default)
+  double noise_sigma = 2.0;         ///< sensor noise, standard deviation (gray levels)
+  std::uint64_t seed = 1;           ///< clutter, lamps, noise
+
+  /// Two plastics on the upper playfield, scaled to a 0.51 x 1.07 m table.
+  static std::vector<SimPlastic> default_plastics();
+};
+
+/// What the simulator knows about a frame: for tests and benchmarks only,
+/// never for the detector (thesis 4.1).
+struct FrameTruth {
+  bool ball_present = false;        ///< the ball was in play during some of the exposure
+  bool ball_whole_exposure = false; ///< ... during all of it
+  Vec2 p_board_mid = Vec2::Zero();  ///< ball centre at mid-exposure (m)
+  cv::Point2d uv_px_mid;            ///< the same in the image (px)
+  double blur_px = 0.0;             ///< distance the ball's image travelled during the exposure (px)
+  double radius_px = 0.0;           ///< ball radius in the image at mid-exposure (px)
+  double occluded_fraction = 0.0;   ///< fraction of the ball's image under plastic
+  bool glare_on = false;            ///< the glare patch was drawn
+  bool in_glare = false;            ///< the glare was on within 3σ + a ball radius of the ball
+  int lamps_lit = 0;                ///< lamps lit in this frame
+};
+
+/// The simulated camera.
+class SimCameraSource final : public FrameSource {
+ public:
+  /// Renders the static scene. Throws std::invalid_argument naming a bad setting.
+  SimCameraSource(const sim::Board& board, const SimCameraConfig& config);
+
+  /// Feeds the simulator's state after a step (call every step, time increasing).
+  void observe(const sim::GameState& state) { observe_ball(state.time_s, state.ball.position_m, state.ball_in_play); }
+  /// The same from a bare ball position: `in_play` false means no ball in view.
+  void observe_ball(double t_s, const Vec2& p_board, bool in_play);
+
+  /// Next frame whose exposure has ended by the latest observed time; false
+  /// when none is due. Frames whose exposure is no longer in the history are
+  /// skipped and counted as dropped.
+  bool read(Frame& out) override;
+
+  /// Renders one frame directly: the ball at `path_board` positions spread
+  /// evenly over the exposure (empty: no ball), stamped t_mid_s. Advances the
+  /// lamps, glare and noise like read(). For tests and benchmarks.
+  void render(std::span<const Vec2> path_board, double t_mid_s, Frame& out);
+
+  /// Truth of the last frame delivered by read() or render().
+  const FrameTruth& truth() const { return truth_; }
+
+  /// Restarts the frame clock: the next exposure starts at t_s; forgets the history.
+  void reset(double t_s);
+
+  /// Switches the glare on or off (and keeps it so unless it toggles by itself).
+  void set_glare(bool on) { glare_on_ = on && glare_ready_; }
+  /// Freezes (false) or resumes (true) lamp toggling.
+  void set_lamps_blinking(bool blinking) { lamps_blinking_ = blinking; }
+
+  /// The camera's homography (board -> image).
+  const CameraHomography& homography() const { return homography_; }
+  /// 255 where a plastic hides the playfield (the detector's occluder mask).
+  const cv::Mat& occluder_mask() const { return occluder_mask_; }
+  /// The static scene without lamps, glare, ball or noise (8-bit).
+  const cv::Mat& static_scene() const { return floor_; }
+  /// The settings.
+  const SimCameraConfig& config() const { return config_; }
+
+  cv::Size frame_size() const override { return {config_.width_px, config_.height_px}; }
+  double fps() const override { return config_.fps; }
+  FrameSourceCounters counters() const override { return counters_; }
+  std::string describe() const override;
+
+ private:
+  struct Sample {
+    double t_s = 0.0;
+    Vec2 p = Vec2::Zero();
+    bool in_play = false;
+  };
+  struct Patch {
+    cv::Rect roi;
+    cv::Mat values;  // CV_8U: lamp delta, glare delta, or plastic alpha
+  };
+  static constexpr std::size_t kHistory = 2048;
+  static constexpr std::size_t kMaxPath = 64;
+
+  void build_floor();
+  void build_lamps();
+  void build_plastics();
+  void build_glare();
+  void build_noise();
+  void advance_effects();
+  void compose(std::span<const Vec2> path_board, int path_total, double t_mid_s, Frame& out);
+  void draw_ball(std::span<const Vec2> path_board, int path_total, cv::Mat& image);
+  bool sample_at(double t_s, Vec2& p, bool& in_play) const;
+
+  const sim::Board& board_;
+  SimCameraConfig config_;
+  CameraHomography homography_;
+  Rng rng_;
+  cv::Mat floor_;          // CV_8U static scene: drawing, clutter, unlit lamps
+  cv::Mat occluder_mask_;  // CV_8U
+  std::vector<Patch> lamps_;
+  std::vector<std::uint8_t> lamp_on_;
+  std::vector<Patch> plastics_;
+  std::vector<double> plastic_gray_;
+  Patch glare_;
+  bool glare_ready_ = false;
+  bool glare_on_ = false;
+  bool lamps_blinking_ = true;
+  std::vector<std::uint8_t> noise_pos_;  // |noise| where noise > 0, else 0
+  std::vector<std::uint8_t> noise_neg_;  // |noise| where noise < 0, else 0
+  std::size_t noise_span_ = 0;           // offsets in [0, noise_span_)
+  std::array<Sample, kHistory> history_{};
+  std::size_t history_head_ = 0;         // index of the oldest sample
+  std::size_t history_size_ = 0;
+  double next_exposure_s_ = 0.0;
+  double period_s_ = 0.0;
+  std::uint64_t sequence_ = 0;
+  std::array<Vec2, kMaxPath> path_{};
+  FrameTruth truth_;
+  FrameSourceCounters counters_;
+};
+
+}  // namespace pinball::vision

@@ -1,0 +1,391 @@
+#include "pinball/vision/ball_detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+namespace pinball::vision {
+namespace {
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("ball detector: " + what);
+}
+
+// Second moments of a uniform stadium of radius 1 and length k (k = L / r), per unit area.
+double stadium_major(double k) {
+  return (k * k * k / 6.0 + std::numbers::pi * k * k / 4.0 + 4.0 * k / 3.0 + std::numbers::pi / 4.0) /
+         (std::numbers::pi + 2.0 * k);
+}
+double stadium_minor(double k) { return (2.0 * k / 3.0 + std::numbers::pi / 4.0) / (std::numbers::pi + 2.0 * k); }
+
+// The stadium (radius r, straight length L) with major and minor variances l1 >= l2.
+void fit_stadium(double l1, double l2, double& r, double& length) {
+  const double target = l1 / l2;
+  double lo = 0.0;
+  double hi = 40.0;
+  for (int i = 0; i < 40; ++i) {  // l1/l2 grows with k
+    const double mid = 0.5 * (lo + hi);
+    if (stadium_major(mid) / stadium_minor(mid) < target) {
+      lo = mid;
+    } else {
+      hi = mid;
+    }
+  }
+  const double k = 0.5 * (lo + hi);
+  r = std::sqrt(l2 / stadium_minor(k));
+  length = k * r;
+}
+
+}  // namespace
+
+const char* to_string(DetectionMiss miss) {
+  switch (miss) {
+    case DetectionMiss::kNone: return "none";
+    case DetectionMiss::kBadFrame: return "bad_frame";
+    case DetectionMiss::kNoBackground: return "no_background";
+    case DetectionMiss::kNoBlob: return "no_blob";
+    case DetectionMiss::kWrongSize: return "wrong_size";
+    case DetectionMiss::kWrongShape: return "wrong_shape";
+    case DetectionMiss::kOccluded: return "occluded";
+    case DetectionMiss::kCut: return "cut";
+  }
+  return "unknown";
+}
+
+BallDetector::BallDetector(const CameraHomography& homography, cv::Size frame_size, const BallDetectorConfig& config)
+    : homography_(homography), size_(frame_size), config_(config), background_(frame_size) {
+  const BallDetectorConfig& c = config_;
+  require(std::isfinite(c.ball_radius_m) && c.ball_radius_m > 0.0, "ball_radius_m must be > 0");
+  require(c.threshold >= 1 && c.threshold <= 254, "threshold must be in [1, 254]");
+  require(c.min_area_ratio > 0.0 && c.min_area_ratio < 1.0 && c.max_area_ratio > 1.0,
+          "area ratios need 0 < min_area_ratio < 1 < max_area_ratio");
+  require(c.max_elongation > 1.0, "max_elongation must be > 1");
+  require(c.max_model_error > 0.0 && c.radius_tolerance > 0.0 && c.radius_tolerance < 1.0,
+          "max_model_error must be > 0 and radius_tolerance in (0, 1)");
+  require(c.min_fill > 0.0 && c.min_fill <= 1.0, "min_fill must be in (0, 1]");
+  require(c.weight_floor_fraction >= 0.0 && c.weight_floor_fraction < 1.0, "weight_floor_fraction must be in [0, 1)");
+  require(c.weight_saturation > 0.0 && c.weight_saturation <= 1.0, "weight_saturation must be in (0, 1]");
+  require(c.roi_radius_factor >= 1.5, "roi_radius_factor must be >= 1.5");
+  require(c.occluder_margin_px >= 0 && c.edge_margin_px >= 0, "margins must be >= 0");
+  require(c.background_rate >= 0.0 && c.background_rate <= 1.0 && c.background_every >= 1,
+          "background_rate must be in [0, 1] and background_every >= 1");
+  diff_ = cv::Mat::zeros(size_, CV_8U);
+  binary_ = cv::Mat::zeros(size_, CV_8U);
+  stack_.resize(static_cast<std::size_t>(size_.width) * static_cast<std::size_t>(size_.height));
+  halo_ = cv::Mat::zeros(size_, CV_8U);
+}
+
+void BallDetector::set_occluder_mask(const cv::Mat& mask) {
+  if (mask.empty()) {
+    occluder_.release();
+    return;
+  }
+  require(mask.type() == CV_8UC1 && mask.size() == size_, "the occluder mask must be 8-bit gray of the frame size");
+  cv::Mat nonzero;
+  cv::threshold(mask, nonzero, 0, 255, cv::THRESH_BINARY);
+  const int m = config_.occluder_margin_px;
+  if (m > 0) {
+    cv::dilate(nonzero, occluder_, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * m + 1, 2 * m + 1)));
+  } else {
+    occluder_ = nonzero;
+  }
+}
+
+double BallDetector::expected_radius_px(const cv::Point2d& uv_px) const {
+  return config_.ball_radius_m * homography_.px_per_m_at(homography_.board_from_image(uv_px));
+}
+
+void BallDetector::fill_blob(int u, int v, const cv::Rect& region, Blob& blob) {
+  const int w = size_.width;
+  const int margin = std::max(2, config_.edge_margin_px);
+  const int ru0 = region.x, rv0 = region.y, ru1 = region.x + region.width - 1, rv1 = region.y + region.height - 1;
+  // Breadth first with a queue that keeps every pixel: afterwards stack_[0, area) is the blob.
+  std::int32_t* queue = stack_.data();
+  std::size_t head = 0;
+  std::size_t tail = 0;
+  std::uint8_t* bin = binary_.data;
+  const std::uint8_t* occ = occluder_.empty() ? nullptr : occluder_.data;
+  bin[v * w + u] = 0;
+  queue[tail++] = v * w + u;
+  blob.u0 = blob.u1 = u;
+  blob.v0 = blob.v1 = v;
+  while (head < tail) {
+    const std::int32_t i = queue[head++];
+    const int pu = i % w;
+    const int pv = i / w;
+    const double du = pu;
+    const double dv = pv;
+    blob.su += du;
+    blob.sv += dv;
+    blob.suu += du * du;
+    blob.svv += dv * dv;
+    blob.suv += du * dv;
+    blob.u0 = std::min(blob.u0, pu);
+    blob.u1 = std::max(blob.u1, pu);
+    blob.v0 = std::min(blob.v0, pv);
+    blob.v1 = std::max(blob.v1, pv);
+    if (occ != nullptr && occ[i] != 0) blob.occluded = true;
+    const int nu0 = std::max(pu - 1, ru0), nu1 = std::min(pu + 1, ru1);
+    const int nv0 = std::max(pv - 1, rv0), nv1 = std::min(pv + 1, rv1);
+    for (int nv = nv0; nv <= nv1; ++nv) {
+      std::uint8_t* row = bin + nv * w;
+      for (int nu = nu0; nu <= nu1; ++nu) {
+        if (row[nu] == 0) continue;
+        row[nu] = 0;
+        queue[tail++] = nv * w + nu;
+      }
+    }
+  }
+  blob.area = static_cast<double>(tail);
+  blob.at_region_edge = blob.u0 - ru0 < margin || ru1 - blob.u1 < margin || blob.v0 - rv0 < margin ||
+                        rv1 - blob.v1 < margin;
+}
+
+cv::Point2d BallDetector::weighted_centroid(const Blob& blob) {
+  // Weights only on the blob and a 2 px halo around it (the anti-aliased rim
+  // below the threshold), never on a neighbouring blob.
+  constexpr int kHalo = 2;
+  const cv::Rect box = cv::Rect(cv::Point(blob.u0 - kHalo, blob.v0 - kHalo),
+                                cv::Point(blob.u1 + kHalo + 1, blob.v1 + kHalo + 1)) &
+                       cv::Rect(0, 0, size_.width, size_.height);
+  const int w = size_.width;
+  const auto n = static_cast<std::size_t>(blob.area);
+  int peak = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::int32_t i = stack_[k];
+    peak = std::max(peak, static_cast<int>(diff_.data[i]));
+    const int pu = i % w;
+    const int pv = i / w;
+    for (int v = std::max(pv - kHalo, box.y); v <= std::min(pv + kHalo, box.y + box.height - 1); ++v) {
+      std::uint8_t* row = halo_.ptr<std::uint8_t>(v);
+      for (int u = std::max(pu - kHalo, box.x); u <= std::min(pu + kHalo, box.x + box.width - 1); ++u) row[u] = 1;
+    }
+  }
+  const double floor = config_.weight_floor_fraction * config_.threshold;
+  const double cap = std::max({config_.weight_saturation * peak, static_cast<double>(config_.threshold), floor + 1.0});
+  const double inv = 1.0 / (cap - floor);
+  double sw = 0.0, su = 0.0, sv = 0.0;
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    const std::uint8_t* row = diff_.ptr<std::uint8_t>(v);
+    std::uint8_t* in = halo_.ptr<std::uint8_t>(v);
+    for (int u = box.x; u < box.x + box.width; ++u) {
+      if (in[u] == 0) continue;
+      in[u] = 0;
+      const double wgt = std::min(1.0, (row[u] - floor) * inv);
+      if (wgt <= 0.0) continue;
+      sw += wgt;
+      su += wgt * u;
+      sv += wgt * v;
+    }
+  }
+  if (!(sw > 0.0)) return {blob.su / blob.area, blob.sv / blob.area};
+  return {su / sw, sv / sw};
+}
+
+bool BallDetector::search(const cv::Rect& region, bool region_is_roi, double t_s, Detection& out) {
+  const cv::Mat frame = (*frame_)(region);
+  const cv::Mat background = background_.image()(region);
+  cv::Mat diff = diff_(region);
+  cv::Mat binary = binary_(region);
+  cv::absdiff(frame, background, diff);
+  cv::threshold(diff, binary, config_.threshold, 255, cv::THRESH_BINARY);
+
+  const BallDetectorConfig& c = config_;
+  bool have = false;
+  Blob best;
+  double best_score = 0.0;
+  double best_conf = 0.0;
+  double best_elong = 0.0;
+  double best_expected = 0.0;
+  double best_model_error = 0.0;
+  double best_r_fit = 0.0;
+  DetectionMiss worst = DetectionMiss::kNoBlob;
+  double worst_closeness = 0.0;
+  cv::Point2d best_uv;
+  const double log_span = std::max(-std::log(c.min_area_ratio), std::log(c.max_area_ratio));
+  for (int v = region.y; v < region.y + region.height; ++v) {
+    const std::uint8_t* row = binary_.ptr<std::uint8_t>(v);
+    int u = region.x;
+    const int end = region.x + region.width;
+    while (u < end) {
+      if (u + 8 <= end) {
+        std::uint64_t word;
+        std::memcpy(&word, row + u, sizeof word);
+        if (word == 0) {
+          u += 8;
+          continue;
+        }
+      }
+      if (row[u] == 0) {
+        ++u;
+        continue;
+      }
+      Blob blob;
+      fill_blob(u, v, region, blob);
+      ++u;
+      ++out.blobs;
+      const cv::Point2d centre{blob.su / blob.area, blob.sv / blob.area};
+      const double r_px = expected_radius_px(centre);
+      const double expected = std::numbers::pi * r_px * r_px;
+      const double ratio = blob.area / expected;
+      if (blob.area < 3.0 && ratio < c.min_area_ratio) continue;  // a speck of noise: not worth a reason
+      DetectionMiss reason = DetectionMiss::kNone;
+      double elong = 0.0;
+      double fill = 0.0;
+      double model_error = 0.0;
+      double r_fit = 0.0;
+      if (blob.occluded) {
+        reason = DetectionMiss::kOccluded;
+        ++counters_.rejected_occluded;
+      } else if (blob.at_region_edge) {
+        reason = DetectionMiss::kCut;
+        if (!region_is_roi) ++counters_.rejected_edge;
+      } else if (ratio < c.min_area_ratio || ratio > c.max_area_ratio) {
+        reason = DetectionMiss::kWrongSize;
+        ++counters_.rejected_size;
+      } else {
+        // Second moments; + 1/12 turns pixel sums into the continuous figure's variance.
+        const double mu20 = blob.suu / blob.area - centre.x * centre.x + 1.0 / 12.0;
+        const double mu02 = blob.svv / blob.area - centre.y * centre.y + 1.0 / 12.0;
+        const double mu11 = blob.suv / blob.area - centre.x * centre.y;
+        const double half = 0.5 * (mu20 + mu02);
+        const double root = std::sqrt(0.25 * (mu20 - mu02) * (mu20 - mu02) + mu11 * mu11);
+        const double l1 = half + root;
+        const double l2 = std::max(half - root, 1e-9);
+        elong = std::sqrt(l1 / l2);
+        fill = blob.area / (4.0 * std::numbers::pi * std::sqrt(l1 * l2));
+        // A ball blurred along a line is, above the threshold, close to a
+        // stadium (a rectangle of length L capped by two half discs of radius
+        // r). Fit r and L to the two second moments and compare the areas: a
+        // ball merged with a lamp or the edge of a glare breaks the relation
+        // even when its area and elongation look right.
+        double length = 0.0;
+        fit_stadium(l1, l2, r_fit, length);
+        const double model_area = r_fit * r_fit * std::numbers::pi + 2.0 * r_fit * length;
+        model_error = std::abs(blob.area / model_area - 1.0);
+        const double r_ratio = r_fit / r_px;
+        if (elong > c.max_elongation || fill < c.min_fill || model_error > c.max_model_error ||
+            r_ratio < 1.0 - c.radius_tolerance || r_ratio > 1.0 + c.radius_tolerance) {
+          reason = DetectionMiss::kWrongShape;
+          ++counters_.rejected_shape;
+        }
+      }
+      if (reason != DetectionMiss::kNone) {
+        // The reason reported is the one of the blob closest to a ball's size.
+        const double closeness = std::abs(std::log(ratio));
+        if (worst == DetectionMiss::kNoBlob || closeness < worst_closeness) {
+          worst = reason;
+          worst_closeness = closeness;
+        }
+        continue;
+      }
+      const double conf = std::clamp(std::min(fill, 1.0) * (1.0 - 0.5 * (elong - 1.0) / (c.max_elongation - 1.0)) *
+                                         (1.0 - 0.5 * std::abs(std::log(ratio)) / log_span),
+                                     0.01, 1.0);
+      if (!have || conf > best_score) {
+        have = true;
+        best = blob;
+        best_uv = weighted_centroid(blob);  // now, while stack_ holds this blob's pixels
+        best_score = conf;
+        best_conf = conf;
+        best_elong = elong;
+        best_expected = expected;
+        best_model_error = model_error;
+        best_r_fit = r_fit;
+      }
+    }
+  }
+  if (!have) {
+    if (!region_is_roi || out.miss == DetectionMiss::kNone) out.miss = worst;
+    return false;
+  }
+  const cv::Point2d uv = best_uv;
+  out.found = true;
+  out.miss = DetectionMiss::kNone;
+  out.uv_px = uv;
+  out.area_px = best.area;
+  out.expected_area_px = best_expected;
+  out.elongation = best_elong;
+  out.model_error = best_model_error;
+  out.radius_px = best_r_fit;
+  out.from_roi = region_is_roi;
+  out.observation.t_s = t_s;
+  out.observation.p_board = homography_.board_from_image(uv);
+  out.observation.confidence = best_conf;
+  return true;
+}
+
+Detection BallDetector::detect(const Frame& frame, const cv::Point2d* predicted_uv_px) {
+  Detection out;
+  ++counters_.frames;
+  if (frame.gray.type() != CV_8UC1 || frame.gray.size() != size_) {
+    ++counters_.bad_frames;
+    out.miss = DetectionMiss::kBadFrame;
+    return out;
+  }
+  if (!background_.ready()) {
+    out.miss = DetectionMiss::kNoBackground;
+    return out;
+  }
+  frame_ = &frame.gray;
+  const cv::Rect image(0, 0, size_.width, size_.height);
+  bool found = false;
+  bool have_prediction = false;
+  cv::Point2d predicted;
+  double motion_px = 0.0;
+  if (predicted_uv_px != nullptr) {
+    predicted = *predicted_uv_px;
+    have_prediction = std::isfinite(predicted.x) && std::isfinite(predicted.y);
+  } else if (track_frames_ > 0) {
+    const double dt = frame.t_s - last_t_s_;
+    const cv::Point2d step = track_frames_ > 1 && std::isfinite(dt) && dt > 0.0 && dt < 0.1 ? velocity_px_ * dt
+                                                                                           : cv::Point2d{0.0, 0.0};
+    predicted = last_uv_px_ + step;
+    motion_px = cv::norm(step);
+    have_prediction = true;
+  }
+  if (config_.use_roi && have_prediction && image.contains(cv::Point(static_cast<int>(predicted.x),
+                                                                     static_cast<int>(predicted.y)))) {
+    const double half = config_.roi_radius_factor * expected_radius_px(predicted) + motion_px + 2.0;
+    const cv::Rect roi = cv::Rect(cv::Point(static_cast<int>(std::floor(predicted.x - half)),
+                                            static_cast<int>(std::floor(predicted.y - half))),
+                                  cv::Point(static_cast<int>(std::ceil(predicted.x + half)) + 1,
+                                            static_cast<int>(std::ceil(predicted.y + half)) + 1)) &
+                         image;
+    if (roi.area() > 0) found = search(roi, roi != image, frame.t_s, out);
+  }
+  if (!found) {
+    ++counters_.full_searches;
+    found = search(image, false, frame.t_s, out);
+  }
+  if (found) {
+    ++counters_.found;
+    if (out.from_roi) ++counters_.found_in_roi;
+    const double dt = frame.t_s - last_t_s_;
+    if (track_frames_ > 0 && std::isfinite(dt) && dt > 0.0) velocity_px_ = (out.uv_px - last_uv_px_) * (1.0 / dt);
+    last_uv_px_ = out.uv_px;
+    last_t_s_ = frame.t_s;
+    ++track_frames_;
+  } else {
+    track_frames_ = 0;
+  }
+  if (config_.background_rate > 0.0 && counters_.frames % static_cast<std::uint64_t>(config_.background_every) == 0) {
+    cv::Rect exclude;
+    if (found || have_prediction) {
+      const cv::Point2d c = found ? out.uv_px : predicted;
+      const double half = 2.5 * expected_radius_px(c) + motion_px + 4.0;
+      exclude = cv::Rect(cv::Point(static_cast<int>(c.x - half), static_cast<int>(c.y - half)),
+                         cv::Point(static_cast<int>(c.x + half) + 1, static_cast<int>(c.y + half) + 1));
+    }
+    background_.update(frame.gray, config_.background_rate, exclude);
+  }
+  frame_ = nullptr;
+  return out;
+}
+
+}  // namespace pinball::vision

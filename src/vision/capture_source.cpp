@@ -1,0 +1,137 @@
+#include "pinball/vision/capture_source.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+namespace pinball::vision {
+namespace {
+
+bool all_digits(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+}
+
+double steady_now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+bool is_device_source(const std::string& source) { return all_digits(source) || source.rfind("/dev/", 0) == 0; }
+
+CaptureSource::CaptureSource(const CaptureConfig& config) : config_(config) {
+  const std::string& src = config_.source;
+  if (src.empty()) throw std::runtime_error("capture: no camera device or video file given");
+  is_device_ = is_device_source(src);
+  if (!is_device_ && !std::filesystem::exists(src)) {
+    throw std::runtime_error("capture: cannot open video file '" + src + "': no such file");
+  }
+  if (is_device_ && !all_digits(src) && !std::filesystem::exists(src)) {
+    throw std::runtime_error("capture: cannot open camera device '" + src + "': no such device");
+  }
+  bool opened = false;
+  try {
+    if (all_digits(src)) {
+      opened = capture_.open(std::stoi(src), cv::CAP_V4L2);
+    } else {
+      opened = capture_.open(src, is_device_ ? cv::CAP_V4L2 : cv::CAP_ANY);
+    }
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error("capture: cannot open " + std::string(is_device_ ? "camera device '" : "video file '") +
+                             src + "': " + e.what());
+  }
+  if (!opened || !capture_.isOpened()) {
+    throw std::runtime_error("capture: cannot open " +
+                             std::string(is_device_ ? "camera device '" + src + "' (V4L2)"
+                                                    : "video file '" + src + "': not a video OpenCV can decode"));
+  }
+  if (is_device_) {
+    if (config_.fourcc.size() == 4) {
+      capture_.set(cv::CAP_PROP_FOURCC, cv::VideoWriter::fourcc(config_.fourcc[0], config_.fourcc[1],
+                                                                config_.fourcc[2], config_.fourcc[3]));
+    }
+    if (config_.width_px > 0) capture_.set(cv::CAP_PROP_FRAME_WIDTH, config_.width_px);
+    if (config_.height_px > 0) capture_.set(cv::CAP_PROP_FRAME_HEIGHT, config_.height_px);
+    if (config_.fps > 0.0) capture_.set(cv::CAP_PROP_FPS, config_.fps);
+    if (config_.buffers > 0) capture_.set(cv::CAP_PROP_BUFFERSIZE, config_.buffers);
+    if (config_.exposure >= 0.0) {
+      capture_.set(cv::CAP_PROP_AUTO_EXPOSURE, 1);  // V4L2: 1 = manual
+      capture_.set(cv::CAP_PROP_EXPOSURE, config_.exposure);
+    }
+  }
+  size_ = cv::Size(static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH)),
+                   static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_HEIGHT)));
+  fps_ = capture_.get(cv::CAP_PROP_FPS);
+  if (!(fps_ > 0.0) || !std::isfinite(fps_)) fps_ = config_.fps > 0.0 ? config_.fps : 30.0;
+  if (size_.width <= 0 || size_.height <= 0) {
+    throw std::runtime_error("capture: '" + src + "' reports no frame size");
+  }
+}
+
+std::string CaptureSource::describe() const {
+  std::ostringstream s;
+  s << (is_device_ ? "camera " : "video file ") << config_.source << " " << size_.width << "x" << size_.height << " at "
+    << fps_ << " fps";
+  return s.str();
+}
+
+bool CaptureSource::read(Frame& out) {
+  if (at_end_) return false;
+  bool ok = false;
+  try {
+    ok = capture_.read(raw_);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  const double now_s = steady_now_s();
+  if (!ok || raw_.empty()) {
+    if (is_device_) {
+      ++counters_.read_failures;
+    } else {
+      at_end_ = true;
+    }
+    return false;
+  }
+  if (raw_.channels() == 3) {
+    cv::cvtColor(raw_, out.gray, cv::COLOR_BGR2GRAY);
+  } else if (raw_.channels() == 4) {
+    cv::cvtColor(raw_, out.gray, cv::COLOR_BGRA2GRAY);
+  } else if (raw_.depth() != CV_8U) {
+    raw_.convertTo(out.gray, CV_8U, 1.0 / 256.0);
+  } else {
+    raw_.copyTo(out.gray);
+  }
+  size_ = out.gray.size();
+  const double pos_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+  // A file's first frame is at 0 ms; a device without timestamps reports 0 for every frame.
+  const bool have_driver = std::isfinite(pos_ms) && (pos_ms > 0.0 || (!is_device_ && counters_.frames == 0));
+  out.driver_t_s = have_driver ? pos_ms * 1e-3 : std::numeric_limits<double>::quiet_NaN();
+  out.t_s = now_s;
+  // Dropped frames: from the driver's clock when it has one, else (devices only) from the steady clock.
+  const bool use_driver = have_driver;
+  const double stamp_s = use_driver ? out.driver_t_s : now_s;
+  if (have_last_ && (use_driver || is_device_)) {
+    const double period_s = 1.0 / fps_;
+    const double gap_s = stamp_s - last_stamp_s_;
+    if (gap_s > 1.5 * period_s) {
+      const auto missing = static_cast<std::uint64_t>(std::llround(gap_s / period_s)) - 1;
+      counters_.dropped += missing;
+      sequence_ += missing;
+    }
+  }
+  if (use_driver || is_device_) {
+    last_stamp_s_ = stamp_s;
+    have_last_ = true;
+  }
+  out.sequence = sequence_++;
+  ++counters_.frames;
+  return true;
+}
+
+}  // namespace pinball::vision

@@ -1,0 +1,120 @@
+#include "pinball/vision/sim_camera_source.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "pinball/sim/board_loader.h"
+
+namespace pinball::vision {
+namespace {
+
+const sim::Board& mit1993() {
+  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  return board;
+}
+
+TEST(SimCameraSource, SameSeedSameBitsOtherSeedOtherNoise) {
+  SimCameraConfig c;
+  SimCameraSource a(mit1993(), c);
+  SimCameraSource b(mit1993(), c);
+  c.seed = 2;
+  SimCameraSource other(mit1993(), c);
+  Frame fa, fb, fo;
+  const std::vector<Vec2> path{Vec2{0.2, 0.4}, Vec2{0.21, 0.41}};
+  for (int i = 0; i < 5; ++i) {
+    a.render(path, i * 0.005, fa);
+    b.render(path, i * 0.005, fb);
+    other.render(path, i * 0.005, fo);
+    EXPECT_EQ(cv::norm(fa.gray, fb.gray, cv::NORM_INF), 0.0);
+    EXPECT_GT(cv::norm(fa.gray, fo.gray, cv::NORM_L1), 0.0);
+  }
+  EXPECT_EQ(fa.gray.type(), CV_8UC1);
+  EXPECT_EQ(fa.gray.size(), cv::Size(640, 480));
+}
+
+TEST(SimCameraSource, DeliversFramesAtItsRateStampedAtMidExposure) {
+  SimCameraConfig c;
+  c.fps = 200.0;
+  c.exposure_s = 0.002;
+  SimCameraSource camera(mit1993(), c);
+  Frame frame;
+  EXPECT_FALSE(camera.read(frame));  // nothing observed yet
+  std::vector<double> stamps;
+  for (int step = 1; step <= 200; ++step) {  // 0.1 s at 0.5 ms
+    const double t = step * 0.0005;
+    camera.observe_ball(t, Vec2{0.25, 0.3 + t}, true);
+    while (camera.read(frame)) {
+      stamps.push_back(frame.t_s);
+      EXPECT_EQ(frame.sequence + 1, stamps.size());
+      EXPECT_TRUE(camera.truth().ball_present);
+      EXPECT_NEAR(camera.truth().p_board_mid.y(), 0.3 + frame.t_s, 1e-9);
+    }
+  }
+  ASSERT_EQ(stamps.size(), 20u);  // exposures starting at 0, 5, ..., 95 ms, all ended by 100 ms
+  for (std::size_t i = 0; i < stamps.size(); ++i) EXPECT_NEAR(stamps[i], 0.001 + 0.005 * i, 1e-12);
+  EXPECT_EQ(camera.counters().frames, 20u);
+  EXPECT_EQ(camera.counters().dropped, 0u);
+}
+
+TEST(SimCameraSource, MotionBlurSpreadsTheBallAlongItsPath) {
+  SimCameraConfig c;
+  c.noise_sigma = 0.0;
+  c.lamp_toggle_probability = 0.0;
+  SimCameraSource camera(mit1993(), c);
+  Frame still, moving, empty;
+  camera.render({}, 0.0, empty);
+  const Vec2 p{0.25, 0.3};
+  const Vec2 v{0.0, 5.0};  // 5 m/s up the table: 10 mm in 2 ms
+  std::vector<Vec2> path;
+  for (int k = 0; k < 40; ++k) path.push_back(p + v * (c.exposure_s * ((k + 0.5) / 40 - 0.5)));
+  camera.render({&p, 1}, 0.0, still);
+  camera.render(path, 0.0, moving);
+  const double blur = camera.truth().blur_px;
+  EXPECT_NEAR(blur, 0.0098 * camera.homography().px_per_m_at(p), 0.5);
+  auto extent_u = [&](const Frame& f) {
+    cv::Mat diff;
+    cv::absdiff(f.gray, empty.gray, diff);
+    cv::threshold(diff, diff, 3, 255, cv::THRESH_BINARY);
+    return cv::boundingRect(diff).width;
+  };
+  // Up the table is along u: the blurred ball is longer by about the blur.
+  EXPECT_NEAR(extent_u(moving) - extent_u(still), blur, 1.5);
+  // ... and dimmer at its ends than a still ball: the peak stays, the sum spreads.
+  EXPECT_GT(cv::norm(moving.gray, empty.gray, cv::NORM_L1), 0.0);
+}
+
+TEST(SimCameraSource, PlasticHidesTheBallAndTheTruthSaysSo) {
+  SimCameraConfig c;
+  c.noise_sigma = 0.0;
+  SimCameraSource camera(mit1993(), c);
+  ASSERT_FALSE(c.plastics.empty());
+  Vec2 centre = Vec2::Zero();
+  for (const Vec2& q : c.plastics[0].polygon_board) centre += q;
+  centre /= static_cast<double>(c.plastics[0].polygon_board.size());
+  Frame under, empty;
+  camera.set_lamps_blinking(false);
+  camera.render({}, 0.0, empty);
+  camera.render({&centre, 1}, 0.0, under);
+  EXPECT_GT(camera.truth().occluded_fraction, 0.95);
+  const cv::Point2d uv = camera.homography().image_from_board(centre);
+  EXPECT_EQ(under.gray.at<std::uint8_t>(cv::Point(uv)), empty.gray.at<std::uint8_t>(cv::Point(uv)));
+  EXPECT_GT(cv::countNonZero(camera.occluder_mask()), 1000);
+}
+
+TEST(SimCameraSource, RejectsBadSettings) {
+  SimCameraConfig c;
+  c.fps = 0.0;
+  EXPECT_THROW(SimCameraSource(mit1993(), c), std::invalid_argument);
+  c = SimCameraConfig{};
+  c.exposure_s = 0.01;  // longer than a frame at 200 fps
+  EXPECT_THROW(SimCameraSource(mit1993(), c), std::invalid_argument);
+  c = SimCameraConfig{};
+  c.plastics.push_back(SimPlastic{{Vec2{0.1, 0.1}, Vec2{0.2, 0.1}}, 90.0, 1.0});
+  EXPECT_THROW(SimCameraSource(mit1993(), c), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pinball::vision
