@@ -16,7 +16,8 @@ namespace pinball::cli {
 /// `pinball sim`
 struct SimArgs {
   std::string board;             ///< board file
-  std::string policy = "none";   ///< none | spastic
+  std::string policy = "none";   ///< none | spastic | controller
+  std::string controller;        ///< controller file (implies policy controller)
   int balls = 1;                 ///< balls to play
   std::uint64_t seed = 1;        ///< launch noise seed
   std::string stepper = "thesis";///< integrator
@@ -69,6 +70,35 @@ struct BenchArgs {
 };
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& args);
 int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& err);
+
+/// `pinball learn`
+struct LearnArgs {
+  std::string board;                    ///< board file
+  std::string method;                   ///< tournament | relay | cem | none | spastic | evaluate
+  std::uint64_t budget_balls = 2000;    ///< simulated balls the search may play
+  std::uint64_t seed = 1;               ///< the only source of randomness
+  std::string out;                      ///< controller file to write (searches)
+  std::string controller;               ///< controller file to evaluate (method evaluate)
+  int threads = 1;                      ///< worker threads (results do not depend on it)
+  std::string curve;                    ///< learning curve CSV, or empty
+  std::string plot;                     ///< learning curve PNG, or empty
+  int eval_balls = 0;                   ///< fresh balls to evaluate the result on (0: none for searches, 1000 otherwise)
+  int partitions = 4;                   ///< k angle partitions per flipper
+  bool partition_by_h = false;          ///< also split by h (thesis 7.1)
+  bool rolling = false;                 ///< separate rolling minicontrollers (thesis 7.1)
+  bool randomise_launch = false;        ///< random pull per ball (thesis 7.1)
+  double pull = -1.0;                   ///< launcher pull; negative: the board's
+  int balls_per_controller = 5;         ///< tournament: b
+  int population = 0;                   ///< relay / cem population (0: the method's default)
+  double max_ball_time_s = 60.0;        ///< a ball alive after this is cut: a cycle
+  double loss_penalty = 500.0;          ///< reward of an opportunity that lost the ball
+  double actuation_delay_s = 0.004;     ///< command to flipper motion (s)
+  double gravity_scale = 1.0;           ///< tracker's g / board's g
+  track::CameraModelConfig camera;      ///< the camera the tracker sees through
+  bool json = false;                    ///< one JSON object on stdout
+};
+CLI::App* add_learn_command(CLI::App& app, LearnArgs& args);
+int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err);
 
 /// Parses argv and runs the chosen subcommand; returns the exit code
 /// (0 success, 1 bad input or failure, 2 bad usage).

@@ -12,10 +12,12 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   RenderArgs render;
   BenchArgs bench;
   TrackArgs track;
+  LearnArgs learn;
   CLI::App* sim_cmd = add_sim_command(app, sim);
   CLI::App* render_cmd = add_render_command(app, render);
   CLI::App* bench_cmd = add_bench_command(app, bench);
   CLI::App* track_cmd = add_track_command(app, track);
+  CLI::App* learn_cmd = add_learn_command(app, learn);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -33,6 +35,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
     if (render_cmd->parsed()) return run_render(render, out, err);
     if (bench_cmd->parsed()) return run_bench(bench, out, err);
     if (track_cmd->parsed()) return run_track(track, out, err);
+    if (learn_cmd->parsed()) return run_learn(learn, out, err);
   } catch (const std::exception& e) {
     err << "pinball: " << e.what() << "\n";
     return 1;

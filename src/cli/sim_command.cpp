@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/board_loader.h"
 #include "pinball/control/can_flipper_drive.h"
+#include "pinball/control/controller_file.h"
 #include "pinball/control/simulated_player.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/sim/state_hash.h"
@@ -29,7 +31,10 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
   cmd->add_option("--policy", a.policy,
                   "who flips: none, or spastic (flip the flipper the tracker's projection names whenever the "
                   "ball is within --reach of impact; sees the ball only through the camera model)")
-      ->check(CLI::IsMember({"none", "spastic"}));
+      ->check(CLI::IsMember({"none", "spastic", "controller"}));
+  cmd->add_option("--controller", a.controller,
+                  "a learned controller file (docs/learning.md); implies --policy controller")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--reach", a.reach_m, "spastic: flip when the projected impact is this close (m)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--fps", a.camera.fps, "camera model: frames per second")->check(CLI::Range(1.0, 10000.0));
@@ -78,8 +83,23 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(board, render_options));
   }
 
+  std::string policy = a.policy;
+  if (!a.controller.empty()) {
+    if (policy == "spastic") throw std::invalid_argument("sim: --controller and --policy spastic exclude each other");
+    policy = "controller";
+  }
+  if (policy == "controller" && a.controller.empty()) throw std::invalid_argument("sim: --policy controller needs --controller FILE");
+  std::optional<control::ActuatorController> learned;
+  std::optional<control::SimulatedPlayer> learned_player;
+  double pull = -1.0;
+  if (policy == "controller") {
+    const control::ControllerSpec spec = control::load_controller(a.controller);
+    learned.emplace(spec.action_function, spec.actuator);
+    learned_player.emplace(board, a.camera, *learned, a.seed ^ 0x5DEECE66Dull);
+    pull = spec.launcher_pull;
+  }
   std::optional<control::SimulatedSpasticPlayer> spastic;
-  if (a.policy == "spastic") {
+  if (policy == "spastic") {
     control::SpasticConfig spastic_config;
     spastic_config.reach_m = a.reach_m;
     spastic.emplace(board, a.camera, spastic_config, a.seed ^ 0x5DEECE66Dull);
@@ -88,6 +108,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   if (a.actuation == "can") can_drive.emplace(board, a.actuation_delay_s);
   sim::BallLimits limits;
   limits.max_ball_time_s = a.max_ball_time_s;
+  limits.pull = pull;
   RunningStats score;
   RunningStats ball_time;
   std::uint64_t steps = 0;
@@ -103,6 +124,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         stepper, state, limits,
         [&](sim::GameState& s) {
           if (spastic) spastic->act(s);
+          if (learned_player) learned_player->act(s);
           if (can_drive) can_drive->apply(s);
         },
         [&](const sim::GameState& s, const sim::StepEvents& e) {
@@ -135,7 +157,8 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   if (a.json) {
     nlohmann::json j = {
         {"board", a.board},
-        {"policy", a.policy},
+        {"policy", policy},
+        {"controller", a.controller},
         {"stepper", a.stepper},
         {"seed", a.seed},
         {"dt_s", stepper.dt_s()},
@@ -162,7 +185,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     };
     out << j.dump(2) << "\n";
   } else {
-    out << "board            " << a.board << " (policy " << a.policy << ", actuation " << a.actuation
+    out << "board            " << a.board << " (policy " << policy << ", actuation " << a.actuation
         << ", stepper " << a.stepper << ", dt "
         << stepper.dt_s() << " s, seed " << a.seed << ")\n"
         << "balls            " << a.balls << " (" << cut << " cut at " << a.max_ball_time_s << " s, " << left_table

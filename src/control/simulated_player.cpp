@@ -2,24 +2,29 @@
 
 namespace pinball::control {
 
-SimulatedSpasticPlayer::SimulatedSpasticPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
-                                               const SpasticConfig& spastic, std::uint64_t seed)
+SimulatedPlayer::SimulatedPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
+                                 FlipperController& controller, std::uint64_t seed)
+    : SimulatedPlayer(board, camera, track::default_tracker_config(board, camera), controller, seed) {}
+
+SimulatedPlayer::SimulatedPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
+                                 const track::TrackerConfig& tracker, FlipperController& controller,
+                                 std::uint64_t seed)
     : board_(board),
       camera_(camera, seed),
-      tracker_(track::flipper_geometry_from_board(board), track::default_tracker_config(board, camera)),
-      spastic_(spastic) {
+      tracker_(track::flipper_geometry_from_board(board), tracker),
+      controller_(controller) {
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
     board_index_[board.flippers[i].side == sim::Side::kLeft ? track::kLeftFlipper : track::kRightFlipper] =
         static_cast<int>(i);
   }
 }
 
-void SimulatedSpasticPlayer::act(sim::GameState& state) {
+void SimulatedPlayer::act(sim::GameState& state) {
   if (!state.ball_in_play) {
     if (ball_was_in_play_) {  // the ball is gone: forget it
       tracker_.reset();
       camera_.reset(state.time_s);
-      spastic_.reset(energized_);
+      controller_.reset(energized_);
     }
     ball_was_in_play_ = false;
   } else {
@@ -30,7 +35,7 @@ void SimulatedSpasticPlayer::act(sim::GameState& state) {
       const track::ContactSensors contacts{state.flippers[board_index_[track::kLeftFlipper]].ball_contact,
                                            state.flippers[board_index_[track::kRightFlipper]].ball_contact};
       last_ = tracker_.update(obs, contacts);
-      spastic_.update(last_, state.time_s, energized_);
+      controller_.update(last_, state.time_s, energized_);
       ++observations_;
     }
   }

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 
+#include "pinball/control/flipper_controller.h"
 #include "pinball/control/spastic_controller.h"
 #include "pinball/sim/board.h"
 #include "pinball/sim/game_state.h"
@@ -15,33 +16,63 @@
 
 namespace pinball::control {
 
-/// The spastic flipper behind a simulated camera and the tracker.
-class SimulatedSpasticPlayer {
+/// Any FlipperController behind a simulated camera and the tracker.
+class SimulatedPlayer {
  public:
-  /// Throws std::invalid_argument for a board without a left and a right
-  /// flipper or a bad camera setting.
-  SimulatedSpasticPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
-                         const SpasticConfig& spastic, std::uint64_t seed);
+  /// Borrows `controller` (it must outlive the player). Throws
+  /// std::invalid_argument for a board without a left and a right flipper or
+  /// a bad camera setting. `tracker` overrides the tracker settings derived
+  /// from the board and camera (e.g. a miscalibrated g).
+  SimulatedPlayer(const sim::Board& board, const track::CameraModelConfig& camera, FlipperController& controller,
+                  std::uint64_t seed);
+  SimulatedPlayer(const sim::Board& board, const track::CameraModelConfig& camera, const track::TrackerConfig& tracker,
+                  FlipperController& controller, std::uint64_t seed);
 
   /// One simulation step: expose the camera, feed delivered observations to
-  /// the tracker, and set the flipper commands in `state`.
+  /// the tracker and the controller, and set the flipper commands in `state`.
   void act(sim::GameState& state);
 
   /// The latest tracker output (for traces and tests).
   const track::TrackerOutput& last_output() const { return last_; }
   /// Observations processed.
   std::uint64_t observations() const { return observations_; }
+  /// Board flipper index of tracker flipper f (track::kLeftFlipper / kRightFlipper).
+  int board_index(int f) const { return board_index_[static_cast<std::size_t>(f)]; }
 
  private:
   const sim::Board& board_;
   track::CameraModel camera_;
   track::Tracker tracker_;
-  SpasticController spastic_;
+  FlipperController& controller_;
   std::array<int, 2> board_index_{};  // tracker flipper -> board flipper
   std::array<bool, 2> energized_{};
   bool ball_was_in_play_ = false;
   track::TrackerOutput last_;
   std::uint64_t observations_ = 0;
+};
+
+/// The spastic flipper behind a simulated camera and the tracker.
+class SimulatedSpasticPlayer {
+ public:
+  /// Throws std::invalid_argument for a board without a left and a right
+  /// flipper or a bad camera setting.
+  SimulatedSpasticPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
+                         const SpasticConfig& spastic, std::uint64_t seed)
+      : spastic_(spastic), player_(board, camera, spastic_, seed) {}
+
+  SimulatedSpasticPlayer(const SimulatedSpasticPlayer&) = delete;
+  SimulatedSpasticPlayer& operator=(const SimulatedSpasticPlayer&) = delete;
+
+  /// One simulation step (see SimulatedPlayer::act).
+  void act(sim::GameState& state) { player_.act(state); }
+  /// The latest tracker output (for traces and tests).
+  const track::TrackerOutput& last_output() const { return player_.last_output(); }
+  /// Observations processed.
+  std::uint64_t observations() const { return player_.observations(); }
+
+ private:
+  SpasticController spastic_;
+  SimulatedPlayer player_;
 };
 
 }  // namespace pinball::control

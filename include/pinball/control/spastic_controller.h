@@ -6,6 +6,7 @@
 
 #include <array>
 
+#include "pinball/control/flipper_controller.h"
 #include "pinball/track/tracker.h"
 
 namespace pinball::control {
@@ -17,16 +18,16 @@ struct SpasticConfig {
 };
 
 /// Flipper commands from tracker output.
-class SpasticController {
+class SpasticController final : public FlipperController {
  public:
   explicit SpasticController(const SpasticConfig& config = {}) : config_(config) {}
 
   /// Updates the commands from one tracker update at time now_s.
   /// energized[track::kLeftFlipper] / [track::kRightFlipper] are the solenoid commands.
-  void update(const track::TrackerOutput& output, double now_s, std::array<bool, 2>& energized);
+  void update(const track::TrackerOutput& output, double now_s, std::array<bool, 2>& energized) override;
 
   /// Releases everything and forgets (new ball).
-  void reset(std::array<bool, 2>& energized);
+  void reset(std::array<bool, 2>& energized) override;
 
  private:
   SpasticConfig config_;

@@ -10,6 +10,9 @@ class RunningStats {
  public:
   /// Adds one sample.
   void add(double x);
+  /// Adds every sample of `other` (Chan et al.'s pairwise combination of
+  /// Welford states): the result equals adding the samples one by one, up to rounding.
+  void merge(const RunningStats& other);
 
   /// Number of samples added.
   std::int64_t count() const { return n_; }

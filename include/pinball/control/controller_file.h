@@ -1,0 +1,43 @@
+#pragma once
+// A learned controller on disk: a readable JSON file with a format name and a
+// version (docs/learning.md). Loading is all or nothing: a bad file throws
+// ControllerFileError naming the file and the field.
+
+#include <stdexcept>
+#include <string>
+
+#include "pinball/control/action_function.h"
+#include "pinball/control/actuator_controller.h"
+
+namespace pinball::control {
+
+/// Version written by save_controller and the only one load_controller reads.
+inline constexpr int kControllerFileVersion = 1;
+
+/// Everything a controller file holds.
+struct ControllerSpec {
+  ActionFunction action_function{uniform_partition(4)};  ///< partitions and minicontrollers
+  ActuatorConfig actuator;                            ///< actuator settings
+  double launcher_pull = -1.0;    ///< launcher pull fraction; negative: the board's
+  bool randomise_launch = false;  ///< draw the pull per ball from [launch_pull_min, launch_pull_max] (thesis 7.1)
+  double launch_pull_min = 0.5;   ///< lower end of a randomised pull
+  double launch_pull_max = 1.0;   ///< upper end of a randomised pull
+  std::string note;               ///< free text: how it was produced
+};
+
+/// Bad controller input; what() is "file: field: message".
+class ControllerFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// The controller as JSON text (pretty-printed).
+std::string controller_to_json(const ControllerSpec& spec);
+/// Parses JSON text; `source_name` is used in error messages.
+ControllerSpec controller_from_json(const std::string& text, const std::string& source_name);
+/// Writes a controller file. Throws ControllerFileError when it cannot be written.
+void save_controller(const ControllerSpec& spec, const std::string& path);
+/// Reads a controller file. Throws ControllerFileError for any bad input.
+ControllerSpec load_controller(const std::string& path);
+
+}  // namespace pinball::control

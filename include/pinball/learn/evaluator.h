@@ -1,0 +1,86 @@
+#pragma once
+// The fast learning loop of the design: simulator -> camera model -> tracker
+// -> action function -> flipper commands (with an actuation delay), no
+// threads, no pixels. One ball per call, fully determined by the controller
+// and the ball's seed, so balls can be played on any thread in any order.
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "pinball/control/controller_file.h"
+#include "pinball/control/flipper_controller.h"
+#include "pinball/sim/board.h"
+#include "pinball/sim/thesis_stepper.h"
+#include "pinball/track/camera_model.h"
+
+namespace pinball::learn {
+
+/// One flip opportunity's reward (thesis 6.3.1).
+struct Opportunity {
+  int partition = -1;  ///< the responsible minicontroller
+  double value = 0.0;  ///< score until the next opportunity, or −loss_penalty when the ball was lost
+};
+
+/// Outcome of one ball.
+struct BallOutcome {
+  double score = 0.0;       ///< points scored by this ball
+  double duration_s = 0.0;  ///< simulated time of the ball (s)
+  int flips = 0;            ///< flipper activations
+  bool cut = false;         ///< still alive at the time limit: a cycle
+  std::vector<Opportunity> opportunities;  ///< per flip opportunity, in order
+};
+
+/// A source of balls played by a controller: the pinball evaluator, or a toy
+/// objective in the tests. play() must be safe to call from several threads at once.
+class BallObjective {
+ public:
+  virtual ~BallObjective() = default;
+  /// Plays one ball with controller `spec`; the same (spec, seed) gives the same outcome.
+  virtual BallOutcome play(const control::ControllerSpec& spec, std::uint64_t ball_seed) const = 0;
+  /// A controller of the right shape (partition) to start a search from; its gains are to be replaced.
+  virtual control::ControllerSpec prototype() const = 0;
+};
+
+/// Settings of the pinball evaluator.
+struct EvaluatorConfig {
+  track::CameraModelConfig camera;     ///< the camera the tracker sees through
+  double actuation_delay_s = 0.004;    ///< command to flipper motion (s): the solenoid's rise
+  double max_ball_time_s = 60.0;       ///< a ball alive after this is cut and reported as a cycle
+  double loss_penalty = 500.0;         ///< reward of an opportunity that ended with the ball lost (6.3.1)
+  double gravity_scale = 1.0;          ///< tracker's g / board's g (1: calibrated)
+  double dt_s = 0.0;                   ///< stepper time step; 0: the board's
+  int angle_partitions = 4;            ///< k of prototype()
+  bool partition_by_h = false;         ///< prototype(): also split each angle bin at the middle of the V (7.1)
+  bool rolling_minicontrollers = false;///< prototype(): separate rolling minicontrollers (7.1)
+};
+
+/// Mixes a run seed and a ball index into a ball seed (splitmix64).
+std::uint64_t ball_seed(std::uint64_t run_seed, std::uint64_t index);
+
+/// Plays balls of a board through the camera model and tracker.
+class PinballEvaluator final : public BallObjective {
+ public:
+  /// Borrows the board. Throws std::invalid_argument for bad settings.
+  PinballEvaluator(const sim::Board& board, const EvaluatorConfig& config);
+
+  BallOutcome play(const control::ControllerSpec& spec, std::uint64_t ball_seed) const override;
+  control::ControllerSpec prototype() const override;
+
+  /// Plays one ball with any flipper controller (the baselines); `pull` < 0 takes the board's.
+  BallOutcome play_with(control::FlipperController& controller, double pull, std::uint64_t ball_seed) const;
+
+  /// The settings and the board.
+  const EvaluatorConfig& config() const { return config_; }
+  const sim::Board& board() const { return board_; }
+
+ private:
+  BallOutcome run(control::FlipperController& controller, const control::ActuatorController* actuator, double pull,
+                  std::uint64_t seed) const;
+
+  const sim::Board& board_;
+  EvaluatorConfig config_;
+  sim::ThesisStepper stepper_;
+};
+
+}  // namespace pinball::learn

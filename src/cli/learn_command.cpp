@@ -1,0 +1,256 @@
+// `pinball learn BOARD --method ...`: searches for a flipper controller on the
+// fast learning loop (docs/learning.md), writes it, its learning curve and a
+// plot; or evaluates a baseline or a controller file on fresh balls.
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <array>
+#include <atomic>
+#include <ostream>
+#include <thread>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "pinball/control/controller_file.h"
+#include "pinball/control/spastic_controller.h"
+#include "pinball/core/running_stats.h"
+#include "pinball/learn/cross_entropy.h"
+#include "pinball/learn/evaluator.h"
+#include "pinball/learn/learning_curve.h"
+#include "pinball/learn/parallel_runner.h"
+#include "pinball/learn/relay_race.h"
+#include "pinball/learn/tournament.h"
+#include "pinball/sim/board_loader.h"
+
+namespace pinball::cli {
+
+CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
+  CLI::App* cmd = app.add_subcommand("learn", "learn a flipper controller on the fast loop (or evaluate one)");
+  cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--method", a.method,
+                  "tournament (thesis 6.2), relay (Hoeffding relay race, 6.3), cem (cross-entropy with common "
+                  "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller)")
+      ->required()
+      ->check(CLI::IsMember({"tournament", "relay", "cem", "none", "spastic", "evaluate"}));
+  cmd->add_option("--budget-balls", a.budget_balls, "simulated balls the search may play")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
+  cmd->add_option("--seed", a.seed, "random seed; same seed, same result, whatever --threads");
+  cmd->add_option("--out", a.out, "controller file to write (JSON, docs/learning.md)");
+  cmd->add_option("--controller", a.controller, "evaluate: the controller file")->check(CLI::ExistingFile);
+  cmd->add_option("--threads", a.threads, "worker threads")->check(CLI::Range(1, 256));
+  cmd->add_option("--curve", a.curve, "write the learning curve to this CSV");
+  cmd->add_option("--plot", a.plot, "draw the learning curve to this PNG");
+  cmd->add_option("--eval-balls", a.eval_balls,
+                  "evaluate the result on this many fresh balls (default: 0 after a search, 1000 otherwise)")
+      ->check(CLI::Range(0, 10'000'000));
+  cmd->add_option("--partitions", a.partitions, "k: impact-angle partitions per flipper (uniform)")
+      ->check(CLI::Range(1, 64));
+  cmd->add_flag("--partition-h", a.partition_by_h, "also partition by h (pivot-to-tip | tip-to-V-centre)");
+  cmd->add_flag("--rolling", a.rolling, "a separate minicontroller for a ball rolling on each flipper");
+  cmd->add_flag("--randomise-launch", a.randomise_launch, "draw the launcher pull per ball from [0.5, 1]");
+  cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")->check(CLI::Range(0.01, 1.0));
+  cmd->add_option("--balls-per-controller", a.balls_per_controller, "tournament: balls per controller (b)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--population", a.population, "relay / cem: population size (default 20 / 16)")
+      ->check(CLI::Range(2, 100000));
+  cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball is cut (a cycle)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--loss-penalty", a.loss_penalty, "reward of a flip opportunity that lost the ball (6.3.1)");
+  cmd->add_option("--actuation-delay", a.actuation_delay_s, "command to flipper motion (s)")
+      ->check(CLI::Range(0.0, 0.5));
+  cmd->add_option("--gravity-scale", a.gravity_scale, "tracker's g over the board's (miscalibration)")
+      ->check(CLI::Range(0.1, 10.0));
+  cmd->add_option("--noise-px", a.camera.noise_px, "camera model: centroid noise (px)")->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--fps", a.camera.fps, "camera model: frames per second")->check(CLI::Range(1.0, 10000.0));
+  cmd->add_flag("--json", a.json, "print one JSON object instead of text");
+  return cmd;
+}
+
+namespace {
+
+struct Evaluation {
+  RunningStats score;
+  RunningStats duration_s;
+  RunningStats flips;
+  int cut = 0;
+  double balls_per_s = 0.0;
+};
+
+// Plays `balls` fresh balls (seeds apart from any search's) with one controller.
+Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const control::ControllerSpec* spec,
+                    int balls) {
+  Evaluation e;
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<learn::BallOutcome> out;
+  if (spec != nullptr) {
+    std::vector<learn::BallTask> tasks;
+    for (int i = 0; i < balls; ++i) {
+      tasks.push_back({spec, learn::ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, static_cast<std::uint64_t>(i))});
+    }
+    out = learn::play_balls(ev, tasks, a.threads);
+  } else {  // a baseline that is no ControllerSpec: none or spastic, one ball per task
+    out.resize(static_cast<std::size_t>(balls));
+    std::vector<std::thread> pool;
+    std::atomic<int> next{0};
+    auto worker = [&] {
+      for (int i = next++; i < balls; i = next++) {
+        control::SpasticController spastic;
+        struct Idle final : control::FlipperController {
+          void update(const track::TrackerOutput&, double, std::array<bool, 2>&) override {}
+          void reset(std::array<bool, 2>& e) override { e = {false, false}; }
+        } idle;
+        control::FlipperController& c = a.method == "spastic" ? static_cast<control::FlipperController&>(spastic)
+                                                               : static_cast<control::FlipperController&>(idle);
+        out[static_cast<std::size_t>(i)] =
+            ev.play_with(c, a.pull, learn::ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, static_cast<std::uint64_t>(i)));
+      }
+    };
+    for (int t = 0; t < a.threads; ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (const auto& o : out) {
+    e.score.add(o.score);
+    e.duration_s.add(o.duration_s);
+    e.flips.add(o.flips);
+    e.cut += o.cut ? 1 : 0;
+  }
+  e.balls_per_s = wall > 0.0 ? balls / wall : 0.0;
+  return e;
+}
+
+nlohmann::json to_json(const Evaluation& e) {
+  return {{"balls", e.score.count()},
+          {"mean_score_per_ball", e.score.mean()},
+          {"score_ci95_half_width", e.score.ci95_half_width()},
+          {"score_stddev", e.score.stddev()},
+          {"mean_ball_time_s", e.duration_s.mean()},
+          {"flips_per_ball", e.flips.mean()},
+          {"balls_cut_at_time_limit", e.cut},
+          {"balls_per_s", e.balls_per_s}};
+}
+
+}  // namespace
+
+int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
+  const bool search = a.method == "tournament" || a.method == "relay" || a.method == "cem";
+  if (search && a.out.empty()) throw std::invalid_argument("learn: --out CONTROLLER is required for a search");
+  if (a.method == "evaluate" && a.controller.empty()) throw std::invalid_argument("learn: evaluate needs --controller FILE");
+  const sim::Board board = sim::load_board(a.board);
+  learn::EvaluatorConfig ec;
+  ec.camera = a.camera;
+  ec.actuation_delay_s = a.actuation_delay_s;
+  ec.max_ball_time_s = a.max_ball_time_s;
+  ec.loss_penalty = a.loss_penalty;
+  ec.gravity_scale = a.gravity_scale;
+  ec.angle_partitions = a.partitions;
+  ec.partition_by_h = a.partition_by_h;
+  ec.rolling_minicontrollers = a.rolling;
+
+  // The prototype carries the launcher settings into every candidate.
+  struct Objective final : learn::BallObjective {
+    Objective(const sim::Board& b, const learn::EvaluatorConfig& c, const LearnArgs& args) : ev(b, c), la(args) {}
+    learn::BallOutcome play(const control::ControllerSpec& s, std::uint64_t seed) const override { return ev.play(s, seed); }
+    control::ControllerSpec prototype() const override {
+      control::ControllerSpec s = ev.prototype();
+      s.launcher_pull = la.pull;
+      s.randomise_launch = la.randomise_launch;
+      return s;
+    }
+    learn::PinballEvaluator ev;
+    const LearnArgs& la;
+  } objective(board, ec, a);
+
+  nlohmann::json j = {{"board", a.board}, {"method", a.method}, {"seed", a.seed}, {"threads", a.threads}};
+  control::ControllerSpec result_spec;
+  const control::ControllerSpec* eval_spec = nullptr;
+  if (search) {
+    learn::SearchConfig sc;
+    sc.budget_balls = a.budget_balls;
+    sc.seed = a.seed;
+    sc.threads = a.threads;
+    sc.progress = &err;
+    const std::string cycle_path = a.out + ".cycle.json";
+    double cycle_score = -1e300;  // keep the highest-scoring cycle (a stuck ball scores little)
+    sc.on_cycle = [&](const control::ControllerSpec& spec, const learn::BallOutcome& o) {
+      if (o.score <= cycle_score) return;
+      cycle_score = o.score;
+      control::ControllerSpec s = spec;
+      s.note = "cycle found by pinball learn --method " + a.method + " --seed " + std::to_string(a.seed) +
+               ": ball alive at the time limit with score " + std::to_string(o.score);
+      control::save_controller(s, cycle_path);
+      err << "learn: cycle controller saved to " << cycle_path << "\n";
+    };
+    learn::SearchResult r;
+    if (a.method == "tournament") {
+      learn::TournamentConfig t;
+      t.balls_per_controller = a.balls_per_controller;
+      r = learn::run_tournament(objective, sc, t);
+    } else if (a.method == "relay") {
+      learn::RelayConfig rc;
+      if (a.population > 0) rc.population = a.population;
+      r = learn::run_relay_race(objective, sc, rc);
+    } else {
+      learn::CrossEntropyConfig cc;
+      if (a.population > 0) cc.population = a.population;
+      r = learn::run_cross_entropy(objective, sc, cc);
+    }
+    result_spec = r.best;
+    result_spec.note = "pinball learn " + a.board + " --method " + a.method + " --budget-balls " +
+                       std::to_string(a.budget_balls) + " --seed " + std::to_string(a.seed) + " --partitions " +
+                       std::to_string(a.partitions) + "; estimated mean " + std::to_string(r.best_mean) + " over " +
+                       std::to_string(r.best_balls) + " balls";
+    control::save_controller(result_spec, a.out);
+    if (!a.curve.empty()) learn::write_curve_csv(r, a.curve);
+    if (!a.plot.empty()) learn::plot_curve_png(r, a.plot);
+    eval_spec = &result_spec;
+    nlohmann::json counters = nlohmann::json::object();
+    for (const auto& [name, v] : r.counters) counters[name] = v;
+    j["budget_balls"] = a.budget_balls;
+    j["balls_used"] = r.balls_used;
+    j["generations"] = r.generations;
+    j["best_estimated_mean"] = r.best_mean;
+    j["best_estimated_balls"] = r.best_balls;
+    j["search_wall_s"] = r.wall_s;
+    j["search_balls_per_s"] = r.wall_s > 0 ? static_cast<double>(r.balls_used) / r.wall_s : 0.0;
+    j["cycle_found"] = r.cycle_found;
+    j["counters"] = counters;
+    j["out"] = a.out;
+  } else if (a.method == "evaluate") {
+    result_spec = control::load_controller(a.controller);
+    eval_spec = &result_spec;
+    j["controller"] = a.controller;
+  }
+  const int eval_balls = a.eval_balls > 0 ? a.eval_balls : (search ? 0 : 1000);
+  if (eval_balls > 0) {
+    const Evaluation e = evaluate(objective.ev, a, eval_spec, eval_balls);
+    j["evaluation"] = to_json(e);
+    j["evaluation"]["camera_noise_px"] = a.camera.noise_px;
+    j["evaluation"]["actuation_delay_s"] = a.actuation_delay_s;
+    j["evaluation"]["gravity_scale"] = a.gravity_scale;
+  }
+  if (a.json) {
+    out << j.dump(2) << "\n";
+  } else {
+    out << "learn " << a.method << " on " << a.board << " (seed " << a.seed << ", " << a.threads << " threads)\n";
+    if (search) {
+      out << "balls used       " << j["balls_used"] << " of " << a.budget_balls << " in " << j["generations"]
+          << " generations, " << j["search_balls_per_s"] << " balls/s\n"
+          << "best estimate    " << j["best_estimated_mean"] << " over " << j["best_estimated_balls"] << " balls\n"
+          << "cycle found      " << (j["cycle_found"].get<bool>() ? "yes" : "no") << "\n"
+          << "controller       " << a.out << "\n";
+    }
+    if (j.contains("evaluation")) {
+      const auto& e = j["evaluation"];
+      out << "evaluation       " << e["balls"] << " fresh balls: " << e["mean_score_per_ball"] << " +/- "
+          << e["score_ci95_half_width"] << " per ball (95 %), " << e["mean_ball_time_s"] << " s per ball, "
+          << e["flips_per_ball"] << " flips per ball, " << e["balls_per_s"] << " balls/s\n";
+    }
+  }
+  return 0;
+}
+
+}  // namespace pinball::cli

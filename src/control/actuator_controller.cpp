@@ -1,0 +1,40 @@
+#include "pinball/control/actuator_controller.h"
+
+namespace pinball::control {
+
+ActuatorController::ActuatorController(ActionFunction action_function, const ActuatorConfig& config)
+    : action_(std::move(action_function)), config_(config) {}
+
+void ActuatorController::reset(std::array<bool, 2>& energized) {
+  energized = {false, false};
+  fired_ = false;
+  responsible_ = -1;
+  held_since_s_ = {0.0, 0.0};
+}
+
+void ActuatorController::update(const track::TrackerOutput& out, double now_s, std::array<bool, 2>& energized) {
+  if (out.launch.launched || out.launch.lost) {  // 5.2.3: release on launch or loss
+    reset(energized);
+    return;
+  }
+  if (config_.max_hold_s > 0.0) {
+    for (int f = 0; f < 2; ++f) {
+      if (energized[f] && now_s - held_since_s_[f] > config_.max_hold_s) {
+        energized[f] = false;  // a cradled ball: drop the coil and allow a new approach
+        fired_ = false;
+      }
+    }
+  }
+  const track::TrajectoryProjection& p = out.projection;
+  if (!p.valid || !p.hittable) return;
+  const Action act = action_.action(p);
+  responsible_ = act.partition;
+  if (!fired_ && p.d_m <= act.d_critical_m) {
+    energized[act.flipper] = true;
+    held_since_s_[act.flipper] = now_s;
+    fired_ = true;
+    ++fires_;
+  }
+}
+
+}  // namespace pinball::control

@@ -1,0 +1,58 @@
+#include "pinball/control/launcher_controller.h"
+
+#include <stdexcept>
+
+#include "pinball/control/simulated_player.h"
+#include "pinball/sim/ball_runner.h"
+#include "pinball/sim/thesis_stepper.h"
+
+namespace pinball::control {
+
+namespace {
+
+// Never flips; remembers whether the tracker ever saw a hittable state.
+class HittableWatcher final : public FlipperController {
+ public:
+  void update(const track::TrackerOutput& out, double, std::array<bool, 2>&) override {
+    if (out.projection.valid && out.projection.hittable) hittable = true;
+  }
+  void reset(std::array<bool, 2>& energized) override { energized = {false, false}; }
+  bool hittable = false;
+};
+
+}  // namespace
+
+LauncherSearchResult search_launcher(const sim::Board& board, const LauncherSearchConfig& config) {
+  if (config.pulls < 1 || config.launches_per_pull < 1 || !(config.time_limit_s > 0.0)) {
+    throw std::invalid_argument("launcher search: pulls and launches must be >= 1 and the time limit > 0");
+  }
+  const sim::ThesisStepper stepper(board);
+  LauncherSearchResult result;
+  result.best_successes = -1;
+  for (int i = 1; i <= config.pulls; ++i) {
+    const double pull = static_cast<double>(i) / config.pulls;
+    int successes = 0;
+    for (int l = 0; l < config.launches_per_pull; ++l) {
+      const std::uint64_t seed = config.seed * 1000003ull + static_cast<std::uint64_t>(i * 1000 + l);
+      sim::GameState state = sim::make_game_state(board, seed);
+      HittableWatcher watcher;
+      SimulatedPlayer player(board, config.camera, watcher, seed ^ 0x9E3779B97F4A7C15ull);
+      sim::BallLimits limits;
+      limits.max_ball_time_s = config.time_limit_s;
+      limits.pull = pull;
+      sim::play_ball(
+          stepper, state, limits, [&](sim::GameState& s) { player.act(s); },
+          [&](const sim::GameState&, const sim::StepEvents&) {});
+      successes += watcher.hittable ? 1 : 0;
+    }
+    result.pull.push_back(pull);
+    result.successes.push_back(successes);
+    if (successes > result.best_successes) {
+      result.best_successes = successes;
+      result.best_pull = pull;
+    }
+  }
+  return result;
+}
+
+}  // namespace pinball::control

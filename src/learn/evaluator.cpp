@@ -1,0 +1,178 @@
+#include "pinball/learn/evaluator.h"
+
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+#include "pinball/control/actuator_controller.h"
+#include "pinball/control/simulated_player.h"
+#include "pinball/sim/ball_runner.h"
+
+namespace pinball::learn {
+
+std::uint64_t ball_seed(std::uint64_t run_seed, std::uint64_t index) {
+  std::uint64_t z = run_seed * 0x9E3779B97F4A7C15ull + index + 0x632BE59BD9B4E019ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+namespace {
+
+sim::ThesisStepperOptions stepper_options(const EvaluatorConfig& c) {
+  sim::ThesisStepperOptions o;
+  o.dt_s = c.dt_s;
+  return o;
+}
+
+// Wraps the controller and books flip opportunities (thesis 6.3.1): an
+// opportunity opens with the first hittable projection after a launch, is
+// charged to the latest responsible partition, and earns the score until the
+// next one opens, or −penalty if the ball is lost first.
+class OpportunityBook final : public control::FlipperController {
+ public:
+  OpportunityBook(control::FlipperController& inner, const control::ActuatorController* actuator,
+                  const double& score, std::vector<Opportunity>& out)
+      : inner_(inner), actuator_(actuator), score_(score), out_(out) {}
+
+  void update(const track::TrackerOutput& o, double now_s, std::array<bool, 2>& energized) override {
+    inner_.update(o, now_s, energized);
+    if (actuator_ == nullptr) return;
+    if (o.launch.launched || o.launch.lost) {
+      approach_open_ = false;
+      return;
+    }
+    const int p = actuator_->responsible_partition();
+    if (o.projection.valid && o.projection.hittable && p >= 0) {
+      if (!approach_open_) {
+        if (active_) out_.push_back({partition_, score_ - start_});
+        active_ = true;
+        approach_open_ = true;
+        start_ = score_;
+      }
+      partition_ = p;
+    }
+  }
+  void reset(std::array<bool, 2>& energized) override {
+    inner_.reset(energized);
+    approach_open_ = false;
+  }
+  void finish(bool lost, double penalty) {
+    if (active_) out_.push_back({partition_, lost ? -penalty : score_ - start_});
+    active_ = false;
+  }
+
+ private:
+  control::FlipperController& inner_;
+  const control::ActuatorController* actuator_;
+  const double& score_;
+  std::vector<Opportunity>& out_;
+  bool active_ = false;
+  bool approach_open_ = false;
+  int partition_ = -1;
+  double start_ = 0.0;
+};
+
+// Commands reach the flippers `delay_s` after they are given.
+class DelayLine {
+ public:
+  explicit DelayLine(double delay_s) : delay_s_(delay_s) {}
+  void apply(sim::GameState& s) {
+    if (delay_s_ <= 0.0) return;
+    for (std::size_t i = 0; i < 2 && i < s.flippers.size(); ++i) {
+      Line& l = lines_[i];
+      const bool want = s.flippers[i].energized;
+      if (want != l.last_command && l.size < kSize) {
+        l.pending[(l.head + l.size) % kSize] = {s.time_s + delay_s_, want};
+        ++l.size;
+        l.last_command = want;
+      }
+      while (l.size > 0 && l.pending[l.head].first <= s.time_s + 1e-12) {
+        l.output = l.pending[l.head].second;
+        l.head = (l.head + 1) % kSize;
+        --l.size;
+      }
+      s.flippers[i].energized = l.output;
+    }
+  }
+
+ private:
+  static constexpr std::size_t kSize = 16;
+  struct Line {
+    std::array<std::pair<double, bool>, kSize> pending{};
+    std::size_t head = 0;
+    std::size_t size = 0;
+    bool last_command = false;
+    bool output = false;
+  };
+  double delay_s_;
+  std::array<Line, 2> lines_{};
+};
+
+}  // namespace
+
+PinballEvaluator::PinballEvaluator(const sim::Board& board, const EvaluatorConfig& config)
+    : board_(board), config_(config), stepper_(board, stepper_options(config)) {
+  if (!(config.actuation_delay_s >= 0.0 && config.actuation_delay_s < 1.0)) {
+    throw std::invalid_argument("evaluator: actuation delay must be in [0, 1) s");
+  }
+  if (!(config.max_ball_time_s > 0.0)) throw std::invalid_argument("evaluator: max ball time must be > 0");
+  if (!(config.gravity_scale > 0.0)) throw std::invalid_argument("evaluator: gravity scale must be > 0");
+  if (!std::isfinite(config.loss_penalty)) throw std::invalid_argument("evaluator: loss penalty must be finite");
+  track::CameraModel check(config.camera, 0);  // throws for a bad camera
+  (void)check;
+}
+
+control::ControllerSpec PinballEvaluator::prototype() const {
+  control::ActionFunctionConfig c = control::uniform_partition(config_.angle_partitions);
+  if (config_.partition_by_h) c.h_borders = {1.0};  // pivot to tip | beyond the tip towards the V's centre
+  c.rolling_minicontrollers = config_.rolling_minicontrollers;
+  control::ControllerSpec spec;
+  spec.action_function = control::ActionFunction(c);
+  return spec;
+}
+
+BallOutcome PinballEvaluator::play(const control::ControllerSpec& spec, std::uint64_t seed) const {
+  control::ActuatorController actuator(spec.action_function, spec.actuator);
+  double pull = spec.launcher_pull;
+  if (spec.randomise_launch) {
+    Rng rng(seed ^ 0xA5A5A5A5DEADBEEFull);
+    pull = rng.uniform(spec.launch_pull_min, spec.launch_pull_max);
+  }
+  return run(actuator, &actuator, pull, seed);
+}
+
+BallOutcome PinballEvaluator::play_with(control::FlipperController& controller, double pull,
+                                        std::uint64_t seed) const {
+  return run(controller, nullptr, pull, seed);
+}
+
+BallOutcome PinballEvaluator::run(control::FlipperController& controller,
+                                  const control::ActuatorController* actuator, double pull,
+                                  std::uint64_t seed) const {
+  BallOutcome outcome;
+  sim::GameState state = sim::make_game_state(board_, seed);
+  OpportunityBook book(controller, actuator, state.score, outcome.opportunities);
+  track::TrackerConfig tracker = track::default_tracker_config(board_, config_.camera);
+  tracker.g_mps2 *= config_.gravity_scale;
+  control::SimulatedPlayer player(board_, config_.camera, tracker, book, seed ^ 0x5DEECE66Dull);
+  DelayLine delay(config_.actuation_delay_s);
+  sim::BallLimits limits;
+  limits.max_ball_time_s = config_.max_ball_time_s;
+  limits.pull = pull;
+  const sim::BallResult r = sim::play_ball(
+      stepper_, state, limits,
+      [&](sim::GameState& s) {
+        player.act(s);
+        delay.apply(s);
+      },
+      [](const sim::GameState&, const sim::StepEvents&) {});
+  book.finish(!r.cut, config_.loss_penalty);
+  outcome.score = r.score;
+  outcome.duration_s = r.duration_s;
+  outcome.flips = r.flips;
+  outcome.cut = r.cut;
+  return outcome;
+}
+
+}  // namespace pinball::learn

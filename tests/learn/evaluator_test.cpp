@@ -1,0 +1,80 @@
+#include "pinball/learn/evaluator.h"
+
+#include <gtest/gtest.h>
+
+#include "pinball/control/spastic_controller.h"
+#include "pinball/sim/board_loader.h"
+
+namespace pinball::learn {
+namespace {
+
+const sim::Board& mit1993() {
+  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  return board;
+}
+
+control::ControllerSpec spastic_like(const PinballEvaluator& ev) {
+  control::ControllerSpec s = ev.prototype();
+  for (int p = 0; p < s.action_function.partitions(); ++p) {
+    s.action_function.minicontroller(p).a = {0.0, 0.0, 0.0, 0.02};
+    s.action_function.minicontroller(p).flipper = p < s.action_function.partitions() / 2 ? 0 : 1;
+  }
+  return s;
+}
+
+TEST(Evaluator, SameSeedSameBall) {
+  const PinballEvaluator ev(mit1993(), EvaluatorConfig{});
+  const control::ControllerSpec s = spastic_like(ev);
+  const BallOutcome a = ev.play(s, 11);
+  const BallOutcome b = ev.play(s, 11);
+  EXPECT_EQ(a.score, b.score);
+  EXPECT_EQ(a.duration_s, b.duration_s);
+  EXPECT_EQ(a.flips, b.flips);
+  EXPECT_EQ(a.opportunities.size(), b.opportunities.size());
+}
+
+TEST(Evaluator, OpportunitiesCarryScoreAndTheLossPenalty) {
+  EvaluatorConfig c;
+  c.loss_penalty = 777.0;
+  const PinballEvaluator ev(mit1993(), c);
+  const control::ControllerSpec s = spastic_like(ev);
+  int balls_with_opportunities = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const BallOutcome o = ev.play(s, seed);
+    EXPECT_FALSE(o.cut);
+    if (o.opportunities.empty()) continue;
+    ++balls_with_opportunities;
+    EXPECT_EQ(o.opportunities.back().value, -777.0) << "the last opportunity lost the ball";
+    double sum = 0.0;
+    for (std::size_t i = 0; i + 1 < o.opportunities.size(); ++i) {
+      EXPECT_GE(o.opportunities[i].value, 0.0);
+      EXPECT_GE(o.opportunities[i].partition, 0);
+      EXPECT_LT(o.opportunities[i].partition, s.action_function.partitions());
+      sum += o.opportunities[i].value;
+    }
+    EXPECT_LE(sum, o.score);  // score before the first opportunity is nobody's
+  }
+  EXPECT_GT(balls_with_opportunities, 5);
+}
+
+TEST(Evaluator, FlippingBeatsNotFlippingAndAGameIsCutAtTheTimeLimit) {
+  EvaluatorConfig c;
+  c.max_ball_time_s = 2.0;
+  const PinballEvaluator ev(mit1993(), c);
+  control::SpasticController spastic;
+  int cut = 0;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) cut += ev.play_with(spastic, -1.0, seed).cut ? 1 : 0;
+  EXPECT_GT(cut, 0) << "balls alive at 2 s are cut and reported";
+  EvaluatorConfig bad;
+  bad.max_ball_time_s = -1.0;
+  EXPECT_THROW(PinballEvaluator(mit1993(), bad), std::invalid_argument);
+}
+
+TEST(Evaluator, BallSeedsAreDistinct) {
+  EXPECT_NE(ball_seed(1, 0), ball_seed(1, 1));
+  EXPECT_NE(ball_seed(1, 0), ball_seed(2, 0));
+  EXPECT_EQ(ball_seed(3, 4), ball_seed(3, 4));
+}
+
+}  // namespace
+}  // namespace pinball::learn
