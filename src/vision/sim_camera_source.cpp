@@ -104,6 +104,9 @@ SimCameraSource::SimCameraSource(const sim::Board& board, const SimCameraConfig&
     require(p.polygon_board.size() >= 3 && p.opacity >= 0.0 && p.opacity <= 1.0 && p.gray >= 0.0 && p.gray <= 255.0,
             "a plastic needs >= 3 vertices, opacity in [0, 1] and gray in [0, 255]");
   }
+  require(c.flipper_gray >= 0.0 && c.flipper_gray <= 255.0 && c.flipper_width_m > 0.0,
+          "flipper_gray must be in [0, 255] and flipper_width_m > 0");
+  for (const sim::Flipper& f : board.flippers) flipper_theta_.push_back(f.theta_min_rad);
   period_s_ = 1.0 / c.fps;
   next_exposure_s_ = c.first_exposure_s;
   build_floor();
@@ -126,7 +129,10 @@ void SimCameraSource::build_floor() {
   ro.px_per_m = homography_.px_per_m_at(Vec2{0.5 * board_.width_m, 0.5 * board_.height_m}) * config_.supersample;
   ro.margin_px = 12 * config_.supersample;
   ro.draw_hud = false;
-  const cv::Mat drawing = sim::render_board(board_, nullptr, ro);
+  // Flippers move: they are drawn per frame at their angle, not into the floor.
+  sim::Board without_flippers = board_;
+  without_flippers.flippers.clear();
+  const cv::Mat drawing = sim::render_board(without_flippers, nullptr, ro);
   cv::Mat gray;
   cv::cvtColor(drawing, gray, cv::COLOR_BGR2GRAY);
 
@@ -250,6 +256,25 @@ void SimCameraSource::build_noise() {
     const double n = std::clamp(std::round(config_.noise_sigma * rng_.normal()), -127.0, 127.0);
     if (n > 0) noise_pos_[i] = static_cast<std::uint8_t>(n);
     if (n < 0) noise_neg_[i] = static_cast<std::uint8_t>(-n);
+  }
+}
+
+void SimCameraSource::observe(const sim::GameState& state) {
+  for (std::size_t i = 0; i < flipper_theta_.size() && i < state.flippers.size(); ++i) {
+    flipper_theta_[i] = state.flippers[i].theta_rad;
+  }
+  observe_ball(state.time_s, state.ball.position_m, state.ball_in_play);
+}
+
+void SimCameraSource::draw_flippers(cv::Mat& image) const {
+  for (std::size_t i = 0; i < flipper_theta_.size(); ++i) {
+    const sim::Flipper& f = board_.flippers[i];
+    const cv::Point2d a = homography_.image_from_board(f.pivot);
+    const cv::Point2d b = homography_.image_from_board(sim::flipper_tip(f, flipper_theta_[i]));
+    const int width_px = std::max(1, static_cast<int>(std::lround(config_.flipper_width_m * homography_.px_per_m_at(f.pivot))));
+    cv::line(image, cv::Point(static_cast<int>(std::lround(a.x)), static_cast<int>(std::lround(a.y))),
+             cv::Point(static_cast<int>(std::lround(b.x)), static_cast<int>(std::lround(b.y))),
+             cv::Scalar(config_.flipper_gray), width_px, cv::LINE_AA);
   }
 }
 
@@ -384,6 +409,7 @@ void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, 
     cv::add(target, lamps_[i].values, target);
     ++truth_.lamps_lit;
   }
+  draw_flippers(image);
   truth_.ball_present = !path_board.empty();
   truth_.ball_whole_exposure = !path_board.empty() && static_cast<int>(path_board.size()) == path_total;
   if (!path_board.empty()) draw_ball(path_board, path_total, image);

@@ -7,6 +7,7 @@
 
 #include "pinball/core/rng.h"
 #include "pinball/sim/board_loader.h"
+#include "pinball/sim/game_state.h"
 #include "pinball/vision/sim_camera_source.h"
 
 namespace pinball::vision {
@@ -254,6 +255,27 @@ TEST(BallDetector, RoiFollowsTheBallThenTheWholeFrameRecoversIt) {
   ASSERT_TRUE(d.found);
   EXPECT_FALSE(d.from_roi);
   EXPECT_LT(s.error_px(d), 0.5);
+}
+
+TEST(BallDetector, ARaisedFlipperIsNeverTakenForTheBall) {
+  Scene s;  // background learned with the flippers down
+  sim::GameState state = sim::make_game_state(mit1993(), 1);
+  state.ball_in_play = false;
+  for (auto& f : state.flippers) f.theta_rad = mit1993().flippers[0].theta_max_rad;
+  int frames = 0;
+  double changed = 0.0;
+  for (int step = 1; step <= 200; ++step) {
+    state.time_s = s.t_s + step * 0.0005;
+    s.camera.observe(state);
+    while (s.camera.read(s.frame)) {
+      ++frames;
+      const Detection d = s.detector.detect(s.frame);
+      EXPECT_FALSE(d.found) << "a raised flipper reported as the ball at frame " << frames;
+      changed = std::max(changed, cv::norm(s.frame.gray, s.detector.background().image(), cv::NORM_L1));
+    }
+  }
+  EXPECT_GT(frames, 10);
+  EXPECT_GT(changed, 1e4) << "the raised flippers must show in the image";
 }
 
 TEST(BallDetector, RejectsBadSettings) {

@@ -54,6 +54,8 @@ struct SimCameraConfig {
   int clutter_shapes = 80;          ///< playfield art: random shapes drawn on the table
   double clutter_contrast = 28.0;   ///< their brightness offset, up to ± this (gray levels)
   double ball_gray = 215.0;         ///< ball body brightness (gray levels)
+  double flipper_gray = 185.0;      ///< flipper brightness (gray levels); drawn at their current angle
+  double flipper_width_m = 0.012;   ///< flipper width as seen from above (m)
   double ball_limb_darkening = 0.35;///< brightness lost at the ball's rim (fraction)
   double highlight_gray = 255.0;    ///< specular highlight peak
   Vec2 highlight_offset{-0.3, 0.3}; ///< highlight centre from the ball centre, in ball radii (board frame)
@@ -92,7 +94,7 @@ class SimCameraSource final : public FrameSource {
   SimCameraSource(const sim::Board& board, const SimCameraConfig& config);
 
   /// Feeds the simulator's state after a step (call every step, time increasing).
-  void observe(const sim::GameState& state) { observe_ball(state.time_s, state.ball.position_m, state.ball_in_play); }
+  void observe(const sim::GameState& state);
   /// The same from a bare ball position: `in_play` false means no ball in view.
   void observe_ball(double t_s, const Vec2& p_board, bool in_play);
 
@@ -141,6 +143,8 @@ class SimCameraSource final : public FrameSource {
     cv::Rect roi;
     cv::Mat values;  // CV_8U: lamp delta, glare delta, or plastic alpha
   };
+  void draw_flippers(cv::Mat& image) const;
+
   static constexpr std::size_t kHistory = 2048;
   static constexpr std::size_t kMaxPath = 64;
 
@@ -158,6 +162,7 @@ class SimCameraSource final : public FrameSource {
   SimCameraConfig config_;
   CameraHomography homography_;
   Rng rng_;
+  std::vector<double> flipper_theta_;  // latest angle per board flipper (sized once)
   cv::Mat floor_;          // CV_8U static scene: drawing, clutter, unlit lamps
   cv::Mat occluder_mask_;  // CV_8U
   std::vector<Patch> lamps_;
