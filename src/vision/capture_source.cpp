@@ -117,13 +117,9 @@ bool CaptureSource::read(Frame& out) {
   const bool use_driver = have_driver;
   const double stamp_s = use_driver ? out.driver_t_s : now_s;
   if (have_last_ && (use_driver || is_device_)) {
-    const double period_s = 1.0 / fps_;
-    const double gap_s = stamp_s - last_stamp_s_;
-    if (gap_s > 1.5 * period_s) {
-      const auto missing = static_cast<std::uint64_t>(std::llround(gap_s / period_s)) - 1;
-      counters_.dropped += missing;
-      sequence_ += missing;
-    }
+    const std::uint64_t missing = frames_dropped_between(last_stamp_s_, stamp_s, 1.0 / fps_);
+    counters_.dropped += missing;
+    sequence_ += missing;
   }
   if (use_driver || is_device_) {
     last_stamp_s_ = stamp_s;
@@ -132,6 +128,12 @@ bool CaptureSource::read(Frame& out) {
   out.sequence = sequence_++;
   ++counters_.frames;
   return true;
+}
+
+std::uint64_t frames_dropped_between(double previous_s, double current_s, double period_s) {
+  const double gap_s = current_s - previous_s;
+  if (!(period_s > 0.0) || !(gap_s > 1.5 * period_s)) return 0;
+  return static_cast<std::uint64_t>(std::llround(gap_s / period_s)) - 1;
 }
 
 }  // namespace pinball::vision

@@ -157,5 +157,15 @@ TEST(CaptureSource, VideoFileGivesTheSameDetectionsAsTheFramesItCameFrom) {
   fs::remove(path);
 }
 
+TEST(CaptureSource, CountsFramesMissingFromTimestampGaps) {
+  constexpr double kPeriod = 0.005;  // 200 fps
+  EXPECT_EQ(frames_dropped_between(1.000, 1.005, kPeriod), 0u);
+  EXPECT_EQ(frames_dropped_between(1.000, 1.007, kPeriod), 0u);  // jitter under 1.5 periods
+  EXPECT_EQ(frames_dropped_between(1.000, 1.010, kPeriod), 1u);
+  EXPECT_EQ(frames_dropped_between(1.000, 1.021, kPeriod), 3u);
+  EXPECT_EQ(frames_dropped_between(1.000, 0.990, kPeriod), 0u);  // clock went back: nothing counted
+  EXPECT_EQ(frames_dropped_between(1.000, 2.000, 0.0), 0u);
+}
+
 }  // namespace
 }  // namespace pinball::vision

@@ -30,6 +30,10 @@ struct CaptureConfig {
 /// True when `source` names a V4L2 device (a number or a /dev/ path) rather than a file.
 bool is_device_source(const std::string& source);
 
+/// Frames lost between two frames stamped previous_s and current_s at a
+/// nominal period: a gap above 1.5 periods counts round(gap / period) − 1.
+std::uint64_t frames_dropped_between(double previous_s, double current_s, double period_s);
+
 /// OpenCV capture of a device or a file.
 class CaptureSource final : public FrameSource {
  public:
