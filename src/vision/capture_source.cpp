@@ -40,7 +40,18 @@ CaptureSource::CaptureSource(const CaptureConfig& config) : config_(config) {
     if (all_digits(src)) {
       opened = capture_.open(std::stoi(src), cv::CAP_V4L2);
     } else {
-      opened = capture_.open(src, is_device_ ? cv::CAP_V4L2 : cv::CAP_ANY);
+      if (is_device_) {
+        opened = capture_.open(src, cv::CAP_V4L2);
+      } else {
+        // Files: the decoders that read files, not every backend (CAP_ANY also
+        // probes camera plugins, which log noise and leak in libusb).
+        for (const int api : {cv::CAP_FFMPEG, cv::CAP_OPENCV_MJPEG}) {
+          if (capture_.open(src, api)) {
+            opened = true;
+            break;
+          }
+        }
+      }
     }
   } catch (const cv::Exception& e) {
     throw std::runtime_error("capture: cannot open " + std::string(is_device_ ? "camera device '" : "video file '") +
