@@ -4,14 +4,12 @@
 
 #include "pinball/sim/board_loader.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "common/thesis_board.h"
 
 namespace pinball::control {
 namespace {
 
-const sim::Board& thesis_board() {
-  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  return board;
-}
+using pinball::testing::thesis_board;
 
 // Holds the left button from t = 0.2 s to 0.5 s and records when the flipper
 // command (after the CAN path) turns on and off.

@@ -9,16 +9,14 @@
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/board_loader.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "common/thesis_board.h"
 
 namespace pinball::control {
 namespace {
 
 constexpr int kBalls = 20;
 
-const sim::Board& mit1993() {
-  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  return board;
-}
+using pinball::testing::thesis_board;
 
 sim::BallLimits limits() {
   sim::BallLimits l;
@@ -35,11 +33,11 @@ struct Totals {
 
 // One ball per seed, seeds 1..kBalls, with the tracked spastic player.
 Totals play_tracked(const track::CameraModelConfig& camera) {
-  const sim::ThesisStepper stepper(mit1993());
+  const sim::ThesisStepper stepper(thesis_board());
   Totals t;
   for (int seed = 1; seed <= kBalls; ++seed) {
-    sim::GameState s = sim::make_game_state(mit1993(), static_cast<std::uint64_t>(seed));
-    SimulatedSpasticPlayer player(mit1993(), camera, SpasticConfig{}, static_cast<std::uint64_t>(seed));
+    sim::GameState s = sim::make_game_state(thesis_board(), static_cast<std::uint64_t>(seed));
+    SimulatedSpasticPlayer player(thesis_board(), camera, SpasticConfig{}, static_cast<std::uint64_t>(seed));
     const sim::BallResult r = sim::play_ball(
         stepper, s, limits(), [&](sim::GameState& st) { player.act(st); },
         [](const sim::GameState&, const sim::StepEvents&) {});
@@ -53,10 +51,10 @@ Totals play_tracked(const track::CameraModelConfig& camera) {
 
 // The same balls with nobody at the buttons.
 Totals play_idle() {
-  const sim::ThesisStepper stepper(mit1993());
+  const sim::ThesisStepper stepper(thesis_board());
   Totals t;
   for (int seed = 1; seed <= kBalls; ++seed) {
-    sim::GameState s = sim::make_game_state(mit1993(), static_cast<std::uint64_t>(seed));
+    sim::GameState s = sim::make_game_state(thesis_board(), static_cast<std::uint64_t>(seed));
     const sim::BallResult r = sim::play_ball(
         stepper, s, limits(), [](sim::GameState&) {}, [](const sim::GameState&, const sim::StepEvents&) {});
     t.score += r.score;
@@ -93,13 +91,13 @@ TEST(SimulatedSpasticPlayer, SeesTheBallOnlyThroughTheCamera) {
   // Two identical players: one acts on the true state, the other on a copy
   // whose velocity (which no camera measures) is NaN. Their commands must
   // agree at every step: nothing but the position reaches the tracker.
-  const sim::ThesisStepper stepper(mit1993());
+  const sim::ThesisStepper stepper(thesis_board());
   track::CameraModelConfig camera;
   camera.latency_s = 0.010;
   for (int seed = 1; seed <= 3; ++seed) {
-    sim::GameState s = sim::make_game_state(mit1993(), static_cast<std::uint64_t>(seed));
-    SimulatedSpasticPlayer truth(mit1993(), camera, SpasticConfig{}, 7);
-    SimulatedSpasticPlayer blind(mit1993(), camera, SpasticConfig{}, 7);
+    sim::GameState s = sim::make_game_state(thesis_board(), static_cast<std::uint64_t>(seed));
+    SimulatedSpasticPlayer truth(thesis_board(), camera, SpasticConfig{}, 7);
+    SimulatedSpasticPlayer blind(thesis_board(), camera, SpasticConfig{}, 7);
     long steps = 0;
     long disagreements = 0;
     long energized_steps = 0;
@@ -128,7 +126,7 @@ TEST(SimulatedSpasticPlayer, SeesTheBallOnlyThroughTheCamera) {
 }
 
 TEST(SimulatedSpasticPlayer, BallOutOfPlayReleasesTheFlippersAndSeesNothing) {
-  const sim::Board& b = mit1993();
+  const sim::Board& b = thesis_board();
   sim::GameState s = sim::make_game_state(b, 1);
   SimulatedSpasticPlayer player(b, track::CameraModelConfig{}, SpasticConfig{}, 1);
   ASSERT_FALSE(s.ball_in_play);
@@ -144,8 +142,8 @@ TEST(SimulatedSpasticPlayer, BallOutOfPlayReleasesTheFlippersAndSeesNothing) {
 TEST(SimulatedSpasticPlayer, BadSettingsThrow) {
   track::CameraModelConfig bad;
   bad.fps = 0.0;
-  EXPECT_THROW(SimulatedSpasticPlayer(mit1993(), bad, SpasticConfig{}, 1), std::invalid_argument);
-  sim::Board one = mit1993();
+  EXPECT_THROW(SimulatedSpasticPlayer(thesis_board(), bad, SpasticConfig{}, 1), std::invalid_argument);
+  sim::Board one = thesis_board();
   one.flippers.pop_back();
   EXPECT_THROW(SimulatedSpasticPlayer(one, track::CameraModelConfig{}, SpasticConfig{}, 1), std::invalid_argument);
 }

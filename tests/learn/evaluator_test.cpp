@@ -4,14 +4,12 @@
 
 #include "pinball/control/spastic_controller.h"
 #include "pinball/sim/board_loader.h"
+#include "common/thesis_board.h"
 
 namespace pinball::learn {
 namespace {
 
-const sim::Board& mit1993() {
-  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  return board;
-}
+using pinball::testing::thesis_board;
 
 control::ControllerSpec spastic_like(const PinballEvaluator& ev) {
   control::ControllerSpec s = ev.prototype();
@@ -23,7 +21,7 @@ control::ControllerSpec spastic_like(const PinballEvaluator& ev) {
 }
 
 TEST(Evaluator, SameSeedSameBall) {
-  const PinballEvaluator ev(mit1993(), EvaluatorConfig{});
+  const PinballEvaluator ev(thesis_board(), EvaluatorConfig{});
   const control::ControllerSpec s = spastic_like(ev);
   const BallOutcome a = ev.play(s, 11);
   const BallOutcome b = ev.play(s, 11);
@@ -36,7 +34,7 @@ TEST(Evaluator, SameSeedSameBall) {
 TEST(Evaluator, OpportunitiesCarryScoreAndTheLossPenalty) {
   EvaluatorConfig c;
   c.loss_penalty = 777.0;
-  const PinballEvaluator ev(mit1993(), c);
+  const PinballEvaluator ev(thesis_board(), c);
   const control::ControllerSpec s = spastic_like(ev);
   int balls_with_opportunities = 0;
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
@@ -60,14 +58,14 @@ TEST(Evaluator, OpportunitiesCarryScoreAndTheLossPenalty) {
 TEST(Evaluator, FlippingBeatsNotFlippingAndAGameIsCutAtTheTimeLimit) {
   EvaluatorConfig c;
   c.max_ball_time_s = 2.0;
-  const PinballEvaluator ev(mit1993(), c);
+  const PinballEvaluator ev(thesis_board(), c);
   control::SpasticController spastic;
   int cut = 0;
   for (std::uint64_t seed = 1; seed <= 5; ++seed) cut += ev.play_with(spastic, -1.0, seed).cut ? 1 : 0;
   EXPECT_GT(cut, 0) << "balls alive at 2 s are cut and reported";
   EvaluatorConfig bad;
   bad.max_ball_time_s = -1.0;
-  EXPECT_THROW(PinballEvaluator(mit1993(), bad), std::invalid_argument);
+  EXPECT_THROW(PinballEvaluator(thesis_board(), bad), std::invalid_argument);
 }
 
 TEST(Evaluator, BallSeedsAreDistinct) {

@@ -8,14 +8,12 @@
 #include "pinball/sim/oracle_policy.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "common/thesis_board.h"
 
 namespace pinball::sim {
 namespace {
 
-const Board& thesis_board() {
-  static const Board board = load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  return board;
-}
+using pinball::testing::thesis_board;
 
 // Plays `seconds` of game with the spastic flipper, relaunching lost balls,
 // and folds every step's state into one hash.

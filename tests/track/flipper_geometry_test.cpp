@@ -7,14 +7,12 @@
 #include <stdexcept>
 
 #include "pinball/sim/board_loader.h"
+#include "common/thesis_board.h"
 
 namespace pinball::track {
 namespace {
 
-const sim::Board& mit1993() {
-  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  return board;
-}
+using pinball::testing::thesis_board;
 
 TEST(MakeFlipperGeometry, SymmetricPairByHand) {
   // Left from (-2, 0) to (-1, -1), right from (2, 0) to (1, -1): the lines
@@ -49,7 +47,7 @@ TEST(MakeFlipperGeometry, ParallelOrDivergingLinesThrow) {
 }
 
 TEST(FlipperGeometryFromBoard, Mit1993) {
-  const FlipperGeometry g = flipper_geometry_from_board(mit1993());
+  const FlipperGeometry g = flipper_geometry_from_board(thesis_board());
   // flipper left 165 160 76 -25 ... / right 345 160 76 -25 (mm, degrees).
   const double c = std::cos(25.0 * std::numbers::pi / 180.0);
   const double s = std::sin(25.0 * std::numbers::pi / 180.0);
@@ -70,7 +68,7 @@ TEST(FlipperGeometryFromBoard, Mit1993) {
 }
 
 TEST(FlipperGeometryFromBoard, AssignsSidesWhateverTheFileOrder) {
-  sim::Board b = mit1993();
+  sim::Board b = thesis_board();
   std::swap(b.flippers[0], b.flippers[1]);  // right first
   const FlipperGeometry g = flipper_geometry_from_board(b);
   EXPECT_NEAR(g.lines[kLeftFlipper].pivot.x(), 0.165, 1e-12);
@@ -78,19 +76,19 @@ TEST(FlipperGeometryFromBoard, AssignsSidesWhateverTheFileOrder) {
 }
 
 TEST(FlipperGeometryFromBoard, NeedsOneFlipperPerSide) {
-  sim::Board one = mit1993();
+  sim::Board one = thesis_board();
   one.flippers.pop_back();
   EXPECT_THROW(flipper_geometry_from_board(one), std::invalid_argument);
-  sim::Board two_left = mit1993();
+  sim::Board two_left = thesis_board();
   two_left.flippers[1].side = sim::Side::kLeft;
   EXPECT_THROW(flipper_geometry_from_board(two_left), std::invalid_argument);
-  sim::Board three = mit1993();
+  sim::Board three = thesis_board();
   three.flippers.push_back(three.flippers[0]);
   EXPECT_THROW(flipper_geometry_from_board(three), std::invalid_argument);
 }
 
 TEST(AboveFlippers, PointsAboveAndBelowTheV) {
-  const FlipperGeometry g = flipper_geometry_from_board(mit1993());
+  const FlipperGeometry g = flipper_geometry_from_board(thesis_board());
   EXPECT_TRUE(above_flippers(g, {0.255, 0.5}));              // high on the centre line
   EXPECT_TRUE(above_flippers(g, g.apex + Vec2(0.0, 0.002)));  // just above the V's centre
   EXPECT_FALSE(above_flippers(g, g.apex - Vec2(0.0, 0.002))); // just below it: in the gap

@@ -10,6 +10,7 @@
 
 #include "pinball/core/rng.h"
 #include "pinball/sim/board_loader.h"
+#include "common/thesis_board.h"
 
 namespace pinball::track {
 namespace {
@@ -17,13 +18,10 @@ namespace {
 constexpr double kFrame_s = 0.005;  // 200 fps
 constexpr ContactSensors kNoContact{};
 
-const sim::Board& mit1993() {
-  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  return board;
-}
+using pinball::testing::thesis_board;
 
-FlipperGeometry geometry() { return flipper_geometry_from_board(mit1993()); }
-TrackerConfig config() { return default_tracker_config(mit1993(), CameraModelConfig{}); }
+FlipperGeometry geometry() { return flipper_geometry_from_board(thesis_board()); }
+TrackerConfig config() { return default_tracker_config(thesis_board(), CameraModelConfig{}); }
 
 Observation obs(double t_s, const Vec2& p) {
   Observation o;
@@ -108,8 +106,8 @@ void expect_finite(const TrackerOutput& out) {
 TEST(DefaultTrackerConfig, FromBoardAndCamera) {
   CameraModelConfig cam;
   cam.noise_px = 1.0;
-  const TrackerConfig c = default_tracker_config(mit1993(), cam);
-  EXPECT_EQ(c.g_mps2, mit1993().gravity_mps2);
+  const TrackerConfig c = default_tracker_config(thesis_board(), cam);
+  EXPECT_EQ(c.g_mps2, thesis_board().gravity_mps2);
   EXPECT_NEAR(c.window_distance_m, 0.038, 1e-12);   // half a 76 mm flipper
   EXPECT_NEAR(c.rolling_epsilon_m, 0.0076, 1e-12);  // a tenth of it
   EXPECT_EQ(c.sigma_m, observation_sigma_m(cam));

@@ -9,21 +9,19 @@
 #include "pinball/sim/board_loader.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/vision/sim_camera_source.h"
+#include "common/thesis_board.h"
 
 namespace pinball::vision {
 namespace {
 
-const sim::Board& mit1993() {
-  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  return board;
-}
+using pinball::testing::thesis_board;
 
 // A simulated camera and a detector whose background was learned from 16
 // ball-free frames (lamps still, glare off). Lamps stay as learned unless a
 // test lets them blink.
 struct Scene {
   explicit Scene(SimCameraConfig c = {}, BallDetectorConfig d = {})
-      : camera(mit1993(), c), detector(camera.homography(), camera.frame_size(), d) {
+      : camera(thesis_board(), c), detector(camera.homography(), camera.frame_size(), d) {
     detector.set_occluder_mask(camera.occluder_mask());
     camera.set_lamps_blinking(false);
     camera.set_glare(false);
@@ -67,7 +65,7 @@ double p99(std::vector<double> v) {
 template <class F>
 void for_clear_points(Scene& s, int n, std::uint64_t seed, F&& f) {
   Rng rng(seed);
-  const sim::Board& b = mit1993();
+  const sim::Board& b = thesis_board();
   int done = 0;
   while (done < n) {
     const Vec2 p{rng.uniform(0.02, b.width_m - 0.02), rng.uniform(0.02, b.height_m - 0.02)};
@@ -115,7 +113,7 @@ TEST(BallDetector, MovingBallWithMotionBlurMeetsTheTargets) {
 
 TEST(BallDetector, BallNearTheTableEdgeIsFoundAccurately) {
   Scene s;
-  const sim::Board& b = mit1993();
+  const sim::Board& b = thesis_board();
   const double r = b.ball.radius_m;
   int found = 0;
   for (const Vec2& p : {Vec2{r, 0.5}, Vec2{b.width_m - r, 0.45}, Vec2{0.3, r + 0.001}, Vec2{0.2, b.height_m - r},
@@ -129,7 +127,7 @@ TEST(BallDetector, BallNearTheTableEdgeIsFoundAccurately) {
 }
 
 TEST(BallDetector, NeedsALearnedBackgroundAndRefusesBadFrames) {
-  SimCameraSource camera(mit1993(), SimCameraConfig{});
+  SimCameraSource camera(thesis_board(), SimCameraConfig{});
   BallDetector detector(camera.homography(), camera.frame_size());
   camera.set_lamps_blinking(false);
   Frame frame;
@@ -259,9 +257,9 @@ TEST(BallDetector, RoiFollowsTheBallThenTheWholeFrameRecoversIt) {
 
 TEST(BallDetector, ARaisedFlipperIsNeverTakenForTheBall) {
   Scene s;  // background learned with the flippers down
-  sim::GameState state = sim::make_game_state(mit1993(), 1);
+  sim::GameState state = sim::make_game_state(thesis_board(), 1);
   state.ball_in_play = false;
-  for (auto& f : state.flippers) f.theta_rad = mit1993().flippers[0].theta_max_rad;
+  for (auto& f : state.flippers) f.theta_rad = thesis_board().flippers[0].theta_max_rad;
   int frames = 0;
   double changed = 0.0;
   for (int step = 1; step <= 200; ++step) {
@@ -279,7 +277,7 @@ TEST(BallDetector, ARaisedFlipperIsNeverTakenForTheBall) {
 }
 
 TEST(BallDetector, RejectsBadSettings) {
-  const CameraHomography h = CameraHomography::default_view(mit1993(), {640, 480});
+  const CameraHomography h = CameraHomography::default_view(thesis_board(), {640, 480});
   BallDetectorConfig c;
   c.threshold = 0;
   EXPECT_THROW(BallDetector(h, {640, 480}, c), std::invalid_argument);

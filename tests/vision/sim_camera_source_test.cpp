@@ -7,21 +7,19 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pinball/sim/board_loader.h"
+#include "common/thesis_board.h"
 
 namespace pinball::vision {
 namespace {
 
-const sim::Board& mit1993() {
-  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  return board;
-}
+using pinball::testing::thesis_board;
 
 TEST(SimCameraSource, SameSeedSameBitsOtherSeedOtherNoise) {
   SimCameraConfig c;
-  SimCameraSource a(mit1993(), c);
-  SimCameraSource b(mit1993(), c);
+  SimCameraSource a(thesis_board(), c);
+  SimCameraSource b(thesis_board(), c);
   c.seed = 2;
-  SimCameraSource other(mit1993(), c);
+  SimCameraSource other(thesis_board(), c);
   Frame fa, fb, fo;
   const std::vector<Vec2> path{Vec2{0.2, 0.4}, Vec2{0.21, 0.41}};
   for (int i = 0; i < 5; ++i) {
@@ -39,7 +37,7 @@ TEST(SimCameraSource, DeliversFramesAtItsRateStampedAtMidExposure) {
   SimCameraConfig c;
   c.fps = 200.0;
   c.exposure_s = 0.002;
-  SimCameraSource camera(mit1993(), c);
+  SimCameraSource camera(thesis_board(), c);
   Frame frame;
   EXPECT_FALSE(camera.read(frame));  // nothing observed yet
   std::vector<double> stamps;
@@ -63,7 +61,7 @@ TEST(SimCameraSource, MotionBlurSpreadsTheBallAlongItsPath) {
   SimCameraConfig c;
   c.noise_sigma = 0.0;
   c.lamp_toggle_probability = 0.0;
-  SimCameraSource camera(mit1993(), c);
+  SimCameraSource camera(thesis_board(), c);
   Frame still, moving, empty;
   camera.render({}, 0.0, empty);
   const Vec2 p{0.25, 0.3};
@@ -89,7 +87,7 @@ TEST(SimCameraSource, MotionBlurSpreadsTheBallAlongItsPath) {
 TEST(SimCameraSource, PlasticHidesTheBallAndTheTruthSaysSo) {
   SimCameraConfig c;
   c.noise_sigma = 0.0;
-  SimCameraSource camera(mit1993(), c);
+  SimCameraSource camera(thesis_board(), c);
   ASSERT_FALSE(c.plastics.empty());
   Vec2 centre = Vec2::Zero();
   for (const Vec2& q : c.plastics[0].polygon_board) centre += q;
@@ -107,13 +105,13 @@ TEST(SimCameraSource, PlasticHidesTheBallAndTheTruthSaysSo) {
 TEST(SimCameraSource, RejectsBadSettings) {
   SimCameraConfig c;
   c.fps = 0.0;
-  EXPECT_THROW(SimCameraSource(mit1993(), c), std::invalid_argument);
+  EXPECT_THROW(SimCameraSource(thesis_board(), c), std::invalid_argument);
   c = SimCameraConfig{};
   c.exposure_s = 0.01;  // longer than a frame at 200 fps
-  EXPECT_THROW(SimCameraSource(mit1993(), c), std::invalid_argument);
+  EXPECT_THROW(SimCameraSource(thesis_board(), c), std::invalid_argument);
   c = SimCameraConfig{};
   c.plastics.push_back(SimPlastic{{Vec2{0.1, 0.1}, Vec2{0.2, 0.1}}, 90.0, 1.0});
-  EXPECT_THROW(SimCameraSource(mit1993(), c), std::invalid_argument);
+  EXPECT_THROW(SimCameraSource(thesis_board(), c), std::invalid_argument);
 }
 
 }  // namespace

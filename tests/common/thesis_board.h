@@ -1,0 +1,14 @@
+#pragma once
+// The reconstructed thesis table, loaded once per test binary.
+
+#include "pinball/sim/board_loader.h"
+
+namespace pinball::testing {
+
+/// boards/mit1993.board, parsed on first use.
+inline const sim::Board& thesis_board() {
+  static const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  return board;
+}
+
+}  // namespace pinball::testing
