@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera_options.h"
 #include "commands.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/control/spastic_controller.h"
@@ -63,8 +64,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
       ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--gravity-scale", a.gravity_scale, "tracker's g over the board's (miscalibration)")
       ->check(CLI::Range(0.1, 10.0));
-  cmd->add_option("--noise-px", a.camera.noise_px, "camera model: centroid noise (px)")->check(CLI::Range(0.0, 100.0));
-  cmd->add_option("--fps", a.camera.fps, "camera model: frames per second")->check(CLI::Range(1.0, 10000.0));
+  add_camera_model_options(*cmd, a.camera);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "camera_options.h"
 #include "commands.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/sim/ball_runner.h"
@@ -37,15 +38,7 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--reach", a.reach_m, "spastic: flip when the projected impact is this close (m)")
       ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--fps", a.camera.fps, "camera model: frames per second")->check(CLI::Range(1.0, 10000.0));
-  cmd->add_option("--m-per-px", a.camera.m_per_px, "camera model: metres per pixel on the table")
-      ->check(CLI::Range(1e-5, 0.1));
-  cmd->add_option("--noise-px", a.camera.noise_px, "camera model: centroid noise, standard deviation (px)")
-      ->check(CLI::Range(0.0, 100.0));
-  cmd->add_option("--latency", a.camera.latency_s, "camera model: exposure to delivery (s)")
-      ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--drop", a.camera.drop_probability, "camera model: probability a frame is lost")
-      ->check(CLI::Range(0.0, 0.99));
+  add_camera_model_options(*cmd, a.camera);
   cmd->add_option("--actuation", a.actuation,
                   "how commands reach the flippers: direct, or can (DriverBus, CAN frames, the virtual "
                   "driver board and the solenoid delay)")
