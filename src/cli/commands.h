@@ -74,7 +74,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& err);
 /// `pinball learn`
 struct LearnArgs {
   std::string board;                    ///< board file
-  std::string method;                   ///< tournament | relay | cem | none | spastic | evaluate
+  std::string method;                   ///< tournament | relay | cem | none | spastic | evaluate | launcher
   std::uint64_t budget_balls = 2000;    ///< simulated balls the search may play
   std::uint64_t seed = 1;               ///< the only source of randomness
   std::string out;                      ///< controller file to write (searches)

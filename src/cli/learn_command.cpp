@@ -15,6 +15,7 @@
 
 #include "camera_options.h"
 #include "commands.h"
+#include "pinball/control/launcher_controller.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/control/spastic_controller.h"
 #include "pinball/core/running_stats.h"
@@ -33,9 +34,10 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--method", a.method,
                   "tournament (thesis 6.2), relay (Hoeffding relay race, 6.3), cem (cross-entropy with common "
-                  "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller)")
+                  "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller); "
+                  "launcher: the launcher controller's search (20 pulls x 10 launches, thesis 5.1)")
       ->required()
-      ->check(CLI::IsMember({"tournament", "relay", "cem", "none", "spastic", "evaluate"}));
+      ->check(CLI::IsMember({"tournament", "relay", "cem", "none", "spastic", "evaluate", "launcher"}));
   cmd->add_option("--budget-balls", a.budget_balls, "simulated balls the search may play")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
   cmd->add_option("--seed", a.seed, "random seed; same seed, same result, whatever --threads");
@@ -135,7 +137,40 @@ nlohmann::json to_json(const Evaluation& e) {
 
 }  // namespace
 
+int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err) {
+  // Thesis 5.1: 20 pull values x 10 launches; keep the one most often hittable.
+  const sim::Board board = sim::load_board(a.board);
+  control::LauncherSearchConfig config;
+  config.seed = a.seed;
+  config.camera = a.camera;
+  err << "learn launcher: " << config.pulls << " pulls x " << config.launches_per_pull << " launches\n";
+  const control::LauncherSearchResult r = control::search_launcher(board, config);
+  nlohmann::json tried = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.pull.size(); ++i) {
+    tried.push_back({{"pull", r.pull[i]}, {"hittable", r.successes[i]}});
+  }
+  if (a.json) {
+    out << nlohmann::json{{"board", a.board},
+                          {"method", "launcher"},
+                          {"seed", a.seed},
+                          {"launches_per_pull", config.launches_per_pull},
+                          {"best_pull", r.best_pull},
+                          {"best_hittable", r.best_successes},
+                          {"pulls", tried}}
+               .dump(2)
+        << "\n";
+    return 0;
+  }
+  out << "launcher search on " << a.board << " (seed " << a.seed << "): pull -> launches reaching a hittable state\n";
+  for (std::size_t i = 0; i < r.pull.size(); ++i) {
+    out << "  " << r.pull[i] << "  " << r.successes[i] << "/" << config.launches_per_pull << "\n";
+  }
+  out << "best pull " << r.best_pull << " (" << r.best_successes << "/" << config.launches_per_pull << ")\n";
+  return 0;
+}
+
 int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
+  if (a.method == "launcher") return run_launcher_search(a, out, err);
   const bool search = a.method == "tournament" || a.method == "relay" || a.method == "cem";
   if (search && a.out.empty()) throw std::invalid_argument("learn: --out CONTROLLER is required for a search");
   if (a.method == "evaluate" && a.controller.empty()) throw std::invalid_argument("learn: evaluate needs --controller FILE");

@@ -1,6 +1,7 @@
 // The `pinball` command as users and scripts run it: JSON on stdout, one-line
 // errors, exit codes, and the same seed giving the same output to the bit.
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -106,6 +107,18 @@ TEST_F(Cli, FlipsCanGoThroughTheCanPath) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("actuation"), "can");
   EXPECT_GT(j.at("flips").get<int>(), 0);
+}
+
+TEST_F(Cli, LauncherSearchTriesTwentyPullsTenTimesEach) {
+  const CommandResult r = run("learn boards/mit1993.board --method launcher --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("pulls").size(), 20u);
+  EXPECT_EQ(j.at("launches_per_pull"), 10);
+  int best = 0;
+  for (const auto& p : j.at("pulls")) best = std::max(best, p.at("hittable").get<int>());
+  EXPECT_EQ(j.at("best_hittable").get<int>(), best);
+  EXPECT_GT(best, 0);
 }
 
 TEST_F(Cli, BadBoardFileIsOneLineNamingFileAndLine) {
