@@ -26,6 +26,7 @@ struct SimArgs {
   std::string trace;             ///< CSV trace path, or empty
   std::string video;             ///< AVI path, or empty
   double video_fps = 60.0;       ///< video frame rate (simulated time)
+  bool video_camera = false;     ///< video from the simulated camera's frames instead of the board view
   track::CameraModelConfig camera;  ///< the camera the spastic player sees through
   double reach_m = 0.02;         ///< spastic: flip when the projected impact is this close (m)
   std::string actuation = "direct";  ///< direct | can: flipper commands through the CAN path

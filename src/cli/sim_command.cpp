@@ -9,6 +9,7 @@
 #include <ostream>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "camera_options.h"
 #include "commands.h"
@@ -22,6 +23,7 @@
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "pinball/sim/video_recorder.h"
+#include "pinball/vision/sim_camera_source.h"
 #include "trace_writer.h"
 
 namespace pinball::cli {
@@ -56,6 +58,8 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
   cmd->add_option("--trace", a.trace, "write every step to this CSV (t,x,y,vx,vy,event)");
   cmd->add_option("--video", a.video, "write an MJPG AVI of the play to this file");
   cmd->add_option("--video-fps", a.video_fps, "video frames per simulated second")->check(CLI::Range(1.0, 1000.0));
+  cmd->add_flag("--video-camera", a.video_camera,
+                "--video: record what the simulated camera sees (perspective, lamps, blur, noise) at --video-fps");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -72,7 +76,17 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   std::unique_ptr<sim::VideoRecorder> video;
   sim::RenderOptions render_options;
   double next_frame_s = 0.0;
-  if (!a.video.empty()) {
+  std::unique_ptr<vision::SimCameraSource> camera;  // --video-camera: the camera's own frames
+  vision::Frame camera_frame;
+  cv::Mat camera_bgr;
+  if (!a.video.empty() && a.video_camera) {
+    vision::SimCameraConfig cc;
+    cc.fps = a.video_fps;
+    cc.exposure_s = std::min(cc.exposure_s, 1.0 / a.video_fps);
+    cc.seed = a.seed;
+    camera = std::make_unique<vision::SimCameraSource>(board, cc);
+    video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, camera->frame_size());
+  } else if (!a.video.empty()) {
     video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(board, render_options));
   }
 
@@ -122,7 +136,13 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         },
         [&](const sim::GameState& s, const sim::StepEvents& e) {
           if (trace) trace->write(board, s, e);
-          if (video && s.time_s >= next_frame_s) {
+          if (camera) {
+            camera->observe(s);
+            while (camera->read(camera_frame)) {
+              cv::cvtColor(camera_frame.gray, camera_bgr, cv::COLOR_GRAY2BGR);
+              video->write(camera_bgr);
+            }
+          } else if (video && s.time_s >= next_frame_s) {
             video->write(sim::render_board(board, &s, render_options));
             next_frame_s += 1.0 / a.video_fps;
           }

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/videoio.hpp>
 
 namespace {
 
@@ -163,6 +164,18 @@ TEST_F(Cli, VideoRecordsFrames) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_TRUE(fs::exists(avi));
   EXPECT_GT(fs::file_size(avi), 10'000u);
+}
+
+TEST_F(Cli, VideoCanRecordTheSimulatedCamera) {
+  const fs::path avi = dir_ / "camera.avi";
+  const CommandResult r =
+      run("sim boards/mit1993.board --balls 1 --max-ball-time 1 --video-camera --video-fps 100 --video " + avi.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  cv::VideoCapture in(avi.string(), cv::CAP_OPENCV_MJPEG);
+  ASSERT_TRUE(in.isOpened());
+  EXPECT_EQ(static_cast<int>(in.get(cv::CAP_PROP_FRAME_WIDTH)), 640);
+  EXPECT_EQ(static_cast<int>(in.get(cv::CAP_PROP_FRAME_HEIGHT)), 480);
+  EXPECT_GE(static_cast<int>(in.get(cv::CAP_PROP_FRAME_COUNT)), 50);
 }
 
 TEST_F(Cli, BenchSpeedJson) {
