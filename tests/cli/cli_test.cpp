@@ -108,6 +108,9 @@ TEST_F(Cli, FlipsCanGoThroughTheCanPath) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("actuation"), "can");
   EXPECT_GT(j.at("flips").get<int>(), 0);
+  // The CAN path runs on the simulated clock: same seed, same game.
+  const CommandResult again = run("sim boards/mit1993.board --policy spastic --balls 3 --actuation can --json");
+  EXPECT_EQ(nlohmann::json::parse(again.out).at("state_hash"), j.at("state_hash"));
 }
 
 TEST_F(Cli, LauncherSearchTriesTwentyPullsTenTimesEach) {
