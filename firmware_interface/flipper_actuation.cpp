@@ -23,7 +23,9 @@ void FlipperActuation::on_coil_change(int driver, const CoilOutput& output) {
 }
 
 bool FlipperActuation::energized(double now_s) {
-  while (count_ > 0 && pending_[static_cast<std::size_t>(head_)].t_s + delay_s_ <= now_s) {
+  // A picosecond of slack: simulated time is a sum of steps and lands a hair
+  // short of the exact due time.
+  while (count_ > 0 && pending_[static_cast<std::size_t>(head_)].t_s + delay_s_ <= now_s + 1e-12) {
     state_ = pending_[static_cast<std::size_t>(head_)].on;
     head_ = (head_ + 1) % kCapacity;
     --count_;

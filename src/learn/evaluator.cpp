@@ -6,6 +6,7 @@
 
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/simulated_player.h"
+#include "pinball/firmware/flipper_actuation.h"
 #include "pinball/sim/ball_runner.h"
 
 namespace pinball::learn {
@@ -73,40 +74,29 @@ class OpportunityBook final : public control::FlipperController {
   double start_ = 0.0;
 };
 
-// Commands reach the flippers `delay_s` after they are given.
+// Commands reach the flippers `delay_s` after they are given: the same
+// solenoid model (FlipperActuation) that the CAN path puts behind the board.
 class DelayLine {
  public:
-  explicit DelayLine(double delay_s) : delay_s_(delay_s) {}
+  DelayLine(std::size_t flippers, double delay_s) : last_(flippers, false) {
+    for (std::size_t i = 0; i < flippers; ++i) actuation_.emplace_back(static_cast<int>(i), delay_s);
+  }
   void apply(sim::GameState& s) {
-    if (delay_s_ <= 0.0) return;
-    for (std::size_t i = 0; i < 2 && i < s.flippers.size(); ++i) {
-      Line& l = lines_[i];
+    for (std::size_t i = 0; i < actuation_.size(); ++i) {
       const bool want = s.flippers[i].energized;
-      if (want != l.last_command && l.size < kSize) {
-        l.pending[(l.head + l.size) % kSize] = {s.time_s + delay_s_, want};
-        ++l.size;
-        l.last_command = want;
+      if (want != last_[i]) {
+        const firmware::CoilOutput coil{want ? firmware::CoilState::kPulse : firmware::CoilState::kOff,
+                                        want ? 1.0 : 0.0, s.time_s};
+        actuation_[i].on_coil_change(static_cast<int>(i), coil);
+        last_[i] = want;
       }
-      while (l.size > 0 && l.pending[l.head].first <= s.time_s + 1e-12) {
-        l.output = l.pending[l.head].second;
-        l.head = (l.head + 1) % kSize;
-        --l.size;
-      }
-      s.flippers[i].energized = l.output;
+      s.flippers[i].energized = actuation_[i].energized(s.time_s);
     }
   }
 
  private:
-  static constexpr std::size_t kSize = 16;
-  struct Line {
-    std::array<std::pair<double, bool>, kSize> pending{};
-    std::size_t head = 0;
-    std::size_t size = 0;
-    bool last_command = false;
-    bool output = false;
-  };
-  double delay_s_;
-  std::array<Line, 2> lines_{};
+  std::vector<firmware::FlipperActuation> actuation_;
+  std::vector<bool> last_;  // command last passed on, per flipper
 };
 
 }  // namespace
@@ -156,7 +146,7 @@ BallOutcome PinballEvaluator::run(control::FlipperController& controller,
   track::TrackerConfig tracker = track::default_tracker_config(board_, config_.camera);
   tracker.g_mps2 *= config_.gravity_scale;
   control::SimulatedPlayer player(board_, config_.camera, tracker, book, seed ^ 0x5DEECE66Dull);
-  DelayLine delay(config_.actuation_delay_s);
+  DelayLine delay(board_.flippers.size(), config_.actuation_delay_s);
   sim::BallLimits limits;
   limits.max_ball_time_s = config_.max_ball_time_s;
   limits.pull = pull;
