@@ -37,10 +37,11 @@ bool resting_in_launcher(const Board& board, const GameState& state);
 /// Ends a ball that ran past its time limit: counted as lost.
 void cut_ball(const Board& board, GameState& state);
 
-/// Plays one ball. `policy(state)` sets flipper commands before each step;
-/// `observer(state, events)` sees the state after each step.
-template <class Policy, class Observer>
-BallResult play_ball(const ThesisStepper& stepper, GameState& state, const BallLimits& limits, Policy&& policy,
+/// Plays one ball on any stepper with step(state), dt_s() and board() (the
+/// thesis or the event stepper). `policy(state)` sets flipper commands before
+/// each step; `observer(state, events)` sees the state after each step.
+template <class Stepper, class Policy, class Observer>
+BallResult play_ball(const Stepper& stepper, GameState& state, const BallLimits& limits, Policy&& policy,
                      Observer&& observer) {
   const Board& board = stepper.board();
   const double pull = limits.pull >= 0.0 ? limits.pull : board.launcher.pull;

@@ -37,7 +37,8 @@ enum Visibility : std::uint8_t {
 /// Everything that changes during a game.
 struct GameState {
   double time_s = 0.0;                 ///< simulated time since the game started (s)
-  std::uint64_t steps = 0;             ///< integration steps taken
+  std::uint64_t steps = 0;             ///< integration steps taken (step() calls)
+  std::uint64_t events = 0;            ///< events handled by the event stepper (impacts, stops, entries, ...)
   std::uint64_t flips = 0;             ///< flipper activations (rising edges of a command)
   BallState ball;                      ///< the ball
   bool ball_in_play = false;           ///< false while the ball waits in the launcher or is lost
