@@ -1,0 +1,14 @@
+#pragma once
+// LCM channel names of the daemon (upper case, the LCM convention). One
+// message type per channel, defined in src/bus/lcmtypes/.
+
+namespace pinball::bus {
+
+inline constexpr const char* kObservationChannel = "PINBALL_OBSERVATION";     ///< lcmt_pinball_observation
+inline constexpr const char* kProjectionChannel = "PINBALL_PROJECTION";       ///< lcmt_pinball_projection
+inline constexpr const char* kFlipperCommandChannel = "PINBALL_FLIPPER_CMD";  ///< lcmt_pinball_flipper_command
+inline constexpr const char* kDriverStatusChannel = "PINBALL_DRIVER_STATUS";  ///< lcmt_pinball_driver_status
+inline constexpr const char* kGameChannel = "PINBALL_GAME";                   ///< lcmt_pinball_game_event
+inline constexpr const char* kStatsChannel = "PINBALL_STATS";                 ///< lcmt_pinball_daemon_stats
+
+}  // namespace pinball::bus

@@ -1,0 +1,103 @@
+#pragma once
+// The daemon's LCM endpoint. Real-time threads never touch LCM: they hand
+// fixed-size messages to lock-free rings (try_publish: no lock, no
+// allocation, no system call) and the bus's own thread encodes and publishes
+// them. liblcm's publish allocates and, for memq://, writes a pipe, so it has
+// no place on the camera or controller thread. The bus thread also receives
+// (observations from an external camera process or lcm-logplayer) and counts
+// what it cannot decode instead of passing it on.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "pinball/core/spsc_ring.h"
+#include "pinball_lcm/lcmt_pinball_daemon_stats.hpp"
+#include "pinball_lcm/lcmt_pinball_driver_status.hpp"
+#include "pinball_lcm/lcmt_pinball_flipper_command.hpp"
+#include "pinball_lcm/lcmt_pinball_game_event.hpp"
+#include "pinball_lcm/lcmt_pinball_observation.hpp"
+#include "pinball_lcm/lcmt_pinball_projection.hpp"
+
+namespace pinball::bus {
+
+/// Counters of the bus (monotonic).
+struct LcmBusCounters {
+  std::uint64_t published = 0;  ///< messages published
+  std::uint64_t overflows = 0;  ///< messages dropped because their ring was full
+  std::uint64_t received = 0;   ///< messages received and accepted
+  std::uint64_t malformed = 0;  ///< messages received that failed to decode or check, ignored
+};
+
+/// Observations arriving over LCM, for the camera thread.
+using ObservationRing = SpscRing<pinball_lcm::lcmt_pinball_observation, 1024>;
+
+/// One LCM instance and the thread that serves it.
+class LcmBus {
+ public:
+  /// Opens LCM at `url` ("memq://", "udpm://239.255.76.67:7667?ttl=0", ...).
+  /// Throws std::runtime_error naming the URL when LCM cannot start.
+  explicit LcmBus(const std::string& url);
+  ~LcmBus();
+  LcmBus(const LcmBus&) = delete;
+  LcmBus& operator=(const LcmBus&) = delete;
+
+  /// Starts the bus thread. `periodic` (may be empty) runs on it every
+  /// `period_s` with the LCM instance (the daemon's stats).
+  void start(std::function<void(lcm::LCM&)> periodic = {}, double period_s = 1.0);
+  /// Publishes what is queued, runs `periodic` once more, stops the thread.
+  void stop();
+
+  /// Queue a message for publication; false (counted) when its ring is full.
+  /// One producer thread per message type.
+  bool try_publish(const pinball_lcm::lcmt_pinball_observation& m);
+  bool try_publish(const pinball_lcm::lcmt_pinball_projection& m);
+  bool try_publish(const pinball_lcm::lcmt_pinball_flipper_command& m);
+  bool try_publish(const pinball_lcm::lcmt_pinball_driver_status& m);
+  bool try_publish(const pinball_lcm::lcmt_pinball_game_event& m);
+
+  /// Receive PINBALL_OBSERVATION into `ring` (call before start()). Messages
+  /// that do not decode, or carry bad fields, are counted as malformed.
+  void subscribe_observations(ObservationRing& ring);
+
+  /// Counters so far.
+  LcmBusCounters counters() const;
+  /// The LCM instance (for publishing from a non-real-time thread).
+  lcm::LCM& lcm() { return *lcm_; }
+
+ private:
+  template <class T, std::size_t N>
+  struct Outbox {
+    SpscRing<T, N> ring;
+    const char* channel;
+  };
+  void run(std::function<void(lcm::LCM&)> periodic, double period_s);
+  int drain();
+  template <class T, std::size_t N>
+  int drain(Outbox<T, N>& box);
+  template <class T, std::size_t N>
+  bool push(Outbox<T, N>& box, const T& m);
+  void on_observation(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::string url_;
+  Outbox<pinball_lcm::lcmt_pinball_observation, 1024> observations_;
+  Outbox<pinball_lcm::lcmt_pinball_projection, 1024> projections_;
+  Outbox<pinball_lcm::lcmt_pinball_flipper_command, 256> commands_;
+  Outbox<pinball_lcm::lcmt_pinball_driver_status, 64> statuses_;
+  Outbox<pinball_lcm::lcmt_pinball_game_event, 1024> games_;
+  ObservationRing* inbox_ = nullptr;
+  std::atomic<std::uint64_t> published_{0};
+  std::atomic<std::uint64_t> overflows_{0};
+  std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> malformed_{0};
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+};
+
+}  // namespace pinball::bus

@@ -1,0 +1,35 @@
+#pragma once
+// Between the tracker's and the controller's plain structs and their LCM
+// messages: fills every field with its documented unit and sign, and checks
+// received messages field by field (a decoded message can still carry NaN or
+// an out-of-range code; such a message is malformed).
+
+#include <cstdint>
+
+#include "pinball_lcm/lcmt_pinball_flipper_command.hpp"
+#include "pinball_lcm/lcmt_pinball_observation.hpp"
+#include "pinball_lcm/lcmt_pinball_projection.hpp"
+#include "pinball/track/observation.h"
+#include "pinball/track/tracker.h"
+
+namespace pinball::bus {
+
+/// An observation message. `found` false leaves the position fields zero.
+pinball_lcm::lcmt_pinball_observation to_lcm_observation(std::int64_t utime, std::int64_t seq, bool found,
+                                                          const track::Observation& observation, double u_px,
+                                                          double v_px, const track::ContactSensors& contacts);
+
+/// A projection message from one tracker update.
+pinball_lcm::lcmt_pinball_projection to_lcm_projection(std::int64_t utime, std::int64_t seq,
+                                                        std::int64_t observation_seq,
+                                                        const track::TrackerOutput& output);
+
+/// The observation inside a message; false when the message is malformed
+/// (non-finite or out-of-range fields, a found ball without a position).
+bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& found, track::Observation& out,
+                          track::ContactSensors& contacts);
+
+/// A received flipper command is well formed (flipper -1..1, cause 0..5).
+bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m);
+
+}  // namespace pinball::bus

@@ -1,0 +1,108 @@
+#pragma once
+// pinballd: the real-time controller daemon. Threads (thread_table.h):
+//   camera:     frames -> BallDetector -> Tracker          (CameraStage)
+//   controller: projections -> action function -> DriverBus (ControllerStage)
+//   driver:     DriverBus: CAN frames, heartbeat, status
+//   sim:        the embedded simulation (SimWorld), in sim mode
+//   lcm:        publishes everything, receives observations (LcmBus)
+// The hot threads hand each other plain records through lock-free rings and
+// never touch LCM. In sim mode the default clock is lockstep: each frame goes
+// camera -> controller -> driver before the world moves on, so a run is fully
+// determined by its seed and runs as fast as the machine allows;
+// sim.realtime paces the world to the wall clock instead.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pinball/bus/lcm_bus.h"
+#include "pinball/daemon/daemon_config.h"
+#include "pinball/daemon/latency_histogram.h"
+#include "pinball/daemon/sim_world.h"
+#include "pinball/firmware/driver_bus.h"
+#include "pinball/firmware/virtual_driver_board.h"
+
+namespace pinball::daemon {
+
+/// The latency table's stages (steady clock).
+enum LatencyStage : int {
+  kCaptureToDetection = 0,  ///< frame handed over -> detector done
+  kDetectionToProjection,   ///< detector done -> tracker done
+  kProjectionToDecision,    ///< tracker done -> controller done with the record
+  kCommandToCan,            ///< command accepted by DriverBus -> its CAN frame written
+  kCanToCoil,               ///< CAN frame written -> coil on at the virtual board (sim only)
+  kFrameToCan,              ///< end to end: frame handed over -> CAN frame written
+  kStageCount
+};
+
+/// Name of a stage ("capture->detection", ...).
+const char* stage_name(int stage);
+
+/// What a run did.
+struct DaemonReport {
+  std::string mode;                          ///< sim or lab
+  bool lockstep = false;                     ///< sim with the virtual clock
+  int balls = 0;                             ///< balls played (sim)
+  double mean_score = 0.0;                   ///< mean score per ball (sim)
+  double score_ci95 = 0.0;                   ///< half-width of its 95 % interval (sim)
+  double mean_ball_time_s = 0.0;             ///< mean simulated ball time (s)
+  int cut_balls = 0;                         ///< balls cut at the time limit (cycles)
+  std::vector<SimBallResult> results;        ///< per ball (sim)
+  std::array<LatencySummary, kStageCount> latency{};  ///< per stage
+  std::uint64_t frames = 0;                  ///< frames processed by the camera thread
+  std::uint64_t frames_dropped = 0;          ///< frames lost before the camera thread
+  std::uint64_t detections = 0;              ///< frames with a ball
+  std::uint64_t projections = 0;             ///< valid projections
+  std::uint64_t commands = 0;                ///< flipper commands given
+  std::uint64_t camera_stalls = 0;           ///< releases because frames stopped
+  std::uint64_t ball_lost_releases = 0;      ///< releases because the ball went out of sight
+  std::uint64_t bus_fault_releases = 0;      ///< releases because the CAN session dropped
+  std::uint64_t ring_overflows = 0;          ///< records dropped between threads
+  bus::LcmBusCounters lcm;                   ///< LCM traffic
+  firmware::DriverBusCounters driver;        ///< CAN host side
+  firmware::BoardCounters board;             ///< virtual board (sim)
+  double wall_s = 0.0;                       ///< run time (s)
+  double sim_s = 0.0;                        ///< simulated time (s)
+  bool coils_off_at_exit = true;             ///< sim: every coil of the virtual board was off after shutdown
+  std::vector<std::string> warnings;         ///< e.g. real-time scheduling refused
+};
+
+/// The report as one JSON object (the --json output).
+nlohmann::json report_to_json(const DaemonReport& report);
+/// The report for people: score line and latency table.
+std::string report_to_text(const DaemonReport& report);
+
+/// The daemon.
+class Daemon {
+ public:
+  /// Loads the board, controller and calibration and builds every part.
+  /// Throws ConfigError / std::runtime_error naming what is wrong.
+  explicit Daemon(const DaemonConfig& config);
+  ~Daemon();
+  Daemon(const Daemon&) = delete;
+  Daemon& operator=(const Daemon&) = delete;
+
+  /// Runs until every ball is played (sim) or request_stop(); then releases
+  /// every coil, stops the heartbeats and returns the report.
+  DaemonReport run();
+  /// Asks run() to finish (async-signal-safe).
+  void request_stop();
+  /// Asks run() to print the latency table to stderr (async-signal-safe).
+  void request_stats();
+  /// A report of the run so far (any thread).
+  DaemonReport snapshot() const;
+  /// The LCM endpoint (tests subscribe on it).
+  bus::LcmBus& lcm_bus();
+  /// The host side of the CAN link.
+  firmware::DriverBus& driver_bus();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace pinball::daemon

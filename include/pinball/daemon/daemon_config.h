@@ -1,0 +1,81 @@
+#pragma once
+// pinballd's configuration: one YAML file (config/lab.example.yaml documents
+// every key). Without a file the defaults run the embedded simulation of
+// boards/mit1993.board over memq:// with the shipped controller. Loading is
+// all or nothing: a bad file throws ConfigError naming the file and the key.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "pinball/firmware/messages.h"
+
+namespace pinball::daemon {
+
+/// Version of the configuration format this build reads.
+inline constexpr int kConfigVersion = 1;
+
+/// Where frames come from.
+struct CameraSettings {
+  std::string source = "sim";     ///< sim (rendered board), v4l2 (a camera device), file (a video), lcm (observations)
+  std::string device;             ///< v4l2: /dev/videoN; file: the video's path
+  int width_px = 640;             ///< requested frame width (px)
+  int height_px = 480;            ///< requested frame height (px)
+  double fps = 200.0;             ///< requested frame rate (frames per second)
+  double stall_timeout_s = 0.02;  ///< no frame (or no ball while a flipper is up) this long: release all (s)
+  int background_frames = 30;     ///< ball-free frames averaged into the detector's background at start
+};
+
+/// The CAN link to the solenoid driver board.
+struct CanSettings {
+  std::string interface = "sim";     ///< sim (the virtual board over a socket pair) or a SocketCAN interface (can0)
+  int board_id = 0;                  ///< driver board number 0..15
+  double heartbeat_period_s = 0.02;  ///< heartbeat period (s)
+  double watchdog_timeout_s = 0.1;   ///< the board switches everything off after this silence (s)
+};
+
+/// Real-time scheduling of the daemon's threads (the table is in thread_table.h).
+struct ThreadSettings {
+  bool realtime = false;  ///< ask for SCHED_FIFO priorities and locked memory
+  bool enforce = false;   ///< true: refuse to run when that is not allowed; false: warn once and run
+};
+
+/// The embedded simulation.
+struct SimSettings {
+  std::string board = "boards/mit1993.board";  ///< board file
+  int balls = 10;                              ///< balls to play
+  std::uint64_t seed = 1;                      ///< launch noise seed (ball i uses ball_seed(seed, i))
+  bool realtime = false;                       ///< pace to the wall clock (default: lockstep, as fast as possible)
+  double actuation_delay_s = 0.004;            ///< coil on -> flipper moves (s)
+  double max_ball_time_s = 60.0;               ///< a ball alive this long is cut (s)
+};
+
+/// Everything pinballd reads.
+struct DaemonConfig {
+  int version = kConfigVersion;  ///< format version
+  std::string mode = "sim";      ///< sim: embedded simulation; lab: camera + SocketCAN
+  SimSettings sim;               ///< sim mode
+  CameraSettings camera;         ///< frames
+  std::string board;             ///< lab: the table's board file (flipper and ball geometry)
+  std::string calibration;       ///< lab: calibration file (docs/calibration.md); empty: the board's geometry
+  CanSettings can;               ///< CAN link
+  firmware::DriverConfig coils;  ///< pulse, hold, caps and recycle time of every flipper coil
+  std::string controller = "controllers/best.json";  ///< controller file (docs/learning.md)
+  std::string lcm_url = "memq://";                   ///< LCM provider URL
+  ThreadSettings threads;                            ///< scheduling
+};
+
+/// Bad configuration; what() is "file: key: message".
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Parses YAML text; `source_name` is used in messages. Unknown keys are errors.
+DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string& source_name);
+/// Reads a configuration file.
+DaemonConfig load_daemon_config(const std::string& path);
+/// Checks cross-key rules (sim mode needs camera.source sim and can.interface sim, ...).
+void validate_daemon_config(const DaemonConfig& config, const std::string& source_name);
+
+}  // namespace pinball::daemon

@@ -1,0 +1,154 @@
+#pragma once
+// The daemon's two hot stages as plain classes, free of threads and clocks so
+// that the lab, the embedded simulation, `pinball replay` and the tests drive
+// the same code:
+//   CameraStage:     frame -> BallDetector -> Tracker -> ProjectionRecord
+//   ControllerStage: ProjectionRecord -> FlipperController -> DriverBus
+// Neither allocates after construction.
+
+#include <array>
+#include <cstdint>
+
+#include "pinball/control/flipper_controller.h"
+#include "pinball/firmware/driver_bus.h"
+#include "pinball/track/observation.h"
+#include "pinball/track/tracker.h"
+#include "pinball/vision/ball_detector.h"
+#include "pinball/vision/frame.h"
+
+namespace pinball::daemon {
+
+/// What the camera thread hands the controller thread for every frame, with
+/// the wall-clock stamps of each stage (steady clock, s) for the latency table.
+struct ProjectionRecord {
+  std::uint64_t seq = 0;           ///< projection number (one per frame)
+  std::uint64_t frame_seq = 0;     ///< the frame's sequence number
+  double t_s = 0.0;                ///< exposure time on the pipeline's clock (s)
+  bool found = false;              ///< the detector saw the ball
+  track::Observation observation;  ///< where (valid when found)
+  double u_px = 0.0;               ///< image position (valid when found)
+  double v_px = 0.0;               ///< image position (valid when found)
+  track::ContactSensors contacts;  ///< flipper contact sensors read with the frame
+  track::TrackerOutput output;     ///< the tracker's answer (projection invalid when not found)
+  double capture_wall_s = 0.0;     ///< steady clock when the frame was handed over
+  double detected_wall_s = 0.0;    ///< ... when detection finished
+  double projected_wall_s = 0.0;   ///< ... when the tracker finished
+};
+
+/// Why a command was given (the lcmt_pinball_flipper_command cause codes).
+enum class CommandCause : std::int8_t {
+  kProjection = 0,  ///< the controller acted on a projection
+  kLaunch = 1,      ///< a launch was seen: release (thesis 5.2.3)
+  kBallLost = 2,    ///< the ball was lost or left the camera's view
+  kCameraStall = 3, ///< no frame within the stall timeout
+  kShutdown = 4,    ///< the daemon is stopping
+  kBusFault = 5,    ///< the CAN link failed
+};
+
+/// One solenoid command as given (for LCM and the latency table).
+struct CommandRecord {
+  std::uint64_t seq = 0;             ///< command number
+  std::int64_t projection_seq = -1;  ///< the projection behind it, -1 for timeouts and shutdown
+  int flipper = -1;                  ///< track::kLeftFlipper / kRightFlipper, -1: all
+  bool energize = false;             ///< fire (true) or release (false)
+  CommandCause cause = CommandCause::kProjection;  ///< why
+  double t_s = 0.0;                  ///< pipeline clock (s)
+  double capture_wall_s = 0.0;       ///< steady clock of the frame behind it (0: none)
+  double command_wall_s = 0.0;       ///< steady clock when DriverBus accepted it
+};
+
+/// Counters of the camera stage.
+struct CameraStageCounters {
+  std::uint64_t frames = 0;       ///< frames processed
+  std::uint64_t detections = 0;   ///< frames with a ball
+  std::uint64_t projections = 0;  ///< valid projections
+  std::uint64_t track_resets = 0; ///< tracker reset because the ball was out of sight
+};
+
+/// Detector and tracker for one camera.
+class CameraStage {
+ public:
+  /// Borrows both; `detector` may be null when only track() is used. `lost_after_s`: a ball unseen this long is forgotten (the
+  /// tracker starts afresh with the next sighting).
+  CameraStage(vision::BallDetector* detector, track::Tracker& tracker, double lost_after_s);
+
+  /// Detects and tracks one frame; fills `out` (seq, times, detection, output).
+  void process(const vision::Frame& frame, const track::ContactSensors& contacts, double capture_wall_s,
+               ProjectionRecord& out);
+  /// Tracks one observation made elsewhere (LCM, a replayed log): `found`
+  /// false is a frame without the ball at `t_s`.
+  void track(bool found, const track::Observation& observation, double t_s, const track::ContactSensors& contacts,
+             double capture_wall_s, ProjectionRecord& out);
+  /// Counters so far.
+  const CameraStageCounters& counters() const { return counters_; }
+
+ private:
+  vision::BallDetector* detector_;
+  track::Tracker& tracker_;
+  double lost_after_s_;
+  double last_seen_t_s_ = -1e300;
+  bool tracking_ = false;
+  std::uint64_t seq_ = 0;
+  CameraStageCounters counters_;
+};
+
+/// Settings of the controller stage.
+struct ControllerStageOptions {
+  /// Release every flipper when no frame has arrived for this long, or the
+  /// ball has not been seen for this long while a flipper is up (s).
+  double stall_timeout_s = 0.02;
+  /// Board driver of tracker flipper f (flipper i of the board is driver i).
+  std::array<int, 2> driver_of_flipper{0, 1};
+};
+
+/// Counters of the controller stage.
+struct ControllerStageCounters {
+  std::uint64_t projections = 0;     ///< records handled
+  std::uint64_t commands = 0;        ///< commands given
+  std::uint64_t refused = 0;         ///< commands DriverBus refused (queue full, not running)
+  std::uint64_t camera_stalls = 0;   ///< releases because frames stopped
+  std::uint64_t ball_lost = 0;       ///< releases because the ball was out of sight
+};
+
+/// The action side: flipper commands from projections, with the fail-safes.
+class ControllerStage {
+ public:
+  /// At most this many commands per call.
+  static constexpr int kMaxCommands = 4;
+  using Commands = std::array<CommandRecord, kMaxCommands>;
+
+  /// Borrows the controller and the bus.
+  ControllerStage(control::FlipperController& controller, firmware::DriverBus& bus,
+                  const ControllerStageOptions& options = {});
+
+  /// Acts on one record at pipeline time `now_s`; returns the number of
+  /// commands written to `out`.
+  int on_record(const ProjectionRecord& record, double now_s, double now_wall_s, Commands& out);
+  /// Call when no record has arrived: releases every flipper once frames have
+  /// been missing for the stall timeout. Returns the commands written.
+  int on_idle(double now_s, double now_wall_s, Commands& out);
+  /// Releases every flipper at once (shutdown, bus fault); returns the commands written.
+  int release_all(CommandCause cause, double now_s, double now_wall_s, Commands& out);
+  /// Commands in force (true: energised), per tracker flipper.
+  const std::array<bool, 2>& energized() const { return energized_; }
+  /// Counters so far.
+  const ControllerStageCounters& counters() const { return counters_; }
+  /// The settings.
+  const ControllerStageOptions& options() const { return options_; }
+
+ private:
+  int apply(const std::array<bool, 2>& want, CommandCause cause, std::int64_t projection_seq, double now_s,
+            double capture_wall_s, double now_wall_s, Commands& out);
+  control::FlipperController& controller_;
+  firmware::DriverBus& bus_;
+  ControllerStageOptions options_;
+  std::array<bool, 2> energized_{};  // commands given to the bus
+  std::array<bool, 2> wanted_{};     // the controller's commands
+  double last_record_t_s_ = -1e300;
+  double last_seen_t_s_ = -1e300;
+  bool started_ = false;
+  std::uint64_t seq_ = 0;
+  ControllerStageCounters counters_;
+};
+
+}  // namespace pinball::daemon

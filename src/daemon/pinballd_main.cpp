@@ -1,0 +1,103 @@
+// pinballd: the real-time controller daemon. With no arguments it plays the
+// embedded simulation of boards/mit1993.board over memq:// with the shipped
+// controller and prints the mean score per ball and the latency table.
+
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "pinball/daemon/daemon.h"
+#include "pinball/daemon/thread_table.h"
+
+namespace {
+
+pinball::daemon::Daemon* g_daemon = nullptr;
+
+extern "C" void on_stop_signal(int) {
+  if (g_daemon != nullptr) g_daemon->request_stop();
+}
+extern "C" void on_stats_signal(int) {
+  if (g_daemon != nullptr) g_daemon->request_stats();
+}
+
+void install(int sig, void (*handler)(int)) {
+  struct sigaction sa {};
+  sa.sa_handler = handler;
+  sigemptyset(&sa.sa_mask);
+  sigaction(sig, &sa, nullptr);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace pinball::daemon;
+  CLI::App app("pinballd: the real-time pinball controller (camera -> tracker -> controller -> CAN)");
+  std::string config_path, sim_board, controller, lcm_url;
+  int balls = -1;
+  long long seed = -1;
+  bool realtime = false, json = false, threads = false;
+  app.add_option("--config", config_path, "YAML configuration (config/lab.example.yaml); none: embedded simulation")
+      ->check(CLI::ExistingFile);
+  app.add_option("--sim", sim_board, "simulate this board (default boards/mit1993.board)")->check(CLI::ExistingFile);
+  app.add_option("--controller", controller, "controller file (default controllers/best.json)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--balls", balls, "balls to play in simulation (default 10)")->check(CLI::Range(0, 1000000));
+  app.add_option("--seed", seed, "launch noise seed in simulation")->check(CLI::NonNegativeNumber);
+  app.add_option("--lcm-url", lcm_url, "LCM provider, e.g. memq:// or udpm://239.255.76.67:7667?ttl=0");
+  app.add_flag("--realtime", realtime, "simulation paced to the wall clock (default: lockstep virtual clock)");
+  app.add_flag("--json", json, "print the report as one JSON object on stdout");
+  app.add_flag("--threads", threads, "print the thread table and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (threads) {
+    for (const ThreadSpec& t : kThreadTable) {
+      std::printf("%-14s FIFO %2d  %-48s %s\n", t.name, t.fifo_priority, t.period, t.job);
+    }
+    return 0;
+  }
+  try {
+    DaemonConfig config = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
+    if (!sim_board.empty()) {
+      config.mode = "sim";
+      config.sim.board = sim_board;
+      config.camera.source = "sim";
+      config.can.interface = "sim";
+    }
+    if (!controller.empty()) config.controller = controller;
+    if (balls >= 0) config.sim.balls = balls;
+    if (seed >= 0) config.sim.seed = static_cast<std::uint64_t>(seed);
+    if (!lcm_url.empty()) config.lcm_url = lcm_url;
+    if (realtime) config.sim.realtime = true;
+    Daemon daemon(config);
+    g_daemon = &daemon;
+    install(SIGINT, on_stop_signal);
+    install(SIGTERM, on_stop_signal);
+    install(SIGUSR1, on_stats_signal);
+    std::fprintf(stderr, "pinballd: %s, %s, LCM %s, controller %s\n",
+                 config.mode == "sim" ? ("simulating " + config.sim.board + ", " + std::to_string(config.sim.balls) +
+                                         " balls")
+                                            .c_str()
+                                      : "lab",
+                 config.mode == "sim" ? (config.sim.realtime ? "real-time clock" : "lockstep clock") : "steady clock",
+                 config.lcm_url.c_str(), config.controller.c_str());
+    const DaemonReport report = daemon.run();
+    g_daemon = nullptr;
+    if (json) {
+      std::cout << report_to_json(report).dump(2) << std::endl;
+    } else {
+      std::cout << report_to_text(report);
+    }
+    return 0;
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "pinballd: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pinballd: %s\n", e.what());
+    return 1;
+  }
+}

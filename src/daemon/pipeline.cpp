@@ -1,0 +1,116 @@
+#include "pinball/daemon/pipeline.h"
+
+#include "pinball/daemon/clock.h"
+
+namespace pinball::daemon {
+
+CameraStage::CameraStage(vision::BallDetector* detector, track::Tracker& tracker, double lost_after_s)
+    : detector_(detector), tracker_(tracker), lost_after_s_(lost_after_s) {}
+
+void CameraStage::process(const vision::Frame& frame, const track::ContactSensors& contacts, double capture_wall_s,
+                          ProjectionRecord& out) {
+  const vision::Detection d = detector_->detect(frame);
+  const double detected_wall_s = steady_now_s();
+  out.u_px = d.found ? d.uv_px.x : 0.0;
+  out.v_px = d.found ? d.uv_px.y : 0.0;
+  track(d.found, d.observation, frame.t_s, contacts, capture_wall_s, out);
+  out.frame_seq = frame.sequence;
+  out.detected_wall_s = detected_wall_s;
+}
+
+void CameraStage::track(bool found, const track::Observation& observation, double t_s,
+                        const track::ContactSensors& contacts, double capture_wall_s, ProjectionRecord& out) {
+  out.seq = seq_++;
+  out.frame_seq = out.seq;
+  out.t_s = t_s;
+  out.contacts = contacts;
+  out.capture_wall_s = capture_wall_s;
+  out.found = found;
+  ++counters_.frames;
+  if (found) {
+    ++counters_.detections;
+    out.observation = observation;
+    last_seen_t_s_ = t_s;
+    tracking_ = true;
+    out.output = tracker_.update(observation, contacts);
+    if (out.output.projection.valid) ++counters_.projections;
+    return;
+  }
+  out.output = track::TrackerOutput{};
+  if (tracking_ && t_s - last_seen_t_s_ > lost_after_s_) {
+    // Out of sight for too long (drained, or hidden): the next sighting is a new trajectory.
+    tracker_.reset();
+    tracking_ = false;
+    ++counters_.track_resets;
+    out.output.launch.lost = true;
+  }
+}
+
+ControllerStage::ControllerStage(control::FlipperController& controller, firmware::DriverBus& bus,
+                                 const ControllerStageOptions& options)
+    : controller_(controller), bus_(bus), options_(options) {}
+
+int ControllerStage::on_record(const ProjectionRecord& record, double now_s, double now_wall_s, Commands& out) {
+  ++counters_.projections;
+  started_ = true;
+  last_record_t_s_ = now_s;
+  CommandCause cause = CommandCause::kProjection;
+  if (record.found) {
+    last_seen_t_s_ = record.t_s;
+    controller_.update(record.output, record.t_s, wanted_);
+    if (record.output.launch.launched) cause = CommandCause::kLaunch;
+    if (record.output.launch.lost) cause = CommandCause::kBallLost;
+  } else if (record.output.launch.lost) {
+    controller_.reset(wanted_);  // the camera stage gave the ball up
+    cause = CommandCause::kBallLost;
+  } else if ((wanted_[0] || wanted_[1]) && record.t_s - last_seen_t_s_ > options_.stall_timeout_s) {
+    // A flipper is up and the ball has not been seen for the timeout: let go.
+    controller_.reset(wanted_);
+    ++counters_.ball_lost;
+    cause = CommandCause::kBallLost;
+  }
+  return apply(wanted_, cause, static_cast<std::int64_t>(record.seq), now_s, record.capture_wall_s, now_wall_s, out);
+}
+
+int ControllerStage::on_idle(double now_s, double now_wall_s, Commands& out) {
+  if (!started_ || now_s - last_record_t_s_ <= options_.stall_timeout_s) return 0;
+  if (!energized_[0] && !energized_[1]) return 0;
+  ++counters_.camera_stalls;
+  controller_.reset(wanted_);
+  return release_all(CommandCause::kCameraStall, now_s, now_wall_s, out);
+}
+
+int ControllerStage::release_all(CommandCause cause, double now_s, double now_wall_s, Commands& out) {
+  bus_.release_all();  // takes priority over anything queued
+  wanted_ = {false, false};
+  int n = 0;
+  CommandRecord& c = out[static_cast<std::size_t>(n++)];
+  c = CommandRecord{seq_++, -1, -1, false, cause, now_s, 0.0, now_wall_s};
+  energized_ = {false, false};
+  counters_.commands += 1;
+  return n;
+}
+
+int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, std::int64_t projection_seq,
+                           double now_s, double capture_wall_s, double now_wall_s, Commands& out) {
+  int n = 0;
+  for (int f = 0; f < 2; ++f) {
+    if (want[static_cast<std::size_t>(f)] == energized_[static_cast<std::size_t>(f)]) continue;
+    const bool on = want[static_cast<std::size_t>(f)];
+    const int driver = options_.driver_of_flipper[static_cast<std::size_t>(f)];
+    const bool accepted = on ? bus_.fire(driver) : bus_.release(driver);
+    if (!accepted) {
+      ++counters_.refused;
+      if (on) continue;     // a refused fire is tried again on the next record
+      bus_.release_all();   // a release must not be lost: this one cannot be refused
+    }
+    energized_[static_cast<std::size_t>(f)] = on;
+    ++counters_.commands;
+    out[static_cast<std::size_t>(n++)] =
+        CommandRecord{seq_++, projection_seq, f, on, on ? CommandCause::kProjection : cause, now_s, capture_wall_s,
+                      now_wall_s};
+  }
+  return n;
+}
+
+}  // namespace pinball::daemon
