@@ -99,7 +99,6 @@ struct Daemon::Impl {
   std::atomic<double> virtual_now_s{0.0};       // lockstep: exposure time of the latest record
   std::atomic<std::uint64_t> frames_dropped{0};
   std::atomic<std::uint64_t> ring_overflows{0};
-  std::atomic<std::uint64_t> bus_fault_releases{0};
   std::atomic<double> sim_time_s{0.0};
   std::array<std::atomic<double>, firmware::kMaxDrivers> can_written_wall_s{};
   double wall_offset_s = 0.0;                   // sim realtime: wall = sim + offset
@@ -177,6 +176,10 @@ void Daemon::Impl::build() {
     throw ConfigError("config: calibration: reading calibration files is not built yet");
   }
   if (homography) {
+    // OpenCV's thread pool would hand the camera thread's work to threads
+    // outside the thread table, allocate task objects per call and add jitter:
+    // the detector runs on the camera thread alone.
+    cv::setNumThreads(1);
     vision::BallDetectorConfig dc;
     dc.ball_radius_m = board.ball.radius_m;
     detector = std::make_unique<vision::BallDetector>(*homography, frame_size, dc);
@@ -362,23 +365,13 @@ void Daemon::Impl::controller_thread() {
   ProjectionRecord record;
   ControllerStage::Commands cmds;
   const double frame_period_s = 1.0 / config.camera.fps;
-  bool was_running = bus->state() == firmware::BusState::kRunning;
   while (!stop.load(std::memory_order_acquire)) {
     if (records.try_pop(record)) {
       HotPathScope hot;
       if (lockstep) virtual_now_s.store(record.t_s, std::memory_order_release);
       const double now = lockstep ? record.t_s : pipeline_now_s();
-      int n = controller_stage->on_record(record, now, steady_now_s(), cmds);
-      const double decided = steady_now_s();
-      latency[kProjectionToDecision].record((decided - record.projected_wall_s) * 1e6);
-      const bool running = bus->state() == firmware::BusState::kRunning;
-      if (was_running && !running) {
-        // The CAN session dropped (bus-off, silence): the bus has made the coils
-        // safe; forget our commands so the next approach fires afresh.
-        n = controller_stage->release_all(CommandCause::kBusFault, now, decided, cmds);
-        bus_fault_releases.fetch_add(1, std::memory_order_relaxed);
-      }
-      was_running = running;
+      const int n = controller_stage->on_record(record, now, steady_now_s(), cmds);
+      latency[kProjectionToDecision].record((steady_now_s() - record.projected_wall_s) * 1e6);
       publish_commands(cmds, n);
       records_done.fetch_add(1, std::memory_order_acq_rel);
       driver_bell.ring();
@@ -492,7 +485,7 @@ DaemonReport Daemon::Impl::report() const {
   r.commands = kc.commands;
   r.camera_stalls = kc.camera_stalls;
   r.ball_lost_releases = kc.ball_lost;
-  r.bus_fault_releases = bus_fault_releases.load();
+  r.bus_fault_releases = kc.bus_faults;
   r.frames_dropped = frames_dropped.load() + (capture ? capture->counters().dropped : 0);
   r.ring_overflows = ring_overflows.load();
   r.lcm = lcm->counters();

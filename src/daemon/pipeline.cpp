@@ -53,6 +53,19 @@ ControllerStage::ControllerStage(control::FlipperController& controller, firmwar
 int ControllerStage::on_record(const ProjectionRecord& record, double now_s, double now_wall_s, Commands& out) {
   ++counters_.projections;
   started_ = true;
+  // A session that dropped, or restarted since the last record, has lost our commands.
+  const bool running = bus_.state() == firmware::BusState::kRunning;
+  const std::uint64_t sessions = bus_.counters().sessions;
+  const bool dropped = (bus_was_running_ && !running) || (sessions_seen_ != 0 && sessions != sessions_seen_);
+  bus_was_running_ = running;
+  sessions_seen_ = sessions;
+  if (dropped) {
+    ++counters_.bus_faults;
+    if (energized_[0] || energized_[1]) {
+      controller_.reset(wanted_);
+      return release_all(CommandCause::kBusFault, now_s, now_wall_s, out);
+    }
+  }
   last_record_t_s_ = now_s;
   CommandCause cause = CommandCause::kProjection;
   if (record.found) {

@@ -108,6 +108,7 @@ struct ControllerStageCounters {
   std::uint64_t refused = 0;         ///< commands DriverBus refused (queue full, not running)
   std::uint64_t camera_stalls = 0;   ///< releases because frames stopped
   std::uint64_t ball_lost = 0;       ///< releases because the ball was out of sight
+  std::uint64_t bus_faults = 0;      ///< releases because the CAN session dropped (bus-off, silence)
 };
 
 /// The action side: flipper commands from projections, with the fail-safes.
@@ -122,7 +123,10 @@ class ControllerStage {
                   const ControllerStageOptions& options = {});
 
   /// Acts on one record at pipeline time `now_s`; returns the number of
-  /// commands written to `out`.
+  /// commands written to `out`. When the CAN session has dropped since the
+  /// last call (bus-off, no Status), the bus has already made the coils safe:
+  /// the stage forgets its commands (a kBusFault release) so that the next
+  /// approach fires afresh once the session is back.
   int on_record(const ProjectionRecord& record, double now_s, double now_wall_s, Commands& out);
   /// Call when no record has arrived: releases every flipper once frames have
   /// been missing for the stall timeout. Returns the commands written.
@@ -147,6 +151,8 @@ class ControllerStage {
   double last_record_t_s_ = -1e300;
   double last_seen_t_s_ = -1e300;
   bool started_ = false;
+  bool bus_was_running_ = false;
+  std::uint64_t sessions_seen_ = 0;
   std::uint64_t seq_ = 0;
   ControllerStageCounters counters_;
 };

@@ -1,0 +1,110 @@
+#include "pinball/bus/message_convert.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace pinball::bus {
+namespace {
+
+template <class T>
+T round_trip(const T& m) {
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
+  EXPECT_EQ(m.encode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+  T out;
+  EXPECT_EQ(out.decode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+  return out;
+}
+
+TEST(MessageConvert, ObservationRoundTrip) {
+  track::Observation o;
+  o.t_s = 1.25;
+  o.p_board = Vec2(0.2, 0.7);
+  o.confidence = 0.9;
+  const auto m = round_trip(to_lcm_observation(1250000, 7, true, o, 100.5, 200.25, {true, false}));
+  EXPECT_EQ(m.utime, 1250000);
+  EXPECT_EQ(m.seq, 7);
+  bool found = false;
+  track::Observation back;
+  track::ContactSensors c;
+  ASSERT_TRUE(from_lcm_observation(m, found, back, c));
+  EXPECT_TRUE(found);
+  EXPECT_DOUBLE_EQ(back.t_s, 1.25);
+  EXPECT_EQ(back.p_board, o.p_board);
+  EXPECT_DOUBLE_EQ(back.confidence, 0.9);
+  EXPECT_TRUE(c.left);
+  EXPECT_FALSE(c.right);
+  EXPECT_DOUBLE_EQ(m.u_px, 100.5);
+}
+
+TEST(MessageConvert, ProjectionCarriesEveryField) {
+  track::TrackerOutput out;
+  out.projection.valid = true;
+  out.projection.reason = track::NoProjection::kNone;
+  out.projection.flipper = track::kRightFlipper;
+  out.projection.speed_mps = 1.5;
+  out.projection.angle_rad = -0.3;
+  out.projection.h = 0.6;
+  out.projection.d_m = 0.2;
+  out.projection.t_impact_s = 0.12;
+  out.projection.impact_point = Vec2(0.3, 0.1);
+  out.projection.hittable = true;
+  out.launch.launched = true;
+  const auto m = round_trip(to_lcm_projection(5, 6, 7, out));
+  EXPECT_TRUE(m.valid);
+  EXPECT_EQ(m.flipper, 1);
+  EXPECT_DOUBLE_EQ(m.speed_mps, 1.5);
+  EXPECT_DOUBLE_EQ(m.angle_rad, -0.3);
+  EXPECT_DOUBLE_EQ(m.h, 0.6);
+  EXPECT_DOUBLE_EQ(m.d_m, 0.2);
+  EXPECT_DOUBLE_EQ(m.t_impact_s, 0.12);
+  EXPECT_DOUBLE_EQ(m.impact_x_m, 0.3);
+  EXPECT_TRUE(m.hittable);
+  EXPECT_TRUE(m.launched);
+  EXPECT_FALSE(m.lost);
+  EXPECT_EQ(m.observation_seq, 7);
+}
+
+TEST(MessageConvert, InvalidProjectionNamesNoFlipper) {
+  track::TrackerOutput out;
+  out.projection.valid = false;
+  out.projection.reason = track::NoProjection::kTooFewPoints;
+  const auto m = to_lcm_projection(1, 1, 1, out);
+  EXPECT_FALSE(m.valid);
+  EXPECT_EQ(m.flipper, -1);
+  EXPECT_EQ(m.reason, static_cast<std::int8_t>(track::NoProjection::kTooFewPoints));
+}
+
+TEST(MessageConvert, MalformedObservationsAreRefused) {
+  bool found;
+  track::Observation o;
+  track::ContactSensors c;
+  pinball_lcm::lcmt_pinball_observation m{};
+  m.found = true;
+  m.x_m = std::nan("");
+  EXPECT_FALSE(from_lcm_observation(m, found, o, c));
+  m.x_m = 0.1;
+  m.y_m = 0.2;
+  m.confidence = 1.5;
+  EXPECT_FALSE(from_lcm_observation(m, found, o, c));
+  m.confidence = 1.0;
+  m.utime = -5;
+  EXPECT_FALSE(from_lcm_observation(m, found, o, c));
+  m.utime = 5;
+  EXPECT_TRUE(from_lcm_observation(m, found, o, c));
+}
+
+TEST(MessageConvert, FlipperCommandRange) {
+  pinball_lcm::lcmt_pinball_flipper_command m{};
+  m.flipper = 1;
+  EXPECT_TRUE(valid_flipper_command(m));
+  m.flipper = 2;
+  EXPECT_FALSE(valid_flipper_command(m));
+  m.flipper = -1;
+  m.cause = 9;
+  EXPECT_FALSE(valid_flipper_command(m));
+}
+
+}  // namespace
+}  // namespace pinball::bus

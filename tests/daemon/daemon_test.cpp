@@ -1,0 +1,202 @@
+// pinballd end to end in the embedded simulation: pixels, detector, tracker,
+// controller, CAN frames, the virtual board and the solenoid delay.
+
+#include "pinball/daemon/daemon.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "pinball/bus/channels.h"
+#include "pinball/control/controller_file.h"
+#include "pinball/core/running_stats.h"
+#include "pinball/learn/evaluator.h"
+#include "pinball/sim/board_loader.h"
+
+namespace pinball::daemon {
+namespace {
+
+const std::string kSource = PINBALL_SOURCE_DIR;
+
+DaemonConfig sim_config(int balls, std::uint64_t seed) {
+  DaemonConfig c;
+  c.sim.board = kSource + "/boards/mit1993.board";
+  c.controller = kSource + "/controllers/best.json";
+  c.sim.balls = balls;
+  c.sim.seed = seed;
+  return c;
+}
+
+TEST(Daemon, LockstepRunsAreDeterminedByTheSeed) {
+  DaemonReport a, b;
+  {
+    Daemon d(sim_config(2, 5));
+    a = d.run();
+  }
+  {
+    Daemon d(sim_config(2, 5));
+    b = d.run();
+  }
+  ASSERT_EQ(a.balls, 2);
+  ASSERT_EQ(b.balls, 2);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(a.results[static_cast<std::size_t>(i)].score, b.results[static_cast<std::size_t>(i)].score);
+    EXPECT_EQ(a.results[static_cast<std::size_t>(i)].duration_s, b.results[static_cast<std::size_t>(i)].duration_s);
+  }
+  EXPECT_EQ(a.commands, b.commands);
+  EXPECT_EQ(a.frames, b.frames);
+  EXPECT_TRUE(a.coils_off_at_exit);
+  EXPECT_EQ(a.frames_dropped, 0u);
+  EXPECT_EQ(a.ring_overflows, 0u);
+  EXPECT_EQ(a.board.watchdog_trips, 0u);
+}
+
+TEST(Daemon, FullPathScoresLikeTheFastLearningLoop) {
+  // The same controller on the same 20 ball seeds: the daemon (pixels,
+  // detector, rings, CAN, virtual board) and the fast loop (camera model,
+  // no threads) must agree within their statistical error.
+  constexpr int kBalls = 20;
+  constexpr std::uint64_t kSeed = 11;
+  Daemon d(sim_config(kBalls, kSeed));
+  const DaemonReport r = d.run();
+  ASSERT_EQ(r.balls, kBalls);
+  RunningStats daemon_scores;
+  for (const SimBallResult& b : r.results) daemon_scores.add(b.score);
+
+  const sim::Board board = sim::load_board(kSource + "/boards/mit1993.board");
+  const control::ControllerSpec spec = control::load_controller(kSource + "/controllers/best.json");
+  learn::EvaluatorConfig ec;
+  ec.actuation_delay_s = 0.004;
+  ec.max_ball_time_s = 60.0;
+  const learn::PinballEvaluator evaluator(board, ec);
+  RunningStats fast_scores;
+  for (int i = 0; i < kBalls; ++i) {
+    fast_scores.add(evaluator.play(spec, learn::ball_seed(kSeed, static_cast<std::uint64_t>(i))).score);
+  }
+  const double se = std::sqrt(daemon_scores.variance() / kBalls + fast_scores.variance() / kBalls);
+  std::printf("daemon %.0f +- %.0f, fast loop %.0f +- %.0f (1 se)\n", daemon_scores.mean(),
+              std::sqrt(daemon_scores.variance() / kBalls), fast_scores.mean(),
+              std::sqrt(fast_scores.variance() / kBalls));
+  EXPECT_LT(std::abs(daemon_scores.mean() - fast_scores.mean()), 3.0 * se);
+  EXPECT_GT(daemon_scores.mean(), 0.0);
+  // The controller really played: it fired, and the board obeyed every fire.
+  EXPECT_GT(r.driver.fires, static_cast<std::uint64_t>(kBalls));
+  EXPECT_EQ(r.board.fires_accepted, r.driver.fires);
+  EXPECT_GT(r.latency[kFrameToCan].count, 0u);
+  EXPECT_TRUE(r.coils_off_at_exit);
+}
+
+struct StatsCounter {
+  std::atomic<int> n{0};
+  std::atomic<std::int64_t> frames{0};
+  void on_stats(const lcm::ReceiveBuffer*, const std::string&, const pinball_lcm::lcmt_pinball_daemon_stats* m) {
+    frames = m->frames;
+    EXPECT_EQ(m->num_stages, static_cast<int>(kStageCount));
+    ++n;
+  }
+  std::atomic<int> games{0};
+  void on_game(const lcm::ReceiveBuffer*, const std::string&, const pinball_lcm::lcmt_pinball_game_event*) {
+    ++games;
+  }
+};
+
+TEST(Daemon, PublishesStatsAndGameEventsOnLcm) {
+  Daemon d(sim_config(1, 3));
+  StatsCounter c;
+  d.lcm_bus().lcm().subscribe(bus::kStatsChannel, &StatsCounter::on_stats, &c);
+  d.lcm_bus().lcm().subscribe(bus::kGameChannel, &StatsCounter::on_game, &c);
+  const DaemonReport r = d.run();
+  EXPECT_GE(c.n.load(), 1);  // at least the one on exit
+  EXPECT_EQ(c.frames.load(), static_cast<std::int64_t>(r.frames));
+  EXPECT_GE(c.games.load(), 2);  // launch and loss
+  EXPECT_EQ(r.lcm.overflows, 0u);
+}
+
+TEST(Daemon, StopMidBallReleasesEveryCoil) {
+  DaemonConfig c = sim_config(1000, 2);
+  c.sim.realtime = true;  // the wall clock: stop arrives mid-game
+  Daemon d(c);
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    d.request_stop();
+  });
+  const DaemonReport r = d.run();
+  stopper.join();
+  EXPECT_LT(r.balls, 1000);
+  EXPECT_TRUE(r.coils_off_at_exit);
+  EXPECT_GE(r.driver.release_alls, 1u);
+  EXPECT_GT(r.frames, 100u);
+}
+
+TEST(Daemon, BadFilesAreNamed) {
+  DaemonConfig c = sim_config(1, 1);
+  c.controller = "/nonexistent/controller.json";
+  EXPECT_THROW(Daemon{c}, std::exception);
+  c = sim_config(1, 1);
+  c.sim.board = "/nonexistent/x.board";
+  try {
+    Daemon d(c);
+    FAIL();
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/x.board"), std::string::npos);
+  }
+}
+
+// pinballd as a child process: SIGINT releases every coil and exits 0.
+TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
+  const std::string out = ::testing::TempDir() + "/pinballd_sigint.json";
+  const std::string cmd = std::string(PINBALLD_EXE) + " --balls 1000 --json --controller " + kSource +
+                          "/controllers/best.json --sim " + kSource + "/boards/mit1993.board > " + out +
+                          " 2>/dev/null";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  FILE* f = std::fopen(out.c_str(), "r");
+  ASSERT_NE(f, nullptr);
+  std::string text;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  std::fclose(f);
+  const nlohmann::json j = nlohmann::json::parse(text);
+  EXPECT_TRUE(j["coils_off_at_exit"].get<bool>());
+  EXPECT_LT(j["balls"].get<int>(), 1000);
+  EXPECT_GE(j["can"]["release_alls"].get<int>(), 1);
+}
+
+TEST(Pinballd, BadConfigExitsOneNamingTheKey) {
+  const std::string path = ::testing::TempDir() + "/bad_pinballd.yaml";
+  FILE* f = std::fopen(path.c_str(), "w");
+  std::fputs("camera:\n  fsp: 200\n", f);
+  std::fclose(f);
+  const std::string cmd = std::string(PINBALLD_EXE) + " --config " + path + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string text;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) text += buf;
+  const int status = pclose(p);
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_NE(text.find("camera.fsp: unknown key"), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace pinball::daemon
