@@ -51,7 +51,7 @@ void LcmBus::subscribe_observations(ObservationRing& ring) {
 }
 
 void LcmBus::on_observation(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-  pinball_lcm::lcmt_pinball_observation m;
+  pinball_lcm::lcmt_pinball_observation m{};
   bool found = false;
   track::Observation o;
   track::ContactSensors c;
@@ -96,7 +96,9 @@ void LcmBus::run(std::function<void(lcm::LCM&)> periodic, double period_s) {
       next += std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(period_s));
     }
     // Publishing is not on anyone's critical path: a short nap when idle.
-    if (n == 0) lcm_->handleTimeout(1);
+    if (n == 0 && lcm_->handleTimeout(1) < 0) {
+      std::this_thread::sleep_for(std::chrono::microseconds(500));  // a provider that cannot receive (file://...?mode=w)
+    }
   }
   drain();
   if (periodic) periodic(*lcm_);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "pinball/core/utime.h"
+
 namespace pinball::bus {
 
 pinball_lcm::lcmt_pinball_observation to_lcm_observation(std::int64_t utime, std::int64_t seq, bool found,
@@ -56,7 +58,7 @@ bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& 
   found = m.found;
   contacts.left = m.contact_left;
   contacts.right = m.contact_right;
-  out.t_s = static_cast<double>(m.utime) * 1e-6;
+  out.t_s = from_utime(m.utime);
   if (!found) return true;
   if (!std::isfinite(m.x_m) || !std::isfinite(m.y_m) || !(m.confidence >= 0.0 && m.confidence <= 1.0)) return false;
   out.p_board = Vec2(m.x_m, m.y_m);

@@ -105,4 +105,16 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err);
 /// (0 success, 1 bad input or failure, 2 bad usage).
 int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
 
+/// `pinball replay`
+struct ReplayArgs {
+  std::string log;         ///< LCM log file
+  std::string config;      ///< pinballd configuration (optional)
+  std::string board;       ///< board override
+  std::string controller;  ///< controller override
+  bool json = false;       ///< one JSON object on stdout
+};
+CLI::App* add_replay_command(CLI::App& app, ReplayArgs& args);
+/// Exit 0 when reproduced, 3 when the decisions differ, 1 for bad input.
+int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err);
+
 }  // namespace pinball::cli

@@ -133,9 +133,7 @@ void Daemon::Impl::build() {
   board = sim::load_board(sim_mode ? config.sim.board : config.board);
   spec = control::load_controller(config.controller);
   controller = std::make_unique<control::ActuatorController>(spec.action_function, spec.actuator);
-  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    driver_of_flipper[board.flippers[i].side == sim::Side::kLeft ? 0 : 1] = static_cast<int>(i);
-  }
+  driver_of_flipper = controller_stage_options_for(config, board).driver_of_flipper;
   const int drivers = static_cast<int>(board.flippers.size());
 
   if (config.can.interface == "sim") {
@@ -149,10 +147,7 @@ void Daemon::Impl::build() {
   }
   bus = std::make_unique<firmware::DriverBus>(*host_link, bus_options(config, drivers));
 
-  track::CameraModelConfig camera_model;
-  camera_model.fps = config.camera.fps;
-  track::TrackerConfig tracker_config = track::default_tracker_config(board, camera_model);
-  tracker = std::make_unique<track::Tracker>(track::flipper_geometry_from_board(board), tracker_config);
+  tracker = std::make_unique<track::Tracker>(track::flipper_geometry_from_board(board), tracker_config_for(config, board));
 
   cv::Size frame_size(config.camera.width_px, config.camera.height_px);
   if (sim_mode) {
@@ -185,13 +180,9 @@ void Daemon::Impl::build() {
     detector = std::make_unique<vision::BallDetector>(*homography, frame_size, dc);
     if (world) detector->set_occluder_mask(world->camera().occluder_mask());
   }
-  // A ball unseen for 4 frame periods plus the stall timeout is gone.
-  camera_stage = std::make_unique<CameraStage>(detector.get(), *tracker,
-                                               config.camera.stall_timeout_s + 4.0 / config.camera.fps);
-  ControllerStageOptions so;
-  so.stall_timeout_s = config.camera.stall_timeout_s;
-  so.driver_of_flipper = driver_of_flipper;
-  controller_stage = std::make_unique<ControllerStage>(*controller, *bus, so);
+  camera_stage = std::make_unique<CameraStage>(detector.get(), *tracker, lost_after_s_for(config));
+  controller_stage =
+      std::make_unique<ControllerStage>(*controller, *bus, controller_stage_options_for(config, board));
 
   lcm = std::make_unique<bus::LcmBus>(config.lcm_url);
   if (config.camera.source == "lcm") lcm->subscribe_observations(lcm_observations);

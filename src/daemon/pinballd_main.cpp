@@ -61,7 +61,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   try {
-    DaemonConfig config = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
+    DaemonConfig config;
+    if (!config_path.empty()) config = load_daemon_config(config_path);
     if (!sim_board.empty()) {
       config.mode = "sim";
       config.sim.board = sim_board;

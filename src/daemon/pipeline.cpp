@@ -1,5 +1,6 @@
 #include "pinball/daemon/pipeline.h"
 
+#include "pinball/core/utime.h"
 #include "pinball/daemon/clock.h"
 
 namespace pinball::daemon {
@@ -20,6 +21,9 @@ void CameraStage::process(const vision::Frame& frame, const track::ContactSensor
 
 void CameraStage::track(bool found, const track::Observation& observation, double t_s,
                         const track::ContactSensors& contacts, double capture_wall_s, ProjectionRecord& out) {
+  // Whole microseconds, as the observation travels on LCM: a replayed log
+  // then gives the tracker exactly the times it had live.
+  t_s = utime_rounded(t_s);
   out.seq = seq_++;
   out.frame_seq = out.seq;
   out.t_s = t_s;
@@ -30,9 +34,10 @@ void CameraStage::track(bool found, const track::Observation& observation, doubl
   if (found) {
     ++counters_.detections;
     out.observation = observation;
+    out.observation.t_s = t_s;
     last_seen_t_s_ = t_s;
     tracking_ = true;
-    out.output = tracker_.update(observation, contacts);
+    out.output = tracker_.update(out.observation, contacts);
     if (out.output.projection.valid) ++counters_.projections;
     return;
   }
@@ -124,6 +129,26 @@ int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, 
                       now_wall_s};
   }
   return n;
+}
+
+track::TrackerConfig tracker_config_for(const DaemonConfig& config, const sim::Board& board) {
+  track::CameraModelConfig camera_model;
+  camera_model.fps = config.camera.fps;
+  return track::default_tracker_config(board, camera_model);
+}
+
+ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const sim::Board& board) {
+  ControllerStageOptions o;
+  o.stall_timeout_s = config.camera.stall_timeout_s;
+  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+    o.driver_of_flipper[board.flippers[i].side == sim::Side::kLeft ? 0 : 1] = static_cast<int>(i);
+  }
+  return o;
+}
+
+double lost_after_s_for(const DaemonConfig& config) {
+  // A ball unseen for the stall timeout plus 4 frame periods is gone.
+  return config.camera.stall_timeout_s + 4.0 / config.camera.fps;
 }
 
 }  // namespace pinball::daemon

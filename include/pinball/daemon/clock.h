@@ -5,14 +5,13 @@
 #include <chrono>
 #include <cstdint>
 
+#include "pinball/core/utime.h"
+
 namespace pinball::daemon {
 
 /// Steady clock now (s).
 inline double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
-
-/// Seconds to LCM's microseconds.
-inline std::int64_t to_utime(double t_s) { return static_cast<std::int64_t>(t_s * 1e6 + (t_s >= 0 ? 0.5 : -0.5)); }
 
 }  // namespace pinball::daemon

@@ -10,7 +10,9 @@
 #include <cstdint>
 
 #include "pinball/control/flipper_controller.h"
+#include "pinball/daemon/daemon_config.h"
 #include "pinball/firmware/driver_bus.h"
+#include "pinball/sim/board.h"
 #include "pinball/track/observation.h"
 #include "pinball/track/tracker.h"
 #include "pinball/vision/ball_detector.h"
@@ -156,5 +158,13 @@ class ControllerStage {
   std::uint64_t seq_ = 0;
   ControllerStageCounters counters_;
 };
+
+/// The tracker settings the daemon uses for `config` on `board` (shared by
+/// pinballd and `pinball replay`, so a replay decides as the daemon did).
+track::TrackerConfig tracker_config_for(const DaemonConfig& config, const sim::Board& board);
+/// The controller stage's settings for `config` on `board`.
+ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const sim::Board& board);
+/// How long the camera stage keeps an unseen ball before forgetting it (s).
+double lost_after_s_for(const DaemonConfig& config);
 
 }  // namespace pinball::daemon

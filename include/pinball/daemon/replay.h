@@ -1,0 +1,35 @@
+#pragma once
+// `pinball replay LOG`: feeds the observations recorded in an LCM log (by
+// lcm-logger, or pinballd --lcm-url file://...?mode=w) through the same
+// tracker and controller stages pinballd ran, offline, and compares the
+// decisions with the flipper commands recorded in the same log.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "pinball/daemon/daemon_config.h"
+
+namespace pinball::daemon {
+
+/// What a replay found.
+struct ReplayReport {
+  std::uint64_t events = 0;             ///< log events read
+  std::uint64_t observations = 0;       ///< PINBALL_OBSERVATION messages replayed
+  std::uint64_t malformed = 0;          ///< messages that failed to decode or check, skipped
+  std::uint64_t recorded_commands = 0;  ///< PINBALL_FLIPPER_CMD messages from projections, launches and losses
+  std::uint64_t replayed_commands = 0;  ///< commands the replay gave for the same causes
+  std::uint64_t matched = 0;            ///< leading commands equal in flipper, direction and cause
+  std::int64_t first_mismatch = -1;     ///< index of the first difference, -1 when none
+  std::string mismatch;                 ///< the two decisions at first_mismatch, for people
+  std::uint64_t skipped_timing = 0;     ///< recorded commands caused by timing alone (stall, shutdown, bus)
+  bool reproduced = false;              ///< every recorded decision was reproduced, in order
+};
+
+/// Replays `log_path` with the board and controller of `config`. Throws
+/// std::runtime_error naming the file when it cannot be read. `progress`
+/// (may be empty) gets a line now and then.
+ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
+                        const std::function<void(const std::string&)>& progress = {});
+
+}  // namespace pinball::daemon

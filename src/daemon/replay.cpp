@@ -1,0 +1,111 @@
+#include "pinball/daemon/replay.h"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <stdexcept>
+#include <vector>
+
+#include "pinball/bus/channels.h"
+#include "pinball/bus/message_convert.h"
+#include "pinball/control/actuator_controller.h"
+#include "pinball/control/controller_file.h"
+#include "pinball/daemon/pipeline.h"
+#include "pinball/firmware/stream_transport.h"
+#include "pinball/sim/board_loader.h"
+#include "pinball/track/flipper_geometry.h"
+
+namespace pinball::daemon {
+namespace {
+
+struct Decision {
+  int flipper;
+  bool energize;
+  int cause;
+  bool operator==(const Decision&) const = default;
+};
+
+// Commands that follow from the observations alone; the others depend on
+// when a thread woke up (stall), on the CAN link, or on the end of the run.
+bool decided_by_observations(int cause) {
+  return cause == static_cast<int>(CommandCause::kProjection) || cause == static_cast<int>(CommandCause::kLaunch) ||
+         cause == static_cast<int>(CommandCause::kBallLost);
+}
+
+}  // namespace
+
+ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
+                        const std::function<void(const std::string&)>& progress) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
+  const sim::Board board = sim::load_board(config.mode == "sim" ? config.sim.board : config.board);
+  const control::ControllerSpec spec = control::load_controller(config.controller);
+  control::ActuatorController controller(spec.action_function, spec.actuator);
+  track::Tracker tracker(track::flipper_geometry_from_board(board), tracker_config_for(config, board));
+  CameraStage camera(nullptr, tracker, lost_after_s_for(config));
+  // The stage drives a DriverBus with no board behind it: its commands go
+  // nowhere, the decisions are what counts.
+  auto [host, far] = firmware::StreamTransport::make_pair();
+  firmware::DriverBusOptions bo;
+  bo.driver_count = static_cast<int>(board.flippers.size());
+  firmware::DriverBus bus(*host, bo);
+  ControllerStage stage(controller, bus, controller_stage_options_for(config, board));
+
+  ReplayReport r;
+  std::vector<Decision> recorded, replayed;
+  ProjectionRecord record;
+  ControllerStage::Commands cmds;
+  for (const lcm::LogEvent* e = log.readNextEvent(); e != nullptr; e = log.readNextEvent()) {
+    ++r.events;
+    if (e->channel == bus::kObservationChannel) {
+      pinball_lcm::lcmt_pinball_observation m{};
+      bool found = false;
+      track::Observation o;
+      track::ContactSensors c;
+      if (m.decode(e->data, 0, static_cast<int>(e->datalen)) < 0 || !bus::from_lcm_observation(m, found, o, c)) {
+        ++r.malformed;
+        continue;
+      }
+      ++r.observations;
+      camera.track(found, o, o.t_s, c, 0.0, record);
+      const int n = stage.on_record(record, record.t_s, 0.0, cmds);
+      for (int i = 0; i < n; ++i) {
+        const CommandRecord& k = cmds[static_cast<std::size_t>(i)];
+        if (decided_by_observations(static_cast<int>(k.cause))) {
+          replayed.push_back({k.flipper, k.energize, static_cast<int>(k.cause)});
+        }
+      }
+      bus.poll_once(record.t_s);  // keeps its queue empty
+      if (progress && r.observations % 20000 == 0) {
+        progress(std::to_string(r.observations) + " observations replayed");
+      }
+    } else if (e->channel == bus::kFlipperCommandChannel) {
+      pinball_lcm::lcmt_pinball_flipper_command m{};
+      if (m.decode(e->data, 0, static_cast<int>(e->datalen)) < 0 || !bus::valid_flipper_command(m)) {
+        ++r.malformed;
+        continue;
+      }
+      if (decided_by_observations(m.cause)) {
+        recorded.push_back({m.flipper, m.energize != 0, m.cause});
+      } else {
+        ++r.skipped_timing;
+      }
+    }
+  }
+  r.recorded_commands = recorded.size();
+  r.replayed_commands = replayed.size();
+  const std::size_t n = std::min(recorded.size(), replayed.size());
+  while (r.matched < n && recorded[r.matched] == replayed[r.matched]) ++r.matched;
+  if (r.matched < std::max(recorded.size(), replayed.size())) {
+    r.first_mismatch = static_cast<std::int64_t>(r.matched);
+    auto show = [](const std::vector<Decision>& v, std::size_t k) {
+      if (k >= v.size()) return std::string("none");
+      return std::string(v[k].flipper < 0 ? "all" : v[k].flipper == 0 ? "left" : "right") +
+             (v[k].energize ? " fire" : " release") + " (cause " + std::to_string(v[k].cause) + ")";
+    };
+    r.mismatch = "recorded " + show(recorded, r.matched) + ", replayed " + show(replayed, r.matched);
+  }
+  r.reproduced = r.first_mismatch < 0 && r.observations > 0;
+  return r;
+}
+
+}  // namespace pinball::daemon
