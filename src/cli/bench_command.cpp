@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "pinball/sim/board_loader.h"
 #include "detector_bench.h"
+#include "daemon_latency_bench.h"
 #include "latency_bench.h"
 #include "speed_bench.h"
 #include "tracker_bench.h"
@@ -22,7 +23,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
       ->check(CLI::Range(10, 1'000'000));
   cmd->add_option("--seed", a.seed, "tracker, detector: seed for play, camera noise and placements");
-  cmd->add_flag("--quick", a.quick, "tracker, detector: a short run (fewer approaches or frames)");
+  cmd->add_flag("--quick", a.quick, "tracker, detector, latency: a short run (fewer approaches, frames or balls)");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -57,10 +58,23 @@ int run_detector(const BenchArgs& a, const sim::Board& board, std::ostream& out,
 }
 
 int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
-  const bench::LatencyReport r = bench::run_latency_bench(
-      bench::LatencyBenchOptions{}, [&](const std::string& line) { err << "bench latency: " << line << "\n"; });
+  auto progress = [&](const std::string& line) { err << "bench latency: " << line << "\n"; };
+  bench::LatencyBenchOptions lo;
+  bench::DaemonLatencyOptions dlo;
+  if (a.quick) {
+    lo.samples = 200;
+    lo.codec_frames = 10'000;
+    lo.baseline_samples = 200;
+    dlo.lockstep_balls = 2;
+    dlo.realtime_s = 1.0;
+    dlo.baseline_samples = 200;
+  }
+  const bench::LatencyReport r = bench::run_latency_bench(lo, progress);
+  const bench::DaemonLatencyReport d = bench::run_daemon_latency_bench(dlo, progress);
   if (a.json) {
-    out << bench::to_json(r).dump(2) << "\n";
+    nlohmann::json j = bench::to_json(r);
+    j["daemon"] = bench::to_json(d);
+    out << j.dump(2) << "\n";
     return 0;
   }
   out << "fire() to coil output over the stream transport, " << r.samples << " samples\n"
@@ -70,6 +84,14 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
       << r.stack_overhead_ratio << "x)\n"
       << "encode+decode per frame " << r.encode_decode_ns << " ns (copy baseline " << r.copy_baseline_ns << " ns)\n"
       << "coil safety violations " << r.coil_violations << "\n";
+  for (const auto* run : {&d.lockstep, &d.realtime}) {
+    const daemon::LatencySummary& e2e = run->stages[daemon::kFrameToCan];
+    out << "pinballd " << (run == &d.lockstep ? "lockstep" : "real-time") << " at " << d.fps << " fps, "
+        << run->frames << " frames: frame -> CAN written p50 " << e2e.p50_us << " us, p99 " << e2e.p99_us
+        << " us, max " << e2e.max_us << " us (" << e2e.count << " commands)\n";
+  }
+  out << "  baseline eventfd wake-up of another thread: p50 " << d.wake_p50_us << " us, p99 " << d.wake_p99_us
+      << " us\n";
   return 0;
 }
 

@@ -19,6 +19,7 @@
 #include "pinball/daemon/hot_path.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/daemon/thread_table.h"
+#include "pinball/firmware/frame_log.h"
 #include "pinball/firmware/socketcan_transport.h"
 #include "pinball/firmware/stream_transport.h"
 #include "pinball/sim/board_loader.h"
@@ -69,6 +70,7 @@ struct Daemon::Impl {
   // CAN.
   std::unique_ptr<firmware::CanTransport> host_link;
   std::unique_ptr<firmware::StreamTransport> board_link;  // sim: the virtual board's end
+  std::unique_ptr<firmware::FrameLog> frame_log;  // optional candump log
   std::unique_ptr<firmware::DriverBus> bus;
   // Frames.
   std::unique_ptr<SimWorld> world;                     // sim
@@ -145,7 +147,13 @@ void Daemon::Impl::build() {
     o.interface = config.can.interface;
     host_link = std::make_unique<firmware::SocketCanTransport>(o);
   }
-  bus = std::make_unique<firmware::DriverBus>(*host_link, bus_options(config, drivers));
+  firmware::DriverBusOptions bo = bus_options(config, drivers);
+  if (!config.can.log.empty()) {
+    frame_log = std::make_unique<firmware::FrameLog>(config.can.log,
+                                                     config.can.interface == "sim" ? "simcan" : config.can.interface);
+    bo.log = frame_log.get();
+  }
+  bus = std::make_unique<firmware::DriverBus>(*host_link, bo);
 
   tracker = std::make_unique<track::Tracker>(track::flipper_geometry_from_board(board), tracker_config_for(config, board));
 
@@ -574,6 +582,7 @@ DaemonReport Daemon::run() {
   driver.join();
   d.shutdown();
   d.lcm->stop();
+  if (d.frame_log) d.frame_log->flush();
   if (d.config.threads.realtime && d.config.threads.enforce && !d.warnings.empty()) {
     throw std::runtime_error("real-time scheduling refused (threads.enforce): " + d.warnings.front());
   }

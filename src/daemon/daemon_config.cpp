@@ -108,6 +108,7 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
   can.read("board_id", c.can.board_id);
   can.read("heartbeat_period_s", c.can.heartbeat_period_s);
   can.read("watchdog_timeout_s", c.can.watchdog_timeout_s);
+  can.read("log", c.can.log);
   can.finish();
 
   Section coils = top.child("coils");

@@ -34,7 +34,7 @@ void install(int sig, void (*handler)(int)) {
 int main(int argc, char** argv) {
   using namespace pinball::daemon;
   CLI::App app("pinballd: the real-time pinball controller (camera -> tracker -> controller -> CAN)");
-  std::string config_path, sim_board, controller, lcm_url;
+  std::string config_path, sim_board, controller, lcm_url, can_log;
   int balls = -1;
   long long seed = -1;
   bool realtime = false, json = false, threads = false;
@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
   app.add_option("--balls", balls, "balls to play in simulation (default 10)")->check(CLI::Range(0, 1000000));
   app.add_option("--seed", seed, "launch noise seed in simulation")->check(CLI::NonNegativeNumber);
   app.add_option("--lcm-url", lcm_url, "LCM provider, e.g. memq:// or udpm://239.255.76.67:7667?ttl=0");
+  app.add_option("--can-log", can_log, "write every CAN frame to this file in candump's log format");
   app.add_flag("--realtime", realtime, "simulation paced to the wall clock (default: lockstep virtual clock)");
   app.add_flag("--json", json, "print the report as one JSON object on stdout");
   app.add_flag("--threads", threads, "print the thread table and exit");
@@ -74,6 +75,7 @@ int main(int argc, char** argv) {
     if (seed >= 0) config.sim.seed = static_cast<std::uint64_t>(seed);
     if (!lcm_url.empty()) config.lcm_url = lcm_url;
     if (realtime) config.sim.realtime = true;
+    if (!can_log.empty()) config.can.log = can_log;
     Daemon daemon(config);
     g_daemon = &daemon;
     install(SIGINT, on_stop_signal);

@@ -32,6 +32,7 @@ struct CanSettings {
   int board_id = 0;                  ///< driver board number 0..15
   double heartbeat_period_s = 0.02;  ///< heartbeat period (s)
   double watchdog_timeout_s = 0.1;   ///< the board switches everything off after this silence (s)
+  std::string log;                   ///< candump-format log of every frame (empty: none); in the lab `candump -l` does the same
 };
 
 /// Real-time scheduling of the daemon's threads (the table is in thread_table.h).

@@ -1,0 +1,105 @@
+#include "daemon_latency_bench.h"
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+#include <vector>
+
+#include "pinball/daemon/clock.h"
+#include "pinball/daemon/doorbell.h"
+
+namespace pinball::bench {
+namespace {
+
+DaemonLatencyRun run_once(const DaemonLatencyOptions& o, bool realtime) {
+  daemon::DaemonConfig c;
+  c.sim.board = o.board;
+  c.controller = o.controller;
+  c.sim.seed = o.seed;
+  c.sim.realtime = realtime;
+  c.sim.balls = realtime ? 1'000'000 : o.lockstep_balls;
+  daemon::Daemon d(c);
+  std::atomic<bool> done{false};
+  std::thread stopper;
+  if (realtime) {
+    stopper = std::thread([&] {
+      const double end = daemon::steady_now_s() + o.realtime_s;
+      while (!done.load() && daemon::steady_now_s() < end) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      d.request_stop();
+    });
+  }
+  const daemon::DaemonReport r = d.run();
+  done = true;
+  if (stopper.joinable()) stopper.join();
+  DaemonLatencyRun run;
+  run.stages = r.latency;
+  run.frames = r.frames;
+  run.dropped = r.frames_dropped;
+  run.wall_s = r.wall_s;
+  run.sim_s = r.sim_s;
+  return run;
+}
+
+// One thread rings, the other wakes: the cost of one hand-off between the daemon's threads.
+void doorbell_baseline(int samples, double& p50_us, double& p99_us) {
+  daemon::Doorbell ping, pong;
+  std::atomic<double> rung_at{0.0};
+  std::vector<double> lat;
+  lat.reserve(static_cast<std::size_t>(samples));
+  std::thread waiter([&] {
+    for (int i = 0; i < samples; ++i) {
+      ping.wait(1.0);
+      lat.push_back((daemon::steady_now_s() - rung_at.load()) * 1e6);
+      pong.ring();
+    }
+  });
+  for (int i = 0; i < samples; ++i) {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));  // let the waiter fall asleep, as between frames
+    rung_at = daemon::steady_now_s();
+    ping.ring();
+    pong.wait(1.0);
+  }
+  waiter.join();
+  std::sort(lat.begin(), lat.end());
+  p50_us = lat[lat.size() / 2];
+  p99_us = lat[std::min(lat.size() - 1, lat.size() * 99 / 100)];
+}
+
+nlohmann::json run_json(const DaemonLatencyRun& r) {
+  nlohmann::json stages = nlohmann::json::object();
+  for (int s = 0; s < daemon::kStageCount; ++s) {
+    const daemon::LatencySummary& x = r.stages[static_cast<std::size_t>(s)];
+    stages[daemon::stage_name(s)] = {
+        {"count", x.count}, {"p50_us", x.p50_us}, {"p99_us", x.p99_us}, {"max_us", x.max_us}};
+  }
+  const daemon::LatencySummary& e2e = r.stages[daemon::kFrameToCan];
+  return {{"frame_to_can_p50_us", e2e.p50_us}, {"frame_to_can_p99_us", e2e.p99_us},
+          {"frame_to_can_max_us", e2e.max_us}, {"frame_to_can_samples", e2e.count},
+          {"frames", r.frames}, {"frames_dropped", r.dropped}, {"wall_s", r.wall_s}, {"sim_s", r.sim_s},
+          {"stages", stages}};
+}
+
+}  // namespace
+
+DaemonLatencyReport run_daemon_latency_bench(const DaemonLatencyOptions& options,
+                                             const std::function<void(const std::string&)>& progress) {
+  DaemonLatencyReport r;
+  if (progress) progress("baseline: eventfd wake-up between two threads");
+  doorbell_baseline(options.baseline_samples, r.wake_p50_us, r.wake_p99_us);
+  if (progress) progress("pinballd lockstep, " + std::to_string(options.lockstep_balls) + " balls");
+  r.lockstep = run_once(options, false);
+  if (progress) progress("pinballd paced to the wall clock, " + std::to_string(options.realtime_s) + " s");
+  r.realtime = run_once(options, true);
+  return r;
+}
+
+nlohmann::json to_json(const DaemonLatencyReport& r) {
+  return {{"fps", r.fps},
+          {"lockstep", run_json(r.lockstep)},
+          {"realtime", run_json(r.realtime)},
+          {"baseline_wake_p50_us", r.wake_p50_us},
+          {"baseline_wake_p99_us", r.wake_p99_us},
+          {"target_frame_to_can_p99_us", 1000.0}};
+}
+
+}  // namespace pinball::bench
