@@ -1,5 +1,7 @@
 #include "pinball/bus/lcm_bus.h"
 
+#include <pthread.h>
+
 #include <chrono>
 #include <stdexcept>
 #include <vector>
@@ -84,6 +86,7 @@ int LcmBus::drain() {
 }
 
 void LcmBus::run(std::function<void(lcm::LCM&)> periodic, double period_s) {
+  pthread_setname_np(pthread_self(), "pb-lcm");
   using clock = std::chrono::steady_clock;
   auto next = clock::now() + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(period_s));
   while (running_.load(std::memory_order_acquire)) {

@@ -57,7 +57,8 @@ int main(int argc, char** argv) {
   }
   if (threads) {
     for (const ThreadSpec& t : kThreadTable) {
-      std::printf("%-14s FIFO %2d  %-48s %s\n", t.name, t.fifo_priority, t.period, t.job);
+      const std::string policy = t.fifo_priority > 0 ? "FIFO " + std::to_string(t.fifo_priority) : "OTHER";
+      std::printf("%-14s %-8s %-48s %s\n", t.name, policy.c_str(), t.period, t.job);
     }
     return 0;
   }

@@ -154,16 +154,19 @@ TEST(Daemon, BadFilesAreNamed) {
 // pinballd as a child process: SIGINT releases every coil and exits 0.
 TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
   const std::string out = ::testing::TempDir() + "/pinballd_sigint.json";
+  const std::string errors = ::testing::TempDir() + "/pinballd_sigint.err";
   const std::string cmd = std::string(PINBALLD_EXE) + " --balls 1000 --json --controller " + kSource +
-                          "/controllers/best.json --sim " + kSource + "/boards/mit1993.board > " + out +
-                          " 2>/dev/null";
+                          "/controllers/best.json --sim " + kSource + "/boards/mit1993.board > " + out + " 2> " +
+                          errors;
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+  ASSERT_EQ(kill(pid, SIGUSR1), 0);  // prints the latency table and goes on
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
   ASSERT_EQ(kill(pid, SIGINT), 0);
   int status = 0;
   ASSERT_EQ(waitpid(pid, &status, 0), pid);
@@ -180,6 +183,12 @@ TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
   EXPECT_TRUE(j["coils_off_at_exit"].get<bool>());
   EXPECT_LT(j["balls"].get<int>(), 1000);
   EXPECT_GE(j["can"]["release_alls"].get<int>(), 1);
+  FILE* e = std::fopen(errors.c_str(), "r");
+  ASSERT_NE(e, nullptr);
+  std::string err_text;
+  while ((n = std::fread(buf, 1, sizeof buf, e)) > 0) err_text.append(buf, n);
+  std::fclose(e);
+  EXPECT_NE(err_text.find("frame->can_written"), std::string::npos) << err_text;
 }
 
 TEST(Pinballd, BadConfigExitsOneNamingTheKey) {
