@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -105,6 +106,7 @@ struct Daemon::Impl {
   std::array<std::atomic<double>, firmware::kMaxDrivers> can_written_wall_s{};
   double wall_offset_s = 0.0;                   // sim realtime: wall = sim + offset
   std::array<LatencyHistogram, kStageCount> latency;
+  mutable std::mutex warnings_mutex;
   std::vector<std::string> warnings;
   double start_wall_s = 0.0;
   bool coils_off_at_exit = true;
@@ -116,6 +118,13 @@ struct Daemon::Impl {
     return steady_now_s() - wall_offset_s;
   }
 
+  // Names the calling thread and applies its scheduling; a refusal becomes a warning.
+  void enter_thread(ThreadId id) {
+    std::string why;
+    if (configure_current_thread(id, config.threads.realtime, why)) return;
+    const std::lock_guard<std::mutex> lock(warnings_mutex);
+    warnings.push_back(why);
+  }
   void build();
   void learn_background();
   void warm_up_bus();
@@ -230,8 +239,7 @@ void Daemon::Impl::warm_up_bus() {
 }
 
 void Daemon::Impl::sim_thread() {
-  std::string why;
-  if (!configure_current_thread(kSimThread, config.threads.realtime, why)) warnings.push_back(why);
+  enter_thread(kSimThread);
   std::uint64_t pushed = 0;
   std::uint64_t seq = 0;
   auto on_event = [&](const GameEvent& e) {
@@ -281,8 +289,7 @@ void Daemon::Impl::sim_thread() {
 }
 
 void Daemon::Impl::camera_thread() {
-  std::string why;
-  if (!configure_current_thread(kCameraThread, config.threads.realtime, why)) warnings.push_back(why);
+  enter_thread(kCameraThread);
   ProjectionRecord record;
   FrameSlot lab_slot;
   const bool from_lcm = config.camera.source == "lcm";
@@ -359,8 +366,7 @@ void Daemon::Impl::publish_commands(const ControllerStage::Commands& cmds, int n
 }
 
 void Daemon::Impl::controller_thread() {
-  std::string why;
-  if (!configure_current_thread(kControllerThread, config.threads.realtime, why)) warnings.push_back(why);
+  enter_thread(kControllerThread);
   ProjectionRecord record;
   ControllerStage::Commands cmds;
   const double frame_period_s = 1.0 / config.camera.fps;
@@ -392,8 +398,7 @@ void Daemon::Impl::controller_thread() {
 }
 
 void Daemon::Impl::driver_thread() {
-  std::string why;
-  if (!configure_current_thread(kDriverThread, config.threads.realtime, why)) warnings.push_back(why);
+  enter_thread(kDriverThread);
   CommandRecord c;
   double next_status_s = 0.0;
   std::uint64_t status_seq = 0;
@@ -491,7 +496,10 @@ DaemonReport Daemon::Impl::report() const {
   r.driver = bus->counters();
   r.wall_s = steady_now_s() - start_wall_s;
   r.sim_s = sim_time_s.load();
-  r.warnings = warnings;
+  {
+    const std::lock_guard<std::mutex> lock(warnings_mutex);
+    r.warnings = warnings;
+  }
   r.coils_off_at_exit = coils_off_at_exit;
   if (world) {
     r.results = world->results();
@@ -551,7 +559,15 @@ DaemonReport Daemon::run() {
   d.start_wall_s = steady_now_s();
   if (d.config.threads.realtime) {
     std::string why;
-    if (!lock_memory(why)) d.warnings.push_back(why);
+    if (!lock_memory(why)) d.warnings.push_back(why);  // before any thread starts
+    // Probe SCHED_FIFO on a throw-away thread, so that `enforce` refuses before anything runs.
+    std::string probe_why;
+    std::thread([&] { configure_current_thread(kDriverThread, true, probe_why); }).join();
+    if (!probe_why.empty()) d.warnings.push_back(probe_why);
+    if (d.config.threads.enforce && !d.warnings.empty()) {
+      throw std::runtime_error("real-time scheduling refused (threads.enforce: true): " + d.warnings.front());
+    }
+    for (const std::string& w : d.warnings) std::fprintf(stderr, "pinballd: warning: %s; running without it\n", w.c_str());
   }
   if (d.config.camera.source == "file" || d.config.camera.source == "v4l2") {
     vision::CaptureConfig cc;
@@ -569,7 +585,6 @@ DaemonReport Daemon::run() {
   std::thread camera([&d] { d.camera_thread(); });
   std::thread world;
   if (d.world) world = std::thread([&d] { d.sim_thread(); });
-  if (d.config.threads.realtime && d.config.threads.enforce && !d.warnings.empty()) d.stop = true;
   while (!d.stop.load(std::memory_order_acquire) && !d.controller_done.load(std::memory_order_acquire)) {
     d.main_bell.wait(0.1);
     if (d.stats_requested.exchange(false)) std::fputs(report_to_text(d.report()).c_str(), stderr);
@@ -583,9 +598,6 @@ DaemonReport Daemon::run() {
   d.shutdown();
   d.lcm->stop();
   if (d.frame_log) d.frame_log->flush();
-  if (d.config.threads.realtime && d.config.threads.enforce && !d.warnings.empty()) {
-    throw std::runtime_error("real-time scheduling refused (threads.enforce): " + d.warnings.front());
-  }
   return d.report();
 }
 
