@@ -50,9 +50,13 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
   } else {
     out << "observations " << r.observations << "  recorded decisions " << r.recorded_commands << "  replayed "
         << r.replayed_commands << "  matched " << r.matched << "  malformed " << r.malformed << "\n";
-    out << (r.reproduced ? "reproduced: every recorded decision came out again, in order\n"
-                         : "NOT reproduced: first difference at decision " + std::to_string(r.first_mismatch) +
-                               ": " + r.mismatch + "\n");
+    if (r.observations == 0) {
+      out << "NOT reproduced: the log holds no PINBALL_OBSERVATION messages\n";
+    } else if (r.reproduced) {
+      out << "reproduced: every recorded decision came out again, in order\n";
+    } else {
+      out << "NOT reproduced: first difference at decision " << r.first_mismatch << ": " << r.mismatch << "\n";
+    }
   }
   return r.reproduced ? 0 : 3;
 }

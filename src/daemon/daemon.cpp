@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iomanip>
 #include <mutex>
 #include <sstream>
@@ -138,8 +139,20 @@ struct Daemon::Impl {
   DaemonReport report() const;
 };
 
+// A relative path that does not exist from the working directory is looked up
+// in the source tree the daemon was built from, so that the defaults
+// (boards/mit1993.board, controllers/best.json) work from any directory.
+std::string find_data_file(const std::string& path) {
+  if (path.empty() || path.front() == '/' || std::filesystem::exists(path)) return path;
+  const std::string in_tree = std::string(PINBALL_DATA_DIR) + "/" + path;
+  return std::filesystem::exists(in_tree) ? in_tree : path;
+}
+
 void Daemon::Impl::build() {
   sim_mode = config.mode == "sim";
+  config.sim.board = find_data_file(config.sim.board);
+  config.board = find_data_file(config.board);
+  config.controller = find_data_file(config.controller);
   lockstep = sim_mode && !config.sim.realtime;
   board = sim::load_board(sim_mode ? config.sim.board : config.board);
   spec = control::load_controller(config.controller);
