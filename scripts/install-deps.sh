@@ -7,6 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
+  libopencv-calib3d-dev
   liblcm-dev liblcm-bin
   libgtest-dev libgmock-dev googletest
   libbenchmark-dev

@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "pinball/sim/board_loader.h"
+#include "calibration_bench.h"
 #include "detector_bench.h"
 #include "daemon_latency_bench.h"
 #include "latency_bench.h"
@@ -13,17 +14,18 @@
 namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
-  CLI::App* cmd = app.add_subcommand("bench", "run a benchmark (speed, tracker, latency, detector)");
-  cmd->add_option("kind", a.which, "which benchmark: speed, tracker, latency, detector")
+  CLI::App* cmd = app.add_subcommand("bench", "run a benchmark (speed, tracker, latency, detector, calibration)");
+  cmd->add_option("kind", a.which, "which benchmark: speed, tracker, latency, detector, calibration")
       ->required()
-      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector"}));
+      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration"}));
   cmd->add_option("--board", a.board, "board file")->check(CLI::ExistingFile);
   cmd->add_option("--steps", a.steps, "steps per timed run")->check(CLI::Range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
       ->check(CLI::Range(10, 1'000'000));
-  cmd->add_option("--seed", a.seed, "tracker, detector: seed for play, camera noise and placements");
-  cmd->add_flag("--quick", a.quick, "tracker, detector, latency: a short run (fewer approaches, frames or balls)");
+  cmd->add_option("--seed", a.seed, "tracker, detector, calibration: seed for play, camera noise and placements");
+  cmd->add_flag("--quick", a.quick,
+                "tracker, detector, calibration, latency: a short run (fewer approaches, frames, roll sets or balls)");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -49,6 +51,23 @@ int run_detector(const BenchArgs& a, const sim::Board& board, std::ostream& out,
   options.seed = a.seed;
   const bench::DetectorReport report = bench::run_detector_bench(
       board, options, [&](const std::string& line) { err << "bench detector: " << line << "\n"; });
+  if (a.json) {
+    out << bench::to_json(report).dump(2) << "\n";
+  } else {
+    out << bench::to_text(report);
+  }
+  return 0;
+}
+
+int run_calibration(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+  bench::CalibrationBenchOptions options;
+  options.seed = a.seed;
+  if (a.quick) {
+    options.gravity_sets = 5;
+    options.approaches = 50;
+  }
+  const bench::CalibrationReport report = bench::run_calibration_bench(
+      board, options, [&](const std::string& line) { err << "bench calibration: " << line << "\n"; });
   if (a.json) {
     out << bench::to_json(report).dump(2) << "\n";
   } else {
@@ -102,6 +121,7 @@ int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   const sim::Board board = sim::load_board(a.board);
   if (a.which == "tracker") return run_tracker(a, board, out, err);
   if (a.which == "detector") return run_detector(a, board, out, err);
+  if (a.which == "calibration") return run_calibration(a, board, out, err);
   bench::SpeedBenchOptions options;
   options.steps = a.steps;
   options.repeats = a.repeats;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -53,6 +54,7 @@ struct TrackArgs {
   std::string observations;    ///< observation CSV
   double gravity_mps2 = -1.0;  ///< calibrated g; negative: the board's
   double sigma_m = 0.0;        ///< observation noise; 0: the default camera's
+  std::string calibration;     ///< calibration file: flipper geometry and g (explicit --gravity wins)
   bool json = false;           ///< one JSON object on stdout
 };
 CLI::App* add_track_command(CLI::App& app, TrackArgs& args);
@@ -100,6 +102,29 @@ struct LearnArgs {
 };
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& args);
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err);
+
+/// `pinball calibrate camera|flippers|gravity`
+struct CalibrateArgs {
+  std::string kind;                  ///< camera | flippers | gravity
+  std::string sim_board;             ///< --sim BOARD: generate the inputs from the simulator
+  std::string board;                 ///< the machine's board file (names, sides, rough places)
+  std::string image;                 ///< camera: marker image
+  std::string markers;               ///< camera: marker layout CSV x,y (m); empty: the default layout
+  std::string down;                  ///< flippers: marker image, flippers down
+  std::string up;                    ///< flippers: marker image, flippers held up
+  std::vector<std::string> sweeps;   ///< flippers: one sweep video per flipper, board order
+  std::string method = "markers";    ///< flippers: the method written to the file when both ran
+  std::vector<std::string> rolls;    ///< gravity: observation CSVs, one roll each
+  int sim_rolls = 5;                 ///< gravity with --sim: rolls to simulate
+  double sigma_m = 0.001;            ///< gravity: observation noise per coordinate (m)
+  std::string calibration;           ///< file to take the camera homography from (default: --out)
+  std::string out;                   ///< calibration file to write or update
+  std::string png;                   ///< picture of what was detected and fitted
+  std::uint64_t seed = 1;            ///< --sim: the simulated lab's seed
+  bool json = false;                 ///< one JSON object on stdout
+};
+CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& args);
+int run_calibrate(const CalibrateArgs& args, std::ostream& out, std::ostream& err);
 
 /// Parses argv and runs the chosen subcommand; returns the exit code
 /// (0 success, 1 bad input or failure, 2 bad usage).

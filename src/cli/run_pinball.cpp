@@ -14,12 +14,14 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   TrackArgs track;
   LearnArgs learn;
   ReplayArgs replay;
+  CalibrateArgs calibrate;
   CLI::App* sim_cmd = add_sim_command(app, sim);
   CLI::App* render_cmd = add_render_command(app, render);
   CLI::App* bench_cmd = add_bench_command(app, bench);
   CLI::App* track_cmd = add_track_command(app, track);
   CLI::App* learn_cmd = add_learn_command(app, learn);
   CLI::App* replay_cmd = add_replay_command(app, replay);
+  CLI::App* calibrate_cmd = add_calibrate_command(app, calibrate);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -39,6 +41,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
     if (track_cmd->parsed()) return run_track(track, out, err);
     if (learn_cmd->parsed()) return run_learn(learn, out, err);
     if (replay_cmd->parsed()) return run_replay(replay, out, err);
+    if (calibrate_cmd->parsed()) return run_calibrate(calibrate, out, err);
   } catch (const std::exception& e) {
     err << "pinball: " << e.what() << "\n";
     return 1;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "pinball/calibration/calibration_file.h"
 #include "pinball/sim/board_loader.h"
 #include "pinball/track/observation_io.h"
 #include "pinball/track/tracker.h"
@@ -24,6 +25,9 @@ CLI::App* add_track_command(CLI::App& app, TrackArgs& a) {
       ->check(CLI::Range(0.0, 100.0));
   cmd->add_option("--sigma", a.sigma_m, "observation noise, standard deviation per coordinate (m)")
       ->check(CLI::Range(1e-7, 1.0));
+  cmd->add_option("--calibration", a.calibration,
+                  "calibration file (pinball calibrate): flipper geometry and gravity instead of the board's")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--json", a.json, "print one JSON object instead of CSV");
   return cmd;
 }
@@ -38,9 +42,13 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
   const sim::Board board = sim::load_board(a.board);
   const std::vector<track::ObservationRow> rows = track::read_observations_csv(a.observations);
   track::TrackerConfig config = track::default_tracker_config(board, track::CameraModelConfig{});
+  track::FlipperGeometry geometry = track::flipper_geometry_from_board(board);
+  if (!a.calibration.empty()) {
+    calibration::apply_calibration(calibration::read_calibration(a.calibration), a.calibration, config, geometry);
+  }
   if (a.gravity_mps2 >= 0.0) config.g_mps2 = a.gravity_mps2;
   if (a.sigma_m > 0.0) config.sigma_m = a.sigma_m;
-  track::Tracker tracker(track::flipper_geometry_from_board(board), config);
+  track::Tracker tracker(geometry, config);
 
   nlohmann::json projections = nlohmann::json::array();
   int valid = 0;
@@ -79,6 +87,7 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
   if (a.json) {
     out << nlohmann::json{{"board", a.board},
                           {"observations_file", a.observations},
+                          {"calibration", a.calibration},
                           {"gravity_mps2", config.g_mps2},
                           {"sigma_m", config.sigma_m},
                           {"observations", rows.size()},

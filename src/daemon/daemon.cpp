@@ -177,7 +177,8 @@ void Daemon::Impl::build() {
   }
   bus = std::make_unique<firmware::DriverBus>(*host_link, bo);
 
-  tracker = std::make_unique<track::Tracker>(track::flipper_geometry_from_board(board), tracker_config_for(config, board));
+  TrackingSetup setup = tracking_setup_for(config, board);
+  tracker = std::make_unique<track::Tracker>(setup.geometry, setup.tracker);
 
   cv::Size frame_size(config.camera.width_px, config.camera.height_px);
   if (sim_mode) {
@@ -193,12 +194,16 @@ void Daemon::Impl::build() {
     wo.max_ball_time_s = config.sim.max_ball_time_s;
     wo.launcher_pull = spec.launcher_pull;
     world = std::make_unique<SimWorld>(board, *board_link, cc, wo);
-    homography = std::make_unique<vision::CameraHomography>(world->camera().homography());
+    // A calibration file (e.g. from `pinball calibrate camera --sim`) stands in
+    // for the simulated camera's true homography, as it would in the lab.
+    homography = std::make_unique<vision::CameraHomography>(setup.homography ? *setup.homography
+                                                                             : world->camera().homography());
   } else if (config.camera.source != "lcm") {
-    if (config.calibration.empty()) {
-      throw ConfigError("config: calibration: the lab camera needs a calibration file (docs/calibration.md)");
+    if (!setup.homography) {
+      throw ConfigError("config: calibration: the lab camera needs a calibration file with a camera section "
+                        "(docs/calibration.md)");
     }
-    throw ConfigError("config: calibration: reading calibration files is not built yet");
+    homography = std::make_unique<vision::CameraHomography>(*setup.homography);
   }
   if (homography) {
     // OpenCV's thread pool would hand the camera thread's work to threads

@@ -1,5 +1,6 @@
 #include "pinball/daemon/pipeline.h"
 
+#include "pinball/calibration/calibration_file.h"
 #include "pinball/core/utime.h"
 #include "pinball/daemon/clock.h"
 
@@ -131,10 +132,16 @@ int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, 
   return n;
 }
 
-track::TrackerConfig tracker_config_for(const DaemonConfig& config, const sim::Board& board) {
+TrackingSetup tracking_setup_for(const DaemonConfig& config, const sim::Board& board) {
   track::CameraModelConfig camera_model;
   camera_model.fps = config.camera.fps;
-  return track::default_tracker_config(board, camera_model);
+  TrackingSetup s{track::default_tracker_config(board, camera_model), track::flipper_geometry_from_board(board), {}};
+  if (!config.calibration.empty()) {
+    const calibration::Calibration c = calibration::read_calibration(config.calibration);
+    calibration::apply_calibration(c, config.calibration, s.tracker, s.geometry);
+    if (c.camera) s.homography = calibration::camera_homography(c, config.calibration);
+  }
+  return s;
 }
 
 ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const sim::Board& board) {

@@ -40,7 +40,8 @@ ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
   const sim::Board board = sim::load_board(config.mode == "sim" ? config.sim.board : config.board);
   const control::ControllerSpec spec = control::load_controller(config.controller);
   control::ActuatorController controller(spec.action_function, spec.actuator);
-  track::Tracker tracker(track::flipper_geometry_from_board(board), tracker_config_for(config, board));
+  const TrackingSetup setup = tracking_setup_for(config, board);
+  track::Tracker tracker(setup.geometry, setup.tracker);
   CameraStage camera(nullptr, tracker, lost_after_s_for(config));
   // The stage drives a DriverBus with no board behind it: its commands go
   // nowhere, the decisions are what counts.

@@ -106,6 +106,9 @@ SimCameraSource::SimCameraSource(const sim::Board& board, const SimCameraConfig&
   }
   require(c.flipper_gray >= 0.0 && c.flipper_gray <= 255.0 && c.flipper_width_m > 0.0,
           "flipper_gray must be in [0, 255] and flipper_width_m > 0");
+  require(c.marker_radius_m > 0.0 && c.marker_ring_m >= c.marker_radius_m && c.marker_gray >= 0.0 &&
+              c.marker_gray <= 255.0 && c.marker_ring_gray >= 0.0 && c.marker_ring_gray <= 255.0,
+          "markers need 0 < marker_radius_m <= marker_ring_m and grays in [0, 255]");
   for (const sim::Flipper& f : board.flippers) flipper_theta_.push_back(f.theta_min_rad);
   period_s_ = 1.0 / c.fps;
   next_exposure_s_ = c.first_exposure_s;
@@ -267,14 +270,44 @@ void SimCameraSource::observe(const sim::GameState& state) {
 }
 
 void SimCameraSource::draw_flippers(cv::Mat& image) const {
+  // Sub-pixel end points (shift 4: 1/16 px), so a flipper's image moves
+  // smoothly with its angle as a real one does; calibration measures its tip.
+  constexpr int kShift = 4;
+  constexpr double kScale = 1 << kShift;
+  const auto fixed = [&](const cv::Point2d& p) {
+    return cv::Point(static_cast<int>(std::lround(p.x * kScale)), static_cast<int>(std::lround(p.y * kScale)));
+  };
   for (std::size_t i = 0; i < flipper_theta_.size(); ++i) {
     const sim::Flipper& f = board_.flippers[i];
     const cv::Point2d a = homography_.image_from_board(f.pivot);
     const cv::Point2d b = homography_.image_from_board(sim::flipper_tip(f, flipper_theta_[i]));
     const int width_px = std::max(1, static_cast<int>(std::lround(config_.flipper_width_m * homography_.px_per_m_at(f.pivot))));
-    cv::line(image, cv::Point(static_cast<int>(std::lround(a.x)), static_cast<int>(std::lround(a.y))),
-             cv::Point(static_cast<int>(std::lround(b.x)), static_cast<int>(std::lround(b.y))),
-             cv::Scalar(config_.flipper_gray), width_px, cv::LINE_AA);
+    cv::line(image, fixed(a), fixed(b), cv::Scalar(config_.flipper_gray), width_px, cv::LINE_AA, kShift);
+  }
+}
+
+void SimCameraSource::set_flipper_angles(std::span<const double> theta_rad) {
+  for (std::size_t i = 0; i < flipper_theta_.size() && i < theta_rad.size(); ++i) flipper_theta_[i] = theta_rad[i];
+}
+
+void SimCameraSource::set_markers(std::span<const Vec2> centres_board) {
+  markers_.clear();
+  marker_gray_.clear();
+  const cv::Size size(config_.width_px, config_.height_px);
+  for (const Vec2& c : centres_board) {
+    for (const auto& [radius, gray] : {std::pair{config_.marker_ring_m, config_.marker_ring_gray},
+                                       std::pair{config_.marker_radius_m, config_.marker_gray}}) {
+      std::vector<cv::Point2d> uv;
+      for (int k = 0; k < 64; ++k) {
+        const double a = 2.0 * std::numbers::pi * k / 64.0;
+        uv.push_back(homography_.image_from_board(c + radius * Vec2{std::cos(a), std::sin(a)}));
+      }
+      Patch disc;
+      polygon_patch(uv, 255.0, size, disc.roi, disc.values);
+      if (disc.roi.area() == 0) continue;
+      markers_.push_back(disc);
+      marker_gray_.push_back(gray);
+    }
   }
 }
 
@@ -387,6 +420,19 @@ void SimCameraSource::render(std::span<const Vec2> path_board, double t_mid_s, F
   out.driver_t_s = t_mid_s - 0.5 * config_.exposure_s;
 }
 
+// Paints `gray` over `image` inside the patch, the patch's values being the opacity (255: opaque).
+void SimCameraSource::blend(const Patch& p, double gray, cv::Mat& image) {
+  for (int v = 0; v < p.roi.height; ++v) {
+    auto* row = image.ptr<std::uint8_t>(p.roi.y + v) + p.roi.x;
+    const auto* alpha = p.values.ptr<std::uint8_t>(v);
+    for (int u = 0; u < p.roi.width; ++u) {
+      if (alpha[u] == 0) continue;
+      const double a = alpha[u] / 255.0;
+      row[u] = cv::saturate_cast<std::uint8_t>(row[u] + a * (gray - row[u]));
+    }
+  }
+}
+
 void SimCameraSource::advance_effects() {
   if (lamps_blinking_ && config_.lamp_toggle_probability > 0.0) {
     for (std::uint8_t& on : lamp_on_) {
@@ -413,19 +459,8 @@ void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, 
   truth_.ball_present = !path_board.empty();
   truth_.ball_whole_exposure = !path_board.empty() && static_cast<int>(path_board.size()) == path_total;
   if (!path_board.empty()) draw_ball(path_board, path_total, image);
-  for (std::size_t i = 0; i < plastics_.size(); ++i) {
-    const Patch& p = plastics_[i];
-    const double gray = plastic_gray_[i];
-    for (int v = 0; v < p.roi.height; ++v) {
-      auto* row = image.ptr<std::uint8_t>(p.roi.y + v) + p.roi.x;
-      const auto* alpha = p.values.ptr<std::uint8_t>(v);
-      for (int u = 0; u < p.roi.width; ++u) {
-        if (alpha[u] == 0) continue;
-        const double a = alpha[u] / 255.0;
-        row[u] = cv::saturate_cast<std::uint8_t>(row[u] + a * (gray - row[u]));
-      }
-    }
-  }
+  for (std::size_t i = 0; i < plastics_.size(); ++i) blend(plastics_[i], plastic_gray_[i], image);
+  for (std::size_t i = 0; i < markers_.size(); ++i) blend(markers_[i], marker_gray_[i], image);
   truth_.glare_on = glare_ready_ && glare_on_;
   if (truth_.glare_on) {
     cv::Mat target = image(glare_.roi);

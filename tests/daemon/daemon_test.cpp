@@ -151,6 +151,46 @@ TEST(Daemon, BadFilesAreNamed) {
   }
 }
 
+TEST(Daemon, ReadsACalibrationFile) {
+  DaemonConfig c = sim_config(1, 6);
+  c.calibration = kSource + "/calibration/lab.example.yaml";
+  Daemon d(c);
+  const DaemonReport r = d.run();
+  EXPECT_EQ(r.balls, 1);
+  EXPECT_GT(r.detections * 10, r.frames * 7);  // the calibrated homography still finds the ball
+}
+
+TEST(Daemon, BadCalibrationIsNamed) {
+  const std::string path = ::testing::TempDir() + "/bad_calibration.yaml";
+  FILE* f = std::fopen(path.c_str(), "w");
+  std::fputs("version: 1\nflippers:\n  - {name: left}\n", f);
+  std::fclose(f);
+  DaemonConfig c = sim_config(1, 6);
+  c.calibration = path;
+  try {
+    Daemon d(c);
+    FAIL();
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(Daemon, TheLabCameraNeedsACalibratedHomography) {
+  DaemonConfig c = load_daemon_config(kSource + "/config/lab.example.yaml");
+  c.board = kSource + "/boards/mit1993.board";
+  c.controller = kSource + "/controllers/best.json";
+  c.calibration = "";
+  c.can.interface = "can0";
+  // SocketCAN is tried first; without CAN in the kernel that is the error.
+  try {
+    Daemon d(c);
+    FAIL();
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    EXPECT_TRUE(what.find("can0") != std::string::npos || what.find("calibration") != std::string::npos) << what;
+  }
+}
+
 // pinballd as a child process: SIGINT releases every coil and exits 0.
 TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
   const std::string out = ::testing::TempDir() + "/pinballd_sigint.json";

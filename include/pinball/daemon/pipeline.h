@@ -8,13 +8,16 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "pinball/control/flipper_controller.h"
 #include "pinball/daemon/daemon_config.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/sim/board.h"
 #include "pinball/track/observation.h"
+#include "pinball/track/flipper_geometry.h"
 #include "pinball/track/tracker.h"
+#include "pinball/vision/camera_homography.h"
 #include "pinball/vision/ball_detector.h"
 #include "pinball/vision/frame.h"
 
@@ -159,9 +162,18 @@ class ControllerStage {
   ControllerStageCounters counters_;
 };
 
-/// The tracker settings the daemon uses for `config` on `board` (shared by
-/// pinballd and `pinball replay`, so a replay decides as the daemon did).
-track::TrackerConfig tracker_config_for(const DaemonConfig& config, const sim::Board& board);
+/// What the tracker and the detector believe about the table: the board's
+/// geometry, corrected by the calibration file when the configuration names
+/// one (flippers, g, camera homography). Shared by pinballd and `pinball
+/// replay`, so that a replay decides as the daemon did.
+struct TrackingSetup {
+  track::TrackerConfig tracker;                      ///< g, windows, critical area
+  track::FlipperGeometry geometry;                   ///< flipper lines the projections use
+  std::optional<vision::CameraHomography> homography;  ///< from the calibration's camera section, if any
+};
+/// The setup for `config` on `board` (the table's board file). Throws
+/// std::runtime_error naming the calibration file and key when it is bad.
+TrackingSetup tracking_setup_for(const DaemonConfig& config, const sim::Board& board);
 /// The controller stage's settings for `config` on `board`.
 ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const sim::Board& board);
 /// How long the camera stage keeps an unseen ball before forgetting it (s).

@@ -66,6 +66,10 @@ struct SimCameraConfig {
   std::vector<SimPlastic> plastics = default_plastics();  ///< occluders (board frame)
   SimGlare glare;                   ///< glare patch (off by default)
   double noise_sigma = 2.0;         ///< sensor noise, standard deviation (gray levels)
+  double marker_radius_m = 0.007;   ///< calibration marker: bright disc radius (m), see set_markers()
+  double marker_ring_m = 0.012;     ///< ... on a dark disc of this radius (m), so it stands out on any art
+  double marker_gray = 245.0;       ///< bright disc brightness (gray levels)
+  double marker_ring_gray = 15.0;   ///< dark disc brightness (gray levels)
   std::uint64_t seed = 1;           ///< clutter, lamps, noise
 
   /// Two plastics on the upper playfield, scaled to a 0.51 x 1.07 m table.
@@ -116,6 +120,11 @@ class SimCameraSource final : public FrameSource {
 
   /// Switches the glare on or off (and keeps it so unless it toggles by itself).
   void set_glare(bool on) { glare_on_ = on && glare_ready_; }
+  /// Calibration markers (stickers on the table) drawn on top of everything
+  /// from the next frame on, centred on these board points; empty: none.
+  void set_markers(std::span<const Vec2> centres_board);
+  /// Sets the flippers' angles (rad, board order) as observe() would, without a game state.
+  void set_flipper_angles(std::span<const double> theta_rad);
   /// Freezes (false) or resumes (true) lamp toggling.
   void set_lamps_blinking(bool blinking) { lamps_blinking_ = blinking; }
 
@@ -144,6 +153,8 @@ class SimCameraSource final : public FrameSource {
     cv::Mat values;  // CV_8U: lamp delta, glare delta, or plastic alpha
   };
   void draw_flippers(cv::Mat& image) const;
+  // Paints `gray` over `image` inside the patch, its values being the opacity (255: opaque).
+  static void blend(const Patch& p, double gray, cv::Mat& image);
 
   static constexpr std::size_t kHistory = 2048;
   static constexpr std::size_t kMaxPath = 64;
@@ -169,6 +180,8 @@ class SimCameraSource final : public FrameSource {
   std::vector<std::uint8_t> lamp_on_;
   std::vector<Patch> plastics_;
   std::vector<double> plastic_gray_;
+  std::vector<Patch> markers_;          // per marker: dark disc, then bright disc
+  std::vector<double> marker_gray_;
   Patch glare_;
   bool glare_ready_ = false;
   bool glare_on_ = false;

@@ -1,0 +1,136 @@
+#include "pinball/calibration/circle_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace pinball::calibration {
+namespace {
+
+double median_of(std::vector<double> v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Gauss-Newton on r_i = |p_i − c| − R over the points with keep[i].
+void refine(std::span<const Vec2> p, const std::vector<char>& keep, int max_iterations, CircleFit& fit) {
+  for (int it = 0; it < max_iterations; ++it) {
+    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (!keep[i]) continue;
+      const Vec2 d = p[i] - fit.centre;
+      const double dist = d.norm();
+      if (!(dist > 0.0)) continue;
+      const Eigen::Vector3d j(-d.x() / dist, -d.y() / dist, -1.0);
+      const double r = dist - fit.radius;
+      jtj += j * j.transpose();
+      jtr += j * r;
+    }
+    const Eigen::Vector3d step = jtj.ldlt().solve(-jtr);
+    if (!step.allFinite()) throw std::invalid_argument("circle fit: the refinement diverged");
+    fit.centre += step.head<2>();
+    fit.radius += step(2);
+    ++fit.iterations;
+    if (step.norm() <= 1e-13 * std::max(1.0, fit.radius)) break;
+  }
+  if (!(fit.radius > 0.0) || !fit.centre.allFinite()) throw std::invalid_argument("circle fit: the refinement diverged");
+}
+
+}  // namespace
+
+CircleFit fit_circle_algebraic(std::span<const Vec2> p) {
+  const std::size_t n = p.size();
+  if (n < 3) throw std::invalid_argument("circle fit: " + std::to_string(n) + " points; at least 3 needed");
+  Vec2 mean = Vec2::Zero();
+  for (const Vec2& q : p) mean += q;
+  mean /= static_cast<double>(n);
+  double mxx = 0, myy = 0, mxy = 0, mxz = 0, myz = 0, mzz = 0;
+  for (const Vec2& q : p) {
+    const double x = q.x() - mean.x(), y = q.y() - mean.y(), z = x * x + y * y;
+    mxx += x * x;
+    myy += y * y;
+    mxy += x * y;
+    mxz += x * z;
+    myz += y * z;
+    mzz += z * z;
+  }
+  const double inv = 1.0 / static_cast<double>(n);
+  mxx *= inv, myy *= inv, mxy *= inv, mxz *= inv, myz *= inv, mzz *= inv;
+  const double mz = mxx + myy;
+  const double cov_xy = mxx * myy - mxy * mxy;
+  const double var_z = mzz - mz * mz;
+  const double a3 = 4.0 * mz;
+  const double a2 = -3.0 * mz * mz - mzz;
+  const double a1 = var_z * mz + 4.0 * cov_xy * mz - mxz * mxz - myz * myz;
+  const double a0 = mxz * (mxz * myy - myz * mxy) + myz * (myz * mxx - mxz * mxy) - var_z * cov_xy;
+  // Newton from x = 0 for the smallest root of the characteristic polynomial.
+  double x = 0.0, y = a0;
+  for (int it = 0; it < 99; ++it) {
+    const double dy = a1 + x * (2.0 * a2 + 3.0 * a3 * x);
+    const double x_new = x - y / dy;
+    if (x_new == x || !std::isfinite(x_new)) break;
+    const double y_new = a0 + x_new * (a1 + x_new * (a2 + x_new * a3));
+    if (std::abs(y_new) >= std::abs(y)) break;
+    x = x_new;
+    y = y_new;
+  }
+  const double det = x * x - x * mz + cov_xy;
+  // Collinear points: the centre runs off to infinity.
+  if (!(std::abs(det) > 1e-12 * mz * mz)) throw std::invalid_argument("circle fit: the points are (nearly) collinear");
+  const double cx = (mxz * (myy - x) - myz * mxy) / det / 2.0;
+  const double cy = (myz * (mxx - x) - mxz * mxy) / det / 2.0;
+  CircleFit fit;
+  fit.centre = mean + Vec2{cx, cy};
+  fit.radius = std::sqrt(cx * cx + cy * cy + mz);
+  if (!fit.centre.allFinite() || !std::isfinite(fit.radius) || fit.radius > 1e6 * std::sqrt(mz)) {
+    throw std::invalid_argument("circle fit: the points are (nearly) collinear");
+  }
+  double ss = 0.0;
+  for (const Vec2& q : p) ss += std::pow((q - fit.centre).norm() - fit.radius, 2);
+  fit.rms = std::sqrt(ss * inv);
+  fit.points = static_cast<int>(n);
+  return fit;
+}
+
+CircleFit fit_circle(std::span<const Vec2> p, const CircleFitOptions& options) {
+  CircleFit fit = fit_circle_algebraic(p);
+  std::vector<char> keep(p.size(), 1);
+  refine(p, keep, options.max_iterations, fit);
+  for (int round = 0; round < options.trim_rounds; ++round) {
+    std::vector<double> r;
+    for (std::size_t i = 0; i < p.size(); ++i) r.push_back((p[i] - fit.centre).norm() - fit.radius);
+    const double med = median_of(r);
+    std::vector<double> dev;
+    for (const double x : r) dev.push_back(std::abs(x - med));
+    const double sigma = 1.4826 * median_of(dev);
+    if (!(sigma > 0.0)) break;
+    bool changed = false;
+    int kept = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const char k = std::abs(r[i] - med) <= options.trim_mad * sigma ? 1 : 0;
+      changed = changed || k != keep[i];
+      keep[i] = k;
+      kept += k;
+    }
+    if (kept < 3) throw std::invalid_argument("circle fit: fewer than 3 points left after trimming outliers");
+    if (!changed) break;
+    refine(p, keep, options.max_iterations, fit);
+  }
+  double ss = 0.0;
+  fit.points = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!keep[i]) continue;
+    ss += std::pow((p[i] - fit.centre).norm() - fit.radius, 2);
+    ++fit.points;
+  }
+  fit.rejected = static_cast<int>(p.size()) - fit.points;
+  fit.rms = std::sqrt(ss / fit.points);
+  return fit;
+}
+
+}  // namespace pinball::calibration

@@ -1,0 +1,123 @@
+#pragma once
+// The lab machine's calibration (thesis 4.1.1, 4.1.3) and its YAML file: the
+// camera homography, each flipper's pivot, tip, length and stops, and gravity
+// along the table. Every section is optional in the file (each `pinball
+// calibrate` kind writes its own and keeps the others); what a consumer needs
+// it asks for by name, and a missing or bad key is reported as file:key.
+// Format field by field: docs/calibration.md.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pinball/core/geometry.h"
+#include "pinball/sim/board.h"
+#include "pinball/track/flipper_geometry.h"
+#include "pinball/track/tracker.h"
+#include "pinball/vision/camera_homography.h"
+
+namespace pinball::calibration {
+
+/// The version this code writes and reads.
+inline constexpr int kCalibrationFileVersion = 1;
+
+/// The camera section: board (m) -> image (px) homography and its quality.
+struct CameraCalibration {
+  cv::Matx33d image_from_board = cv::Matx33d::eye();  ///< board (x, y, 1) m -> image (u, v, w) px
+  int image_width_px = 0;             ///< size of the images it was measured on (px)
+  int image_height_px = 0;
+  int markers_used = 0;               ///< markers matched and kept by RANSAC
+  double reprojection_rms_px = 0.0;   ///< RMS distance between detected and reprojected markers (px)
+  double reprojection_max_px = 0.0;   ///< largest such distance (px)
+};
+
+/// How a flipper's geometry was measured.
+enum class FlipperMethod { kMarkers, kMarkerless };
+
+/// "markers" or "markerless".
+const char* to_string(FlipperMethod method);
+
+/// Where the two methods differ (first minus second in the file's order; m, rad).
+struct FlipperDisagreement {
+  double pivot_m = 0.0;        ///< distance between the pivots (m)
+  double tip_m = 0.0;          ///< distance between the down tips (m)
+  double length_m = 0.0;       ///< difference of lengths (m)
+  double theta_min_rad = 0.0;  ///< difference of down stops (rad)
+  double theta_max_rad = 0.0;  ///< difference of up stops (rad)
+};
+
+/// One flipper as measured.
+struct FlipperCalibration {
+  std::string name;                        ///< the board's flipper name
+  sim::Side side = sim::Side::kLeft;       ///< left flippers point right
+  FlipperMethod method = FlipperMethod::kMarkers;  ///< how
+  Vec2 pivot_m = Vec2::Zero();             ///< pivot (m, board frame)
+  Vec2 tip_m = Vec2::Zero();               ///< tip at rest, θ_min (m)
+  double length_m = 0.0;                   ///< pivot to tip (m)
+  double theta_min_rad = 0.0;              ///< down stop, the board's θ convention (rad)
+  double theta_max_rad = 0.0;              ///< up stop (rad)
+  double fit_rms_m = 0.0;                  ///< markerless: RMS distance of the tip points to the fitted circle (m)
+  int points = 0;                          ///< markers or tip points behind the figures
+  std::optional<FlipperDisagreement> disagreement;  ///< against the other method, when both were run
+};
+
+/// The gravity section.
+struct GravityEstimate {
+  double g_mps2 = 0.0;            ///< acceleration of a ball rolling from rest, along −y (m/s²)
+  double ci_low_mps2 = 0.0;       ///< confidence interval (t over rolls) lower end
+  double ci_high_mps2 = 0.0;      ///< upper end
+  double confidence = 0.95;       ///< of that interval
+  int rolls_used = 0;             ///< rolls in the estimate
+  int rolls_rejected = 0;         ///< outlier or unusable rolls left out
+  std::vector<double> per_roll_mps2;  ///< every usable roll's acceleration, rejected ones too
+};
+
+/// A whole calibration file.
+struct Calibration {
+  int version = kCalibrationFileVersion;   ///< file format version
+  std::string date;                        ///< when written, ISO 8601 UTC; set by write_calibration when empty
+  std::string board;                       ///< the board file the machine was described by
+  std::optional<CameraCalibration> camera; ///< camera section
+  std::vector<FlipperCalibration> flippers;///< flippers section (board order)
+  std::optional<GravityEstimate> gravity;  ///< gravity section
+};
+
+/// Writes `calibration` as YAML to `path` (the date set to now when empty).
+/// Throws std::runtime_error when the file cannot be written.
+void write_calibration(const Calibration& calibration, const std::string& path);
+
+/// The YAML text write_calibration writes.
+std::string calibration_to_yaml(const Calibration& calibration);
+
+/// Reads a calibration file. Throws std::runtime_error "path:key: what is
+/// wrong" for a missing, mistyped or out-of-range key, a wrong version, or
+/// YAML that does not parse ("path:line: ...").
+Calibration read_calibration(const std::string& path);
+
+/// Parses YAML text; `name` stands for the file in messages.
+Calibration parse_calibration(const std::string& text, const std::string& name);
+
+/// The tracker's flipper geometry: the calibrated left and right flippers
+/// (pivot and down tip). Throws std::runtime_error "name:flippers: ..." unless
+/// exactly one left and one right flipper are present.
+track::FlipperGeometry flipper_geometry_from_calibration(const Calibration& calibration, const std::string& name);
+
+/// Applies a calibration to the tracker: g from the gravity section (when
+/// present) and the flipper geometry from the flippers section (when
+/// present; the window distances follow the calibrated length as
+/// track::default_tracker_config derives them from the board).
+void apply_calibration(const Calibration& calibration, const std::string& name, track::TrackerConfig& config,
+                       track::FlipperGeometry& geometry);
+
+/// The detector's homography from the camera section. Throws
+/// std::runtime_error "name:camera: missing" without one.
+vision::CameraHomography camera_homography(const Calibration& calibration, const std::string& name);
+
+/// Copies the calibrated flippers into a board (pivot, length, stops, by
+/// name), for the simulator and the daemon. Throws std::runtime_error naming a
+/// calibrated flipper the board lacks.
+void apply_calibration(const Calibration& calibration, const std::string& name, sim::Board& board);
+
+}  // namespace pinball::calibration

@@ -1,0 +1,110 @@
+#pragma once
+// Flipper calibration, two ways.
+// Markers (thesis 4.1.3): a marker on the pivot and one on the tip of every
+// flipper, photographed once with the flippers down and once held up; the
+// markers' board positions (through the camera homography) give the pivot,
+// the tip, the length and both stops.
+// Markerless: a short video of one flipper swept by hand from stop to stop.
+// The background is the per-pixel minimum over the video (the bright flipper
+// is elsewhere in some frame everywhere it moves), the flipper is the largest
+// bright blob above it, its axis the blob's principal axis and its tip the
+// half-contrast edge along that axis less half the blade's width (a rounded
+// tip). The tips, mapped to the board, lie on a circle about the pivot: the
+// circle fit gives pivot and length, and the angles where the tip rests give
+// θ_min and θ_max.
+
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pinball/calibration/calibration_file.h"
+#include "pinball/calibration/circle_fit.h"
+#include "pinball/core/geometry.h"
+#include "pinball/sim/board.h"
+#include "pinball/vision/camera_homography.h"
+#include "pinball/vision/frame_source.h"
+
+namespace pinball::calibration {
+
+/// Elevation θ (rad) of a flipper of `side` whose tip is at `tip` (the board's convention).
+double flipper_angle(sim::Side side, const Vec2& pivot, const Vec2& tip);
+
+/// Marker method: `down` and `up` are the markers seen (board frame, m) with
+/// the flippers down and held up. The markers of `nominal` are those nearest
+/// to its nominal pivot and tips, within tolerance_m. Throws
+/// std::runtime_error naming the flipper and the marker that is missing.
+FlipperCalibration calibrate_flipper_markers(const sim::Flipper& nominal, std::span<const Vec2> down,
+                                             std::span<const Vec2> up, double tolerance_m = 0.03);
+
+/// Markerless method settings.
+struct SweepOptions {
+  int threshold = 40;              ///< frame − background above this (gray levels) is the flipper
+  int min_area_px = 20;            ///< smallest flipper blob (px)
+  double stop_band_rad = 0.026;    ///< tips within this of the extreme angles (5th/95th percentile) rest on a stop
+  CircleFitOptions circle;         ///< the tip circle fit
+};
+
+/// The tips seen in a sweep video.
+struct SweepTrack {
+  int frames = 0;                      ///< frames read (second pass)
+  std::vector<double> t_s;             ///< time of each tip (s)
+  std::vector<Vec2> tips_board;        ///< tip positions (m, board frame)
+  Vec2 rough_pivot_board = Vec2::Zero();  ///< where the blade axes meet (m): the start for the circle fit
+  CircleFit circle;                    ///< the fitted circle (m)
+};
+
+/// Finds the flipper's tip in the frames of a sweep: learn() every frame
+/// once (the background), then measure() every frame again, then finish().
+class TipTracker {
+ public:
+  /// For frames of `size` seen through `homography`.
+  TipTracker(cv::Size size, const vision::CameraHomography& homography, const SweepOptions& options = {});
+
+  /// First pass: one frame into the background (per-pixel minimum).
+  void learn(const cv::Mat& gray);
+  /// Second pass: finds the blade in one frame; false when none is visible.
+  bool measure(const cv::Mat& gray, double t_s);
+  /// The tips in board coordinates. Throws std::runtime_error when the blade
+  /// was seen in fewer than 10 frames or never turned.
+  SweepTrack finish() const;
+
+ private:
+  struct Sighting {
+    double t_s = 0.0;
+    cv::Point2d centre_px;
+    cv::Point2d axis;               // unit, image
+    cv::Point2d end_plus_px, end_minus_px;
+    double width_px = 0.0;
+  };
+  double edge_along(const cv::Point2d& from, const cv::Point2d& dir, double level, double max_px) const;
+
+  cv::Size size_;
+  vision::CameraHomography homography_;
+  SweepOptions options_;
+  cv::Mat background_;
+  cv::Mat diff_, binary_, labels_, stats_, centroids_;
+  int learned_ = 0;
+  int measured_ = 0;
+  std::vector<Sighting> sightings_;
+};
+
+/// Opens a frame source afresh (the video is read twice).
+using FrameSourceFactory = std::function<std::unique_ptr<vision::FrameSource>()>;
+
+/// Markerless method on a sweep video of flipper `nominal` (its name and side
+/// only). `track` (may be null) receives the tips and the circle.
+FlipperCalibration calibrate_flipper_sweep(const FrameSourceFactory& open, const vision::CameraHomography& homography,
+                                           const sim::Flipper& nominal, const SweepOptions& options = {},
+                                           SweepTrack* track = nullptr);
+
+/// The fit of a sweep track alone (for tests and for tracks from elsewhere).
+FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const sim::Flipper& nominal, const SweepOptions& options);
+
+/// How `a` differs from `b` (a minus b; distances for the points).
+FlipperDisagreement compare_flippers(const FlipperCalibration& a, const FlipperCalibration& b);
+
+}  // namespace pinball::calibration

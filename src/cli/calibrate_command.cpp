@@ -1,0 +1,296 @@
+// `pinball calibrate camera|flippers|gravity`: measures the lab machine (or
+// the simulated one with --sim) and writes the calibration file.
+
+#include <filesystem>
+#include <memory>
+#include <numbers>
+#include <ostream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "commands.h"
+#include "pinball/calibration/calibration_figure.h"
+#include "pinball/calibration/calibration_file.h"
+#include "pinball/calibration/camera_calibration.h"
+#include "pinball/calibration/flipper_calibration.h"
+#include "pinball/calibration/gravity_calibration.h"
+#include "pinball/calibration/sim_lab.h"
+#include "pinball/sim/board_loader.h"
+#include "pinball/sim/renderer.h"
+#include "pinball/track/observation_io.h"
+#include "pinball/vision/capture_source.h"
+
+namespace pinball::cli {
+
+CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
+  CLI::App* cmd = app.add_subcommand("calibrate", "measure the camera homography, the flippers or gravity");
+  cmd->add_option("kind", a.kind, "what to calibrate: camera, flippers, gravity")
+      ->required()
+      ->check(CLI::IsMember({"camera", "flippers", "gravity"}));
+  auto* sim = cmd->add_option("--sim", a.sim_board, "generate the inputs from the simulator on this board")
+                  ->check(CLI::ExistingFile);
+  cmd->add_option("--board", a.board, "the machine's board file (flipper names, sides, rough places)")
+      ->check(CLI::ExistingFile)
+      ->excludes(sim);
+  cmd->add_option("--image", a.image, "camera: image of the markers")->check(CLI::ExistingFile);
+  cmd->add_option("--markers", a.markers, "camera: marker positions, CSV x,y (m); default: the board's default layout")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--down", a.down, "flippers: image of the pivot and tip markers, flippers down")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--up", a.up, "flippers: the same with the flippers held up")->check(CLI::ExistingFile);
+  cmd->add_option("--sweep", a.sweeps, "flippers: video of one flipper swept stop to stop (repeat, board order)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--method", a.method, "flippers: method written to the file when both ran")
+      ->check(CLI::IsMember({"markers", "markerless"}));
+  cmd->add_option("--roll", a.rolls, "gravity: observation CSV (t,x,y) of one roll from rest (repeat)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")->check(CLI::Range(1, 1000));
+  cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")->check(CLI::Range(1e-6, 0.1));
+  cmd->add_option("--calibration", a.calibration, "calibration file holding the camera homography (default: --out)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", a.out, "calibration file to write, or update keeping its other sections");
+  cmd->add_option("--png", a.png, "picture of the detected markers, fitted circles or gravity fit");
+  cmd->add_option("--seed", a.seed, "--sim: seed of the simulated lab");
+  cmd->add_flag("--json", a.json, "print one JSON object instead of text");
+  return cmd;
+}
+
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+cv::Mat read_gray(const std::string& path) {
+  const cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (img.empty()) throw std::runtime_error(path + ": not an image");
+  return img;
+}
+
+nlohmann::json vec_json(const Vec2& v) { return nlohmann::json::array({v.x(), v.y()}); }
+
+nlohmann::json flipper_json(const calibration::FlipperCalibration& f) {
+  return {{"method", calibration::to_string(f.method)}, {"pivot_m", vec_json(f.pivot_m)}, {"tip_m", vec_json(f.tip_m)},
+          {"length_m", f.length_m}, {"theta_min_deg", f.theta_min_rad * kDeg}, {"theta_max_deg", f.theta_max_rad * kDeg},
+          {"fit_rms_m", f.fit_rms_m}, {"points", f.points}};
+}
+
+// Errors against the simulated machine's truth.
+nlohmann::json flipper_truth_json(const calibration::FlipperCalibration& f, const sim::Flipper& t) {
+  return {{"pivot_error_mm", (f.pivot_m - t.pivot).norm() * 1e3},
+          {"tip_error_mm", (f.tip_m - sim::flipper_tip(t, t.theta_min_rad)).norm() * 1e3},
+          {"length_error_mm", (f.length_m - t.length_m) * 1e3},
+          {"theta_min_error_deg", (f.theta_min_rad - t.theta_min_rad) * kDeg},
+          {"theta_max_error_deg", (f.theta_max_rad - t.theta_max_rad) * kDeg}};
+}
+
+struct Context {
+  const CalibrateArgs& a;
+  std::ostream& err;
+  sim::Board board;
+  std::unique_ptr<calibration::SimLab> lab;
+  calibration::Calibration cal;
+  nlohmann::json report;
+};
+
+calibration::HomographyFit camera(Context& c) {
+  const std::vector<Vec2> layout = c.a.markers.empty() ? calibration::default_marker_layout(c.board)
+                                                       : calibration::read_marker_layout_csv(c.a.markers);
+  const cv::Mat image = c.lab ? c.lab->camera_image() : read_gray(c.a.image);
+  c.err << "calibrate camera: " << layout.size() << " markers in the layout, image " << image.cols << "x" << image.rows
+        << "\n";
+  calibration::HomographyFit fit = calibration::calibrate_camera(image, layout);
+  c.err << "calibrate camera: " << fit.detections << " detected, " << fit.calibration.markers_used
+        << " used, reprojection rms " << fit.calibration.reprojection_rms_px << " px\n";
+  if (c.a.kind == "camera" && !c.a.png.empty()) sim::write_png(calibration::draw_camera_figure(image, fit), c.a.png);
+  return fit;
+}
+
+void run_camera(Context& c) {
+  if (!c.lab && c.a.image.empty()) throw std::runtime_error("calibrate camera: give --image (or --sim BOARD)");
+  const calibration::HomographyFit fit = camera(c);
+  c.cal.camera = fit.calibration;
+  nlohmann::json j = {{"markers_detected", fit.detections},
+                      {"markers_used", fit.calibration.markers_used},
+                      {"reprojection_rms_px", fit.calibration.reprojection_rms_px},
+                      {"reprojection_max_px", fit.calibration.reprojection_max_px}};
+  if (c.lab) {
+    const vision::CameraHomography h(fit.calibration.image_from_board);
+    double worst = 0.0;
+    for (int i = 0; i <= 10; ++i) {
+      for (int k = 0; k <= 20; ++k) {
+        const Vec2 p{c.board.width_m * i / 10.0, c.board.height_m * k / 20.0};
+        worst = std::max(worst, (h.board_from_image(c.lab->true_homography().image_from_board(p)) - p).norm());
+      }
+    }
+    j["truth"] = {{"homography_max_error_mm", worst * 1e3}};
+  }
+  c.report["camera"] = j;
+}
+
+void run_flippers(Context& c) {
+  const bool markers = c.lab || (!c.a.down.empty() && !c.a.up.empty());
+  const bool sweeps = c.lab || !c.a.sweeps.empty();
+  if (!markers && !sweeps) throw std::runtime_error("calibrate flippers: give --down and --up, or --sweep (or --sim)");
+  if (!c.lab && !c.a.sweeps.empty() && c.a.sweeps.size() != c.board.flippers.size()) {
+    throw std::runtime_error("calibrate flippers: " + std::to_string(c.a.sweeps.size()) + " sweep videos for " +
+                             std::to_string(c.board.flippers.size()) + " flippers");
+  }
+  // The homography: the simulated camera calibrated afresh, or the file's.
+  cv::Mat background;
+  std::optional<vision::CameraHomography> h;
+  if (c.lab) {
+    h.emplace(camera(c).calibration.image_from_board);
+  } else {
+    const std::string from = c.a.calibration.empty() ? c.a.out : c.a.calibration;
+    if (from.empty()) throw std::runtime_error("calibrate flippers: give --calibration FILE with a camera section");
+    h.emplace(calibration::camera_homography(calibration::read_calibration(from), from));
+  }
+  std::vector<Vec2> down, up;
+  if (markers) {
+    const cv::Mat di = c.lab ? c.lab->flipper_markers_image(false) : read_gray(c.a.down);
+    const cv::Mat ui = c.lab ? c.lab->flipper_markers_image(true) : read_gray(c.a.up);
+    for (const auto& m : calibration::detect_markers(di)) down.push_back(h->board_from_image(m.uv_px));
+    for (const auto& m : calibration::detect_markers(ui)) up.push_back(h->board_from_image(m.uv_px));
+    background = di;
+    c.err << "calibrate flippers: " << down.size() << " markers down, " << up.size() << " up\n";
+  }
+  std::vector<calibration::FlipperCalibration> by_markers, markerless;
+  std::vector<calibration::SweepTrack> tracks(c.board.flippers.size());
+  nlohmann::json list = nlohmann::json::array();
+  for (std::size_t i = 0; i < c.board.flippers.size(); ++i) {
+    const sim::Flipper& f = c.board.flippers[i];
+    nlohmann::json j = {{"name", f.name}};
+    if (markers) {
+      by_markers.push_back(calibration::calibrate_flipper_markers(f, down, up));
+      j["markers"] = flipper_json(by_markers.back());
+    }
+    if (sweeps) {
+      calibration::FrameSourceFactory open;
+      if (c.lab) {
+        open = [&, i] { return c.lab->sweep_video(i); };
+      } else {
+        vision::CaptureConfig cc;
+        cc.source = c.a.sweeps[i];
+        open = [cc] { return std::make_unique<vision::CaptureSource>(cc); };
+      }
+      c.err << "calibrate flippers: sweep of " << f.name << "\n";
+      markerless.push_back(calibration::calibrate_flipper_sweep(open, *h, f, {}, &tracks[i]));
+      j["markerless"] = flipper_json(markerless.back());
+      if (background.empty()) {
+        vision::Frame frame;
+        if (open()->read(frame)) background = frame.gray.clone();
+      }
+    }
+    if (markers && sweeps) {
+      const calibration::FlipperDisagreement d = calibration::compare_flippers(by_markers[i], markerless[i]);
+      j["disagreement"] = {{"pivot_mm", d.pivot_m * 1e3}, {"tip_mm", d.tip_m * 1e3}, {"length_mm", d.length_m * 1e3},
+                           {"theta_min_deg", d.theta_min_rad * kDeg}, {"theta_max_deg", d.theta_max_rad * kDeg}};
+    }
+    if (c.lab) {
+      const sim::Flipper& t = c.lab->truth().flippers[i];
+      if (markers) j["markers"]["truth"] = flipper_truth_json(by_markers[i], t);
+      if (sweeps) j["markerless"]["truth"] = flipper_truth_json(markerless[i], t);
+    }
+    list.push_back(j);
+    const bool use_markers = markers && (c.a.method == "markers" || !sweeps);
+    calibration::FlipperCalibration chosen = use_markers ? by_markers[i] : markerless[i];
+    if (markers && sweeps) {
+      chosen.disagreement =
+          calibration::compare_flippers(chosen, use_markers ? markerless[i] : by_markers[i]);
+    }
+    c.err << "calibrate flippers: " << f.name << " (" << calibration::to_string(chosen.method) << "): pivot ("
+          << chosen.pivot_m.x() << ", " << chosen.pivot_m.y() << ") m, length " << chosen.length_m << " m, theta "
+          << chosen.theta_min_rad * kDeg << " .. " << chosen.theta_max_rad * kDeg << " deg\n";
+    c.cal.flippers.push_back(chosen);
+  }
+  c.report["flippers"] = list;
+  if (!c.a.png.empty()) {
+    std::vector<calibration::FlipperFigureItem> items;
+    for (std::size_t i = 0; i < c.board.flippers.size(); ++i) {
+      items.push_back({sweeps ? &tracks[i] : nullptr, markers ? &by_markers[i] : nullptr,
+                       sweeps ? &markerless[i] : nullptr});
+    }
+    sim::write_png(calibration::draw_flipper_figure(background, *h, items), c.a.png);
+  }
+}
+
+void run_gravity(Context& c) {
+  std::vector<calibration::GravityRoll> rolls;
+  if (c.lab) {
+    rolls = c.lab->rolls(c.a.sim_rolls);
+  } else {
+    if (c.a.rolls.empty()) throw std::runtime_error("calibrate gravity: give --roll FILE.csv (or --sim BOARD)");
+    for (const std::string& path : c.a.rolls) {
+      calibration::GravityRoll r;
+      r.source = path;
+      for (const track::ObservationRow& row : track::read_observations_csv(path)) r.observations.push_back(row.observation);
+      rolls.push_back(std::move(r));
+    }
+  }
+  calibration::GravityOptions o;
+  o.sigma_m = c.a.sigma_m;
+  const calibration::GravityCalibration g = calibration::calibrate_gravity(rolls, o);
+  nlohmann::json per_roll = nlohmann::json::array();
+  for (const calibration::RollFit& f : g.rolls) {
+    nlohmann::json j = {{"source", f.source}, {"usable", f.usable}};
+    if (f.usable) {
+      j.update({{"accel_mps2", f.accel_mps2}, {"stderr_mps2", f.accel_stderr_mps2}, {"lateral_mps2", f.lateral_mps2},
+                {"rms_m", f.rms_m}, {"points", f.last - f.first + 1}, {"outlier", f.outlier}});
+    } else {
+      j["why"] = f.why;
+    }
+    c.err << "calibrate gravity: " << f.source << ": "
+          << (f.usable ? std::to_string(f.accel_mps2) + " m/s^2" + (f.outlier ? " (outlier)" : "") : f.why) << "\n";
+    per_roll.push_back(j);
+  }
+  const calibration::GravityEstimate& e = g.estimate;
+  c.report["gravity"] = {{"g_mps2", e.g_mps2},          {"ci_low_mps2", e.ci_low_mps2},
+                         {"ci_high_mps2", e.ci_high_mps2}, {"confidence", e.confidence},
+                         {"rolls_used", e.rolls_used},  {"rolls_rejected", e.rolls_rejected},
+                         {"rolls", per_roll}};
+  if (c.lab) {
+    c.report["gravity"]["truth"] = {{"g_mps2", c.lab->truth().gravity_mps2},
+                                    {"error_pct", (e.g_mps2 / c.lab->truth().gravity_mps2 - 1.0) * 100.0}};
+  }
+  c.err << "calibrate gravity: g = " << e.g_mps2 << " m/s^2, " << e.confidence * 100 << "% interval ["
+        << e.ci_low_mps2 << ", " << e.ci_high_mps2 << "]\n";
+  c.cal.gravity = e;
+  if (!c.a.png.empty()) sim::write_png(calibration::draw_gravity_figure(rolls, g), c.a.png);
+}
+
+}  // namespace
+
+int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) {
+  const std::string board_path = a.sim_board.empty() ? a.board : a.sim_board;
+  if (board_path.empty()) throw std::runtime_error("calibrate: give --board BOARD (or --sim BOARD)");
+  Context c{a, err, sim::load_board(board_path), nullptr, {}, {}};
+  if (!a.sim_board.empty()) {
+    calibration::SimLabOptions o;
+    o.seed = a.seed;
+    c.lab = std::make_unique<calibration::SimLab>(c.board, o);
+  }
+  // --out updates an existing file: the other sections stay.
+  if (!a.out.empty() && std::filesystem::exists(a.out)) c.cal = calibration::read_calibration(a.out);
+  c.cal.board = board_path;
+  c.cal.date.clear();
+  if (a.kind == "flippers") c.cal.flippers.clear();
+  if (a.kind == "camera") run_camera(c);
+  if (a.kind == "flippers") run_flippers(c);
+  if (a.kind == "gravity") run_gravity(c);
+  if (!a.out.empty()) {
+    calibration::write_calibration(c.cal, a.out);
+    err << "calibrate: wrote " << a.out << "\n";
+  }
+  c.report["kind"] = a.kind;
+  c.report["board"] = board_path;
+  c.report["simulated"] = c.lab != nullptr;
+  c.report["out"] = a.out;
+  if (a.json) {
+    out << c.report.dump(2) << "\n";
+  } else {
+    out << calibration::calibration_to_yaml(c.cal);
+  }
+  return 0;
+}
+
+}  // namespace pinball::cli

@@ -1,0 +1,118 @@
+#include "pinball/calibration/camera_calibration.h"
+
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "pinball/core/rng.h"
+#include "pinball/sim/board_loader.h"
+#include "pinball/vision/camera_homography.h"
+
+namespace pinball::calibration {
+namespace {
+
+sim::Board table() {
+  sim::Board b;
+  b.width_m = 0.51;
+  b.height_m = 1.07;
+  return b;
+}
+
+// Detections at the layout's true image positions (shuffled, with extras and noise).
+std::vector<DetectedMarker> seen(const vision::CameraHomography& h, const std::vector<Vec2>& layout, double noise_px,
+                                 std::uint64_t seed) {
+  Rng rng(seed);
+  std::vector<DetectedMarker> out;
+  for (const Vec2& p : layout) {
+    const cv::Point2d uv = h.image_from_board(p);
+    out.push_back({uv + cv::Point2d(noise_px * rng.normal(), noise_px * rng.normal()), 50.0, 200.0});
+  }
+  std::reverse(out.begin(), out.end());
+  out.push_back({cv::Point2d(320.5, 100.25), 40.0, 150.0});  // a stray bright blob
+  return out;
+}
+
+TEST(CameraCalibration, RecoversTheHomographyFromExactMarkers) {
+  const sim::Board b = table();
+  const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
+  const std::vector<Vec2> layout = default_marker_layout(b);
+  const HomographyFit fit = fit_homography(seen(truth, layout, 0.0, 1), layout, cv::Size(640, 480));
+  EXPECT_EQ(fit.calibration.markers_used, 7);
+  EXPECT_LT(fit.calibration.reprojection_rms_px, 1e-4);  // cv::findHomography works partly in float
+  const vision::CameraHomography h(fit.calibration.image_from_board);
+  for (const Vec2& p : {Vec2{0.1, 0.2}, Vec2{0.4, 0.9}, Vec2{0.25, 0.5}}) {
+    EXPECT_LT((h.board_from_image(truth.image_from_board(p)) - p).norm(), 1e-7);
+  }
+}
+
+TEST(CameraCalibration, NoisyMarkersGiveSubMillimetreHomography) {
+  const sim::Board b = table();
+  const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
+  const std::vector<Vec2> layout = default_marker_layout(b);
+  const HomographyFit fit = fit_homography(seen(truth, layout, 0.2, 7), layout, cv::Size(640, 480));
+  EXPECT_EQ(fit.calibration.markers_used, 7);
+  EXPECT_GT(fit.calibration.reprojection_rms_px, 0.02);
+  EXPECT_LT(fit.calibration.reprojection_rms_px, 0.5);
+  const vision::CameraHomography h(fit.calibration.image_from_board);
+  for (const Vec2& p : {Vec2{0.05, 0.05}, Vec2{0.45, 1.0}, Vec2{0.25, 0.5}}) {
+    EXPECT_LT((h.board_from_image(truth.image_from_board(p)) - p).norm(), 1e-3);
+  }
+}
+
+TEST(CameraCalibration, DegenerateLayoutsAreRefused) {
+  const std::vector<Vec2> three{{0.0, 0.0}, {0.3, 0.0}, {0.0, 0.5}};
+  EXPECT_THROW(check_marker_layout(three), std::invalid_argument);
+  const std::vector<Vec2> collinear{{0.0, 0.0}, {0.1, 0.1}, {0.2, 0.2}, {0.4, 0.0}};
+  try {
+    check_marker_layout(collinear);
+    FAIL() << "collinear triple accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("collinear"), std::string::npos) << e.what();
+  }
+  const std::vector<Vec2> line{{0.0, 0.0}, {0.1, 0.1}, {0.2, 0.2}, {0.3, 0.3001}, {0.4, 0.4}};
+  EXPECT_THROW(check_marker_layout(line), std::invalid_argument);
+  const std::vector<Vec2> coincide{{0.0, 0.0}, {0.3, 0.0}, {0.0, 0.5}, {0.3, 0.5}, {0.3005, 0.5}};
+  try {
+    check_marker_layout(coincide);
+    FAIL() << "coincident markers accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("coincide"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(check_marker_layout(default_marker_layout(table())));
+}
+
+TEST(CameraCalibration, SymmetricLayoutIsAmbiguous) {
+  const sim::Board b = table();
+  const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
+  // A rectangle with its centre: a half turn maps it onto itself.
+  const std::vector<Vec2> layout{{0.05, 0.05}, {0.45, 0.05}, {0.45, 1.0}, {0.05, 1.0}, {0.25, 0.525}};
+  EXPECT_THROW(fit_homography(seen(truth, layout, 0.0, 1), layout, cv::Size(640, 480)), std::runtime_error);
+}
+
+TEST(CameraCalibration, TooFewDetectionsIsAnError) {
+  const sim::Board b = table();
+  const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
+  const std::vector<Vec2> layout = default_marker_layout(b);
+  std::vector<DetectedMarker> det = seen(truth, layout, 0.0, 1);
+  det.resize(3);
+  EXPECT_THROW(fit_homography(det, layout, cv::Size(640, 480)), std::runtime_error);
+}
+
+TEST(CameraCalibration, DetectsDrawnMarkersWithSubpixelCentres) {
+  cv::Mat img(200, 300, CV_8U, cv::Scalar(40));
+  const cv::Point2d centre(120.3, 80.7);
+  cv::circle(img, cv::Point(static_cast<int>(centre.x * 16), static_cast<int>(centre.y * 16)), 12 * 16, cv::Scalar(10),
+             cv::FILLED, cv::LINE_AA, 4);
+  cv::circle(img, cv::Point(static_cast<int>(centre.x * 16), static_cast<int>(centre.y * 16)), 6 * 16, cv::Scalar(245),
+             cv::FILLED, cv::LINE_AA, 4);
+  cv::rectangle(img, cv::Rect(200, 50, 60, 8), cv::Scalar(250), cv::FILLED);  // bright, but a bar
+  const std::vector<DetectedMarker> m = detect_markers(img);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NEAR(m[0].uv_px.x, centre.x, 0.1);
+  EXPECT_NEAR(m[0].uv_px.y, centre.y, 0.1);
+  EXPECT_THROW(detect_markers(cv::Mat(10, 10, CV_8UC3)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pinball::calibration

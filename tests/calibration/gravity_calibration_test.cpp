@@ -1,0 +1,78 @@
+#include "pinball/calibration/gravity_calibration.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "pinball/core/rng.h"
+
+namespace pinball::calibration {
+namespace {
+
+// A ball resting at y0 for `hold` s, then rolling down at g, then bouncing back up at t_hit.
+GravityRoll roll(double g, double noise_m, std::uint64_t seed, double hold = 0.1, double t_hit = 0.8) {
+  Rng rng(seed);
+  GravityRoll r;
+  r.source = "roll " + std::to_string(seed);
+  const double y0 = 0.9;
+  for (int k = 0; k < 240; ++k) {
+    const double t = k / 200.0;
+    const double tau = std::max(0.0, t - hold);
+    double y = y0 - 0.5 * g * tau * tau;
+    if (tau > t_hit) y = y0 - 0.5 * g * t_hit * t_hit + 0.5 * g * t_hit * (tau - t_hit);  // bounced
+    r.observations.push_back({t, Vec2{0.2 + noise_m * rng.normal(), y + noise_m * rng.normal()}, 1.0});
+  }
+  return r;
+}
+
+TEST(GravityCalibration, ExactRollGivesExactG) {
+  const RollFit f = fit_roll(roll(1.11, 0.0, 1));
+  ASSERT_TRUE(f.usable) << f.why;
+  EXPECT_NEAR(f.accel_mps2, 1.11, 1e-9);
+  EXPECT_NEAR(f.lateral_mps2, 0.0, 1e-9);
+  // The bounce is cut off, the rest before release too.
+  EXPECT_GT(f.first, 20u);
+  EXPECT_LT(f.last, 185u);
+  EXPECT_GT(f.last, 170u);
+}
+
+TEST(GravityCalibration, NoisyRollsWithAnOutlierRejected) {
+  std::vector<GravityRoll> rolls;
+  for (std::uint64_t s = 1; s <= 6; ++s) rolls.push_back(roll(1.11, 0.0007, s));
+  rolls.push_back(roll(1.30, 0.0007, 99));  // a roll that was pushed
+  const GravityCalibration c = calibrate_gravity(rolls);
+  EXPECT_EQ(c.estimate.rolls_used, 6);
+  EXPECT_EQ(c.estimate.rolls_rejected, 1);
+  EXPECT_TRUE(c.rolls.back().outlier);
+  EXPECT_NEAR(c.estimate.g_mps2, 1.11, 0.005);
+  EXPECT_LE(c.estimate.ci_low_mps2, c.estimate.g_mps2);
+  EXPECT_GE(c.estimate.ci_high_mps2, c.estimate.g_mps2);
+  EXPECT_LT(c.estimate.ci_high_mps2 - c.estimate.ci_low_mps2, 0.02);
+  EXPECT_EQ(c.estimate.per_roll_mps2.size(), 7u);
+}
+
+TEST(GravityCalibration, UnusableRollsAreReportedNotFatal) {
+  GravityRoll still;
+  still.source = "still";
+  for (int k = 0; k < 100; ++k) still.observations.push_back({k / 200.0, Vec2{0.2, 0.5}, 1.0});
+  const RollFit f = fit_roll(still);
+  EXPECT_FALSE(f.usable);
+  EXPECT_FALSE(f.why.empty());
+  const std::vector<GravityRoll> only_still{still};
+  EXPECT_THROW(calibrate_gravity(only_still), std::runtime_error);
+  const std::vector<GravityRoll> mixed{still, roll(1.11, 0.0, 2), roll(1.11, 0.0, 3)};
+  const GravityCalibration c = calibrate_gravity(mixed);
+  EXPECT_EQ(c.estimate.rolls_used, 2);
+  EXPECT_EQ(c.estimate.rolls_rejected, 1);
+}
+
+TEST(GravityCalibration, StudentT) {
+  EXPECT_NEAR(student_t_quantile(0.95, 4), 2.776, 1e-3);
+  EXPECT_NEAR(student_t_quantile(0.95, 60), 2.000, 2e-3);
+  EXPECT_NEAR(student_t_quantile(0.99, 120), 2.617, 2e-3);
+  EXPECT_THROW(student_t_quantile(0.8, 4), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pinball::calibration
