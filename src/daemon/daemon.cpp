@@ -508,6 +508,7 @@ DaemonReport Daemon::Impl::report() const {
   r.camera_stalls = kc.camera_stalls;
   r.ball_lost_releases = kc.ball_lost;
   r.bus_fault_releases = kc.bus_faults;
+  r.fires_deferred = kc.deferred;
   r.frames_dropped = frames_dropped.load() + (capture ? capture->counters().dropped : 0);
   r.ring_overflows = ring_overflows.load();
   r.lcm = lcm->counters();
@@ -659,6 +660,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["camera_stalls"] = r.camera_stalls;
   j["ball_lost_releases"] = r.ball_lost_releases;
   j["bus_fault_releases"] = r.bus_fault_releases;
+  j["fires_deferred"] = r.fires_deferred;
   j["ring_overflows"] = r.ring_overflows;
   j["lcm"] = {{"published", r.lcm.published}, {"overflows", r.lcm.overflows}, {"received", r.lcm.received},
               {"malformed", r.lcm.malformed}};

@@ -102,6 +102,9 @@ int ControllerStage::on_idle(double now_s, double now_wall_s, Commands& out) {
 int ControllerStage::release_all(CommandCause cause, double now_s, double now_wall_s, Commands& out) {
   bus_.release_all();  // takes priority over anything queued
   wanted_ = {false, false};
+  for (std::size_t f = 0; f < 2; ++f) {
+    if (energized_[f]) released_at_s_[f] = now_s;
+  }
   int n = 0;
   CommandRecord& c = out[static_cast<std::size_t>(n++)];
   c = CommandRecord{seq_++, -1, -1, false, cause, now_s, 0.0, now_wall_s};
@@ -116,6 +119,12 @@ int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, 
   for (int f = 0; f < 2; ++f) {
     if (want[static_cast<std::size_t>(f)] == energized_[static_cast<std::size_t>(f)]) continue;
     const bool on = want[static_cast<std::size_t>(f)];
+    // The board measures the recycle time on its own clock; a millisecond of
+    // margin covers the hand-off to the driver thread.
+    if (on && now_s - released_at_s_[static_cast<std::size_t>(f)] < options_.recycle_s + 1e-3) {
+      ++counters_.deferred;  // the next record fires it, once the coil may be fired again
+      continue;
+    }
     const int driver = options_.driver_of_flipper[static_cast<std::size_t>(f)];
     const bool accepted = on ? bus_.fire(driver) : bus_.release(driver);
     if (!accepted) {
@@ -124,6 +133,7 @@ int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, 
       bus_.release_all();   // a release must not be lost: this one cannot be refused
     }
     energized_[static_cast<std::size_t>(f)] = on;
+    if (!on) released_at_s_[static_cast<std::size_t>(f)] = now_s;
     ++counters_.commands;
     out[static_cast<std::size_t>(n++)] =
         CommandRecord{seq_++, projection_seq, f, on, on ? CommandCause::kProjection : cause, now_s, capture_wall_s,
@@ -147,6 +157,7 @@ TrackingSetup tracking_setup_for(const DaemonConfig& config, const sim::Board& b
 ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const sim::Board& board) {
   ControllerStageOptions o;
   o.stall_timeout_s = config.camera.stall_timeout_s;
+  o.recycle_s = config.coils.recycle_ms * 1e-3;
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
     o.driver_of_flipper[board.flippers[i].side == sim::Side::kLeft ? 0 : 1] = static_cast<int>(i);
   }

@@ -88,7 +88,8 @@ TEST(Daemon, FullPathScoresLikeTheFastLearningLoop) {
               std::sqrt(fast_scores.variance() / kBalls));
   EXPECT_LT(std::abs(daemon_scores.mean() - fast_scores.mean()), 3.0 * se);
   EXPECT_GT(daemon_scores.mean(), 0.0);
-  // The controller really played: it fired, and the board obeyed every fire.
+  // The controller really played: it fired, and the board obeyed every fire
+  // (the controller never fires within a coil's recycle time).
   EXPECT_GT(r.driver.fires, static_cast<std::uint64_t>(kBalls));
   EXPECT_EQ(r.board.fires_accepted, r.driver.fires);
   EXPECT_GT(r.latency[kFrameToCan].count, 0u);

@@ -123,6 +123,26 @@ TEST(ControllerStage, ABallOutOfSightReleasesAfterTheTimeout) {
   EXPECT_EQ(rig.board.coil(0).state, firmware::CoilState::kOff);
 }
 
+TEST(ControllerStage, AFireWaitsForTheCoilsRecycleTime) {
+  Rig rig;
+  ControllerStage::Commands cmds;
+  rig.stage->on_record(rig.record(true, true), rig.t, 0.0, cmds);
+  rig.run(0.001);
+  rig.stage->release_all(CommandCause::kBallLost, rig.t, 0.0, cmds);
+  rig.run(0.001);
+  // Wanted again 2 ms after the release: held back, then fired once the 10 ms have passed.
+  EXPECT_EQ(rig.stage->on_record(rig.record(true, true), rig.t, 0.0, cmds), 0);
+  EXPECT_EQ(rig.stage->counters().deferred, 1u);
+  rig.run(0.005);
+  EXPECT_EQ(rig.stage->on_record(rig.record(true, true), rig.t, 0.0, cmds), 0);
+  rig.run(0.006);
+  ASSERT_EQ(rig.stage->on_record(rig.record(true, true), rig.t, 0.0, cmds), 1);
+  EXPECT_TRUE(cmds[0].energize);
+  rig.run(0.001);
+  EXPECT_NE(rig.board.coil(0).state, firmware::CoilState::kOff);
+  EXPECT_EQ(rig.board.counters().refused_recycle, 0u);
+}
+
 TEST(ControllerStage, ReleaseAllSwitchesEverythingOff) {
   Rig rig;
   ControllerStage::Commands cmds;

@@ -61,6 +61,7 @@ struct DaemonReport {
   std::uint64_t camera_stalls = 0;           ///< releases because frames stopped
   std::uint64_t ball_lost_releases = 0;      ///< releases because the ball went out of sight
   std::uint64_t bus_fault_releases = 0;      ///< releases because the CAN session dropped
+  std::uint64_t fires_deferred = 0;          ///< fires held back for the coil's recycle time
   std::uint64_t ring_overflows = 0;          ///< records dropped between threads
   bus::LcmBusCounters lcm;                   ///< LCM traffic
   firmware::DriverBusCounters driver;        ///< CAN host side

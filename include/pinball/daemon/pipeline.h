@@ -104,6 +104,9 @@ struct ControllerStageOptions {
   double stall_timeout_s = 0.02;
   /// Board driver of tracker flipper f (flipper i of the board is driver i).
   std::array<int, 2> driver_of_flipper{0, 1};
+  /// The coils' recycle time (s): a fire this soon after a release would be
+  /// refused by the board, so it waits (PROTOCOL.md, Configure.recycle_ms).
+  double recycle_s = 0.010;
 };
 
 /// Counters of the controller stage.
@@ -114,6 +117,7 @@ struct ControllerStageCounters {
   std::uint64_t camera_stalls = 0;   ///< releases because frames stopped
   std::uint64_t ball_lost = 0;       ///< releases because the ball was out of sight
   std::uint64_t bus_faults = 0;      ///< releases because the CAN session dropped (bus-off, silence)
+  std::uint64_t deferred = 0;        ///< fires held back until the coil's recycle time had passed
 };
 
 /// The action side: flipper commands from projections, with the fail-safes.
@@ -153,6 +157,7 @@ class ControllerStage {
   ControllerStageOptions options_;
   std::array<bool, 2> energized_{};  // commands given to the bus
   std::array<bool, 2> wanted_{};     // the controller's commands
+  std::array<double, 2> released_at_s_{-1e300, -1e300};  // last release per flipper (pipeline clock)
   double last_record_t_s_ = -1e300;
   double last_seen_t_s_ = -1e300;
   bool started_ = false;
