@@ -741,7 +741,14 @@ EventStepper::EventStepper(const Board& board, EventStepperOptions options) : bo
   // magnitude (a board far from the origin keeps fewer digits).
   double extent = std::hypot(board.width_m, board.height_m);
   double coord = extent;
-  for (const Shape& s : board.shapes) coord = std::max({coord, s.p0.cwiseAbs().maxCoeff(), s.p1.cwiseAbs().maxCoeff()});
+  // Shapes off the table (the bench's far copies) never meet the ball.
+  auto on_table = [&](const Vec2& q) {
+    return q.x() >= -extent && q.y() >= -extent && q.x() <= board.width_m + extent && q.y() <= board.height_m + extent;
+  };
+  for (const Shape& s : board.shapes) {
+    if (on_table(s.p0)) coord = std::max(coord, s.p0.cwiseAbs().maxCoeff());
+    if (on_table(s.p1)) coord = std::max(coord, s.p1.cwiseAbs().maxCoeff());
+  }
   for (const Flipper& f : board.flippers) coord = std::max(coord, f.pivot.cwiseAbs().maxCoeff() + f.length_m);
   length_tol_m_ = options_.relative_tolerance * extent;
   touch_m_ = 4.0 * length_tol_m_ + 64.0 * std::numeric_limits<double>::epsilon() * coord;
