@@ -774,9 +774,7 @@ StepEvents EventStepper::step(GameState& state) const {
   for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
     const Flipper& f = board_.flippers[i];
     FlipperState& fs = state.flippers[i];
-    if (fs.energized && !fs.was_energized) ++state.flips;
-    fs.was_energized = fs.energized;
-    const double omega = fs.energized ? f.omega_rad_s : -f.omega_rad_s;
+    const double omega = rules::take_command(f, fs, state.flips);
     const bool at_stop = omega > 0.0 ? fs.theta_rad >= f.theta_max_rad : fs.theta_rad <= f.theta_min_rad;
     fs.omega_rad_s = at_stop ? 0.0 : omega;
   }

@@ -79,6 +79,12 @@ void fire_sensor(const Board& board, GameState& state, std::int32_t index, StepE
   }
 }
 
+double take_command(const Flipper& f, FlipperState& fs, std::uint64_t& flips) {
+  if (fs.energized && !fs.was_energized) ++flips;
+  fs.was_energized = fs.energized;
+  return fs.energized ? f.omega_rad_s : -f.omega_rad_s;
+}
+
 bool on_sensor(const Sensor& sensor, const Vec2& p, double r) {
   const Shape& shape = sensor.shape;
   if (sensor.kind == SensorKind::kHole) return (p - shape.p0).norm() <= shape.radius_m;

@@ -30,6 +30,11 @@ void hit_obstacle(const Board& board, GameState& state, std::int32_t index, cons
 /// The ball entered sensor `index`: score, eat, or the hole's kickout.
 void fire_sensor(const Board& board, GameState& state, std::int32_t index, StepEvents& events);
 
+/// Reads a flipper's command at the start of a step: counts a press (rising
+/// edge) in `flips`, remembers the command, and returns the commanded θ̇
+/// (+θ̇₀ energised, −θ̇₀ released).
+double take_command(const Flipper& f, FlipperState& fs, std::uint64_t& flips);
+
 /// True while a ball of radius r at p is on the sensor (touching it; for a
 /// hole, its centre inside).
 bool on_sensor(const Sensor& sensor, const Vec2& p, double r);

@@ -66,9 +66,7 @@ void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const 
   for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
     const Flipper& f = board_.flippers[i];
     FlipperState& fs = state.flippers[i];
-    if (fs.energized && !fs.was_energized) ++state.flips;
-    fs.was_energized = fs.energized;
-    const double omega = fs.energized ? f.omega_rad_s : -f.omega_rad_s;
+    const double omega = rules::take_command(f, fs, state.flips);
     const double theta_old = fs.theta_rad;
     const double theta_new = std::clamp(theta_old + dt * omega, f.theta_min_rad, f.theta_max_rad);
     if (theta_new == theta_old) {  // resting on a stop
