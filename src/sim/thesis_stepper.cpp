@@ -5,6 +5,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "game_rules.h"
 #include "pinball/sim/collision.h"
 #include "pinball/sim/penetration.h"
 
@@ -38,15 +39,11 @@ ThesisStepper::ThesisStepper(const Board& board, ThesisStepperOptions options) :
              options_.separation_m;
   const double cell_m = std::max(reach_m_, 1e-3);
   obstacle_grid_ = UniformGrid(board.shapes, reach_m_, cell_m);
-  sensor_shapes_.reserve(board.sensors.size());
-  for (const Sensor& s : board.sensors) sensor_shapes_.push_back(s.shape);
+  sensor_shapes_ = rules::sensor_shapes(board);
   sensor_grid_ = UniformGrid(sensor_shapes_, reach_m_, cell_m);
-  all_obstacles_.resize(board.shapes.size());
-  std::iota(all_obstacles_.begin(), all_obstacles_.end(), 0);
-  all_sensors_.resize(board.sensors.size());
-  std::iota(all_sensors_.begin(), all_sensors_.end(), 0);
-  has_contact_score_ = std::any_of(board.obstacles.begin(), board.obstacles.end(),
-                                   [](const Obstacle& o) { return o.action.contact_score_per_s > 0.0; });
+  all_obstacles_ = rules::all_indices(board.shapes.size());
+  all_sensors_ = rules::all_indices(board.sensors.size());
+  has_contact_score_ = rules::has_contact_score(board);
 }
 
 std::span<const std::int32_t> ThesisStepper::obstacle_candidates(const Vec2& p) const {
@@ -69,9 +66,7 @@ void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const 
   for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
     const Flipper& f = board_.flippers[i];
     FlipperState& fs = state.flippers[i];
-    if (fs.energized && !fs.was_energized) ++state.flips;
-    fs.was_energized = fs.energized;
-    const double omega = fs.energized ? f.omega_rad_s : -f.omega_rad_s;
+    const double omega = rules::take_command(f, fs, state.flips);
     const double theta_old = fs.theta_rad;
     const double theta_new = std::clamp(theta_old + dt * omega, f.theta_min_rad, f.theta_max_rad);
     if (theta_new == theta_old) {  // resting on a stop
@@ -210,37 +205,7 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
 
 void ThesisStepper::apply_obstacle_hit(GameState& state, std::int32_t index, const Vec2& normal,
                                        StepEvents& events) const {
-  const Obstacle& o = board_.obstacles[index];
-  Vec2& v = state.ball.velocity_mps;
-  v = reflect(v, normal, o.rho);
-  v += o.action.kick_mps * normal;
-  events.flags |= StepEvents::kHitObstacle;
-  events.obstacle = index;
-  state.score += o.action.score;
-  events.score_gained += o.action.score;
-  if (o.bank >= 0) {
-    // A flag falls (every shape of its statement); when the whole bank is
-    // down it pays and resets (thesis 3.4).
-    const Bank& bank = board_.banks[o.bank];
-    for (const std::int32_t m : bank.members) {
-      const bool same_flag = m == index || (o.source_line > 0 && board_.obstacles[m].source_line == o.source_line);
-      if (same_flag) state.visible[m] = kHidden;
-    }
-    const bool all_down = std::none_of(bank.members.begin(), bank.members.end(),
-                                       [&](std::int32_t m) { return state.visible[m] != kHidden; });
-    if (all_down) {
-      // A flag never rises into the ball: it waits until the ball has left.
-      for (const std::int32_t m : bank.members) {
-        state.visible[m] = kRising;
-        ++state.rising_flags;
-      }
-      raise_flags(state);
-      state.score += bank.bonus;
-      events.score_gained += bank.bonus;
-      events.flags |= StepEvents::kBankComplete;
-    }
-  }
-  if (o.action.eats_ball) lose_ball(state, events);
+  rules::hit_obstacle(board_, state, index, normal, events, board_.ball.radius_m + options_.separation_m);
 }
 
 void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvents& events) const {
@@ -251,77 +216,33 @@ void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvent
     const Vec2& to = state.ball.position_m;
     // Swept over the whole move so that a fast ball cannot skip a sensor.
     bool touched = false;
-    bool inside = false;
+    const bool inside = rules::on_sensor(sensor, to, r);
     const Shape& shape = sensor.shape;
     if (sensor.kind == SensorKind::kHole) {
       touched = distance_point_segment(shape.p0, from, to) <= shape.radius_m;
-      inside = (to - shape.p0).norm() <= shape.radius_m;
     } else if (shape.kind == ShapeKind::kLine) {
       touched = distance_segment_segment(from, to, shape.p0, shape.p1) <= r;
-      inside = distance_point_segment(to, shape.p0, shape.p1) <= r;
     } else {
       touched = distance_point_segment(shape.p0, from, to) <= r + shape.radius_m;
-      inside = (to - shape.p0).norm() <= r + shape.radius_m;
     }
     const bool entered = touched && !state.sensor_inside[i];
     state.sensor_inside[i] = inside ? 1 : 0;
     if (!entered) continue;
-    if (events.sensor < 0) events.sensor = i;
-    events.flags |= StepEvents::kSensor;
-    state.score += sensor.action.score;
-    events.score_gained += sensor.action.score;
-    if (sensor.action.eats_ball) {
-      lose_ball(state, events);
-      return;
-    }
-    if (sensor.has_kickout) {
-      state.ball.position_m = shape.p0;
-      state.ball.velocity_mps = sensor.kickout_mps;
-      state.sensor_inside[i] = 1;
-    }
+    rules::fire_sensor(board_, state, i, events);
+    if (!state.ball_in_play) return;
   }
 }
 
 void ThesisStepper::update_contacts(GameState& state, std::span<const std::int32_t> candidates,
                                     StepEvents& events) const {
-  const double r = board_.ball.radius_m;
-  const double touch = r + options_.contact_tolerance_m;
-  const Vec2& p = state.ball.position_m;
-  for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
-    const Flipper& f = board_.flippers[i];
-    state.flippers[i].ball_contact =
-        distance_point_segment(p, f.pivot, flipper_tip(f, state.flippers[i].theta_rad)) <= touch;
-  }
-  if (!has_contact_score_) return;
-  for (const std::int32_t i : candidates) {
-    const double rate = board_.obstacles[i].action.contact_score_per_s;
-    if (rate <= 0.0 || state.visible[i] != kVisible) continue;
-    if (distance_to_shape(board_.shapes[i], p) <= touch) {
-      state.score += rate * options_.dt_s;
-      events.score_gained += rate * options_.dt_s;
-    }
-  }
+  rules::update_contacts(board_, state, candidates, board_.ball.radius_m + options_.contact_tolerance_m,
+                         options_.dt_s, has_contact_score_, events);
 }
 
 void ThesisStepper::raise_flags(GameState& state) const {
-  const double clear_m = board_.ball.radius_m + options_.separation_m;
-  for (const Bank& bank : board_.banks) {
-    for (const std::int32_t m : bank.members) {
-      if (state.visible[m] != kRising) continue;
-      if (state.ball_in_play && distance_to_shape(board_.shapes[m], state.ball.position_m) < clear_m) continue;
-      state.visible[m] = kVisible;
-      --state.rising_flags;
-    }
-  }
+  rules::raise_flags(board_, state, board_.ball.radius_m + options_.separation_m);
 }
 
-void ThesisStepper::lose_ball(GameState& state, StepEvents& events) const {
-  events.flags |= StepEvents::kBallLost;
-  state.ball_in_play = false;
-  state.balls_left = std::max(0, state.balls_left - 1);
-  state.ball.position_m = board_.launcher.position;
-  state.ball.velocity_mps = Vec2::Zero();
-  for (auto& f : state.flippers) f.ball_contact = false;
-}
+void ThesisStepper::lose_ball(GameState& state, StepEvents& events) const { rules::lose_ball(board_, state, events); }
 
 }  // namespace pinball::sim
