@@ -24,9 +24,13 @@ LcmBus::LcmBus(const std::string& url)
 
 LcmBus::~LcmBus() { stop(); }
 
-void LcmBus::start(std::function<void(lcm::LCM&)> periodic, double period_s) {
+void LcmBus::start(std::function<void(lcm::LCM&)> periodic, double period_s, std::function<void()> on_start) {
   if (running_.exchange(true)) throw std::logic_error("lcm bus already running");
-  thread_ = std::thread([this, periodic = std::move(periodic), period_s] { run(periodic, period_s); });
+  thread_ = std::thread([this, periodic = std::move(periodic), period_s, on_start = std::move(on_start)] {
+    pthread_setname_np(pthread_self(), "pb-lcm");
+    if (on_start) on_start();
+    run(periodic, period_s);
+  });
 }
 
 void LcmBus::stop() {
@@ -85,8 +89,7 @@ int LcmBus::drain() {
   return n;
 }
 
-void LcmBus::run(std::function<void(lcm::LCM&)> periodic, double period_s) {
-  pthread_setname_np(pthread_self(), "pb-lcm");
+void LcmBus::run(const std::function<void(lcm::LCM&)>& periodic, double period_s) {
   using clock = std::chrono::steady_clock;
   auto next = clock::now() + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(period_s));
   while (running_.load(std::memory_order_acquire)) {

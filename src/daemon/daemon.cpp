@@ -122,7 +122,10 @@ struct Daemon::Impl {
   // Names the calling thread and applies its scheduling; a refusal becomes a warning.
   void enter_thread(ThreadId id) {
     std::string why;
-    if (configure_current_thread(id, config.threads.realtime, why)) return;
+    if (configure_current_thread(id, config.threads.realtime, why,
+                                 config.threads.priorities[static_cast<std::size_t>(id)])) {
+      return;
+    }
     const std::lock_guard<std::mutex> lock(warnings_mutex);
     warnings.push_back(why);
   }
@@ -581,7 +584,9 @@ DaemonReport Daemon::run() {
     if (!lock_memory(why)) d.warnings.push_back(why);  // before any thread starts
     // Probe SCHED_FIFO on a throw-away thread, so that `enforce` refuses before anything runs.
     std::string probe_why;
-    std::thread([&] { configure_current_thread(kDriverThread, true, probe_why); }).join();
+    std::thread([&] {
+      configure_current_thread(kDriverThread, true, probe_why, d.config.threads.priorities[kDriverThread]);
+    }).join();
     if (!probe_why.empty()) d.warnings.push_back(probe_why);
     if (d.config.threads.enforce && !d.warnings.empty()) {
       throw std::runtime_error("real-time scheduling refused (threads.enforce: true): " + d.warnings.front());
@@ -598,7 +603,7 @@ DaemonReport Daemon::run() {
   }
   d.learn_background();
   d.warm_up_bus();
-  d.lcm->start([&d](lcm::LCM& l) { d.publish_stats(l); }, 1.0);
+  d.lcm->start([&d](lcm::LCM& l) { d.publish_stats(l); }, 1.0, [&d] { d.enter_thread(kLcmThread); });
   std::thread driver([&d] { d.driver_thread(); });
   std::thread controller([&d] { d.controller_thread(); });
   std::thread camera([&d] { d.camera_thread(); });

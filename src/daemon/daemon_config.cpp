@@ -138,6 +138,14 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
   Section threads = top.child("threads");
   threads.read("realtime", c.threads.realtime);
   threads.read("enforce", c.threads.enforce);
+  Section prio = threads.child("priorities");
+  static constexpr std::array<const char*, 5> kNames{"driver", "controller", "camera", "sim", "lcm"};
+  for (std::size_t i = 0; i < kNames.size(); ++i) {
+    prio.read(kNames[i], c.threads.priorities[i]);
+    require(c.threads.priorities[i] >= 0 && c.threads.priorities[i] <= 99, source_name,
+            std::string("threads.priorities.") + kNames[i], "must be in [0, 99]");
+  }
+  prio.finish();
   threads.finish();
   top.finish();
   validate_daemon_config(c, source_name);

@@ -9,16 +9,16 @@
 
 namespace pinball::daemon {
 
-bool configure_current_thread(ThreadId id, bool realtime, std::string& why) {
+bool configure_current_thread(ThreadId id, bool realtime, std::string& why, int priority) {
   const ThreadSpec& spec = kThreadTable[static_cast<std::size_t>(id)];
   pthread_setname_np(pthread_self(), spec.name);
-  if (!realtime || spec.fifo_priority <= 0) return true;
+  if (priority < 0) priority = spec.fifo_priority;
+  if (!realtime || priority <= 0) return true;
   sched_param p{};
-  p.sched_priority = spec.fifo_priority;
+  p.sched_priority = priority;
   const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
   if (rc != 0) {
-    why = std::string("SCHED_FIFO ") + std::to_string(spec.fifo_priority) + " for " + spec.name + ": " +
-          std::strerror(rc);
+    why = std::string("SCHED_FIFO ") + std::to_string(priority) + " for " + spec.name + ": " + std::strerror(rc);
     return false;
   }
   return true;

@@ -33,7 +33,7 @@ sim: {balls: 3, seed: 9, realtime: true, actuation_delay_s: 0.002}
 camera: {fps: 300, stall_timeout_s: 0.03}
 can: {board_id: 2, heartbeat_period_s: 0.01, watchdog_timeout_s: 0.05}
 coils: {pulse_ms: 25, hold_duty_pct: 30, max_hold_ms: 4000}
-threads: {realtime: true, enforce: false}
+threads: {realtime: true, enforce: false, priorities: {driver: 95, lcm: 10}}
 lcm_url: "udpm://239.255.76.67:7667?ttl=0"
 )", "t.yaml");
   EXPECT_EQ(c.sim.balls, 3);
@@ -45,6 +45,9 @@ lcm_url: "udpm://239.255.76.67:7667?ttl=0"
   EXPECT_EQ(c.coils.hold_duty_pct, 30);
   EXPECT_EQ(c.coils.max_hold_ms, 4000);
   EXPECT_TRUE(c.threads.realtime);
+  EXPECT_EQ(c.threads.priorities[0], 95);
+  EXPECT_EQ(c.threads.priorities[1], 85);  // the table's
+  EXPECT_EQ(c.threads.priorities[4], 10);
   EXPECT_EQ(c.lcm_url, "udpm://239.255.76.67:7667?ttl=0");
 }
 
@@ -58,6 +61,8 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
             "t.yaml: can.watchdog_timeout_s: must be at least 3 heartbeat periods");
   EXPECT_EQ(error_of("mode: arcade"), "t.yaml: mode: must be sim or lab");
   EXPECT_EQ(error_of("camera: 5"), "t.yaml: camera: must be a mapping");
+  EXPECT_EQ(error_of("threads: {priorities: {camera: 120}}"), "t.yaml: threads.priorities.camera: must be in [0, 99]");
+  EXPECT_EQ(error_of("threads: {priorities: {gpu: 1}}"), "t.yaml: threads.priorities.gpu: unknown key");
   EXPECT_NE(error_of("camera: {fps: [").find("t.yaml:1: not valid YAML"), std::string::npos);
 }
 

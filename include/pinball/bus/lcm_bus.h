@@ -48,8 +48,10 @@ class LcmBus {
   LcmBus& operator=(const LcmBus&) = delete;
 
   /// Starts the bus thread. `periodic` (may be empty) runs on it every
-  /// `period_s` with the LCM instance (the daemon's stats).
-  void start(std::function<void(lcm::LCM&)> periodic = {}, double period_s = 1.0);
+  /// `period_s` with the LCM instance (the daemon's stats); `on_start` (may be
+  /// empty) runs first on the new thread (naming and scheduling it).
+  void start(std::function<void(lcm::LCM&)> periodic = {}, double period_s = 1.0,
+             std::function<void()> on_start = {});
   /// Publishes what is queued, runs `periodic` once more, stops the thread.
   void stop();
 
@@ -76,7 +78,7 @@ class LcmBus {
     SpscRing<T, N> ring;
     const char* channel;
   };
-  void run(std::function<void(lcm::LCM&)> periodic, double period_s);
+  void run(const std::function<void(lcm::LCM&)>& periodic, double period_s);
   int drain();
   template <class T, std::size_t N>
   int drain(Outbox<T, N>& box);

@@ -4,6 +4,7 @@
 // boards/mit1993.board over memq:// with the shipped controller. Loading is
 // all or nothing: a bad file throws ConfigError naming the file and the key.
 
+#include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -39,6 +40,9 @@ struct CanSettings {
 struct ThreadSettings {
   bool realtime = false;  ///< ask for SCHED_FIFO priorities and locked memory
   bool enforce = false;   ///< true: refuse to run when that is not allowed; false: warn once and run
+  /// SCHED_FIFO priority (1..99) per thread, in ThreadId order (driver, controller, camera, sim, lcm);
+  /// 0 leaves a thread SCHED_OTHER. Defaults: the thread table.
+  std::array<int, 5> priorities{90, 85, 80, 70, 0};
 };
 
 /// The embedded simulation.

@@ -33,9 +33,10 @@ inline constexpr std::array<ThreadSpec, kThreadCount> kThreadTable{{
      "encode and publish LCM messages, receive observations, count malformed ones"},
 }};
 
-/// Names the calling thread and, when `realtime`, gives it its SCHED_FIFO
-/// priority. Returns false (with `why`) when the system refuses.
-bool configure_current_thread(ThreadId id, bool realtime, std::string& why);
+/// Names the calling thread and, when `realtime`, gives it SCHED_FIFO at
+/// `priority` (the table's when negative; 0 leaves it SCHED_OTHER). Returns
+/// false (with `why`) when the system refuses.
+bool configure_current_thread(ThreadId id, bool realtime, std::string& why, int priority = -1);
 
 /// Locks all current and future memory (mlockall). False (with `why`) when refused.
 bool lock_memory(std::string& why);
