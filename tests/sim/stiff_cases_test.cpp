@@ -14,6 +14,7 @@
 #include "pinball/sim/board_loader.h"
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "invariants.h"
 #include "test_boards.h"
 
 namespace pinball::sim {
@@ -22,29 +23,7 @@ namespace {
 using namespace pinball::sim::testing;
 
 constexpr double kR = 0.0135;
-constexpr double kMaxDepth = 1e-6;
-
-// Checks the per-step invariants; returns false (after recording a failure) on the first violation.
-bool invariants_hold(const Board& b, const GameState& s, long step) {
-  if (!finite(s.ball.position_m) || !finite(s.ball.velocity_mps)) {
-    ADD_FAILURE() << "non-finite ball state at step " << step;
-    return false;
-  }
-  for (const FlipperState& f : s.flippers) {
-    if (!std::isfinite(f.theta_rad)) {
-      ADD_FAILURE() << "non-finite flipper angle at step " << step;
-      return false;
-    }
-  }
-  const double depth = max_penetration_m(b, s);
-  if (!(depth < kMaxDepth)) {
-    ADD_FAILURE() << "penetration " << depth << " m at step " << step << " ball (" << s.ball.position_m.x() << ", "
-                  << s.ball.position_m.y() << ") v (" << s.ball.velocity_mps.x() << ", " << s.ball.velocity_mps.y()
-                  << ")";
-    return false;
-  }
-  return true;
-}
+constexpr double kMaxDepth = kDefaultMaxDepth_m;
 
 TEST(StiffCases, FastBallAgainstThinWall) {
   // A vertical two-sided wall at x = 0.5; the ball at 50 m/s (10x a real
