@@ -79,6 +79,31 @@ UniformGrid::UniformGrid(std::span<const Shape> shapes, double reach_m, double c
   }
 }
 
+int UniformGrid::candidates_in_box(const Vec2& lo, const Vec2& hi, std::span<const std::int32_t>* lists,
+                                   int max_lists) const {
+  if (nx_ == 0 || ny_ == 0) return 0;
+  const double fx0 = std::max(0.0, (lo.x() - origin_.x()) * inv_cell_);
+  const double fy0 = std::max(0.0, (lo.y() - origin_.y()) * inv_cell_);
+  const double fx1 = std::min(nx_ - 1.0, (hi.x() - origin_.x()) * inv_cell_);
+  const double fy1 = std::min(ny_ - 1.0, (hi.y() - origin_.y()) * inv_cell_);
+  if (!(fx0 <= fx1 && fy0 <= fy1)) return 0;  // outside the grid (or NaN)
+  const int x0 = static_cast<int>(fx0), x1 = static_cast<int>(fx1);
+  const int y0 = static_cast<int>(fy0), y1 = static_cast<int>(fy1);
+  int n = 0;
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const int cell = y * nx_ + x;
+      if (cell_start_[cell + 1] == cell_start_[cell]) continue;
+      if (n < max_lists) {
+        lists[n] = {entries_.data() + cell_start_[cell],
+                    static_cast<std::size_t>(cell_start_[cell + 1] - cell_start_[cell])};
+      }
+      ++n;
+    }
+  }
+  return n;
+}
+
 std::size_t UniformGrid::max_candidates() const {
   std::size_t best = 0;
   for (std::size_t c = 0; c + 1 < cell_start_.size(); ++c) {

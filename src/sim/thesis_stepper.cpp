@@ -5,6 +5,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "game_rules.h"
 #include "pinball/sim/collision.h"
 #include "pinball/sim/penetration.h"
 
@@ -210,37 +211,7 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
 
 void ThesisStepper::apply_obstacle_hit(GameState& state, std::int32_t index, const Vec2& normal,
                                        StepEvents& events) const {
-  const Obstacle& o = board_.obstacles[index];
-  Vec2& v = state.ball.velocity_mps;
-  v = reflect(v, normal, o.rho);
-  v += o.action.kick_mps * normal;
-  events.flags |= StepEvents::kHitObstacle;
-  events.obstacle = index;
-  state.score += o.action.score;
-  events.score_gained += o.action.score;
-  if (o.bank >= 0) {
-    // A flag falls (every shape of its statement); when the whole bank is
-    // down it pays and resets (thesis 3.4).
-    const Bank& bank = board_.banks[o.bank];
-    for (const std::int32_t m : bank.members) {
-      const bool same_flag = m == index || (o.source_line > 0 && board_.obstacles[m].source_line == o.source_line);
-      if (same_flag) state.visible[m] = kHidden;
-    }
-    const bool all_down = std::none_of(bank.members.begin(), bank.members.end(),
-                                       [&](std::int32_t m) { return state.visible[m] != kHidden; });
-    if (all_down) {
-      // A flag never rises into the ball: it waits until the ball has left.
-      for (const std::int32_t m : bank.members) {
-        state.visible[m] = kRising;
-        ++state.rising_flags;
-      }
-      raise_flags(state);
-      state.score += bank.bonus;
-      events.score_gained += bank.bonus;
-      events.flags |= StepEvents::kBankComplete;
-    }
-  }
-  if (o.action.eats_ball) lose_ball(state, events);
+  rules::hit_obstacle(board_, state, index, normal, events, board_.ball.radius_m + options_.separation_m);
 }
 
 void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvents& events) const {
@@ -266,19 +237,8 @@ void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvent
     const bool entered = touched && !state.sensor_inside[i];
     state.sensor_inside[i] = inside ? 1 : 0;
     if (!entered) continue;
-    if (events.sensor < 0) events.sensor = i;
-    events.flags |= StepEvents::kSensor;
-    state.score += sensor.action.score;
-    events.score_gained += sensor.action.score;
-    if (sensor.action.eats_ball) {
-      lose_ball(state, events);
-      return;
-    }
-    if (sensor.has_kickout) {
-      state.ball.position_m = shape.p0;
-      state.ball.velocity_mps = sensor.kickout_mps;
-      state.sensor_inside[i] = 1;
-    }
+    rules::fire_sensor(board_, state, i, events);
+    if (!state.ball_in_play) return;
   }
 }
 
@@ -304,24 +264,9 @@ void ThesisStepper::update_contacts(GameState& state, std::span<const std::int32
 }
 
 void ThesisStepper::raise_flags(GameState& state) const {
-  const double clear_m = board_.ball.radius_m + options_.separation_m;
-  for (const Bank& bank : board_.banks) {
-    for (const std::int32_t m : bank.members) {
-      if (state.visible[m] != kRising) continue;
-      if (state.ball_in_play && distance_to_shape(board_.shapes[m], state.ball.position_m) < clear_m) continue;
-      state.visible[m] = kVisible;
-      --state.rising_flags;
-    }
-  }
+  rules::raise_flags(board_, state, board_.ball.radius_m + options_.separation_m);
 }
 
-void ThesisStepper::lose_ball(GameState& state, StepEvents& events) const {
-  events.flags |= StepEvents::kBallLost;
-  state.ball_in_play = false;
-  state.balls_left = std::max(0, state.balls_left - 1);
-  state.ball.position_m = board_.launcher.position;
-  state.ball.velocity_mps = Vec2::Zero();
-  for (auto& f : state.flippers) f.ball_contact = false;
-}
+void ThesisStepper::lose_ball(GameState& state, StepEvents& events) const { rules::lose_ball(board_, state, events); }
 
 }  // namespace pinball::sim

@@ -33,6 +33,15 @@ class UniformGrid {
             static_cast<std::size_t>(cell_start_[cell + 1] - cell_start_[cell])};
   }
 
+  /// Candidate lists of the cells that the box [lo, hi] overlaps (cells
+  /// outside the grid hold nothing and are skipped). Writes at most max_lists
+  /// spans and returns how many cells overlap; a return above max_lists means
+  /// the box is too big for the caller's buffer (only max_lists were written).
+  int candidates_in_box(const Vec2& lo, const Vec2& hi, std::span<const std::int32_t>* lists, int max_lists) const;
+
+  /// Cell edge (m); 0 for an empty grid.
+  double cell_m() const { return inv_cell_ > 0.0 ? 1.0 / inv_cell_ : 0.0; }
+
   /// Number of cells.
   int cell_count() const { return nx_ * ny_; }
   /// Total stored (cell, shape) pairs.

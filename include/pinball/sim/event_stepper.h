@@ -11,6 +11,7 @@
 // Its choices are written down in docs/physics.md.
 
 #include <cstdint>
+#include <vector>
 
 #include "pinball/sim/board.h"
 #include "pinball/sim/broadphase.h"
@@ -63,10 +64,21 @@ class EventStepper {
   const EventStepperOptions& options() const { return options_; }
 
  private:
+  struct Run;  // one step's working state (event_stepper.cpp)
+
   const Board& board_;
   EventStepperOptions options_;
   UniformGrid obstacle_grid_;
   UniformGrid sensor_grid_;
+  double length_tol_m_ = 0.0;   // relative_tolerance x board diagonal: root accuracy in metres
+  double touch_m_ = 0.0;        // a ball this close to a surface touches it (root accuracy + round-off)
+  double touch_speed_mps_ = 0.0;  // normal speeds below this are zero (resting, sliding)
+  double separation_speed_mps_ = 0.0;  // a moving flipper sends the ball off at least this much faster than its face
+  double circle_slide_m_ = 0.0;  // half-length of a slide along the tangent of a circle (contact mode)
+  bool has_contact_score_ = false;
+  std::vector<std::int32_t> all_obstacles_;  // 0..n-1 for use_grid = false
+  std::vector<std::int32_t> all_sensors_;
+  std::vector<Shape> sensor_shapes_;
 };
 
 }  // namespace pinball::sim

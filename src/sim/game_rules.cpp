@@ -1,0 +1,81 @@
+#include "game_rules.h"
+
+#include <algorithm>
+
+#include "pinball/sim/collision.h"
+
+namespace pinball::sim::rules {
+
+void lose_ball(const Board& board, GameState& state, StepEvents& events) {
+  events.flags |= StepEvents::kBallLost;
+  state.ball_in_play = false;
+  state.balls_left = std::max(0, state.balls_left - 1);
+  state.ball.position_m = board.launcher.position;
+  state.ball.velocity_mps = Vec2::Zero();
+  for (auto& f : state.flippers) f.ball_contact = false;
+}
+
+void raise_flags(const Board& board, GameState& state, double clear_m) {
+  for (const Bank& bank : board.banks) {
+    for (const std::int32_t m : bank.members) {
+      if (state.visible[m] != kRising) continue;
+      if (state.ball_in_play && distance_to_shape(board.shapes[m], state.ball.position_m) < clear_m) continue;
+      state.visible[m] = kVisible;
+      --state.rising_flags;
+    }
+  }
+}
+
+void hit_obstacle(const Board& board, GameState& state, std::int32_t index, const Vec2& normal,
+                  StepEvents& events, double clear_m) {
+  const Obstacle& o = board.obstacles[index];
+  Vec2& v = state.ball.velocity_mps;
+  v = reflect(v, normal, o.rho);
+  v += o.action.kick_mps * normal;
+  events.flags |= StepEvents::kHitObstacle;
+  events.obstacle = index;
+  state.score += o.action.score;
+  events.score_gained += o.action.score;
+  if (o.bank >= 0) {
+    // A flag falls (every shape of its statement); when the whole bank is
+    // down it pays and resets (thesis 3.4).
+    const Bank& bank = board.banks[o.bank];
+    for (const std::int32_t m : bank.members) {
+      const bool same_flag = m == index || (o.source_line > 0 && board.obstacles[m].source_line == o.source_line);
+      if (same_flag) state.visible[m] = kHidden;
+    }
+    const bool all_down = std::none_of(bank.members.begin(), bank.members.end(),
+                                       [&](std::int32_t m) { return state.visible[m] != kHidden; });
+    if (all_down) {
+      // A flag never rises into the ball: it waits until the ball has left.
+      for (const std::int32_t m : bank.members) {
+        state.visible[m] = kRising;
+        ++state.rising_flags;
+      }
+      raise_flags(board, state, clear_m);
+      state.score += bank.bonus;
+      events.score_gained += bank.bonus;
+      events.flags |= StepEvents::kBankComplete;
+    }
+  }
+  if (o.action.eats_ball) lose_ball(board, state, events);
+}
+
+void fire_sensor(const Board& board, GameState& state, std::int32_t index, StepEvents& events) {
+  const Sensor& sensor = board.sensors[index];
+  if (events.sensor < 0) events.sensor = index;
+  events.flags |= StepEvents::kSensor;
+  state.score += sensor.action.score;
+  events.score_gained += sensor.action.score;
+  if (sensor.action.eats_ball) {
+    lose_ball(board, state, events);
+    return;
+  }
+  if (sensor.has_kickout) {
+    state.ball.position_m = sensor.shape.p0;
+    state.ball.velocity_mps = sensor.kickout_mps;
+    state.sensor_inside[index] = 1;
+  }
+}
+
+}  // namespace pinball::sim::rules

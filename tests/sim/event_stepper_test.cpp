@@ -1,0 +1,318 @@
+// The event stepper against closed-form answers: free flight, a ball
+// bouncing to rest, sliding down an incline, an elastic box, a bounce off a
+// circle; flippers (rolling off a raised one, striking a resting ball); the
+// energy invariant; and agreement with the thesis stepper at a tiny dt.
+
+#include "pinball/sim/event_stepper.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "pinball/sim/ball_runner.h"
+#include "pinball/sim/board_loader.h"
+#include "pinball/sim/oracle_policy.h"
+#include "pinball/sim/penetration.h"
+#include "pinball/sim/thesis_stepper.h"
+#include "test_boards.h"
+
+namespace pinball::sim {
+namespace {
+
+using namespace pinball::sim::testing;
+
+constexpr double kR = 0.0135;
+
+double energy(const Board& b, const GameState& s) {
+  return 0.5 * s.ball.velocity_mps.squaredNorm() + b.gravity_mps2 * s.ball.position_m.y();
+}
+
+TEST(EventStepper, RejectsBadSettings) {
+  const Board b = box_board();
+  EventStepperOptions o;
+  o.dt_s = -1.0;
+  EXPECT_THROW(EventStepper(b, o), std::invalid_argument);
+  o = {};
+  o.relative_tolerance = 0.0;
+  EXPECT_THROW(EventStepper(b, o), std::invalid_argument);
+  o = {};
+  o.rest_height_m = NAN;
+  EXPECT_THROW(EventStepper(b, o), std::invalid_argument);
+  EXPECT_EQ(EventStepper(b).dt_s(), b.dt_s);
+}
+
+TEST(EventStepper, FreeFlightIsTheParabola) {
+  // The step horizon is not an integration step: the only error is the
+  // round-off of storing the state once per step.
+  Board b = empty_board(10.0, 30.0, 1.11, 1e-2);
+  const Vec2 p0{5.0, 5.0}, v0{0.3, 5.55};
+  for (const double dt : {1e-2, 5e-4}) {
+    EventStepperOptions o;
+    o.dt_s = dt;
+    const EventStepper stepper(b, o);
+    GameState s = state_with_ball(b, p0, v0);
+    const int steps = static_cast<int>(std::lround(10.0 / dt));
+    double worst = 0.0;
+    for (int i = 0; i < steps; ++i) {
+      stepper.step(s);
+      const double t = (i + 1) * dt;
+      const Vec2 exact = p0 + t * v0 - Vec2{0.0, 0.5 * b.gravity_mps2 * t * t};
+      worst = std::max(worst, (s.ball.position_m - exact).norm());
+    }
+    // 1000 state updates: 1e-12 m; 20000: their round-off adds up to a few 1e-12.
+    EXPECT_LT(worst, dt > 1e-3 ? 1e-12 : 1e-11) << "dt " << dt;
+    EXPECT_NEAR(s.time_s, 10.0, 1e-9);
+    EXPECT_EQ(s.events, 0u);
+    EXPECT_EQ(s.steps, static_cast<std::uint64_t>(steps));
+  }
+}
+
+TEST(EventStepper, BouncesOnAFloorFollowTheGeometricSeriesThenRest) {
+  const double g = 1.11, rho = 0.8, h0 = 0.3;
+  Board b = empty_board(1.0, 1.0, g, 5e-4);
+  add_line(b, {-1.0, 0.0}, {2.0, 0.0}, rho);
+  const EventStepper stepper(b);
+  GameState s = state_with_ball(b, {0.5, kR + h0}, Vec2::Zero());
+  // Impact k happens at t1·(1 + 2ρ + ... + 2ρ^(k−1)), t1 = sqrt(2 h0 / g);
+  // the apex after it is h0·ρ^(2k).
+  const double t1 = std::sqrt(2.0 * h0 / g);
+  int bounces = 0;
+  double next_impact = t1;
+  for (int i = 0; i < 20000 && bounces < 30; ++i) {
+    const StepEvents e = stepper.step(s);
+    if (!e.has(StepEvents::kHitObstacle)) continue;
+    const double y = s.ball.position_m.y() - kR;
+    const double vy = s.ball.velocity_mps.y();
+    if (vy <= 0.0) break;  // came to rest on this bounce
+    ++bounces;
+    // Back out the impact time and the apex from the parabola after it.
+    const double w = std::sqrt(vy * vy + 2.0 * g * y);
+    const double impact = s.time_s - (w - vy) / g;
+    const double apex = y + vy * vy / (2.0 * g);
+    EXPECT_NEAR(impact, next_impact, 1e-9) << "bounce " << bounces;
+    EXPECT_NEAR(apex, h0 * std::pow(rho, 2 * bounces), 1e-9) << "bounce " << bounces;
+    next_impact += 2.0 * t1 * std::pow(rho, bounces);
+  }
+  // Rest once the apex would be below rest_height (1e-5 m): 23 bounces from 0.3 m.
+  EXPECT_GE(bounces, 20);
+  EXPECT_LE(bounces, 25);
+  for (int i = 0; i < 20000; ++i) stepper.step(s);  // 10 more seconds
+  const std::uint64_t events = s.events;
+  EXPECT_LT(events, 40u);
+  for (int i = 0; i < 2000; ++i) stepper.step(s);
+  EXPECT_EQ(s.events, events) << "a resting ball has no more events";
+  EXPECT_NEAR(s.ball.position_m.y(), kR, 1e-9);
+  EXPECT_EQ(s.ball.velocity_mps.norm(), 0.0);
+}
+
+TEST(EventStepper, SlidesDownAnInclineUniformlyAccelerated) {
+  const double g = 1.11, alpha = 0.3;
+  Board b = empty_board(2.0, 2.0, g, 5e-4);
+  const Vec2 a{0.0, 1.5}, c{2.0, 1.5 - 2.0 * std::tan(alpha)};
+  add_line(b, a, c, 0.5);
+  const EventStepper stepper(b);
+  const Shape& line = b.shapes[0];
+  const Vec2 tangent = (c - a).normalized();
+  const Vec2 start = a + 0.1 * tangent + kR * line.normal;
+  GameState s = state_with_ball(b, start, Vec2::Zero());
+  for (int i = 0; i < 2000; ++i) {
+    stepper.step(s);
+    const double t = (i + 1) * 5e-4;
+    const double along = 0.5 * g * std::sin(alpha) * t * t;
+    const Vec2 exact = start + along * tangent;
+    ASSERT_LT((s.ball.position_m - exact).norm(), 1e-9) << "t = " << t;
+  }
+  EXPECT_LT(s.events, 5u);
+}
+
+TEST(EventStepper, ElasticBoxIsPeriodic) {
+  const double g = 1.11;
+  Board b = box_board(1.0, g, 5e-4);
+  const EventStepper stepper(b);
+  // Dropped from rest 0.5 m above the floor: period 2·sqrt(2h/g).
+  const double h = 0.5;
+  const Vec2 start{0.2, kR + h};
+  GameState s = state_with_ball(b, start, Vec2::Zero());
+  const double period = 2.0 * std::sqrt(2.0 * h / g);
+  const double e0 = energy(b, s);
+  double t_next = period;
+  int periods = 0;
+  while (periods < 5) {
+    // Step exactly to the period's end with a shorter last step.
+    EventStepperOptions o;
+    const double left = t_next - s.time_s;
+    o.dt_s = std::min(5e-4, left);
+    const EventStepper part(b, o);
+    part.step(s);
+    if (std::abs(s.time_s - t_next) < 1e-12) {
+      ++periods;
+      EXPECT_LT((s.ball.position_m - start).norm(), 1e-9) << "period " << periods;
+      EXPECT_LT(s.ball.velocity_mps.norm(), 1e-8);
+      t_next += period;
+    }
+  }
+  // Diagonal motion: energy is kept to round-off over 10 s of bounces.
+  GameState d = state_with_ball(b, {0.2, 0.5}, {1.3, 0.7});
+  for (int i = 0; i < 20000; ++i) {
+    stepper.step(d);
+    ASSERT_NEAR(energy(b, d), energy(b, state_with_ball(b, {0.2, 0.5}, {1.3, 0.7})), 1e-11);
+  }
+  EXPECT_GT(d.events, 20u);
+  (void)e0;
+}
+
+TEST(EventStepper, BounceOffACircleIsTheReflectedRay) {
+  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  const Vec2 c{0.5, 0.5};
+  const double radius = 0.05;
+  add_circle(b, c, radius, 1.0);
+  const EventStepper stepper(b);
+  const Vec2 p0{0.2, 0.52}, v0{1.0, 0.0};
+  GameState s = state_with_ball(b, p0, v0);
+  // Closed form: |p0 + v0·t − c| = R + r.
+  const double reach = radius + kR;
+  const Vec2 d = p0 - c;
+  const double bq = d.dot(v0), cq = d.squaredNorm() - reach * reach;
+  const double t_hit = cq / (-bq + std::sqrt(bq * bq - cq));
+  const Vec2 hit = p0 + t_hit * v0;
+  const Vec2 n = (hit - c) / reach;
+  const Vec2 v1 = v0 - 2.0 * v0.dot(n) * n;
+  for (int i = 0; i < 800; ++i) stepper.step(s);
+  const double t = 800 * 5e-4;
+  EXPECT_LT((s.ball.position_m - (hit + (t - t_hit) * v1)).norm(), 1e-12);
+  EXPECT_LT((s.ball.velocity_mps - v1).norm(), 1e-12);
+  EXPECT_EQ(s.events, 1u);
+}
+
+Board flipper_board() {
+  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  add_line(b, {-1.0, 0.0}, {2.0, 0.0}, 0.5);  // a floor far below
+  add_flipper(b, Side::kLeft, {0.3, 0.4}, 0.076, -0.5, 0.5, 33.0, 0.6, 1.6);
+  return b;
+}
+
+TEST(EventStepper, BallOnARaisedFlipperRollsOff) {
+  const Board b = flipper_board();
+  const Flipper& f = b.flippers[0];
+  const EventStepper stepper(b);
+  GameState s = make_game_state(b, 1);
+  s.flippers[0].theta_rad = f.theta_max_rad;
+  s.flippers[0].energized = s.flippers[0].was_energized = true;
+  const Vec2 start = f.pivot + 0.06 * flipper_direction(f, f.theta_max_rad) +
+                     kR * flipper_up_normal(f, f.theta_max_rad);
+  s.ball_in_play = true;
+  s.ball.position_m = start;
+  s.ball.velocity_mps = Vec2::Zero();
+  const double e0 = energy(b, s);
+  bool left_flipper = false;
+  for (int i = 0; i < 4000 && s.ball_in_play; ++i) {
+    stepper.step(s);
+    ASSERT_LT(max_penetration_m(b, s), 1e-9) << "step " << i;
+    ASSERT_LE(energy(b, s), e0 + 1e-12) << "step " << i;
+    if (s.ball.position_m.x() < f.pivot.x() - kR) left_flipper = true;
+  }
+  EXPECT_TRUE(left_flipper) << "the ball rolls down the raised flipper past its pivot";
+  EXPECT_LT(s.ball.position_m.y(), f.pivot.y());
+  EXPECT_LT(s.events, 2000u);
+}
+
+TEST(EventStepper, FlipperStrikesARestingBallWithTheThesisImpulse) {
+  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  add_flipper(b, Side::kLeft, {0.3, 0.4}, 0.076, 0.0, 0.5, 33.0, 0.6, 1.6);  // rests horizontal
+  const Flipper& f = b.flippers[0];
+  const EventStepper stepper(b);
+  GameState s = make_game_state(b, 1);
+  const double arm = 0.05;
+  s.ball_in_play = true;
+  s.ball.position_m = f.pivot + Vec2{arm, kR};
+  s.ball.velocity_mps = Vec2::Zero();
+  stepper.step(s);  // rests on the horizontal face
+  EXPECT_LT(s.ball.velocity_mps.norm(), 1e-12);
+  s.flippers[0].energized = true;
+  const StepEvents e = stepper.step(s);
+  EXPECT_TRUE(e.has(StepEvents::kFlipperPush));
+  // Struck at t = 0 at rest: v = μ·θ̇·l·n with n straight up, then a step of gravity.
+  const Vec2 v = s.ball.velocity_mps + Vec2{0.0, b.gravity_mps2 * stepper.dt_s()};
+  EXPECT_NEAR(v.x(), 0.0, 1e-12);
+  EXPECT_NEAR(v.y(), f.mu * f.omega_rad_s * arm, 1e-9);
+  EXPECT_EQ(s.events, 1u);
+}
+
+TEST(EventStepper, EnergyNeverGrowsWithoutKickersOrFlippers) {
+  Board b = box_board(0.9, 1.11, 5e-4);
+  add_circle(b, {0.15, 0.70}, 0.03, 0.95);
+  add_circle(b, {0.35, 0.72}, 0.03, 1.0);
+  add_point(b, {0.40, 0.45}, 0.9);
+  add_wall(b, {0.05, 0.40}, {0.15, 0.30}, 0.7);
+  add_wall(b, {0.46, 0.40}, {0.36, 0.30}, 0.7);
+  add_line(b, {0.0, 0.25}, {0.255, 0.05}, 0.5);  // a V at the bottom, its joint a point
+  add_line(b, {0.255, 0.05}, {0.51, 0.25}, 0.5);
+  add_point(b, {0.255, 0.05}, 0.5);
+  const EventStepper stepper(b);
+  Rng rng(3);
+  for (int run = 0; run < 20; ++run) {
+    GameState s = state_with_ball(b, {rng.uniform(0.1, 0.4), rng.uniform(0.5, 1.0)},
+                                  {rng.uniform(-3.0, 3.0), rng.uniform(-3.0, 3.0)});
+    bool clear = true;
+    for (const Shape& shape : b.shapes) clear = clear && distance_to_shape(shape, s.ball.position_m) > kR;
+    if (!clear) continue;  // a start inside an obstacle
+    double e = energy(b, s);
+    for (int i = 0; i < 20000; ++i) {
+      stepper.step(s);
+      ASSERT_TRUE(finite(s.ball.position_m) && finite(s.ball.velocity_mps));
+      const double now = energy(b, s);
+      ASSERT_LE(now, e + 1e-12) << "run " << run << " step " << i;
+      ASSERT_LT(max_penetration_m(b, s), 1e-9) << "run " << run << " step " << i;
+      e = now;
+    }
+    EXPECT_LT(s.ball.velocity_mps.norm(), 1e-6) << "run " << run << ": settled in the V";
+    EXPECT_LT(s.events, 20000u) << "run " << run;
+  }
+}
+
+TEST(EventStepper, AgreesWithTheThesisStepperAtTinyDt) {
+  const Board b = load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  ThesisStepperOptions to;
+  to.dt_s = 1e-5;
+  const ThesisStepper thesis(b, to);
+  EventStepperOptions eo;
+  eo.dt_s = 1e-3;
+  const EventStepper event(b, eo);
+  GameState a = make_game_state(b, 5);
+  GameState e = make_game_state(b, 5);
+  launch_ball(b, a, 0.95);
+  launch_ball(b, e, 0.95);
+  ASSERT_EQ(a.ball.velocity_mps, e.ball.velocity_mps);
+  double worst = 0.0;
+  for (int i = 0; i < 330; ++i) {  // 0.33 s: up the chute, round the hook, down the lane
+    event.step(e);
+    for (int k = 0; k < 100; ++k) thesis.step(a);
+    worst = std::max(worst, (a.ball.position_m - e.ball.position_m).norm());
+  }
+  EXPECT_GT(e.events, 2u);
+  // Euler's lag g·dt·t/2 (2 µm) plus the thesis's 1 µm separations; later
+  // the bounces off the hook's polyline amplify any difference (chaos).
+  EXPECT_LT(worst, 1e-5);
+}
+
+TEST(EventStepper, PlaysBallsOnMit1993WithoutPenetration) {
+  const Board b = load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  const EventStepper stepper(b);
+  GameState s = make_game_state(b, 11);
+  BallLimits limits;
+  limits.max_ball_time_s = 60.0;
+  double worst = 0.0;
+  for (int ball = 0; ball < 4; ++ball) {
+    play_ball(stepper, s, limits, [&](GameState& st) { oracle_spastic_policy(b, st); },
+              [&](const GameState& st, const StepEvents&) {
+                ASSERT_TRUE(finite(st.ball.position_m) && finite(st.ball.velocity_mps));
+                if (st.ball_in_play) worst = std::max(worst, max_penetration_m(b, st));
+              });
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(s.events, 10u);
+}
+
+}  // namespace
+}  // namespace pinball::sim
