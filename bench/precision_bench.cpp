@@ -16,9 +16,6 @@
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
 
-// TEMPORARY until the event stepper's implementation is merged: 0 builds the thesis half only.
-#define PRECISION_WITH_EVENT 0
-
 namespace pinball::bench {
 namespace {
 
@@ -215,7 +212,7 @@ PrecisionPoint measure_thesis(const Scene& scene, double dt, int repeats) {
   return measure(scene, stepper, "thesis", dt, repeats);
 }
 
-[[maybe_unused]] sim::EventStepperOptions event_options(const PrecisionBenchOptions& options, double tolerance, double step_s) {
+sim::EventStepperOptions event_options(const PrecisionBenchOptions& options, double tolerance, double step_s) {
   sim::EventStepperOptions o;
   o.dt_s = step_s;
   o.relative_tolerance = tolerance;
@@ -224,15 +221,8 @@ PrecisionPoint measure_thesis(const Scene& scene, double dt, int repeats) {
 }
 
 PrecisionPoint measure_event(const Scene& scene, const PrecisionBenchOptions& options, double tolerance) {
-#if PRECISION_WITH_EVENT
   const sim::EventStepper stepper(*scene.board, event_options(options, tolerance, options.event_step_s));
   return measure(scene, stepper, "event", tolerance, options.repeats);
-#else
-  (void)scene;
-  (void)options;
-  (void)tolerance;
-  throw std::logic_error("event stepper not built");
-#endif
 }
 
 void run_scene(const Scene& scene, const PrecisionBenchOptions& options, PrecisionReport& report,
@@ -293,7 +283,6 @@ std::string sci(double v, int digits = 2) {
 
 PrecisionBenchOptions default_precision_bench_options() {
   PrecisionBenchOptions o;
-  o.with_event = PRECISION_WITH_EVENT != 0;
   for (double decade = 1e-2; decade > 0.5e-6; decade /= 10.0) {
     for (double m : {1.0, 0.5, 0.2}) {
       if (m * decade >= 0.9e-6) o.thesis_dt_s.push_back(m * decade);
@@ -308,7 +297,6 @@ PrecisionBenchOptions quick_precision_bench_options() {
   o.thesis_dt_s = {1e-2, 1e-3, 1e-4};
   o.event_tolerances = {1e-6, 1e-10, 1e-14};
   o.repeats = 1;
-  o.with_event = PRECISION_WITH_EVENT != 0;
   return o;
 }
 
@@ -399,7 +387,6 @@ PrecisionReport run_precision_bench(const Board& table, const PrecisionBenchOpti
     scene.horizon_s = options.table_horizon_s;
     scene.sample_period_s = options.table_reference_step_s;
     std::vector<Vec2> path{scene.start.ball.position_m};
-#if PRECISION_WITH_EVENT
     const sim::EventStepper reference(
         table, event_options(options, options.table_reference_tolerance, options.table_reference_step_s));
     GameState s = scene.start;
@@ -408,7 +395,6 @@ PrecisionReport run_precision_bench(const Board& table, const PrecisionBenchOpti
       reference.step(s);
       path.push_back(s.ball.position_m);
     }
-#endif
     const double h = options.table_reference_step_s;
     scene.exact = [path, h](double t) {
       const auto k = static_cast<std::size_t>(std::clamp(std::lround(t / h), 0L, static_cast<long>(path.size()) - 1));

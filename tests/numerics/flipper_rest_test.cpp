@@ -48,5 +48,32 @@ TYPED_TEST(FlipperRestTest, RollsDownARaisedFlipperAndOff) {
        Traits::kName, left_at, t_pivot, max_gap_on_face, static_cast<unsigned long long>(s.events));
 }
 
+TYPED_TEST(FlipperRestTest, SlidesOffTheFreeEndOfAnIncline) {
+  // The static counterpart: a ball sliding down a 10° line leaves its free
+  // lower end and falls; it must not stop at the edge.
+  using Traits = StepperTraits<TypeParam>;
+  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  add_box(b, 1.0, 1.0, 0.5);  // catches it afterwards
+  const double slope = 0.1745;  // 10°
+  const Vec2 p0{0.0, 0.5}, p1{0.9, 0.5 - 0.9 * std::tan(slope)};
+  add_line(b, p0, p1, 0.5);
+  const auto stepper = Traits::make(b, 5e-4);
+  // On the line at rest, its centre r above the surface along the normal.
+  GameState s = state_with_ball(b, {0.05, 0.5 - 0.05 * std::tan(slope) + kBallR / std::cos(slope)}, Vec2::Zero());
+  Checker<TypeParam> check(stepper, s, false, 2000);
+  // Frictionless: the centre passes the end at t = sqrt(2 s / (g sin α)).
+  const double t_end = std::sqrt(2.0 * (0.85 / std::cos(slope)) / (1.11 * std::sin(slope)));
+  double passed_at = -1.0;
+  ASSERT_TRUE(run_checked(stepper, s, static_cast<long>((t_end + 0.5) / 5e-4), check, [](GameState&, long) {},
+                          [&](const GameState& st, long i) {
+                            if (passed_at < 0.0 && st.ball.position_m.x() > p1.x() + kBallR) passed_at = (i + 1) * 5e-4;
+                          }))
+      << Traits::kName;
+  ASSERT_GT(passed_at, 0.0) << Traits::kName << ": stopped at the end of the line";
+  EXPECT_NEAR(passed_at, t_end, 0.1) << Traits::kName;
+  note("incline_end %s: passed the free end at %.4f s (frictionless %.4f s), %llu events", Traits::kName, passed_at,
+       t_end, static_cast<unsigned long long>(s.events));
+}
+
 }  // namespace
 }  // namespace pinball::sim::testing

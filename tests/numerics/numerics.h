@@ -72,7 +72,7 @@ struct StepperTraits<EventStepper> {
 };
 
 /// The steppers every case runs on.
-using Steppers = ::testing::Types<ThesisStepper>;
+using Steppers = ::testing::Types<ThesisStepper, EventStepper>;
 
 /// Names the typed tests by stepper.
 struct StepperNames {
@@ -156,7 +156,7 @@ class Checker {
 };
 
 /// Steps n times under a Checker; `policy(state, i)` runs before each step and
-/// `observe(state, i)` after the checks. Returns false after the first failure.
+/// `observe(state, i)` after the checks (it may ASSERT). Returns false after the first failure.
 template <class Stepper, class Policy, class Observe>
 bool run_checked(const Stepper& stepper, GameState& s, long n, Checker<Stepper>& check, Policy&& policy,
                  Observe&& observe) {
@@ -165,6 +165,7 @@ bool run_checked(const Stepper& stepper, GameState& s, long n, Checker<Stepper>&
     stepper.step(s);
     if (!check(s, i)) return false;
     observe(static_cast<const GameState&>(s), i);
+    if (::testing::Test::HasFatalFailure()) return false;  // an ASSERT inside observe
   }
   return true;
 }
