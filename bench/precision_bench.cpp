@@ -255,10 +255,19 @@ std::vector<std::pair<double, double>> curve(const PrecisionReport& report, cons
   return xy;
 }
 
+// Equal run time: the thesis error at the event's run time, interpolated
+// log-log between the two thesis settings around it. Equal error: the thesis
+// run time at the event's error, interpolated the same way inside the thesis
+// curve's range; outside it (the usual case: the event error is far below
+// the thesis's best), extrapolated along a least-squares power law fitted to
+// the whole thesis curve. best_speedup needs no extrapolation.
 void compare(PrecisionReport& report, const std::string& scene) {
   const auto thesis_by_time = curve(report, scene, "thesis", false);
   const auto thesis_by_error = curve(report, scene, "thesis", true);
   if (thesis_by_time.size() < 2) return;
+  const LogLogFit fit = loglog_fit(thesis_by_time);  // error against time
+  const auto best = *std::min_element(thesis_by_time.begin(), thesis_by_time.end(),
+                                      [](const auto& a, const auto& b) { return a.second < b.second; });
   for (const PrecisionPoint& p : report.points) {
     if (p.scene != scene || p.stepper != "event") continue;
     PrecisionComparison c;
@@ -268,7 +277,15 @@ void compare(PrecisionReport& report, const std::string& scene) {
     c.event_time_s = p.run_time_s;
     const double e = std::max(p.max_error_m, kErrorFloor_m);
     c.error_ratio = loglog_interpolate(thesis_by_time, p.run_time_s, c.error_ratio_extrapolated) / e;
-    c.speedup = loglog_interpolate(thesis_by_error, e, c.speedup_extrapolated) / p.run_time_s;
+    double thesis_time = loglog_interpolate(thesis_by_error, e, c.speedup_extrapolated);
+    if (c.speedup_extrapolated) {
+      thesis_time = fit.slope < 0.0 ? std::exp((std::log(e) - fit.intercept) / fit.slope) : INFINITY;
+    }
+    c.speedup = thesis_time / p.run_time_s;
+    c.thesis_fit_exponent = fit.slope;
+    c.thesis_best_error_m = best.second;
+    c.thesis_best_time_s = best.first;
+    c.best_speedup = best.first / p.run_time_s;
     report.comparisons.push_back(c);
   }
 }
@@ -295,7 +312,7 @@ PrecisionBenchOptions default_precision_bench_options() {
 PrecisionBenchOptions quick_precision_bench_options() {
   PrecisionBenchOptions o;
   o.thesis_dt_s = {1e-2, 1e-3, 1e-4};
-  o.event_tolerances = {1e-6, 1e-10, 1e-14};
+  o.event_tolerances = {1e-6, 1e-12, 1e-14};
   o.repeats = 1;
   return o;
 }
@@ -357,6 +374,24 @@ double loglog_interpolate(const std::vector<std::pair<double, double>>& xy, doub
   const double y0 = std::log(xy[i].second), y1 = std::log(xy[i + 1].second);
   const double w = x1 == x0 ? 0.0 : (lx - x0) / (x1 - x0);
   return std::exp(y0 + w * (y1 - y0));
+}
+
+LogLogFit loglog_fit(const std::vector<std::pair<double, double>>& xy) {
+  if (xy.size() < 2) throw std::invalid_argument("loglog_fit: need two points");
+  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  for (const auto& [x, y] : xy) {
+    const double lx = std::log(x), ly = std::log(y);
+    sx += lx;
+    sy += ly;
+    sxx += lx * lx;
+    sxy += lx * ly;
+  }
+  const double n = static_cast<double>(xy.size());
+  LogLogFit f;
+  const double den = n * sxx - sx * sx;
+  f.slope = den == 0.0 ? 0.0 : (n * sxy - sx * sy) / den;
+  f.intercept = (sy - f.slope * sx) / n;
+  return f;
 }
 
 PrecisionReport run_precision_bench(const Board& table, const PrecisionBenchOptions& options,
@@ -427,7 +462,11 @@ nlohmann::json to_json(const PrecisionReport& report) {
                            {"error_ratio", c.error_ratio},
                            {"error_ratio_extrapolated", c.error_ratio_extrapolated},
                            {"speedup", c.speedup},
-                           {"speedup_extrapolated", c.speedup_extrapolated}});
+                           {"speedup_extrapolated", c.speedup_extrapolated},
+                           {"thesis_fit_exponent", c.thesis_fit_exponent},
+                           {"thesis_best_error_m", c.thesis_best_error_m},
+                           {"thesis_best_time_s", c.thesis_best_time_s},
+                           {"best_speedup", c.best_speedup}});
   }
   const PrecisionBenchOptions& o = report.options;
   return {{"benchmark", "precision"},
@@ -483,28 +522,44 @@ std::string to_markdown(const PrecisionReport& report) {
     }
     out << '\n';
   }
-  if (!report.comparisons.empty()) {
-    out << "| event tolerance |";
-    for (const std::string& s : scenes) out << ' ' << s << " |";
-    out << "\n|---|";
-    for (std::size_t i = 0; i < scenes.size(); ++i) out << "---:|";
-    out << '\n';
-    std::map<double, std::map<std::string, const PrecisionComparison*>, std::greater<>> rows;
-    for (const PrecisionComparison& c : report.comparisons) rows[c.tolerance][c.scene] = &c;
-    for (const auto& [tol, by_scene] : rows) {
-      out << "| " << sci(tol, 1) << " |";
-      for (const std::string& s : scenes) {
-        const auto it = by_scene.find(s);
-        out << ' ';
-        if (it != by_scene.end()) {
-          const PrecisionComparison& c = *it->second;
-          out << sci(c.error_ratio) << (c.error_ratio_extrapolated ? "*" : "") << " / " << sci(c.speedup)
-              << (c.speedup_extrapolated ? "*" : "");
-        }
-        out << " |";
-      }
-      out << '\n';
+  if (report.comparisons.empty()) return out.str();
+  // Headline at the event stepper's default tolerance.
+  const double tol = sim::EventStepperOptions{}.relative_tolerance;
+  out << "| scene (event tolerance " << sci(tol, 1) << ") | event error (m) | event run time (s) | thesis error at "
+      << "equal run time (m) | error ratio | thesis best error (m) at run time (s) | speed-up over thesis best "
+      << "(measured) | speed-up at equal error (power-law fit) |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const PrecisionComparison& c : report.comparisons) {
+    if (c.tolerance != tol) continue;
+    out << "| " << c.scene << " | " << sci(c.event_error_m) << " | " << sci(c.event_time_s) << " | "
+        << sci(c.error_ratio * std::max(c.event_error_m, kErrorFloor_m)) << (c.error_ratio_extrapolated ? "*" : "")
+        << " | " << sci(c.error_ratio) << " | " << sci(c.thesis_best_error_m) << " at " << sci(c.thesis_best_time_s)
+        << " | " << sci(c.best_speedup) << " | ";
+    if (std::isfinite(c.speedup)) {
+      out << sci(c.speedup) << (c.speedup_extrapolated ? "*" : "") << " (p = " << sci(c.thesis_fit_exponent) << ")";
+    } else {
+      out << "never (p = " << sci(c.thesis_fit_exponent) << ")";
     }
+    out << " |\n";
+  }
+  out << "\n| event tolerance |";
+  for (const std::string& s : scenes) out << ' ' << s << " |";
+  out << "\n|---|";
+  for (std::size_t i = 0; i < scenes.size(); ++i) out << "---:|";
+  out << '\n';
+  std::map<double, std::map<std::string, const PrecisionComparison*>, std::greater<>> rows;
+  for (const PrecisionComparison& c : report.comparisons) rows[c.tolerance][c.scene] = &c;
+  for (const auto& [t, by_scene] : rows) {
+    out << "| " << sci(t, 1) << " |";
+    for (const std::string& s : scenes) {
+      const auto it = by_scene.find(s);
+      out << ' ';
+      if (it != by_scene.end()) {
+        const PrecisionComparison& c = *it->second;
+        out << sci(c.error_ratio) << (c.error_ratio_extrapolated ? "*" : "") << " / " << sci(c.best_speedup);
+      }
+      out << " |";
+    }
+    out << '\n';
   }
   return out.str();
 }

@@ -59,6 +59,10 @@ struct PrecisionComparison {
   double speedup = 0.0;           ///< thesis run time at the event's error / event run time
   bool error_ratio_extrapolated = false;  ///< the event run time lies outside the thesis curve's range
   bool speedup_extrapolated = false;      ///< the event error lies outside the thesis curve's range
+  double thesis_fit_exponent = 0.0;  ///< p in thesis error ∝ run time^p (least squares, log-log): extrapolation
+  double thesis_best_error_m = 0.0;  ///< smallest thesis error measured on the scene
+  double thesis_best_time_s = 0.0;   ///< ... and its run time
+  double best_speedup = 0.0;         ///< thesis_best_time_s / event run time: measured, no extrapolation
 };
 
 /// The whole measurement.
@@ -84,7 +88,15 @@ PrecisionReport run_precision_bench(const sim::Board& table, const PrecisionBenc
 
 /// log-log interpolation of y(x) through points sorted by x; outside the
 /// range, the nearest end segment is extended. Sets `extrapolated` then.
+/// (The report extrapolates with loglog_fit instead: end segments are noisy.)
 double loglog_interpolate(const std::vector<std::pair<double, double>>& xy, double x, bool& extrapolated);
+
+/// Least-squares line through (log x, log y): y ≈ exp(intercept)·x^slope.
+struct LogLogFit {
+  double intercept = 0.0;  ///< ln y at x = 1
+  double slope = 0.0;      ///< exponent
+};
+LogLogFit loglog_fit(const std::vector<std::pair<double, double>>& xy);
 
 /// The report as one JSON object.
 nlohmann::json to_json(const PrecisionReport& report);
