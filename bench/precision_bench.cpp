@@ -620,9 +620,10 @@ void plot_precision_png(const PrecisionReport& report, const std::string& path) 
     cv::putText(img, "run time (s)", cv::Point(ox + kLeft + w / 2 - 40, oy + kPanelH - 8), font, 0.4, black, 1,
                 cv::LINE_AA);
     for (const std::string stepper : {"thesis", "event"}) {
-      const auto xy = curve(report, scenes[k], stepper, false);
-      std::vector<cv::Point> pts;
-      for (const auto& [t, e] : xy) pts.push_back(to_px(t, e));
+      std::vector<cv::Point> pts;  // in sweep order, so a curve runs from coarse to fine
+      for (const PrecisionPoint& p : report.points) {
+        if (p.scene == scenes[k] && p.stepper == stepper) pts.push_back(to_px(p.run_time_s, p.max_error_m));
+      }
       const bool is_thesis = stepper == std::string("thesis");
       const cv::Scalar colour = is_thesis ? thesis_colour : event_colour;
       if (pts.size() >= 2) cv::polylines(img, pts, false, colour, 1, cv::LINE_AA);
