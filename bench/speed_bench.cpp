@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "pinball/sim/ball_runner.h"
+#include "pinball/sim/event_stepper.h"
 #include "pinball/sim/oracle_policy.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -103,6 +104,42 @@ SpeedRun measure(const std::string& name, const sim::Board& board, bool use_grid
   return run;
 }
 
+// Event stepper: the same play, timed the same way.
+EventSpeedRun measure_event(const std::string& name, const sim::Board& board, const SpeedBenchOptions& options,
+                            const std::function<void(const std::string&)>& progress) {
+  const sim::EventStepper stepper(board);
+  sim::BallLimits limits;
+  limits.max_ball_time_s = 60.0;
+  std::vector<double> times;
+  EventSpeedRun run;
+  run.name = name;
+  run.obstacles = board.shapes.size();
+  for (int i = 0; i < std::max(1, options.repeats); ++i) {
+    sim::GameState state = sim::make_game_state(board, options.seed);
+    const auto start = std::chrono::steady_clock::now();
+    while (state.steps < options.steps) {
+      sim::play_ball(stepper, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+                     [&](const sim::GameState&, const sim::StepEvents&) {});
+    }
+    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    run.steps = state.steps;
+    run.events = state.events;
+    run.simulated_s = state.time_s;
+  }
+  std::sort(times.begin(), times.end());
+  run.median_s = times[times.size() / 2];
+  run.events_per_s = static_cast<double>(run.events) / run.median_s;
+  run.steps_per_s = static_cast<double>(run.steps) / run.median_s;
+  run.sim_s_per_wall_s = run.simulated_s / run.median_s;
+  if (progress) {
+    std::ostringstream line;
+    line << name << ": " << run.events << " events in " << run.simulated_s << " s simulated, median " << run.median_s
+         << " s, " << run.events_per_s << " events/s, " << run.sim_s_per_wall_s << " simulated s per wall s";
+    progress(line.str());
+  }
+  return run;
+}
+
 }  // namespace
 
 SpeedReport run_speed_bench(const sim::Board& board, const SpeedBenchOptions& options,
@@ -122,6 +159,12 @@ SpeedReport run_speed_bench(const sim::Board& board, const SpeedBenchOptions& op
   report.crowded_cost_ratio = (grid_crowded.median_s / static_cast<double>(grid_crowded.steps)) /
                               (grid.median_s / static_cast<double>(grid.steps));
   report.grid_matches_linear = grid.final_hash == linear.final_hash && grid.steps == linear.steps;
+  report.event_runs.push_back(measure_event("event", board, options, progress));
+  report.event_runs.push_back(measure_event("event_crowded", crowded, options, progress));
+  const EventSpeedRun& event = report.event_runs[0];
+  const EventSpeedRun& event_crowded = report.event_runs[1];
+  report.event_crowded_cost_ratio =
+      (event_crowded.median_s / event_crowded.simulated_s) / (event.median_s / event.simulated_s);
   return report;
 }
 
@@ -136,13 +179,27 @@ nlohmann::json to_json(const SpeedReport& report) {
                     {"steps_per_s", r.steps_per_s},
                     {"mean_candidates_per_step", r.mean_candidates}});
   }
+  nlohmann::json event_runs = nlohmann::json::array();
+  for (const EventSpeedRun& r : report.event_runs) {
+    event_runs.push_back({{"name", r.name},
+                          {"obstacles", r.obstacles},
+                          {"steps", r.steps},
+                          {"events", r.events},
+                          {"simulated_s", r.simulated_s},
+                          {"median_s", r.median_s},
+                          {"events_per_s", r.events_per_s},
+                          {"steps_per_s", r.steps_per_s},
+                          {"sim_s_per_wall_s", r.sim_s_per_wall_s}});
+  }
   return {{"benchmark", "speed"},
           {"board", report.board},
           {"dt_s", report.dt_s},
           {"runs", runs},
           {"grid_speedup", report.grid_speedup},
           {"crowded_cost_ratio", report.crowded_cost_ratio},
-          {"grid_matches_linear", report.grid_matches_linear}};
+          {"grid_matches_linear", report.grid_matches_linear},
+          {"event_runs", event_runs},
+          {"event_crowded_cost_ratio", report.event_crowded_cost_ratio}};
 }
 
 }  // namespace pinball::bench

@@ -1,7 +1,9 @@
 #pragma once
 // `pinball bench speed`: thesis-stepper steps per second with the grid and
 // with the linear scan, on the board and on a copy crowded with ten times its
-// obstacles out of the ball's reach, all measured in one run.
+// obstacles out of the ball's reach, all measured in one run; and the event
+// stepper's events per second and simulated seconds per wall second on the
+// same two boards.
 
 #include <cstdint>
 #include <functional>
@@ -34,6 +36,20 @@ struct SpeedRun {
   std::uint64_t final_hash = 0;     ///< state hash after the run (equal runs, equal hash)
 };
 
+/// One event-stepper configuration's figures (same play as the thesis runs:
+/// spastic oracle policy, the board's dt as the step horizon).
+struct EventSpeedRun {
+  std::string name;                 ///< "event" or "event_crowded"
+  std::size_t obstacles = 0;        ///< obstacle shapes on the board
+  std::uint64_t steps = 0;          ///< step() calls per timed run
+  std::uint64_t events = 0;         ///< events per timed run
+  double simulated_s = 0.0;         ///< simulated time per timed run (s)
+  double median_s = 0.0;            ///< median wall time of one run (s)
+  double events_per_s = 0.0;        ///< events / median_s
+  double steps_per_s = 0.0;         ///< steps / median_s
+  double sim_s_per_wall_s = 0.0;    ///< simulated_s / median_s
+};
+
 /// The whole measurement.
 struct SpeedReport {
   std::string board;                 ///< board file
@@ -42,6 +58,8 @@ struct SpeedReport {
   double grid_speedup = 0.0;         ///< grid steps/s over linear steps/s (plain board)
   double crowded_cost_ratio = 0.0;   ///< grid time per step, crowded over plain (target <= 1.5)
   bool grid_matches_linear = false;  ///< the two broadphases produced bit-identical runs
+  std::vector<EventSpeedRun> event_runs;  ///< event, event_crowded
+  double event_crowded_cost_ratio = 0.0;  ///< event stepper wall time per simulated second, crowded over plain (target <= 1.5)
 };
 
 /// A copy of `board` with `copies` extra copies of every obstacle placed side

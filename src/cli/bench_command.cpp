@@ -122,6 +122,12 @@ int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   out << "grid speed-up over linear scan: " << report.grid_speedup << "x\n"
       << "cost with 10x obstacles out of reach: " << report.crowded_cost_ratio << "x\n"
       << "grid and linear scan bit-identical: " << (report.grid_matches_linear ? "yes" : "NO") << "\n";
+  out << "event stepper (step horizon " << report.dt_s << " s)\n";
+  for (const bench::EventSpeedRun& r : report.event_runs) {
+    out << "  " << r.name << ": " << r.obstacles << " obstacles, " << r.events_per_s << " events/s, "
+        << r.sim_s_per_wall_s << " simulated s per wall s, " << r.steps_per_s << " steps/s\n";
+  }
+  out << "event stepper cost with 10x obstacles out of reach: " << report.event_crowded_cost_ratio << "x\n";
   return 0;
 }
 

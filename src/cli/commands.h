@@ -20,7 +20,7 @@ struct SimArgs {
   std::string controller;        ///< controller file (implies policy controller)
   int balls = 1;                 ///< balls to play
   std::uint64_t seed = 1;        ///< launch noise seed
-  std::string stepper = "thesis";///< integrator
+  std::string stepper = "thesis";///< integrator: thesis | event
   double dt_s = 0.0;             ///< time step override (0: the board's)
   double max_ball_time_s = 300.0;///< cut a ball still in play after this
   std::string trace;             ///< CSV trace path, or empty

@@ -21,6 +21,7 @@
 #include "pinball/control/simulated_player.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/sim/state_hash.h"
+#include "pinball/sim/event_stepper.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "pinball/sim/video_recorder.h"
 #include "pinball/vision/sim_camera_source.h"
@@ -49,9 +50,12 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
       ->check(CLI::Range(0.0, 0.1));
   cmd->add_option("--balls", a.balls, "balls to play")->check(CLI::Range(1, 100'000'000));
   cmd->add_option("--seed", a.seed, "random seed (launch noise); same seed, same results");
-  cmd->add_option("--stepper", a.stepper, "integrator: thesis (fixed-step, Ch. 3)")
-      ->check(CLI::IsMember({"thesis"}));
-  cmd->add_option("--dt", a.dt_s, "time step in seconds (default: the board's)")
+  cmd->add_option("--stepper", a.stepper,
+                  "integrator: thesis (fixed-step Euler, Ch. 3) or event (exact between events, docs/physics.md)")
+      ->check(CLI::IsMember({"thesis", "event"}));
+  cmd->add_option("--dt", a.dt_s,
+                  "time step in seconds (default: the board's); for --stepper event the rate at which the "
+                  "policy may change the flipper commands")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball still in play is cut")
       ->check(CLI::PositiveNumber);
@@ -66,9 +70,18 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
 
 int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   const sim::Board board = sim::load_board(a.board);
-  sim::ThesisStepperOptions options;
-  options.dt_s = a.dt_s;
-  const sim::ThesisStepper stepper(board, options);
+  std::optional<sim::ThesisStepper> thesis;
+  std::optional<sim::EventStepper> event;
+  if (a.stepper == "event") {
+    sim::EventStepperOptions options;
+    options.dt_s = a.dt_s;
+    event.emplace(board, options);
+  } else {
+    sim::ThesisStepperOptions options;
+    options.dt_s = a.dt_s;
+    thesis.emplace(board, options);
+  }
+  const double dt_s = event ? event->dt_s() : thesis->dt_s();
   sim::GameState state = sim::make_game_state(board, a.seed);
 
   std::optional<TraceWriter> trace;
@@ -126,8 +139,9 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   const auto start = std::chrono::steady_clock::now();
   auto last_progress = start;
 
-  for (int ball = 0; ball < a.balls; ++ball) {
-    const sim::BallResult r = sim::play_ball(
+  const std::uint64_t events_before = state.events;
+  auto play = [&](const auto& stepper) {
+    return sim::play_ball(
         stepper, state, limits,
         [&](sim::GameState& s) {
           if (spastic) spastic->act(s);
@@ -147,6 +161,9 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
             next_frame_s += 1.0 / a.video_fps;
           }
         });
+  };
+  for (int ball = 0; ball < a.balls; ++ball) {
+    const sim::BallResult r = event ? play(*event) : play(*thesis);
     score.add(r.score);
     ball_time.add(r.duration_s);
     steps += r.steps;
@@ -165,6 +182,8 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   if (video) video->close();
 
   const double steps_per_s = wall_s > 0.0 ? static_cast<double>(steps) / wall_s : 0.0;
+  const std::uint64_t events = state.events - events_before;
+  const double events_per_s = wall_s > 0.0 ? static_cast<double>(events) / wall_s : 0.0;
   char hash_hex[17];
   std::snprintf(hash_hex, sizeof(hash_hex), "%016llx", static_cast<unsigned long long>(run_hash));
   if (a.json) {
@@ -174,7 +193,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"controller", a.controller},
         {"stepper", a.stepper},
         {"seed", a.seed},
-        {"dt_s", stepper.dt_s()},
+        {"dt_s", dt_s},
         {"balls", a.balls},
         {"camera",
          {{"fps", a.camera.fps},
@@ -195,18 +214,21 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"state_hash", hash_hex},
         {"wall_time_s", wall_s},
         {"steps_per_s", steps_per_s},
+        {"events", events},
+        {"events_per_s", events_per_s},
     };
     out << j.dump(2) << "\n";
   } else {
     out << "board            " << a.board << " (policy " << policy << ", actuation " << a.actuation
         << ", stepper " << a.stepper << ", dt "
-        << stepper.dt_s() << " s, seed " << a.seed << ")\n"
+        << dt_s << " s, seed " << a.seed << ")\n"
         << "balls            " << a.balls << " (" << cut << " cut at " << a.max_ball_time_s << " s, " << left_table
         << " left the table)\n"
         << "score per ball   " << score.mean() << " +/- " << score.ci95_half_width() << " (95 % interval), max "
         << score.max() << "\n"
         << "mean ball time   " << ball_time.mean() << " s, " << flips << " flips\n"
         << "steps            " << steps << " in " << wall_s << " s wall = " << steps_per_s << " steps/s\n"
+        << "events           " << events << " = " << events_per_s << " events/s\n"
         << "state hash       " << hash_hex << "\n";
   }
   return 0;

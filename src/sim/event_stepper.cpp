@@ -428,10 +428,11 @@ struct EventStepper::Run {
     }
   }
 
-  // Touching (within tolerance) and approaching, to first or second order.
-  bool approaching_now(double gap, double vn, double an) const {
-    const double vt = stepper.touch_speed_mps_;
-    return gap <= stepper.touch_m_ && (vn < -vt || (vn <= vt && an < 0.0));
+  // Touching (within tolerance) and approaching. A touching ball whose
+  // normal speed is below touch_speed was classified as a contact (or as
+  // leaving over an end) before the search, so only a real approach counts.
+  bool approaching_now(double gap, double vn) const {
+    return gap <= stepper.touch_m_ && vn < -stepper.touch_speed_mps_;
   }
 
   // One-sided line: the ball's surface reaches the front face within the segment.
@@ -446,7 +447,7 @@ struct EventStepper::Run {
       const double u = (m.pos(t) - s.p0).dot(ab);
       return u >= 0.0 && u <= ab.squaredNorm();
     };
-    if (sc >= 0.0 && approaching_now(gap, vn, an)) {
+    if (sc >= 0.0 && approaching_now(gap, vn)) {
       if (!foot_inside(0.0)) return false;
       t_hit = 0.0;
       return true;
@@ -466,8 +467,8 @@ struct EventStepper::Run {
     const Vec2 d = m.p - c;
     const double dist = d.norm();
     double t = 0.0;
-    // d/dτ and ½ d²/dτ² of |p − c|² at τ = 0, scaled to speeds along the normal.
-    const bool now = dist > 0.0 && approaching_now(dist - reach_m, poly[1] / (2.0 * dist), poly[2] / dist);
+    // d/dτ |p − c|² at τ = 0 is 2·|d|·(normal speed).
+    const bool now = dist > 0.0 && approaching_now(dist - reach_m, poly[1] / (2.0 * dist));
     if (!now && !first_crossing_down(poly, 4, 0.0, horizon, t_tol, t)) return false;
     const Vec2 at = m.pos(t) - c;
     const double len = at.norm();
@@ -740,7 +741,14 @@ EventStepper::EventStepper(const Board& board, EventStepperOptions options) : bo
   // magnitude (a board far from the origin keeps fewer digits).
   double extent = std::hypot(board.width_m, board.height_m);
   double coord = extent;
-  for (const Shape& s : board.shapes) coord = std::max({coord, s.p0.cwiseAbs().maxCoeff(), s.p1.cwiseAbs().maxCoeff()});
+  // Shapes off the table (the bench's far copies) never meet the ball.
+  auto on_table = [&](const Vec2& q) {
+    return q.x() >= -extent && q.y() >= -extent && q.x() <= board.width_m + extent && q.y() <= board.height_m + extent;
+  };
+  for (const Shape& s : board.shapes) {
+    if (on_table(s.p0)) coord = std::max(coord, s.p0.cwiseAbs().maxCoeff());
+    if (on_table(s.p1)) coord = std::max(coord, s.p1.cwiseAbs().maxCoeff());
+  }
   for (const Flipper& f : board.flippers) coord = std::max(coord, f.pivot.cwiseAbs().maxCoeff() + f.length_m);
   length_tol_m_ = options_.relative_tolerance * extent;
   touch_m_ = 4.0 * length_tol_m_ + 64.0 * std::numeric_limits<double>::epsilon() * coord;

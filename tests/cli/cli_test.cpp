@@ -64,6 +64,22 @@ int count_lines(const std::string& s) {
   return n;
 }
 
+TEST_F(Cli, SimPlaysTheEventStepper) {
+  const CommandResult r = run("sim boards/mit1993.board --stepper event --policy spastic --balls 5 --seed 3 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("stepper"), "event");
+  EXPECT_EQ(j.at("balls"), 5);
+  EXPECT_GT(j.at("events").get<double>(), 0.0);
+  EXPECT_GT(j.at("events_per_s").get<double>(), 0.0);
+  EXPECT_GT(j.at("steps").get<double>(), 0.0);
+  EXPECT_EQ(j.at("balls_left_table"), 0);
+  // Same seed, same run.
+  const CommandResult again = run("sim boards/mit1993.board --stepper event --policy spastic --balls 5 --seed 3 --json");
+  EXPECT_EQ(nlohmann::json::parse(again.out).at("state_hash"), j.at("state_hash"));
+  EXPECT_EQ(run("sim boards/mit1993.board --stepper rk4").exit_code, 2);
+}
+
 TEST_F(Cli, SimJsonReportsEveryFigure) {
   const CommandResult r = run("sim boards/mit1993.board --policy spastic --balls 5 --seed 3 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;

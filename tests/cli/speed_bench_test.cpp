@@ -26,7 +26,7 @@ TEST(SpeedBench, ReportComparesGridWithLinearScanOnTheSameRun) {
   int progress_lines = 0;
   const SpeedReport r = run_speed_bench(b, options, [&](const std::string&) { ++progress_lines; });
   ASSERT_EQ(r.runs.size(), 4u);
-  EXPECT_EQ(progress_lines, 4);
+  EXPECT_EQ(progress_lines, 6);
   EXPECT_TRUE(r.grid_matches_linear);
   EXPECT_EQ(r.runs[0].steps, r.runs[2].steps) << "far obstacles must not change the game";
   EXPECT_LT(r.runs[0].mean_candidates, r.runs[1].mean_candidates);
@@ -35,6 +35,28 @@ TEST(SpeedBench, ReportComparesGridWithLinearScanOnTheSameRun) {
   const auto j = to_json(r);
   EXPECT_EQ(j.at("runs").size(), 4u);
   EXPECT_TRUE(j.contains("crowded_cost_ratio"));
+}
+
+TEST(SpeedBench, EventStepperRunsOnBothBoards) {
+  const sim::Board b = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  SpeedBenchOptions options;
+  options.steps = 20'000;
+  options.repeats = 1;
+  const SpeedReport r = run_speed_bench(b, options, {});
+  ASSERT_EQ(r.event_runs.size(), 2u);
+  for (const EventSpeedRun& e : r.event_runs) {
+    EXPECT_GE(e.steps, options.steps) << e.name;
+    EXPECT_GT(e.events, 0u) << e.name;
+    EXPECT_NEAR(e.simulated_s, static_cast<double>(e.steps) * b.dt_s, 1e-6 * e.simulated_s) << e.name;
+    EXPECT_GT(e.sim_s_per_wall_s, 0.0) << e.name;
+  }
+  // Far obstacles must not change the game.
+  EXPECT_EQ(r.event_runs[0].events, r.event_runs[1].events);
+  EXPECT_EQ(r.event_runs[0].steps, r.event_runs[1].steps);
+  EXPECT_GT(r.event_crowded_cost_ratio, 0.0);
+  const auto j = to_json(r);
+  EXPECT_EQ(j.at("event_runs").size(), 2u);
+  EXPECT_TRUE(j.contains("event_crowded_cost_ratio"));
 }
 
 }  // namespace
