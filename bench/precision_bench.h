@@ -65,11 +65,24 @@ struct PrecisionComparison {
   double best_speedup = 0.0;         ///< thesis_best_time_s / event run time: measured, no extrapolation
 };
 
+/// The targets at the event stepper's default tolerance, over every
+/// scene compared (the closed-form ones, and the table for the two ratios).
+struct PrecisionTargets {
+  bool evaluated = false;                ///< false when the default tolerance was not in the sweep
+  double tolerance = 0.0;                ///< the event stepper's default relative tolerance
+  double worst_closed_form_error_m = 0.0;  ///< largest event max error over the closed-form scenes (target <= 1e-9)
+  std::string worst_scene;               ///< where it was
+  double min_error_ratio = 0.0;          ///< smallest error ratio at equal run time (target >= 1000)
+  double min_best_speedup = 0.0;         ///< smallest measured speed-up over the thesis's best (target >= 100)
+  double min_fit_speedup = 0.0;          ///< smallest speed-up at equal error (power-law extrapolation)
+};
+
 /// The whole measurement.
 struct PrecisionReport {
   PrecisionBenchOptions options;                 ///< what was run
   std::vector<PrecisionPoint> points;            ///< every (scene, stepper, setting)
   std::vector<PrecisionComparison> comparisons;  ///< every (scene, event tolerance), closed-form scenes and table
+  PrecisionTargets targets;                      ///< the targets at the default tolerance
 };
 
 /// Names of the scenes with closed-form answers, in report order.
