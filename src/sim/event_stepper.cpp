@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <span>
 #include <stdexcept>
 
@@ -763,15 +762,11 @@ EventStepper::EventStepper(const Board& board, EventStepperOptions options) : bo
   const double reach = r + options_.contact_tolerance_m + touch_m_;
   const double cell = 2.0 * reach;
   obstacle_grid_ = UniformGrid(board.shapes, reach, cell);
-  sensor_shapes_.reserve(board.sensors.size());
-  for (const Sensor& s : board.sensors) sensor_shapes_.push_back(s.shape);
+  sensor_shapes_ = rules::sensor_shapes(board);
   sensor_grid_ = UniformGrid(sensor_shapes_, reach, obstacle_grid_.cell_m() > 0.0 ? obstacle_grid_.cell_m() : cell);
-  all_obstacles_.resize(board.shapes.size());
-  std::iota(all_obstacles_.begin(), all_obstacles_.end(), 0);
-  all_sensors_.resize(board.sensors.size());
-  std::iota(all_sensors_.begin(), all_sensors_.end(), 0);
-  has_contact_score_ = std::any_of(board.obstacles.begin(), board.obstacles.end(),
-                                   [](const Obstacle& o) { return o.action.contact_score_per_s > 0.0; });
+  all_obstacles_ = rules::all_indices(board.shapes.size());
+  all_sensors_ = rules::all_indices(board.sensors.size());
+  has_contact_score_ = rules::has_contact_score(board);
 }
 
 StepEvents EventStepper::step(GameState& state) const {
@@ -779,9 +774,7 @@ StepEvents EventStepper::step(GameState& state) const {
   for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
     const Flipper& f = board_.flippers[i];
     FlipperState& fs = state.flippers[i];
-    if (fs.energized && !fs.was_energized) ++state.flips;
-    fs.was_energized = fs.energized;
-    const double omega = fs.energized ? f.omega_rad_s : -f.omega_rad_s;
+    const double omega = rules::take_command(f, fs, state.flips);
     const bool at_stop = omega > 0.0 ? fs.theta_rad >= f.theta_max_rad : fs.theta_rad <= f.theta_min_rad;
     fs.omega_rad_s = at_stop ? 0.0 : omega;
   }
@@ -791,37 +784,12 @@ StepEvents EventStepper::step(GameState& state) const {
   const double r = board_.ball.radius_m;
   if (state.ball_in_play) {
     const Vec2& p = state.ball.position_m;
-    const double touch = r + options_.contact_tolerance_m;
-    for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
-      const Flipper& f = board_.flippers[i];
-      state.flippers[i].ball_contact =
-          distance_point_segment(p, f.pivot, flipper_tip(f, state.flippers[i].theta_rad)) <= touch;
-    }
-    if (has_contact_score_) {
-      const auto near = options_.use_grid ? obstacle_grid_.candidates(p) : std::span<const std::int32_t>(all_obstacles_);
-      for (const std::int32_t i : near) {
-        const double rate = board_.obstacles[i].action.contact_score_per_s;
-        if (rate <= 0.0 || state.visible[i] != kVisible) continue;
-        if (distance_to_shape(board_.shapes[i], p) <= touch) {
-          state.score += rate * options_.dt_s;
-          events.score_gained += rate * options_.dt_s;
-        }
-      }
-    }
+    rules::update_contacts(board_, state,
+                           options_.use_grid ? obstacle_grid_.candidates(p) : std::span<const std::int32_t>(all_obstacles_),
+                           r + options_.contact_tolerance_m, options_.dt_s, has_contact_score_, events);
     // A sensor is entered again only after the ball has left it.
     for (std::size_t i = 0; i < board_.sensors.size(); ++i) {
-      if (!state.sensor_inside[i]) continue;
-      const Sensor& sensor = board_.sensors[i];
-      const Shape& s = sensor.shape;
-      bool inside;
-      if (sensor.kind == SensorKind::kHole) {
-        inside = (p - s.p0).norm() <= s.radius_m;
-      } else if (s.kind == ShapeKind::kLine) {
-        inside = distance_point_segment(p, s.p0, s.p1) <= r;
-      } else {
-        inside = (p - s.p0).norm() <= r + s.radius_m;
-      }
-      state.sensor_inside[i] = inside ? 1 : 0;
+      if (state.sensor_inside[i]) state.sensor_inside[i] = rules::on_sensor(board_.sensors[i], p, r) ? 1 : 0;
     }
     const double margin = 2.0 * r;
     if (p.x() < -margin || p.y() < -margin || p.x() > board_.width_m + margin || p.y() > board_.height_m + margin) {

@@ -1,6 +1,7 @@
 #include "game_rules.h"
 
 #include <algorithm>
+#include <numeric>
 
 #include "pinball/sim/collision.h"
 
@@ -76,6 +77,56 @@ void fire_sensor(const Board& board, GameState& state, std::int32_t index, StepE
     state.ball.velocity_mps = sensor.kickout_mps;
     state.sensor_inside[index] = 1;
   }
+}
+
+double take_command(const Flipper& f, FlipperState& fs, std::uint64_t& flips) {
+  if (fs.energized && !fs.was_energized) ++flips;
+  fs.was_energized = fs.energized;
+  return fs.energized ? f.omega_rad_s : -f.omega_rad_s;
+}
+
+bool on_sensor(const Sensor& sensor, const Vec2& p, double r) {
+  const Shape& shape = sensor.shape;
+  if (sensor.kind == SensorKind::kHole) return (p - shape.p0).norm() <= shape.radius_m;
+  if (shape.kind == ShapeKind::kLine) return distance_point_segment(p, shape.p0, shape.p1) <= r;
+  return (p - shape.p0).norm() <= r + shape.radius_m;
+}
+
+void update_contacts(const Board& board, GameState& state, std::span<const std::int32_t> candidates, double touch_m,
+                     double dt_s, bool has_contact_score, StepEvents& events) {
+  const Vec2& p = state.ball.position_m;
+  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+    const Flipper& f = board.flippers[i];
+    state.flippers[i].ball_contact =
+        distance_point_segment(p, f.pivot, flipper_tip(f, state.flippers[i].theta_rad)) <= touch_m;
+  }
+  if (!has_contact_score) return;
+  for (const std::int32_t i : candidates) {
+    const double rate = board.obstacles[i].action.contact_score_per_s;
+    if (rate <= 0.0 || state.visible[i] != kVisible) continue;
+    if (distance_to_shape(board.shapes[i], p) <= touch_m) {
+      state.score += rate * dt_s;
+      events.score_gained += rate * dt_s;
+    }
+  }
+}
+
+bool has_contact_score(const Board& board) {
+  return std::any_of(board.obstacles.begin(), board.obstacles.end(),
+                     [](const Obstacle& o) { return o.action.contact_score_per_s > 0.0; });
+}
+
+std::vector<Shape> sensor_shapes(const Board& board) {
+  std::vector<Shape> shapes;
+  shapes.reserve(board.sensors.size());
+  for (const Sensor& s : board.sensors) shapes.push_back(s.shape);
+  return shapes;
+}
+
+std::vector<std::int32_t> all_indices(std::size_t n) {
+  std::vector<std::int32_t> v(n);
+  std::iota(v.begin(), v.end(), 0);
+  return v;
 }
 
 }  // namespace pinball::sim::rules

@@ -4,6 +4,8 @@
 // to pinball_sim.
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "pinball/core/geometry.h"
 #include "pinball/sim/board.h"
@@ -27,5 +29,29 @@ void hit_obstacle(const Board& board, GameState& state, std::int32_t index, cons
 
 /// The ball entered sensor `index`: score, eat, or the hole's kickout.
 void fire_sensor(const Board& board, GameState& state, std::int32_t index, StepEvents& events);
+
+/// Reads a flipper's command at the start of a step: counts a press (rising
+/// edge) in `flips`, remembers the command, and returns the commanded θ̇
+/// (+θ̇₀ energised, −θ̇₀ released).
+double take_command(const Flipper& f, FlipperState& fs, std::uint64_t& flips);
+
+/// True while a ball of radius r at p is on the sensor (touching it; for a
+/// hole, its centre inside).
+bool on_sensor(const Sensor& sensor, const Vec2& p, double r);
+
+/// The flippers' contact sensors (ball within touch_m of the segment) and the
+/// contact scores (rate·dt for each listed obstacle within touch_m) at the
+/// ball's current position.
+void update_contacts(const Board& board, GameState& state, std::span<const std::int32_t> candidates, double touch_m,
+                     double dt_s, bool has_contact_score, StepEvents& events);
+
+/// Whether any obstacle pays for contact time.
+bool has_contact_score(const Board& board);
+
+/// The sensors' shapes, same index as Board::sensors (for a sensor grid).
+std::vector<Shape> sensor_shapes(const Board& board);
+
+/// 0, 1, ..., n − 1 (the candidate list of a linear scan).
+std::vector<std::int32_t> all_indices(std::size_t n);
 
 }  // namespace pinball::sim::rules

@@ -77,6 +77,18 @@ void refine_bracket(const double* c, int degree, double& a, double& b, double fa
   }
 }
 
+// lo, the turning points inside (lo, hi), and hi: the polynomial is
+// monotone between consecutive knots. Returns the number of knots.
+int monotone_knots(const double* c, int degree, double lo, double hi, double t_tol, double* knots) {
+  double d[kMaxPolyDegree] = {};
+  derivative(c, degree, d);
+  const int turns = real_roots(d, degree - 1, lo, hi, t_tol, knots + 1);
+  knots[0] = lo;
+  int k = turns + 1;
+  if (knots[k - 1] < hi) knots[k++] = hi;
+  return k;
+}
+
 }  // namespace
 
 double poly_eval(const double* c, int degree, double t) {
@@ -86,34 +98,19 @@ double poly_eval(const double* c, int degree, double t) {
 }
 
 QuadraticRoots quadratic_roots(double a, double b, double c) {
-  QuadraticRoots r;
-  if (a == 0.0) {
-    if (b == 0.0) return r;
-    r.count = 1;
-    r.t0 = r.t1 = -c / b;
-    return r;
+  if (a != 0.0) {
+    // Round-off in b² − 4ac is a few ulps of the larger term; within that the
+    // discriminant is zero and the root double.
+    const double b2 = b * b;
+    const double ac4 = 4.0 * a * c;
+    if (std::abs(b2 - ac4) <= 4.0 * kEps * std::max(b2, std::abs(ac4))) {
+      QuadraticRoots r;
+      r.count = 1;
+      r.t0 = r.t1 = -b / (2.0 * a);
+      return r;
+    }
   }
-  const double b2 = b * b;
-  const double ac4 = 4.0 * a * c;
-  double disc = b2 - ac4;
-  // Round-off in b² − 4ac is a few ulps of the larger term; within that the
-  // discriminant is zero and the root double.
-  if (std::abs(disc) <= 4.0 * kEps * std::max(b2, std::abs(ac4))) disc = 0.0;
-  if (disc < 0.0) return r;
-  if (disc == 0.0) {
-    r.count = 1;
-    r.t0 = r.t1 = -b / (2.0 * a);
-    return r;
-  }
-  // q has the sign of b, so b + sign(b)·sqrt(disc) never cancels.
-  const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
-  double x0 = q / a;
-  double x1 = q != 0.0 ? c / q : -x0;
-  if (x0 > x1) std::swap(x0, x1);
-  r.count = 2;
-  r.t0 = x0;
-  r.t1 = x1;
-  return r;
+  return solve_quadratic(a, b, c);
 }
 
 int real_roots(const double* c, int degree, double lo, double hi, double t_tol, double* roots) {
@@ -138,13 +135,8 @@ int real_roots(const double* c, int degree, double lo, double hi, double t_tol, 
   // Between consecutive turning points the polynomial is monotone: at most
   // one root each, found by its sign change; a turning point where the value
   // is zero within round-off is a double root.
-  double d[kMaxPolyDegree] = {};
-  derivative(c, degree, d);
-  double knots[kMaxPolyDegree + 1];
-  const int turns = real_roots(d, degree - 1, lo, hi, t_tol, knots + 1);
-  knots[0] = lo;
-  int k = turns + 1;
-  if (knots[k - 1] < hi) knots[k++] = hi;
+  double knots[kMaxPolyDegree + 2];
+  const int k = monotone_knots(c, degree, lo, hi, t_tol, knots);
   double a = knots[0];
   double fa = poly_eval(c, degree, a);
   if (fa == 0.0) add(a);
@@ -192,13 +184,8 @@ bool first_crossing_down(const double* c, int degree, double lo, double hi, doub
     }
     return false;
   }
-  double d[kMaxPolyDegree] = {};
-  derivative(c, degree, d);
-  double knots[kMaxPolyDegree + 1];
-  const int turns = real_roots(d, degree - 1, lo, hi, t_tol, knots + 1);
-  knots[0] = lo;
-  int k = turns + 1;
-  if (knots[k - 1] < hi) knots[k++] = hi;
+  double knots[kMaxPolyDegree + 2];
+  const int k = monotone_knots(c, degree, lo, hi, t_tol, knots);
   double a = lo;
   double fa = poly_eval(c, degree, a);
   for (int i = 1; i < k; ++i) {

@@ -39,15 +39,11 @@ ThesisStepper::ThesisStepper(const Board& board, ThesisStepperOptions options) :
              options_.separation_m;
   const double cell_m = std::max(reach_m_, 1e-3);
   obstacle_grid_ = UniformGrid(board.shapes, reach_m_, cell_m);
-  sensor_shapes_.reserve(board.sensors.size());
-  for (const Sensor& s : board.sensors) sensor_shapes_.push_back(s.shape);
+  sensor_shapes_ = rules::sensor_shapes(board);
   sensor_grid_ = UniformGrid(sensor_shapes_, reach_m_, cell_m);
-  all_obstacles_.resize(board.shapes.size());
-  std::iota(all_obstacles_.begin(), all_obstacles_.end(), 0);
-  all_sensors_.resize(board.sensors.size());
-  std::iota(all_sensors_.begin(), all_sensors_.end(), 0);
-  has_contact_score_ = std::any_of(board.obstacles.begin(), board.obstacles.end(),
-                                   [](const Obstacle& o) { return o.action.contact_score_per_s > 0.0; });
+  all_obstacles_ = rules::all_indices(board.shapes.size());
+  all_sensors_ = rules::all_indices(board.sensors.size());
+  has_contact_score_ = rules::has_contact_score(board);
 }
 
 std::span<const std::int32_t> ThesisStepper::obstacle_candidates(const Vec2& p) const {
@@ -70,9 +66,7 @@ void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const 
   for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
     const Flipper& f = board_.flippers[i];
     FlipperState& fs = state.flippers[i];
-    if (fs.energized && !fs.was_energized) ++state.flips;
-    fs.was_energized = fs.energized;
-    const double omega = fs.energized ? f.omega_rad_s : -f.omega_rad_s;
+    const double omega = rules::take_command(f, fs, state.flips);
     const double theta_old = fs.theta_rad;
     const double theta_new = std::clamp(theta_old + dt * omega, f.theta_min_rad, f.theta_max_rad);
     if (theta_new == theta_old) {  // resting on a stop
@@ -222,17 +216,14 @@ void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvent
     const Vec2& to = state.ball.position_m;
     // Swept over the whole move so that a fast ball cannot skip a sensor.
     bool touched = false;
-    bool inside = false;
+    const bool inside = rules::on_sensor(sensor, to, r);
     const Shape& shape = sensor.shape;
     if (sensor.kind == SensorKind::kHole) {
       touched = distance_point_segment(shape.p0, from, to) <= shape.radius_m;
-      inside = (to - shape.p0).norm() <= shape.radius_m;
     } else if (shape.kind == ShapeKind::kLine) {
       touched = distance_segment_segment(from, to, shape.p0, shape.p1) <= r;
-      inside = distance_point_segment(to, shape.p0, shape.p1) <= r;
     } else {
       touched = distance_point_segment(shape.p0, from, to) <= r + shape.radius_m;
-      inside = (to - shape.p0).norm() <= r + shape.radius_m;
     }
     const bool entered = touched && !state.sensor_inside[i];
     state.sensor_inside[i] = inside ? 1 : 0;
@@ -244,23 +235,8 @@ void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvent
 
 void ThesisStepper::update_contacts(GameState& state, std::span<const std::int32_t> candidates,
                                     StepEvents& events) const {
-  const double r = board_.ball.radius_m;
-  const double touch = r + options_.contact_tolerance_m;
-  const Vec2& p = state.ball.position_m;
-  for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
-    const Flipper& f = board_.flippers[i];
-    state.flippers[i].ball_contact =
-        distance_point_segment(p, f.pivot, flipper_tip(f, state.flippers[i].theta_rad)) <= touch;
-  }
-  if (!has_contact_score_) return;
-  for (const std::int32_t i : candidates) {
-    const double rate = board_.obstacles[i].action.contact_score_per_s;
-    if (rate <= 0.0 || state.visible[i] != kVisible) continue;
-    if (distance_to_shape(board_.shapes[i], p) <= touch) {
-      state.score += rate * options_.dt_s;
-      events.score_gained += rate * options_.dt_s;
-    }
-  }
+  rules::update_contacts(board_, state, candidates, board_.ball.radius_m + options_.contact_tolerance_m,
+                         options_.dt_s, has_contact_score_, events);
 }
 
 void ThesisStepper::raise_flags(GameState& state) const {

@@ -271,6 +271,56 @@ TEST(EventStepper, EnergyNeverGrowsWithoutKickersOrFlippers) {
   }
 }
 
+TEST(EventStepper, WedgesHoldTheBallStillWithoutChatter) {
+  // V's of 1°, 45° and 179° opening, symmetric about the vertical, lines
+  // 2 m long meeting at a point; the ball dropped into them off-centre.
+  for (const double opening_deg : {1.0, 45.0, 179.0}) {
+    const double half = 0.5 * opening_deg * std::numbers::pi / 180.0;
+    Board b = empty_board(4.0, 3.0, 1.11, 5e-4);
+    const Vec2 vertex{2.0, 0.2};
+    const Vec2 left = vertex + 2.0 * Vec2{-std::sin(half), std::cos(half)};
+    const Vec2 right = vertex + 2.0 * Vec2{std::sin(half), std::cos(half)};
+    add_line(b, left, vertex, 0.6);
+    add_line(b, vertex, right, 0.6);
+    add_point(b, vertex, 0.6);
+    const EventStepper stepper(b);
+    // Start inside the V, off its axis, clear of both lines.
+    const double dx = opening_deg < 10.0 ? 1e-3 : 0.1;
+    const double h0 = std::min(1.9 * std::cos(half), dx / std::tan(half) + 2.0 * kR / std::sin(half));
+    GameState s = state_with_ball(b, vertex + Vec2{dx, h0}, Vec2::Zero());
+    ASSERT_GT(distance_to_shape(b.shapes[0], s.ball.position_m), kR);
+    ASSERT_GT(distance_to_shape(b.shapes[1], s.ball.position_m), kR);
+    double e = energy(b, s);
+    std::uint64_t events_at_19s = 0;
+    for (int i = 0; i < 40000; ++i) {  // 20 s
+      stepper.step(s);
+      ASSERT_TRUE(finite(s.ball.position_m) && finite(s.ball.velocity_mps));
+      ASSERT_LT(max_penetration_m(b, s), 1e-9) << opening_deg << " deg, step " << i;
+      const double now = energy(b, s);
+      ASSERT_LE(now, e + 1e-12) << opening_deg << " deg, step " << i;
+      e = now;
+      if (i == 38000) events_at_19s = s.events;
+    }
+    EXPECT_TRUE(s.ball_in_play) << opening_deg << " deg";
+    EXPECT_LT(s.events, 2000u) << opening_deg << " deg";
+    if (opening_deg > 170.0) {
+      // Nearly flat and frictionless: the ball slides to and fro across the
+      // vertex, losing only the normal speed of the 1° turn there; it stays
+      // on the lines and inside its first swing.
+      const double d0 = distance_to_shape(b.shapes[0], s.ball.position_m);
+      const double d1 = distance_to_shape(b.shapes[1], s.ball.position_m);
+      EXPECT_NEAR(std::min(d0, d1), kR, 1e-9);
+      EXPECT_LE(std::abs(s.ball.position_m.x() - vertex.x()), dx + 1e-9);
+      continue;
+    }
+    EXPECT_LT(s.ball.velocity_mps.norm(), 1e-9) << opening_deg << " deg: at rest";
+    EXPECT_EQ(s.events, events_at_19s) << opening_deg << " deg: no events while resting";
+    // Held by both lines, on the axis.
+    EXPECT_NEAR(distance_to_shape(b.shapes[0], s.ball.position_m), kR, 1e-9) << opening_deg << " deg";
+    EXPECT_NEAR(distance_to_shape(b.shapes[1], s.ball.position_m), kR, 1e-9) << opening_deg << " deg";
+  }
+}
+
 TEST(EventStepper, AgreesWithTheThesisStepperAtTinyDt) {
   const Board b = load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
   ThesisStepperOptions to;
