@@ -1,6 +1,8 @@
 // `pinball bench KIND`: the measurements behind docs/results.md.
 
+#include <fstream>
 #include <ostream>
+#include <stdexcept>
 
 #include "commands.h"
 #include "pinball/sim/board_loader.h"
@@ -8,16 +10,18 @@
 #include "detector_bench.h"
 #include "daemon_latency_bench.h"
 #include "latency_bench.h"
+#include "precision_bench.h"
 #include "speed_bench.h"
 #include "tracker_bench.h"
 
 namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
-  CLI::App* cmd = app.add_subcommand("bench", "run a benchmark (speed, tracker, latency, detector, calibration)");
-  cmd->add_option("kind", a.which, "which benchmark: speed, tracker, latency, detector, calibration")
+  CLI::App* cmd =
+      app.add_subcommand("bench", "run a benchmark (speed, tracker, latency, detector, calibration, precision)");
+  cmd->add_option("kind", a.which, "which benchmark: speed, tracker, latency, detector, calibration, precision")
       ->required()
-      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration"}));
+      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration", "precision"}));
   cmd->add_option("--board", a.board, "board file")->check(CLI::ExistingFile);
   cmd->add_option("--steps", a.steps, "steps per timed run")->check(CLI::Range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
@@ -25,7 +29,10 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
       ->check(CLI::Range(10, 1'000'000));
   cmd->add_option("--seed", a.seed, "tracker, detector, calibration: seed for play, camera noise and placements");
   cmd->add_flag("--quick", a.quick,
-                "tracker, detector, calibration, latency: a short run (fewer approaches, frames, roll sets or balls)");
+                "tracker, detector, calibration, latency, precision: a short run (fewer approaches, frames, roll "
+                "sets, balls or settings)");
+  cmd->add_option("--csv", a.csv, "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here");
+  cmd->add_option("--png", a.png, "precision: write the log-log plot of error against run time here");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -114,6 +121,25 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
+int run_precision(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+  const bench::PrecisionBenchOptions options =
+      a.quick ? bench::quick_precision_bench_options() : bench::default_precision_bench_options();
+  const bench::PrecisionReport report = bench::run_precision_bench(
+      board, options, [&](const std::string& line) { err << "bench precision: " << line << "\n"; });
+  if (!a.csv.empty()) {
+    std::ofstream f(a.csv);
+    f << bench::to_csv(report);
+    if (!f) throw std::runtime_error(a.csv + ": cannot write CSV");
+  }
+  if (!a.png.empty()) bench::plot_precision_png(report, a.png);
+  if (a.json) {
+    out << bench::to_json(report).dump(2) << "\n";
+  } else {
+    out << bench::to_markdown(report);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
@@ -122,6 +148,7 @@ int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   if (a.which == "tracker") return run_tracker(a, board, out, err);
   if (a.which == "detector") return run_detector(a, board, out, err);
   if (a.which == "calibration") return run_calibration(a, board, out, err);
+  if (a.which == "precision") return run_precision(a, board, out, err);
   bench::SpeedBenchOptions options;
   options.steps = a.steps;
   options.repeats = a.repeats;

@@ -62,13 +62,15 @@ int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 
 /// `pinball bench`
 struct BenchArgs {
-  std::string which;                                 ///< speed | tracker
+  std::string which;                                 ///< speed | tracker | latency | detector | precision
   std::string board = "boards/mit1993.board";        ///< board to measure on
   std::uint64_t steps = 2'000'000;                   ///< steps per timed run
   int repeats = 3;                                   ///< timed runs per configuration
   int approaches = 2000;                             ///< tracker: free-flight approaches
   std::uint64_t seed = 1;                            ///< tracker: approach and noise seed
-  bool quick = false;                                ///< tracker: 100 approaches, target camera only
+  bool quick = false;                                ///< tracker, detector, precision: a short run
+  std::string csv;                                   ///< precision: CSV file to write, or empty
+  std::string png;                                   ///< precision: log-log plot to write, or empty
   bool json = false;                                 ///< one JSON object on stdout
 };
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& args);

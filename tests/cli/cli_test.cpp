@@ -206,6 +206,20 @@ TEST_F(Cli, BenchSpeedJson) {
   EXPECT_GT(j.at("grid_speedup").get<double>(), 0.0);
 }
 
+TEST_F(Cli, BenchPrecisionQuickWritesJsonCsvAndPng) {
+  const fs::path csv = dir_ / "precision.csv";
+  const fs::path png = dir_ / "precision.png";
+  const CommandResult r =
+      run("bench precision --quick --json --csv " + csv.string() + " --png " + png.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("benchmark"), "precision");
+  EXPECT_FALSE(j.at("points").empty());
+  EXPECT_TRUE(j.at("targets").at("error_target_met").get<bool>()) << j.at("targets").dump();
+  EXPECT_TRUE(fs::exists(csv));
+  EXPECT_GT(fs::file_size(png), 10'000u);
+}
+
 TEST_F(Cli, TrackPrintsOneProjectionPerObservation) {
   // A ball falling straight onto the left flipper of the thesis table, seen at 200 fps.
   const fs::path obs = dir_ / "obs.csv";

@@ -14,6 +14,7 @@
 #include "pinball/sim/board_loader.h"
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "invariants.h"
 #include "test_boards.h"
 
 namespace pinball::sim {
@@ -22,29 +23,7 @@ namespace {
 using namespace pinball::sim::testing;
 
 constexpr double kR = 0.0135;
-constexpr double kMaxDepth = 1e-6;
-
-// Checks the per-step invariants; returns false (after recording a failure) on the first violation.
-bool invariants_hold(const Board& b, const GameState& s, long step) {
-  if (!finite(s.ball.position_m) || !finite(s.ball.velocity_mps)) {
-    ADD_FAILURE() << "non-finite ball state at step " << step;
-    return false;
-  }
-  for (const FlipperState& f : s.flippers) {
-    if (!std::isfinite(f.theta_rad)) {
-      ADD_FAILURE() << "non-finite flipper angle at step " << step;
-      return false;
-    }
-  }
-  const double depth = max_penetration_m(b, s);
-  if (!(depth < kMaxDepth)) {
-    ADD_FAILURE() << "penetration " << depth << " m at step " << step << " ball (" << s.ball.position_m.x() << ", "
-                  << s.ball.position_m.y() << ") v (" << s.ball.velocity_mps.x() << ", " << s.ball.velocity_mps.y()
-                  << ")";
-    return false;
-  }
-  return true;
-}
+constexpr double kMaxDepth = kDefaultMaxDepth_m;
 
 TEST(StiffCases, FastBallAgainstThinWall) {
   // A vertical two-sided wall at x = 0.5; the ball at 50 m/s (10x a real
@@ -162,17 +141,10 @@ TEST(StiffCases, FlipperJammedInClosedPocketStaysStalled) {
   // can never reach its up stop; it must stall every time it tries.
   Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
   const int fl = add_flipper(b, Side::kLeft, {0.3, 0.3}, 0.076, -0.4, 0.6, 33.0, 0.5, 1.0);
+  const FlipperPocket pocket = add_flipper_pocket(b, fl);
   const Flipper& f = b.flippers[fl];
-  const Vec2 up_max = flipper_up_normal(f, f.theta_max_rad);
-  const Vec2 dir_max = flipper_direction(f, f.theta_max_rad);
-  const Vec2 roof0 = f.pivot + 0.020 * up_max - 0.01 * dir_max;
-  const Vec2 roof1 = f.pivot + 0.020 * up_max + 0.15 * dir_max;
-  add_wall(b, roof0, roof1, 0.5);
-  const double left_x = f.pivot.x() - 0.001;
-  const double right_x = f.pivot.x() + f.length_m + 0.002;
-  add_wall(b, {left_x, 0.22}, {left_x, roof0.y()}, 0.5);
-  const double roof_at_right = roof0.y() + (right_x - roof0.x()) * dir_max.y() / dir_max.x();
-  add_wall(b, {right_x, 0.22}, {right_x, roof_at_right}, 0.5);
+  const double left_x = pocket.left_x, right_x = pocket.right_x;
+  const Vec2 roof0 = pocket.roof0, roof1 = pocket.roof1;
   const Vec2 p = f.pivot + 0.05 * flipper_direction(f, f.theta_min_rad) +
                  (kR + 1e-6) * flipper_up_normal(f, f.theta_min_rad);
   const ThesisStepper stepper(b);

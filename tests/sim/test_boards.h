@@ -131,6 +131,34 @@ inline Board box_with_bumpers_and_flippers(double dt_s = 5e-4) {
   return b;
 }
 
+/// A pocket closed round a left flipper: a roof parallel to the raised flipper
+/// 20 mm above its face (less than the ball's 27 mm diameter) and walls at the
+/// pivot and just beyond the tip, all with rho 0.5. With the ball inside, the
+/// flipper can never reach its up stop.
+struct FlipperPocket {
+  Vec2 roof0 = Vec2::Zero();  ///< roof start (above the pivot)
+  Vec2 roof1 = Vec2::Zero();  ///< roof end (beyond the tip)
+  double left_x = 0.0;        ///< inner wall at the pivot
+  double right_x = 0.0;       ///< inner wall beyond the tip
+};
+
+/// Adds the walls of a FlipperPocket round left flipper `fl`.
+inline FlipperPocket add_flipper_pocket(Board& b, int fl) {
+  const Flipper f = b.flippers[fl];
+  const Vec2 up_max = flipper_up_normal(f, f.theta_max_rad);
+  const Vec2 dir_max = flipper_direction(f, f.theta_max_rad);
+  FlipperPocket p;
+  p.roof0 = f.pivot + 0.020 * up_max - 0.01 * dir_max;
+  p.roof1 = f.pivot + 0.020 * up_max + 0.15 * dir_max;
+  add_wall(b, p.roof0, p.roof1, 0.5);
+  p.left_x = f.pivot.x() - 0.001;
+  p.right_x = f.pivot.x() + f.length_m + 0.002;
+  add_wall(b, {p.left_x, f.pivot.y() - 0.08}, {p.left_x, p.roof0.y()}, 0.5);
+  const double roof_at_right = p.roof0.y() + (p.right_x - p.roof0.x()) * dir_max.y() / dir_max.x();
+  add_wall(b, {p.right_x, f.pivot.y() - 0.08}, {p.right_x, roof_at_right}, 0.5);
+  return p;
+}
+
 /// A fresh state with the ball in play at p with velocity v.
 inline GameState state_with_ball(const Board& board, const Vec2& p, const Vec2& v, std::uint64_t seed = 1) {
   GameState s = make_game_state(board, seed);
