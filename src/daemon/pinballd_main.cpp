@@ -2,6 +2,7 @@
 // embedded simulation of boards/mit1993.board over memq:// with the shipped
 // controller and prints the mean score per ball and the latency table.
 
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -13,13 +14,17 @@
 
 namespace {
 
-pinball::daemon::Daemon* g_daemon = nullptr;
+// Signals may arrive before the daemon exists (while it loads and trains its
+// background): they are remembered and delivered once it does.
+std::atomic<pinball::daemon::Daemon*> g_daemon{nullptr};
+volatile std::sig_atomic_t g_stop_pending = 0;
 
 extern "C" void on_stop_signal(int) {
-  if (g_daemon != nullptr) g_daemon->request_stop();
+  g_stop_pending = 1;
+  if (pinball::daemon::Daemon* d = g_daemon.load()) d->request_stop();
 }
 extern "C" void on_stats_signal(int) {
-  if (g_daemon != nullptr) g_daemon->request_stats();
+  if (pinball::daemon::Daemon* d = g_daemon.load()) d->request_stats();
 }
 
 void install(int sig, void (*handler)(int)) {
@@ -62,6 +67,9 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
+  install(SIGINT, on_stop_signal);
+  install(SIGTERM, on_stop_signal);
+  install(SIGUSR1, on_stats_signal);
   try {
     DaemonConfig config;
     if (!config_path.empty()) config = load_daemon_config(config_path);
@@ -79,9 +87,7 @@ int main(int argc, char** argv) {
     if (!can_log.empty()) config.can.log = can_log;
     Daemon daemon(config);
     g_daemon = &daemon;
-    install(SIGINT, on_stop_signal);
-    install(SIGTERM, on_stop_signal);
-    install(SIGUSR1, on_stats_signal);
+    if (g_stop_pending) daemon.request_stop();
     std::fprintf(stderr, "pinballd: %s, %s, LCM %s, controller %s\n",
                  config.mode == "sim" ? ("simulating " + config.sim.board + ", " + std::to_string(config.sim.balls) +
                                          " balls")
