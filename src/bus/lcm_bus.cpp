@@ -11,6 +11,18 @@
 
 namespace pinball::bus {
 
+namespace {
+
+extern "C" void raw_callback(const lcm_recv_buf_t* rbuf, const char*, void* user_data) {
+  (*static_cast<RawHandler*>(user_data))(rbuf->data, static_cast<int>(rbuf->data_size));
+}
+
+}  // namespace
+
+void subscribe_raw(lcm::LCM& lcm, const char* channel, RawHandler& handler) {
+  lcm_subscribe(lcm.getUnderlyingLCM(), channel, &raw_callback, &handler);
+}
+
 LcmBus::LcmBus(const std::string& url)
     : lcm_(std::make_unique<lcm::LCM>(url)),
       url_(url),
@@ -53,15 +65,16 @@ bool LcmBus::try_publish(const pinball_lcm::lcmt_pinball_game_event& m) { return
 
 void LcmBus::subscribe_observations(ObservationRing& ring) {
   inbox_ = &ring;
-  lcm_->subscribe(kObservationChannel, &LcmBus::on_observation, this);
+  observation_handler_ = [this](const void* data, int size) { on_observation(data, size); };
+  subscribe_raw(*lcm_, kObservationChannel, observation_handler_);
 }
 
-void LcmBus::on_observation(const lcm::ReceiveBuffer* rbuf, const std::string&) {
+void LcmBus::on_observation(const void* data, int size) {
   pinball_lcm::lcmt_pinball_observation m{};
   bool found = false;
   track::Observation o;
   track::ContactSensors c;
-  if (m.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0 || !from_lcm_observation(m, found, o, c)) {
+  if (m.decode(data, 0, size) < 0 || !from_lcm_observation(m, found, o, c)) {
     malformed_.fetch_add(1, std::memory_order_relaxed);
     return;
   }

@@ -26,16 +26,17 @@ bool eventually(Pred pred, double timeout_s = 5.0) {
 struct Counter {
   std::atomic<int> n{0};
   std::atomic<std::int64_t> last_seq{-1};
-  void on_projection(const lcm::ReceiveBuffer*, const std::string&, const pinball_lcm::lcmt_pinball_projection* m) {
-    last_seq = m->seq;
-    ++n;
-  }
+  RawHandler handler = typed_handler<pinball_lcm::lcmt_pinball_projection>(
+      [this](const pinball_lcm::lcmt_pinball_projection& m) {
+        last_seq = m.seq;
+        ++n;
+      });
 };
 
 TEST(LcmBus, PublishesQueuedMessagesInOrder) {
-  LcmBus bus("memq://");
   Counter c;
-  bus.lcm().subscribe(kProjectionChannel, &Counter::on_projection, &c);
+  LcmBus bus("memq://");
+  subscribe_raw(bus.lcm(), kProjectionChannel, c.handler);
   bus.start();
   for (int i = 0; i < 100; ++i) {
     pinball_lcm::lcmt_pinball_projection m{};

@@ -99,24 +99,28 @@ TEST(Daemon, FullPathScoresLikeTheFastLearningLoop) {
 struct StatsCounter {
   std::atomic<int> n{0};
   std::atomic<std::int64_t> frames{0};
-  void on_stats(const lcm::ReceiveBuffer*, const std::string&, const pinball_lcm::lcmt_pinball_daemon_stats* m) {
-    frames = m->frames;
-    EXPECT_EQ(m->num_stages, static_cast<int>(kStageCount));
-    ++n;
-  }
+  std::atomic<int> stages{0};
   std::atomic<int> games{0};
-  void on_game(const lcm::ReceiveBuffer*, const std::string&, const pinball_lcm::lcmt_pinball_game_event*) {
-    ++games;
-  }
+  bus::RawHandler on_stats = bus::typed_handler<pinball_lcm::lcmt_pinball_daemon_stats>(
+      [this](const pinball_lcm::lcmt_pinball_daemon_stats& m) {
+        frames = m.frames;
+        stages = m.num_stages;
+        ++n;
+      });
+  bus::RawHandler on_game =
+      bus::typed_handler<pinball_lcm::lcmt_pinball_game_event>([this](const pinball_lcm::lcmt_pinball_game_event&) {
+        ++games;
+      });
 };
 
 TEST(Daemon, PublishesStatsAndGameEventsOnLcm) {
-  Daemon d(sim_config(1, 3));
   StatsCounter c;
-  d.lcm_bus().lcm().subscribe(bus::kStatsChannel, &StatsCounter::on_stats, &c);
-  d.lcm_bus().lcm().subscribe(bus::kGameChannel, &StatsCounter::on_game, &c);
+  Daemon d(sim_config(1, 3));
+  bus::subscribe_raw(d.lcm_bus().lcm(), bus::kStatsChannel, c.on_stats);
+  bus::subscribe_raw(d.lcm_bus().lcm(), bus::kGameChannel, c.on_game);
   const DaemonReport r = d.run();
   EXPECT_GE(c.n.load(), 1);  // at least the one on exit
+  EXPECT_EQ(c.stages.load(), static_cast<int>(kStageCount));
   EXPECT_EQ(c.frames.load(), static_cast<std::int64_t>(r.frames));
   EXPECT_GE(c.games.load(), 2);  // launch and loss
   EXPECT_EQ(r.lcm.overflows, 0u);
