@@ -4,6 +4,8 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
+#include <initializer_list>
+#include <utility>
 #include <sstream>
 #include <stdexcept>
 
@@ -47,6 +49,11 @@ class Reader {
       fail(join(path, key), "expected a finite number");
     }
     return v;
+  }
+  // Several finite numbers of one mapping, each into its field, in order (the first missing or bad one is named).
+  void numbers_into(const YAML::Node& parent, const std::string& path,
+                    std::initializer_list<std::pair<const char*, double*>> fields) const {
+    for (const auto& [key, field] : fields) *field = number(parent, path, key);
   }
   int integer(const YAML::Node& parent, const std::string& path, const char* key) const {
     const YAML::Node n = need(parent, path, key);
@@ -116,10 +123,8 @@ FlipperCalibration read_flipper(const Reader& r, const YAML::Node& n, const std:
   f.method = method == "markers" ? FlipperMethod::kMarkers : FlipperMethod::kMarkerless;
   f.pivot_m = r.vec2(n, p, "pivot_m");
   f.tip_m = r.vec2(n, p, "tip_m");
-  f.length_m = r.number(n, p, "length_m");
-  f.theta_min_rad = r.number(n, p, "theta_min_rad");
-  f.theta_max_rad = r.number(n, p, "theta_max_rad");
-  f.fit_rms_m = r.number(n, p, "fit_rms_m");
+  r.numbers_into(n, p, {{"length_m", &f.length_m}, {"theta_min_rad", &f.theta_min_rad},
+                        {"theta_max_rad", &f.theta_max_rad}, {"fit_rms_m", &f.fit_rms_m}});
   f.points = r.integer(n, p, "points");
   if (!(f.length_m > 0.0)) r.fail(p + ".length_m", "must be > 0");
   if (!(f.theta_max_rad > f.theta_min_rad)) r.fail(p + ".theta_max_rad", "must be above theta_min_rad");
@@ -127,11 +132,8 @@ FlipperCalibration read_flipper(const Reader& r, const YAML::Node& n, const std:
     const std::string q = p + ".disagreement";
     const YAML::Node d = n["disagreement"];
     FlipperDisagreement g;
-    g.pivot_m = r.number(d, q, "pivot_m");
-    g.tip_m = r.number(d, q, "tip_m");
-    g.length_m = r.number(d, q, "length_m");
-    g.theta_min_rad = r.number(d, q, "theta_min_rad");
-    g.theta_max_rad = r.number(d, q, "theta_max_rad");
+    r.numbers_into(d, q, {{"pivot_m", &g.pivot_m}, {"tip_m", &g.tip_m}, {"length_m", &g.length_m},
+                          {"theta_min_rad", &g.theta_min_rad}, {"theta_max_rad", &g.theta_max_rad}});
     f.disagreement = g;
   }
   return f;
@@ -140,10 +142,8 @@ FlipperCalibration read_flipper(const Reader& r, const YAML::Node& n, const std:
 GravityEstimate read_gravity(const Reader& r, const YAML::Node& n) {
   const std::string p = "gravity";
   GravityEstimate g;
-  g.g_mps2 = r.number(n, p, "g_mps2");
-  g.ci_low_mps2 = r.number(n, p, "ci_low_mps2");
-  g.ci_high_mps2 = r.number(n, p, "ci_high_mps2");
-  g.confidence = r.number(n, p, "confidence");
+  r.numbers_into(n, p, {{"g_mps2", &g.g_mps2}, {"ci_low_mps2", &g.ci_low_mps2}, {"ci_high_mps2", &g.ci_high_mps2},
+                        {"confidence", &g.confidence}});
   g.rolls_used = r.integer(n, p, "rolls_used");
   g.rolls_rejected = r.integer(n, p, "rolls_rejected");
   g.per_roll_mps2 = r.numbers(r.need(n, p, "per_roll_mps2"), p + ".per_roll_mps2", 0);

@@ -16,6 +16,52 @@ double median_of(std::vector<double> v) {
   return *mid;
 }
 
+// Keeps the residuals within trim_mad robust sigmas (1.4826·MAD) of their
+// median. Returns how many are kept, or -1 when nothing changed (or all agree).
+int trim(const std::vector<double>& r, double trim_mad, std::vector<char>& keep) {
+  const double med = median_of(r);
+  std::vector<double> dev;
+  for (const double x : r) dev.push_back(std::abs(x - med));
+  const double sigma = 1.4826 * median_of(dev);
+  if (!(sigma > 0.0)) return -1;
+  bool changed = false;
+  int kept = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const char k = std::abs(r[i] - med) <= trim_mad * sigma ? 1 : 0;
+    changed = changed || k != keep[i];
+    keep[i] = k;
+    kept += k;
+  }
+  return changed ? kept : -1;
+}
+
+// Least-squares meeting point of the lines with keep[i]: sum of (I − d dᵀ)(x − p) = 0.
+Vec2 solve_meet(std::span<const Line2> lines, const std::vector<char>& keep) {
+  Eigen::Matrix2d a = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  int n = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (!keep[i]) continue;
+    const Eigen::Vector2d d = lines[i].direction.normalized();
+    const Eigen::Matrix2d p = Eigen::Matrix2d::Identity() - d * d.transpose();
+    a += p;
+    b += p * lines[i].point;
+    ++n;
+  }
+  // Parallel lines leave one eigenvalue of `a` near 0 (it is n·sin² of their spread, roughly).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(a);
+  if (n < 2 || !(eig.eigenvalues()(0) > 1e-4 * eig.eigenvalues()(1))) {
+    throw std::invalid_argument("line meet: the lines are (nearly) parallel");
+  }
+  return a.ldlt().solve(b);
+}
+
+double distance_to(const Line2& l, const Vec2& x) {
+  const Vec2 d = l.direction.normalized();
+  const Vec2 v = x - l.point;
+  return d.x() * v.y() - d.y() * v.x();  // signed: which side of the line
+}
+
 // Gauss-Newton on r_i = |p_i − c| − R over the points with keep[i].
 void refine(std::span<const Vec2> p, const std::vector<char>& keep, int max_iterations, CircleFit& fit) {
   for (int it = 0; it < max_iterations; ++it) {
@@ -104,21 +150,9 @@ CircleFit fit_circle(std::span<const Vec2> p, const CircleFitOptions& options) {
   for (int round = 0; round < options.trim_rounds; ++round) {
     std::vector<double> r;
     for (std::size_t i = 0; i < p.size(); ++i) r.push_back((p[i] - fit.centre).norm() - fit.radius);
-    const double med = median_of(r);
-    std::vector<double> dev;
-    for (const double x : r) dev.push_back(std::abs(x - med));
-    const double sigma = 1.4826 * median_of(dev);
-    if (!(sigma > 0.0)) break;
-    bool changed = false;
-    int kept = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const char k = std::abs(r[i] - med) <= options.trim_mad * sigma ? 1 : 0;
-      changed = changed || k != keep[i];
-      keep[i] = k;
-      kept += k;
-    }
+    const int kept = trim(r, options.trim_mad, keep);
+    if (kept < 0) break;
     if (kept < 3) throw std::invalid_argument("circle fit: fewer than 3 points left after trimming outliers");
-    if (!changed) break;
     refine(p, keep, options.max_iterations, fit);
   }
   double ss = 0.0;
@@ -131,6 +165,30 @@ CircleFit fit_circle(std::span<const Vec2> p, const CircleFitOptions& options) {
   fit.rejected = static_cast<int>(p.size()) - fit.points;
   fit.rms = std::sqrt(ss / fit.points);
   return fit;
+}
+
+LinesMeet meet_lines(std::span<const Line2> lines, const CircleFitOptions& options) {
+  if (lines.size() < 2) throw std::invalid_argument("line meet: " + std::to_string(lines.size()) + " lines; at least 2 needed");
+  std::vector<char> keep(lines.size(), 1);
+  LinesMeet m;
+  m.point = solve_meet(lines, keep);
+  for (int round = 0; round < options.trim_rounds; ++round) {
+    std::vector<double> r;
+    for (const Line2& l : lines) r.push_back(distance_to(l, m.point));
+    const int kept = trim(r, options.trim_mad, keep);
+    if (kept < 0) break;
+    if (kept < 2) throw std::invalid_argument("line meet: fewer than 2 lines left after trimming outliers");
+    m.point = solve_meet(lines, keep);
+  }
+  double ss = 0.0;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (!keep[i]) continue;
+    ss += std::pow(distance_to(lines[i], m.point), 2);
+    ++m.lines;
+  }
+  m.rejected = static_cast<int>(lines.size()) - m.lines;
+  m.rms = std::sqrt(ss / m.lines);
+  return m;
 }
 
 }  // namespace pinball::calibration

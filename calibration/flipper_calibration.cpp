@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <vector>
 #include <stdexcept>
 
 #include <Eigen/Dense>
@@ -152,33 +153,114 @@ bool TipTracker::measure(const cv::Mat& gray, double t_s) {
     }
   }
   const double a = best_area;
-  const cv::Point2d c(su / a, sv / a);
+  cv::Point2d c(su / a, sv / a);
   const double mu20 = suu / a - c.x * c.x, mu02 = svv / a - c.y * c.y, mu11 = suv / a - c.x * c.y;
   const double angle = 0.5 * std::atan2(2.0 * mu11, mu20 - mu02);
-  const cv::Point2d d(std::cos(angle), std::sin(angle));
-  const cv::Point2d nrm(-d.y, d.x);
-  const double level = sample(diff_, c);
+  cv::Point2d d(std::cos(angle), std::sin(angle));
+  // The blob's principal axis is only a start: the centre line comes from the long edges.
   const double reach = std::hypot(box.width, box.height) + 4.0;
-  const double e_plus = edge_along(c, d, level, reach);
-  const double e_minus = edge_along(c, -d, level, reach);
-  // Blade width: the half-contrast edges across the axis, a little either side of the centre.
-  std::vector<double> widths;
-  for (const double s : {-2.0, 0.0, 2.0}) {
-    const cv::Point2d at = c + s * d;
-    const double l = sample(diff_, at);
-    const double w1 = edge_along(at, nrm, l, 30.0);
-    const double w2 = edge_along(at, -nrm, l, 30.0);
-    if (w1 > 0.0 && w2 > 0.0) widths.push_back(w1 + w2);
+  double e_plus = edge_along(c, d, sample(diff_, c), reach);
+  double e_minus = edge_along(c, -d, sample(diff_, c), reach);
+  if (e_plus < 0.0 || e_minus < 0.0) return false;
+  double width_px = 0.0;
+  for (int pass = 0; pass < 2; ++pass) {
+    c += 0.5 * (e_plus - e_minus) * d;  // the middle of the blade along its axis
+    if (!fit_centre_line(c, d, 0.5 * (e_plus + e_minus), width_px)) return false;
+    e_plus = edge_along(c, d, sample(diff_, c), reach);
+    e_minus = edge_along(c, -d, sample(diff_, c), reach);
+    if (e_plus < 0.0 || e_minus < 0.0) return false;
   }
-  if (e_plus < 0.0 || e_minus < 0.0 || widths.empty()) return false;
+  // Either end may be the tip. The pivot's end is no clean circle: where the
+  // blade lies in every frame it is part of the background.
+  double s_plus = e_plus, s_minus = e_minus;
+  const bool plus_ok = fit_end(c, d, width_px, reach, s_plus);
+  const bool minus_ok = fit_end(c, -d, width_px, reach, s_minus);
+  if (!plus_ok && !minus_ok) return false;
   Sighting s;
   s.t_s = t_s;
   s.centre_px = c;
   s.axis = d;
   s.end_plus_px = c + e_plus * d;
   s.end_minus_px = c - e_minus * d;
-  s.width_px = median_of(widths);
+  s.tip_plus_px = c + s_plus * d;
+  s.tip_minus_px = c - s_minus * d;
+  s.tip_plus_ok = plus_ok;
+  s.tip_minus_ok = minus_ok;
   sightings_.push_back(s);
+  return true;
+}
+
+bool TipTracker::fit_centre_line(cv::Point2d& c, cv::Point2d& d, double half_length_px, double& width_px) const {
+  // Stations 1 px apart along the axis, a blade width clear of the rounded
+  // ends: at each the two half-contrast edges across the axis; their midpoint
+  // is on the centre line. A straight line through the midpoints (offset
+  // across the axis against position along it) corrects c and d.
+  const cv::Point2d n(-d.y, d.x);
+  const double guess = width_px > 0.0 ? width_px : 4.0;
+  const double clear = std::max(1.5, guess);
+  double s0 = 0, s1 = 0, s2 = 0, so = 0, sso = 0;
+  std::vector<double> widths;
+  for (double s = -half_length_px + clear; s <= half_length_px - clear + 1e-9; s += 1.0) {
+    const cv::Point2d at = c + s * d;
+    const double level = sample(diff_, at);
+    const double w1 = edge_along(at, n, level, 3.0 * guess + 6.0);
+    const double w2 = edge_along(at, -n, level, 3.0 * guess + 6.0);
+    if (w1 <= 0.0 || w2 <= 0.0) continue;
+    const double off = 0.5 * (w1 - w2);
+    s0 += 1.0;
+    s1 += s;
+    s2 += s * s;
+    so += off;
+    sso += s * off;
+    widths.push_back(w1 + w2);
+  }
+  if (s0 < 3.0) return false;
+  const double det = s0 * s2 - s1 * s1;
+  if (!(det > 1e-9)) return false;
+  const double slope = (s0 * sso - s1 * so) / det;
+  const double offset = (so - slope * s1) / s0;
+  c += offset * n;
+  d = d + slope * n;
+  d *= 1.0 / cv::norm(d);
+  width_px = median_of(widths);
+  return true;
+}
+
+bool TipTracker::fit_end(const cv::Point2d& c, const cv::Point2d& d, double width_px, double reach_px,
+                         double& s_px) const {
+  // The rounded end is a circle centred on the centre line: half-contrast
+  // edges along rays from a point near its centre, within 60° of the axis
+  // (farther round, the blade's straight sides take over), give points
+  // (a, b) in axis coordinates about that point, and (a − δ)² + b² = r² is
+  // linear in δ and r² − δ². s_px comes in as the end (edge along the axis)
+  // and goes out as the centre of the end's circle.
+  const cv::Point2d n(-d.y, d.x);
+  double s = s_px - 0.5 * width_px;
+  constexpr int kRays = 17;
+  constexpr double kSpan = 60.0 * std::numbers::pi / 180.0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const cv::Point2d q = c + s * d;
+    const double level = sample(diff_, q);
+    Eigen::Matrix2d ata = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d atb = Eigen::Vector2d::Zero();
+    int used = 0;
+    for (int k = 0; k < kRays; ++k) {
+      const double phi = -kSpan + 2.0 * kSpan * k / (kRays - 1);
+      const cv::Point2d u = std::cos(phi) * d + std::sin(phi) * n;
+      const double rho = edge_along(q, u, level, std::min(reach_px, 2.0 * width_px + 4.0));
+      if (rho <= 0.0) continue;
+      const double ax = rho * std::cos(phi), bx = rho * std::sin(phi);
+      const Eigen::Vector2d row(2.0 * ax, 1.0);
+      ata += row * row.transpose();
+      atb += row * (ax * ax + bx * bx);
+      ++used;
+    }
+    if (used < 5) return false;
+    const Eigen::Vector2d x = ata.ldlt().solve(atb);
+    if (!x.allFinite() || std::abs(x(0)) > width_px) return false;
+    s += x(0);
+  }
+  s_px = s;
   return true;
 }
 
@@ -187,40 +269,57 @@ SweepTrack TipTracker::finish() const {
     throw std::runtime_error("flipper sweep: the blade was seen in " + std::to_string(sightings_.size()) + " of " +
                              std::to_string(measured_) + " frames; at least 10 needed");
   }
-  // Where the blade axes meet: least squares over the lines (centre, axis).
-  Eigen::Matrix2d a = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d b = Eigen::Vector2d::Zero();
-  for (const Sighting& s : sightings_) {
-    const Eigen::Vector2d d(s.axis.x, s.axis.y);
-    const Eigen::Matrix2d p = Eigen::Matrix2d::Identity() - d * d.transpose();
-    a += p;
-    b += p * Eigen::Vector2d(s.centre_px.x, s.centre_px.y);
-  }
-  const Eigen::JacobiSVD<Eigen::Matrix2d> svd(a);
-  if (!(svd.singularValues()(1) > 1e-3 * svd.singularValues()(0))) {
-    throw std::runtime_error("flipper sweep: the blade never turned; sweep it from stop to stop");
-  }
-  const Eigen::Vector2d apex = a.ldlt().solve(b);
-  const cv::Point2d apex_px(apex.x(), apex.y());
   SweepTrack track;
   track.frames = measured_;
-  track.rough_pivot_board = to_board(homography_, apex_px);
+  std::vector<Line2> lines;
   for (const Sighting& s : sightings_) {
-    // The tip end is the one away from the pivot; its rounded cap is half a blade wide.
-    const bool plus = cv::norm(s.end_plus_px - apex_px) > cv::norm(s.end_minus_px - apex_px);
-    const cv::Point2d end_px = plus ? s.end_plus_px : s.end_minus_px;
-    const Vec2 end = to_board(homography_, end_px);
-    const Vec2 centre = to_board(homography_, s.centre_px);
-    const Vec2 out = (end - centre).normalized();
-    const double half_width_m = 0.5 * s.width_px / homography_.px_per_m_at(end);
-    track.t_s.push_back(s.t_s);
-    track.tips_board.push_back(end - half_width_m * out);
+    // Two points of the image line, mapped: lines stay lines under a homography.
+    const Vec2 p0 = to_board(homography_, s.centre_px - 8.0 * s.axis);
+    const Vec2 p1 = to_board(homography_, s.centre_px + 8.0 * s.axis);
+    lines.push_back({0.5 * (p0 + p1), (p1 - p0).normalized()});
   }
+  LinesMeet meet;
+  try {
+    meet = meet_lines(lines, options_.circle);
+  } catch (const std::invalid_argument&) {
+    throw std::runtime_error("flipper sweep: the blade never turned; sweep it from stop to stop");
+  }
+  for (std::size_t i = 0; i < sightings_.size(); ++i) {
+    const Sighting& s = sightings_[i];
+    // The tip is the end away from the pivot; a frame whose tip end was no circle is left out.
+    const bool use_plus = (to_board(homography_, s.end_plus_px) - meet.point).norm() >
+                          (to_board(homography_, s.end_minus_px) - meet.point).norm();
+    if (!(use_plus ? s.tip_plus_ok : s.tip_minus_ok)) continue;
+    track.t_s.push_back(s.t_s);
+    track.tips_board.push_back(to_board(homography_, use_plus ? s.tip_plus_px : s.tip_minus_px));
+    Line2 l = lines[i];
+    if (l.direction.dot(track.tips_board.back() - meet.point) < 0.0) l.direction = -l.direction;
+    track.blades_board.push_back(l);
+  }
+  if (track.tips_board.size() < 10) {
+    throw std::runtime_error("flipper sweep: the blade's tip was found in " + std::to_string(track.tips_board.size()) +
+                             " of " + std::to_string(measured_) + " frames; at least 10 needed");
+  }
+  track.meet = meet;
   return track;
 }
 
 FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const sim::Flipper& nominal, const SweepOptions& options) {
-  track.circle = fit_circle(track.tips_board, options.circle);
+  if (track.blades_board.empty()) {
+    track.circle = fit_circle(track.tips_board, options.circle);
+  } else {
+    // The pivot is where the blade's centre lines meet; the length is the tips' median distance from it.
+    track.meet = meet_lines(track.blades_board, options.circle);
+    std::vector<double> r;
+    for (const Vec2& t : track.tips_board) r.push_back((t - track.meet.point).norm());
+    const double length = median_of(r);
+    double ss = 0.0;
+    for (const double x : r) ss += (x - length) * (x - length);
+    track.circle.centre = track.meet.point;
+    track.circle.radius = length;
+    track.circle.rms = std::sqrt(ss / static_cast<double>(r.size()));
+    track.circle.points = static_cast<int>(r.size());
+  }
   FlipperCalibration c;
   c.name = nominal.name;
   c.side = nominal.side;

@@ -1,50 +1,23 @@
 // `pinball calibrate` as the lab runs it: JSON on stdout, the file written and
 // updated section by section, and `pinball track --calibration` reading it.
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
-
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "common/command_test.h"
 #include "pinball/calibration/calibration_file.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int exit_code = -1;
-  std::string out;
-};
+using Result = pinball::testing::CommandResult;
 
-class Calibrate : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("pinball_calibrate_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  Result run(const std::string& args) {
-    const std::string cmd = std::string("cd " PINBALL_SOURCE_DIR " && " PINBALL_EXE " ") + args + " 2>/dev/null";
-    Result r;
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    char buf[4096];
-    std::size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
-    const int status = ::pclose(pipe);
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-  }
-  fs::path dir_;
-};
+class Calibrate : public pinball::testing::CommandTest {};
 
 TEST_F(Calibrate, SimulatedLabEndToEnd) {
   const std::string file = (dir_ / "lab.yaml").string();

@@ -58,7 +58,7 @@ struct FlipperCalibration {
   double length_m = 0.0;                   ///< pivot to tip (m)
   double theta_min_rad = 0.0;              ///< down stop, the board's θ convention (rad)
   double theta_max_rad = 0.0;              ///< up stop (rad)
-  double fit_rms_m = 0.0;                  ///< markerless: RMS distance of the tip points to the fitted circle (m)
+  double fit_rms_m = 0.0;                  ///< markerless: RMS distance of the tip points to the circle about the pivot (m)
   int points = 0;                          ///< markers or tip points behind the figures
   std::optional<FlipperDisagreement> disagreement;  ///< against the other method, when both were run
 };

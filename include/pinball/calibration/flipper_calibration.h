@@ -7,11 +7,14 @@
 // Markerless: a short video of one flipper swept by hand from stop to stop.
 // The background is the per-pixel minimum over the video (the bright flipper
 // is elsewhere in some frame everywhere it moves), the flipper is the largest
-// bright blob above it, its axis the blob's principal axis and its tip the
-// half-contrast edge along that axis less half the blade's width (a rounded
-// tip). The tips, mapped to the board, lie on a circle about the pivot: the
-// circle fit gives pivot and length, and the angles where the tip rests give
-// θ_min and θ_max.
+// bright blob above it. In every frame the blade's centre line is fitted to
+// the midpoints of its two long edges (half-contrast, subpixel) and its tip is
+// the centre of its rounded end: a circle, centred on that line, fitted to the
+// half-contrast outline of the end (so neither the end's radius nor the
+// blade's width needs to be known). The centre lines, mapped to the board,
+// all pass through the pivot: their least-squares meeting point is the pivot,
+// whatever the tip model. The length is the median distance of the tips from
+// it, and the angles where the tip rests give θ_min and θ_max.
 
 #include <functional>
 #include <memory>
@@ -45,19 +48,20 @@ struct SweepOptions {
   int threshold = 40;              ///< frame − background above this (gray levels) is the flipper
   int min_area_px = 20;            ///< smallest flipper blob (px)
   double stop_band_rad = 0.026;    ///< tips within this of the extreme angles (5th/95th percentile) rest on a stop
-  CircleFitOptions circle;         ///< the tip circle fit
+  CircleFitOptions circle;         ///< the pivot fit (lines meeting) and the tip circle fit's trimming
 };
 
-/// The tips seen in a sweep video.
+/// The blade seen in a sweep video.
 struct SweepTrack {
   int frames = 0;                      ///< frames read (second pass)
-  std::vector<double> t_s;             ///< time of each tip (s)
-  std::vector<Vec2> tips_board;        ///< tip positions (m, board frame)
-  Vec2 rough_pivot_board = Vec2::Zero();  ///< where the blade axes meet (m): the start for the circle fit
-  CircleFit circle;                    ///< the fitted circle (m)
+  std::vector<double> t_s;             ///< time of each sighting (s)
+  std::vector<Vec2> tips_board;        ///< tip positions (m, board frame): the centres of the blade's rounded end
+  std::vector<Line2> blades_board;     ///< the blade's centre line in each sighting (m, board frame); may be empty
+  LinesMeet meet;                      ///< where the centre lines meet (m): the pivot
+  CircleFit circle;                    ///< pivot and length as a circle through the tips (m)
 };
 
-/// Finds the flipper's tip in the frames of a sweep: learn() every frame
+/// Finds the flipper's blade in the frames of a sweep: learn() every frame
 /// once (the background), then measure() every frame again, then finish().
 class TipTracker {
  public:
@@ -68,19 +72,23 @@ class TipTracker {
   void learn(const cv::Mat& gray);
   /// Second pass: finds the blade in one frame; false when none is visible.
   bool measure(const cv::Mat& gray, double t_s);
-  /// The tips in board coordinates. Throws std::runtime_error when the blade
-  /// was seen in fewer than 10 frames or never turned.
+  /// The tips and centre lines in board coordinates. Throws
+  /// std::runtime_error when the blade was seen in fewer than 10 frames or
+  /// never turned.
   SweepTrack finish() const;
 
  private:
   struct Sighting {
     double t_s = 0.0;
-    cv::Point2d centre_px;
+    cv::Point2d centre_px;          // on the centre line
     cv::Point2d axis;               // unit, image
-    cv::Point2d end_plus_px, end_minus_px;
-    double width_px = 0.0;
+    cv::Point2d end_plus_px, end_minus_px;  // half-contrast ends along the axis, either way
+    cv::Point2d tip_plus_px, tip_minus_px;  // centres of the rounded ends
+    bool tip_plus_ok = false, tip_minus_ok = false;  // whether that end fitted a circle
   };
   double edge_along(const cv::Point2d& from, const cv::Point2d& dir, double level, double max_px) const;
+  bool fit_centre_line(cv::Point2d& c, cv::Point2d& d, double half_length_px, double& width_px) const;
+  bool fit_end(const cv::Point2d& c, const cv::Point2d& d, double width_px, double reach_px, double& s_px) const;
 
   cv::Size size_;
   vision::CameraHomography homography_;
@@ -96,12 +104,14 @@ class TipTracker {
 using FrameSourceFactory = std::function<std::unique_ptr<vision::FrameSource>()>;
 
 /// Markerless method on a sweep video of flipper `nominal` (its name and side
-/// only). `track` (may be null) receives the tips and the circle.
+/// only). `track` (may be null) receives the tips, the centre lines and the fits.
 FlipperCalibration calibrate_flipper_sweep(const FrameSourceFactory& open, const vision::CameraHomography& homography,
                                            const sim::Flipper& nominal, const SweepOptions& options = {},
                                            SweepTrack* track = nullptr);
 
-/// The fit of a sweep track alone (for tests and for tracks from elsewhere).
+/// The fit of a sweep track alone (for tests and for tracks from elsewhere):
+/// the pivot where track.blades_board meet, or, when the track has no lines
+/// (tips tracked some other way), the centre of the circle fitted to the tips.
 FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const sim::Flipper& nominal, const SweepOptions& options);
 
 /// How `a` differs from `b` (a minus b; distances for the points).

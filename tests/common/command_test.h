@@ -1,0 +1,64 @@
+#pragma once
+// Runs the `pinball` executable (PINBALL_EXE, from the source directory) as
+// users and scripts do: stdout and stderr captured, exit code, and a fresh
+// temporary directory per test for the files it writes.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+namespace pinball::testing {
+
+/// What one run of the command gave.
+struct CommandResult {
+  int exit_code = -1;  ///< exit status (-1: killed by a signal)
+  std::string out;     ///< stdout
+  std::string err;     ///< stderr
+};
+
+/// The whole file as bytes ("" when it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// A test fixture with run("args") and a temporary directory dir_, removed after the test.
+class CommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() / ("pinball_" + std::string(info->test_suite_name()) + "_" +
+                                                     std::to_string(::getpid()) + "_" + info->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  /// Runs `pinball args` in the source directory.
+  CommandResult run(const std::string& args) {
+    const std::filesystem::path err = dir_ / "stderr.txt";
+    const std::string cmd = std::string("cd " PINBALL_SOURCE_DIR " && " PINBALL_EXE " ") + args + " 2>" + err.string();
+    CommandResult r;
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    if (!pipe) return r;
+    char buf[4096];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
+    const int status = ::pclose(pipe);
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.err = slurp(err);
+    return r;
+  }
+
+  std::filesystem::path dir_;
+};
+
+}  // namespace pinball::testing
