@@ -276,8 +276,13 @@ struct EventStepper::Run {
     Vec2& v = state.ball.velocity_mps;
     std::array<Touch, kMaxTouches> touches;
     int n = 0;
+    // Only a touch without normal speed (round-off, or one that settle()
+    // dropped after a bounce too weak to lift the ball by rest_height) is a
+    // contact. A real normal speed, however small, is a bounce or a lift-off
+    // for the impact search: two touches that each had a little would
+    // otherwise stop a ball sliding fast through a flat V.
     auto keep = [&](const Touch& t) {
-      if (std::abs(v.dot(t.normal)) > stepper.touch_speed_mps_) return;  // approaching or leaving
+      if (std::abs(v.dot(t.normal)) > stepper.touch_speed_mps_) return;
       if (n < kMaxTouches) touches[n++] = t;
     };
     const double touch = stepper.touch_m_;
@@ -353,7 +358,12 @@ struct EventStepper::Run {
     int slide = -1;
     bool pressed = false;
     for (int i = 0; i < n; ++i) pressed = pressed || gravity.dot(touches[i].normal) < 0.0;
-    if (!pressed) return;  // nothing supports it: flight
+    if (!pressed) {
+      // Nothing supports it: flight. An approach too slow to count as an
+      // impact (round-off) stops, or the ball would creep into the surface.
+      for (int i = 0; i < n; ++i) v -= std::min(v.dot(touches[i].normal), 0.0) * touches[i].normal;
+      return;
+    }
     const double eps_a = 1e-12 * std::max(board.gravity_mps2, 1e-300);
     for (int i = 0; i < n && slide < 0; ++i) {
       const Vec2& ni = touches[i].normal;
@@ -752,7 +762,7 @@ EventStepper::EventStepper(const Board& board, EventStepperOptions options) : bo
   length_tol_m_ = options_.relative_tolerance * extent;
   touch_m_ = 4.0 * length_tol_m_ + 64.0 * std::numeric_limits<double>::epsilon() * coord;
   const double rest_speed = std::sqrt(2.0 * board.gravity_mps2 * options_.rest_height_m);
-  touch_speed_mps_ = std::max(1e-3 * rest_speed, 1e3 * touch_m_ / options_.dt_s);
+  touch_speed_mps_ = 1e-3 * rest_speed;
   separation_speed_mps_ = std::max(rest_speed, 1e-3);
   // The tangent of a circle leaves it by circle_slide²/2R; a hundredth of the
   // rest height keeps the slide's error far below it.
