@@ -276,8 +276,13 @@ struct EventStepper::Run {
     Vec2& v = state.ball.velocity_mps;
     std::array<Touch, kMaxTouches> touches;
     int n = 0;
+    // Only a touch without normal speed (round-off, or one that settle()
+    // dropped after a bounce too weak to lift the ball by rest_height) is a
+    // contact. A real normal speed, however small, is a bounce or a lift-off
+    // for the impact search: two touches that each had a little would
+    // otherwise stop a ball sliding fast through a flat V.
     auto keep = [&](const Touch& t) {
-      if (std::abs(v.dot(t.normal)) > stepper.touch_speed_mps_) return;  // approaching or leaving
+      if (std::abs(v.dot(t.normal)) > stepper.touch_speed_mps_) return;
       if (n < kMaxTouches) touches[n++] = t;
     };
     const double touch = stepper.touch_m_;
@@ -353,7 +358,12 @@ struct EventStepper::Run {
     int slide = -1;
     bool pressed = false;
     for (int i = 0; i < n; ++i) pressed = pressed || gravity.dot(touches[i].normal) < 0.0;
-    if (!pressed) return;  // nothing supports it: flight
+    if (!pressed) {
+      // Nothing supports it: flight. An approach too slow to count as an
+      // impact (round-off) stops, or the ball would creep into the surface.
+      for (int i = 0; i < n; ++i) v -= std::min(v.dot(touches[i].normal), 0.0) * touches[i].normal;
+      return;
+    }
     const double eps_a = 1e-12 * std::max(board.gravity_mps2, 1e-300);
     for (int i = 0; i < n && slide < 0; ++i) {
       const Vec2& ni = touches[i].normal;
@@ -736,23 +746,41 @@ EventStepper::EventStepper(const Board& board, EventStepperOptions options) : bo
     throw std::invalid_argument("event stepper: contact_tolerance_m must be >= 0");
   }
   const double r = board.ball.radius_m;
-  // Lengths scale with the board; round-off scales with the coordinates'
-  // magnitude (a board far from the origin keeps fewer digits).
-  double extent = std::hypot(board.width_m, board.height_m);
-  double coord = extent;
-  // Shapes off the table (the bench's far copies) never meet the ball.
-  auto on_table = [&](const Vec2& q) {
-    return q.x() >= -extent && q.y() >= -extent && q.x() <= board.width_m + extent && q.y() <= board.height_m + extent;
+  // Root tolerances scale with the board's size: the diagonal of what is on
+  // it (the table's when it is empty), not the coordinates, so a board far
+  // from the origin is solved as finely as at the origin. Round-off scales
+  // with the coordinates' magnitude (far from the origin fewer digits are
+  // left) and goes into the touch distance instead.
+  const double table = std::hypot(board.width_m, board.height_m);
+  double coord = table;
+  Vec2 lo = Vec2::Constant(INFINITY);
+  Vec2 hi = Vec2::Constant(-INFINITY);
+  // What the ball can meet: a ball leaves the table 2r beyond its bounds, so
+  // a shape wholly more than 3r outside them is out of reach (the bench's
+  // far copies) and does not count.
+  const Vec2 reach_lo = Vec2::Constant(-3.0 * r);
+  const Vec2 reach_hi = Vec2(board.width_m, board.height_m) + Vec2::Constant(3.0 * r);
+  auto cover = [&](Vec2 a, Vec2 b) {
+    if ((a.array() > reach_hi.array()).any() || (b.array() < reach_lo.array()).any()) return;
+    lo = lo.cwiseMin(a);
+    hi = hi.cwiseMax(b);
+    coord = std::max({coord, a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()});
   };
   for (const Shape& s : board.shapes) {
-    if (on_table(s.p0)) coord = std::max(coord, s.p0.cwiseAbs().maxCoeff());
-    if (on_table(s.p1)) coord = std::max(coord, s.p1.cwiseAbs().maxCoeff());
+    if (s.kind == ShapeKind::kCircle) {
+      cover(s.p0 - Vec2::Constant(s.radius_m), s.p0 + Vec2::Constant(s.radius_m));
+    } else {
+      cover(s.p0.cwiseMin(s.p1), s.p0.cwiseMax(s.p1));
+    }
   }
-  for (const Flipper& f : board.flippers) coord = std::max(coord, f.pivot.cwiseAbs().maxCoeff() + f.length_m);
+  for (const Flipper& f : board.flippers) {
+    cover(f.pivot - Vec2::Constant(f.length_m), f.pivot + Vec2::Constant(f.length_m));
+  }
+  const double extent = lo.x() <= hi.x() ? std::max((hi - lo).norm(), 2.0 * r) : table;
   length_tol_m_ = options_.relative_tolerance * extent;
   touch_m_ = 4.0 * length_tol_m_ + 64.0 * std::numeric_limits<double>::epsilon() * coord;
   const double rest_speed = std::sqrt(2.0 * board.gravity_mps2 * options_.rest_height_m);
-  touch_speed_mps_ = std::max(1e-3 * rest_speed, 1e3 * touch_m_ / options_.dt_s);
+  touch_speed_mps_ = 1e-3 * rest_speed;
   separation_speed_mps_ = std::max(rest_speed, 1e-3);
   // The tangent of a circle leaves it by circle_slide²/2R; a hundredth of the
   // rest height keeps the slide's error far below it.

@@ -54,8 +54,9 @@ TYPED_TEST(FarOriginTest, BoardShiftedAKilometreFromTheOrigin) {
   const Vec2 d{1000.0, 1000.0};
   for (int which = 0; which < 3; ++which) {
     // The run near the origin gets the same width and height (the table's
-    // bounds start at the origin, so the far board needs them; the event
-    // stepper scales its tolerances with them): only the coordinates differ.
+    // bounds start at the origin, so the far board needs them): only the
+    // coordinates differ. The event stepper's root tolerance scales with
+    // what is on the table (1.4 m here), not with the coordinates.
     Board near = scene(which);
     const Board far = shifted(near, d);
     near.width_m = far.width_m;

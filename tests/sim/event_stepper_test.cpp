@@ -106,6 +106,44 @@ TEST(EventStepper, BouncesOnAFloorFollowTheGeometricSeriesThenRest) {
   EXPECT_EQ(s.ball.velocity_mps.norm(), 0.0);
 }
 
+TEST(EventStepper, LooseTolerancesCostPrecisionNotPhysics) {
+  // The root tolerance may only move impacts by about tolerance·size: the
+  // same bounces must happen. (A touch speed once derived from it reached
+  // metres per second at 1e-6 and turned real bounces into slides.)
+  const double g = 1.11, h0 = 0.3, rho = 0.8;
+  Board floor = empty_board(1.0, 1.0, g, 5e-4);
+  add_line(floor, {0.0, 0.0}, {1.0, 0.0}, rho);  // size: 1 m
+  const Board box = box_board(1.0, g, 5e-4);    // elastic, 0.51 x 1.07 m
+  for (const double tol : {1e-6, 1e-8, 1e-10}) {
+    EventStepperOptions o;
+    o.relative_tolerance = tol;
+    const EventStepper bouncing(floor, o);
+    GameState s = state_with_ball(floor, {0.5, kR + h0}, Vec2::Zero());
+    int bounces = 0;
+    double worst_apex = 0.0;
+    for (int i = 0; i < 20000 && bounces < 30; ++i) {
+      if (!bouncing.step(s).has(StepEvents::kHitObstacle)) continue;
+      const double y = s.ball.position_m.y() - kR;
+      const double vy = s.ball.velocity_mps.y();
+      if (vy <= 0.0) break;
+      ++bounces;
+      const double apex = y + vy * vy / (2.0 * g);
+      worst_apex = std::max(worst_apex, std::abs(apex - h0 * std::pow(rho, 2 * bounces)));
+    }
+    EXPECT_GE(bounces, 20) << "tolerance " << tol;  // as at the default: the series, then rest
+    EXPECT_LE(bounces, 25) << "tolerance " << tol;
+    EXPECT_LT(worst_apex, 10.0 * tol) << "tolerance " << tol;
+
+    // rho = 1 walls: every bounce keeps the energy; none may become a slide.
+    const EventStepper elastic(box, o);
+    const GameState start = state_with_ball(box, {0.2, 0.5}, {1.3, 0.7});
+    GameState d = start;
+    for (int i = 0; i < 4000; ++i) elastic.step(d);
+    EXPECT_NEAR(energy(box, d), energy(box, start), 100.0 * tol) << "tolerance " << tol;
+    EXPECT_GT(d.events, 4u) << "tolerance " << tol;
+  }
+}
+
 TEST(EventStepper, SlidesDownAnInclineUniformlyAccelerated) {
   const double g = 1.11, alpha = 0.3;
   Board b = empty_board(2.0, 2.0, g, 5e-4);
