@@ -236,18 +236,17 @@ bool BallDetector::search(const cv::Rect& region, bool region_is_roi, double t_s
   // cuts a ball loose from a flipper or rail it touches, and test the pieces.
   for (int k = 0; k < split_count_; ++k) {
     const auto label = static_cast<std::uint8_t>(k + 1);
+    const cv::Rect& box = split_box_[static_cast<std::size_t>(k)];
     if (!best.have) {
       ++counters_.separations;
-      open_split(label, split_box_[static_cast<std::size_t>(k)]);
-      scan(region, split_box_[static_cast<std::size_t>(k)], region_is_roi, true, out, best);
-    } else {
-      for (int v = split_box_[static_cast<std::size_t>(k)].y;
-           v < split_box_[static_cast<std::size_t>(k)].y + split_box_[static_cast<std::size_t>(k)].height; ++v) {
-        std::uint8_t* row = split_label_.ptr<std::uint8_t>(v);
-        for (int u = split_box_[static_cast<std::size_t>(k)].x;
-             u < split_box_[static_cast<std::size_t>(k)].x + split_box_[static_cast<std::size_t>(k)].width; ++u) {
-          if (row[u] == label) row[u] = 0;
-        }
+      open_split(label, box);  // also clears the candidate's labels
+      scan(region, box, region_is_roi, true, out, best);
+      continue;
+    }
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      std::uint8_t* row = split_label_.ptr<std::uint8_t>(v);
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        if (row[u] == label) row[u] = 0;
       }
     }
   }
