@@ -44,6 +44,10 @@ void fit_stadium(double l1, double l2, double& r, double& length) {
 // A ball cut loose by the opening keeps nearly all its area; less is a ball
 // partly eaten by the opening or a lump of something else.
 constexpr double kMinSeparatedAreaRatio = 0.85;
+// Blobs opened are at most this many balls' area: a ball and a flipper make
+// about 3; a glare patch or a lit insert many more, and opening those would
+// cost a whole-frame search's time for nothing.
+constexpr double kMaxSplitAreaRatio = 8.0;
 
 }  // namespace
 
@@ -347,7 +351,7 @@ void BallDetector::scan(const cv::Rect& region, const cv::Rect& box, bool region
         }
       }
       if (reason != DetectionMiss::kNone) {
-        if (!opened && ratio >= c.min_area_ratio) add_split(blob);
+        if (!opened && ratio >= c.min_area_ratio && ratio <= kMaxSplitAreaRatio) add_split(blob);
         // The reason reported is the one of the blob closest to a ball's size.
         const double closeness = std::abs(std::log(ratio));
         if (best.worst == DetectionMiss::kNoBlob || closeness < best.worst_closeness) {
