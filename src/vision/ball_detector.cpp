@@ -41,6 +41,14 @@ void fit_stadium(double l1, double l2, double& r, double& length) {
   length = k * r;
 }
 
+// A ball cut loose by the opening keeps nearly all its area; less is a ball
+// partly eaten by the opening or a lump of something else.
+constexpr double kMinSeparatedAreaRatio = 0.85;
+// Blobs opened are at most this many balls' area: a ball and a flipper make
+// about 3; a glare patch or a lit insert many more, and opening those would
+// cost a whole-frame search's time for nothing.
+constexpr double kMaxSplitAreaRatio = 8.0;
+
 }  // namespace
 
 const char* to_string(DetectionMiss miss) {
@@ -78,6 +86,13 @@ BallDetector::BallDetector(const CameraHomography& homography, cv::Size frame_si
   binary_ = cv::Mat::zeros(size_, CV_8U);
   stack_.resize(static_cast<std::size_t>(size_.width) * static_cast<std::size_t>(size_.height));
   halo_ = cv::Mat::zeros(size_, CV_8U);
+  require(std::isfinite(c.separation_radius_fraction) && c.separation_radius_fraction >= 0.0 &&
+              c.separation_radius_fraction < 1.0,
+          "separation_radius_fraction must be in [0, 1)");
+  require(c.max_separated_elongation >= 1.0, "max_separated_elongation must be >= 1");
+  split_label_ = cv::Mat::zeros(size_, CV_8U);
+  split_core_ = cv::Mat::zeros(size_, CV_8U);
+  split_run_ = cv::Mat::zeros(size_, CV_16S);
 }
 
 void BallDetector::set_occluder_mask(const cv::Mat& mask) {
@@ -146,7 +161,7 @@ void BallDetector::fill_blob(int u, int v, const cv::Rect& region, Blob& blob) {
                         rv1 - blob.v1 < margin;
 }
 
-cv::Point2d BallDetector::weighted_centroid(const Blob& blob) {
+cv::Point2d BallDetector::weighted_centroid(const Blob& blob, bool opened) {
   // Weights only on the blob and a 2 px halo around it (the anti-aliased rim
   // below the threshold), never on a neighbouring blob.
   constexpr int kHalo = 2;
@@ -163,8 +178,15 @@ cv::Point2d BallDetector::weighted_centroid(const Blob& blob) {
     const int pv = i / w;
     for (int v = std::max(pv - kHalo, box.y); v <= std::min(pv + kHalo, box.y + box.height - 1); ++v) {
       std::uint8_t* row = halo_.ptr<std::uint8_t>(v);
-      for (int u = std::max(pu - kHalo, box.x); u <= std::min(pu + kHalo, box.x + box.width - 1); ++u) row[u] = 1;
+      for (int u = std::max(pu - kHalo, box.x); u <= std::min(pu + kHalo, box.x + box.width - 1); ++u) {
+        row[u] = std::max<std::uint8_t>(row[u], 1);
+      }
     }
+  }
+  if (opened) {
+    // The rim is what lies below the threshold; foreground around the opened
+    // blob belongs to the thin object the opening cut away.
+    for (std::size_t k = 0; k < n; ++k) halo_.data[stack_[k]] = 2;
   }
   const double floor = config_.weight_floor_fraction * config_.threshold;
   const double cap = std::max({config_.weight_saturation * peak, static_cast<double>(config_.threshold), floor + 1.0});
@@ -175,7 +197,9 @@ cv::Point2d BallDetector::weighted_centroid(const Blob& blob) {
     std::uint8_t* in = halo_.ptr<std::uint8_t>(v);
     for (int u = box.x; u < box.x + box.width; ++u) {
       if (in[u] == 0) continue;
+      const bool removed = opened && in[u] == 1 && row[u] > config_.threshold;
       in[u] = 0;
+      if (removed) continue;
       const double wgt = std::min(1.0, (row[u] - floor) * inv);
       if (wgt <= 0.0) continue;
       sw += wgt;
@@ -187,6 +211,20 @@ cv::Point2d BallDetector::weighted_centroid(const Blob& blob) {
   return {su / sw, sv / sw};
 }
 
+struct BallDetector::Best {
+  bool have = false;
+  Blob blob;
+  cv::Point2d uv;
+  double conf = 0.0;
+  double elong = 0.0;
+  double expected = 0.0;
+  double model_error = 0.0;
+  double r_fit = 0.0;
+  bool opened = false;
+  DetectionMiss worst = DetectionMiss::kNoBlob;
+  double worst_closeness = 0.0;
+};
+
 bool BallDetector::search(const cv::Rect& region, bool region_is_roi, double t_s, Detection& out) {
   const cv::Mat frame = (*frame_)(region);
   const cv::Mat background = background_.image()(region);
@@ -195,23 +233,56 @@ bool BallDetector::search(const cv::Rect& region, bool region_is_roi, double t_s
   cv::absdiff(frame, background, diff);
   cv::threshold(diff, binary, config_.threshold, 255, cv::THRESH_BINARY);
 
+  Best best;
+  split_count_ = 0;
+  scan(region, region, region_is_roi, false, out, best);
+  // No blob passed: open the rejected ones big enough to hold a ball, which
+  // cuts a ball loose from a flipper or rail it touches, and test the pieces.
+  for (int k = 0; k < split_count_; ++k) {
+    const auto label = static_cast<std::uint8_t>(k + 1);
+    const cv::Rect& box = split_box_[static_cast<std::size_t>(k)];
+    if (!best.have) {
+      ++counters_.separations;
+      open_split(label, box);  // also clears the candidate's labels
+      scan(region, box, region_is_roi, true, out, best);
+      continue;
+    }
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      std::uint8_t* row = split_label_.ptr<std::uint8_t>(v);
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        if (row[u] == label) row[u] = 0;
+      }
+    }
+  }
+  if (!best.have) {
+    if (!region_is_roi || out.miss == DetectionMiss::kNone) out.miss = best.worst;
+    return false;
+  }
+  const cv::Point2d uv = best.uv;
+  out.found = true;
+  out.miss = DetectionMiss::kNone;
+  out.uv_px = uv;
+  out.area_px = best.blob.area;
+  out.expected_area_px = best.expected;
+  out.elongation = best.elong;
+  out.model_error = best.model_error;
+  out.radius_px = best.r_fit;
+  out.from_roi = region_is_roi;
+  out.separated = best.opened;
+  out.observation.t_s = t_s;
+  out.observation.p_board = homography_.board_from_image(uv);
+  out.observation.confidence = best.conf;
+  return true;
+}
+
+void BallDetector::scan(const cv::Rect& region, const cv::Rect& box, bool region_is_roi, bool opened, Detection& out,
+                        Best& best) {
   const BallDetectorConfig& c = config_;
-  bool have = false;
-  Blob best;
-  double best_score = 0.0;
-  double best_conf = 0.0;
-  double best_elong = 0.0;
-  double best_expected = 0.0;
-  double best_model_error = 0.0;
-  double best_r_fit = 0.0;
-  DetectionMiss worst = DetectionMiss::kNoBlob;
-  double worst_closeness = 0.0;
-  cv::Point2d best_uv;
   const double log_span = std::max(-std::log(c.min_area_ratio), std::log(c.max_area_ratio));
-  for (int v = region.y; v < region.y + region.height; ++v) {
+  for (int v = box.y; v < box.y + box.height; ++v) {
     const std::uint8_t* row = binary_.ptr<std::uint8_t>(v);
-    int u = region.x;
-    const int end = region.x + region.width;
+    int u = box.x;
+    const int end = box.x + box.width;
     while (u < end) {
       if (u + 8 <= end) {
         std::uint64_t word;
@@ -269,55 +340,125 @@ bool BallDetector::search(const cv::Rect& region, bool region_is_roi, double t_s
         const double model_area = r_fit * r_fit * std::numbers::pi + 2.0 * r_fit * length;
         model_error = std::abs(blob.area / model_area - 1.0);
         const double r_ratio = r_fit / r_px;
-        if (elong > c.max_elongation || fill < c.min_fill || model_error > c.max_model_error ||
-            r_ratio < 1.0 - c.radius_tolerance || r_ratio > 1.0 + c.radius_tolerance) {
+        // A piece cut loose by the opening must be a whole ball: nearly all of
+        // its area, its radius, and little blur (see max_separated_elongation).
+        const double r_tol = opened ? 0.5 * c.radius_tolerance : c.radius_tolerance;
+        if (elong > (opened ? c.max_separated_elongation : c.max_elongation) || fill < c.min_fill ||
+            model_error > c.max_model_error || r_ratio < 1.0 - r_tol || r_ratio > 1.0 + r_tol ||
+            (opened && ratio < kMinSeparatedAreaRatio)) {
           reason = DetectionMiss::kWrongShape;
           ++counters_.rejected_shape;
         }
       }
       if (reason != DetectionMiss::kNone) {
+        if (!opened && ratio >= c.min_area_ratio && ratio <= kMaxSplitAreaRatio) add_split(blob);
         // The reason reported is the one of the blob closest to a ball's size.
         const double closeness = std::abs(std::log(ratio));
-        if (worst == DetectionMiss::kNoBlob || closeness < worst_closeness) {
-          worst = reason;
-          worst_closeness = closeness;
+        if (best.worst == DetectionMiss::kNoBlob || closeness < best.worst_closeness) {
+          best.worst = reason;
+          best.worst_closeness = closeness;
         }
         continue;
       }
       const double conf = std::clamp(std::min(fill, 1.0) * (1.0 - 0.5 * (elong - 1.0) / (c.max_elongation - 1.0)) *
                                          (1.0 - 0.5 * std::abs(std::log(ratio)) / log_span),
                                      0.01, 1.0);
-      if (!have || conf > best_score) {
-        have = true;
-        best = blob;
-        best_uv = weighted_centroid(blob);  // now, while stack_ holds this blob's pixels
-        best_score = conf;
-        best_conf = conf;
-        best_elong = elong;
-        best_expected = expected;
-        best_model_error = model_error;
-        best_r_fit = r_fit;
+      if (!best.have || conf > best.conf) {
+        best.have = true;
+        best.blob = blob;
+        best.uv = weighted_centroid(blob, opened);  // now, while stack_ holds this blob's pixels
+        best.conf = conf;
+        best.elong = elong;
+        best.expected = expected;
+        best.model_error = model_error;
+        best.r_fit = r_fit;
+        best.opened = opened;
       }
     }
   }
-  if (!have) {
-    if (!region_is_roi || out.miss == DetectionMiss::kNone) out.miss = worst;
-    return false;
+}
+
+void BallDetector::add_split(const Blob& blob) {
+  if (config_.separation_radius_fraction <= 0.0 || split_count_ >= kMaxSplits) return;
+  const auto label = static_cast<std::uint8_t>(split_count_ + 1);
+  const auto n = static_cast<std::size_t>(blob.area);
+  for (std::size_t k = 0; k < n; ++k) split_label_.data[stack_[k]] = label;
+  split_box_[static_cast<std::size_t>(split_count_)] =
+      cv::Rect(cv::Point(blob.u0, blob.v0), cv::Point(blob.u1 + 1, blob.v1 + 1));
+  ++split_count_;
+}
+
+void BallDetector::open_split(std::uint8_t label, const cv::Rect& box) {
+  // Opening by a disc of radius rho, made of horizontal chords of half-width
+  // chord[dy]: a pixel survives the erosion when, on every row dy away, the
+  // candidate's run through it reaches chord[dy] to both sides; the dilation
+  // sets a pixel when, on some row dy away, an eroded pixel lies within
+  // chord[dy]. Both read per-row run lengths, so the cost is the box's area
+  // times the disc's height. Pixels of other blobs in the box are not used.
+  const cv::Point2d centre(box.x + 0.5 * box.width, box.y + 0.5 * box.height);
+  const double rho = config_.separation_radius_fraction * expected_radius_px(centre);
+  const int r = std::min(static_cast<int>(std::floor(rho)), kMaxSplitRadius);
+  std::array<std::int16_t, 2 * kMaxSplitRadius + 1> chord{};
+  for (int dy = -r; dy <= r; ++dy) {
+    chord[static_cast<std::size_t>(dy + r)] =
+        static_cast<std::int16_t>(std::floor(std::sqrt(std::max(0.0, rho * rho - dy * dy))));
   }
-  const cv::Point2d uv = best_uv;
-  out.found = true;
-  out.miss = DetectionMiss::kNone;
-  out.uv_px = uv;
-  out.area_px = best.area;
-  out.expected_area_px = best_expected;
-  out.elongation = best_elong;
-  out.model_error = best_model_error;
-  out.radius_px = best_r_fit;
-  out.from_roi = region_is_roi;
-  out.observation.t_s = t_s;
-  out.observation.p_board = homography_.board_from_image(uv);
-  out.observation.confidence = best_conf;
-  return true;
+  const int u0 = box.x, u1 = box.x + box.width, v0 = box.y, v1 = box.y + box.height;
+  constexpr std::int16_t kFar = 10000;
+  // Half run lengths: 1 + how far the candidate extends to the nearer side.
+  for (int v = v0; v < v1; ++v) {
+    std::uint8_t* lab = split_label_.ptr<std::uint8_t>(v);
+    auto* run = split_run_.ptr<std::int16_t>(v);
+    std::int16_t n = 0;
+    for (int u = u0; u < u1; ++u) {
+      n = lab[u] == label ? static_cast<std::int16_t>(n + 1) : std::int16_t{0};
+      run[u] = n;
+    }
+    n = 0;
+    for (int u = u1 - 1; u >= u0; --u) {
+      n = lab[u] == label ? static_cast<std::int16_t>(n + 1) : std::int16_t{0};
+      run[u] = std::min(run[u], n);
+      if (lab[u] == label) lab[u] = 0;
+    }
+  }
+  // Erosion.
+  for (int v = v0 + r; v < v1 - r; ++v) {
+    std::uint8_t* core = split_core_.ptr<std::uint8_t>(v);
+    for (int u = u0; u < u1; ++u) {
+      bool in = true;
+      for (int dy = -r; dy <= r && in; ++dy) {
+        in = split_run_.ptr<std::int16_t>(v + dy)[u] > chord[static_cast<std::size_t>(dy + r)];
+      }
+      core[u] = in ? 1 : 0;
+    }
+  }
+  // Horizontal distance to the nearest eroded pixel.
+  for (int v = v0; v < v1; ++v) {
+    const std::uint8_t* core = split_core_.ptr<std::uint8_t>(v);
+    auto* run = split_run_.ptr<std::int16_t>(v);
+    std::int16_t d = kFar;
+    for (int u = u0; u < u1; ++u) {
+      d = core[u] != 0 ? std::int16_t{0} : static_cast<std::int16_t>(std::min<int>(d + 1, kFar));
+      run[u] = d;
+    }
+    d = kFar;
+    for (int u = u1 - 1; u >= u0; --u) {
+      d = core[u] != 0 ? std::int16_t{0} : static_cast<std::int16_t>(std::min<int>(d + 1, kFar));
+      run[u] = std::min(run[u], d);
+    }
+  }
+  // Dilation into the foreground; the erosion scratch is cleared afterwards.
+  for (int v = v0; v < v1; ++v) {
+    std::uint8_t* bin = binary_.ptr<std::uint8_t>(v);
+    for (int u = u0; u < u1; ++u) {
+      bool in = false;
+      for (int dy = std::max(-r, v0 - v); dy <= std::min(r, v1 - 1 - v) && !in; ++dy) {
+        in = split_run_.ptr<std::int16_t>(v + dy)[u] <= chord[static_cast<std::size_t>(dy + r)];
+      }
+      bin[u] = in ? 255 : 0;
+    }
+  }
+  for (int v = v0; v < v1; ++v) std::memset(split_core_.ptr<std::uint8_t>(v) + u0, 0, static_cast<std::size_t>(box.width));
 }
 
 Detection BallDetector::detect(const Frame& frame, const cv::Point2d* predicted_uv_px) {
@@ -366,6 +507,7 @@ Detection BallDetector::detect(const Frame& frame, const cv::Point2d* predicted_
   if (found) {
     ++counters_.found;
     if (out.from_roi) ++counters_.found_in_roi;
+    if (out.separated) ++counters_.found_separated;
     const double dt = frame.t_s - last_t_s_;
     if (track_frames_ > 0 && std::isfinite(dt) && dt > 0.0) velocity_px_ = (out.uv_px - last_uv_px_) * (1.0 / dt);
     last_uv_px_ = out.uv_px;

@@ -276,6 +276,81 @@ TEST(BallDetector, ARaisedFlipperIsNeverTakenForTheBall) {
   EXPECT_GT(changed, 1e4) << "the raised flippers must show in the image";
 }
 
+// Board point `off_m` from flipper `f` (at theta) on its upper side, `along`
+// of the way from the pivot to the tip.
+Vec2 beside_flipper(const sim::Flipper& f, double theta_rad, double along, double off_m) {
+  const Vec2 tip = sim::flipper_tip(f, theta_rad);
+  const Vec2 d = (tip - f.pivot).normalized();
+  Vec2 n{-d.y(), d.x()};
+  if (n.y() < 0.0) n = -n;
+  return f.pivot + (tip - f.pivot) * along + n * off_m;
+}
+
+TEST(BallDetector, ABallTouchingARaisedFlipperIsFoundAndCentred) {
+  Scene s;  // background learned with the flippers down
+  const sim::Board& b = thesis_board();
+  std::vector<double> up;
+  for (const sim::Flipper& f : b.flippers) up.push_back(f.theta_max_rad);
+  s.camera.set_flipper_angles(up);
+  const double touch_m = b.ball.radius_m + 0.5 * s.camera.config().flipper_width_m;
+  std::vector<double> errors;
+  for (const sim::Flipper& f : b.flippers) {
+    for (double along : {0.35, 0.5, 0.65, 0.8}) {
+      const Detection d = s.shoot(beside_flipper(f, f.theta_max_rad, along, touch_m));
+      if (!d.found) continue;  // a miss is allowed, a wrong centre is not
+      EXPECT_TRUE(d.separated) << f.name << " at " << along << ": the merged blob itself is not a ball";
+      EXPECT_LT(s.error_px(d), 1.0) << f.name << " at " << along;
+      errors.push_back(s.error_px(d));
+    }
+  }
+  // Found only by the separation: the whole blob (ball plus flipper) is not a ball.
+  EXPECT_GE(errors.size(), 4u);  // of 8; the others are missed, never misplaced
+  EXPECT_LT(median(errors), 0.3);
+  EXPECT_EQ(s.detector.counters().found_separated, errors.size());
+}
+
+TEST(BallDetector, ABlurredBallTouchingAMovingFlipperIsFound) {
+  Scene s;
+  const sim::Board& b = thesis_board();
+  std::vector<double> mid;  // half way up: the flippers are moving
+  for (const sim::Flipper& f : b.flippers) mid.push_back(0.5 * (f.theta_min_rad + f.theta_max_rad));
+  s.camera.set_flipper_angles(mid);
+  const double touch_m = b.ball.radius_m + 0.5 * s.camera.config().flipper_width_m;
+  std::vector<double> errors;
+  for (std::size_t i = 0; i < b.flippers.size(); ++i) {
+    for (double along : {0.4, 0.6, 0.8}) {
+      // Rolling down onto the flipper at 2 m/s: blurred along its path.
+      const Detection d = s.shoot(beside_flipper(b.flippers[i], mid[i], along, touch_m), Vec2{0.3, -2.0});
+      EXPECT_GT(s.camera.truth().blur_px, 2.0);
+      if (!d.found) continue;
+      EXPECT_TRUE(d.separated);
+      EXPECT_LT(s.error_px(d), 1.0) << b.flippers[i].name << " at " << along;
+      errors.push_back(s.error_px(d));
+    }
+  }
+  EXPECT_GE(errors.size(), 1u);  // of 6; the others are missed, never misplaced
+  EXPECT_LT(median(errors), 0.3);
+}
+
+TEST(BallDetector, AFlipperAloneIsNeverTakenForTheBallAtAnyAngle) {
+  Scene s;  // background learned with the flippers down
+  const sim::Board& b = thesis_board();
+  std::vector<double> theta(b.flippers.size());
+  for (int k = 1; k <= 40; ++k) {
+    for (std::size_t i = 0; i < theta.size(); ++i) {
+      const sim::Flipper& f = b.flippers[i];
+      theta[i] = f.theta_min_rad + (f.theta_max_rad - f.theta_min_rad) * (k / 40.0);
+    }
+    s.camera.set_flipper_angles(theta);
+    s.camera.render({}, s.t_s, s.frame);
+    s.t_s += 0.005;
+    s.detector.forget_track();
+    EXPECT_FALSE(s.detector.detect(s.frame).found) << "a flipper alone reported as the ball at step " << k;
+  }
+  EXPECT_GT(s.detector.counters().separations, 20u) << "the flippers' blobs must have been opened and tested";
+  EXPECT_EQ(s.detector.counters().found_separated, 0u);
+}
+
 TEST(BallDetector, RejectsBadSettings) {
   const CameraHomography h = CameraHomography::default_view(thesis_board(), {640, 480});
   BallDetectorConfig c;
@@ -283,6 +358,9 @@ TEST(BallDetector, RejectsBadSettings) {
   EXPECT_THROW(BallDetector(h, {640, 480}, c), std::invalid_argument);
   c = BallDetectorConfig{};
   c.min_area_ratio = 1.5;
+  EXPECT_THROW(BallDetector(h, {640, 480}, c), std::invalid_argument);
+  c = BallDetectorConfig{};
+  c.separation_radius_fraction = 1.0;  // would open the ball itself away
   EXPECT_THROW(BallDetector(h, {640, 480}, c), std::invalid_argument);
   BallDetector ok(h, {640, 480});
   EXPECT_THROW(ok.set_occluder_mask(cv::Mat(10, 10, CV_8U)), std::invalid_argument);

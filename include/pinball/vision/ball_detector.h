@@ -6,10 +6,15 @@
 // flippers are rejected) and it touches neither a known occluder nor the edge
 // of the image. The centre is the sub-pixel centroid of the difference image
 // with saturating weights (shading and the specular highlight do not pull it),
-// mapped to the board through the camera homography. The search looks first
+// mapped to the board through the camera homography. A ball touching a thin
+// bright object (a flipper, a rail) merges with it into one blob of the wrong
+// shape; when no blob passes, such blobs are opened (eroded then dilated) with
+// a disc smaller than the ball, which removes the thin parts and keeps the
+// ball, and the pieces are tested again. The search looks first
 // in a region around the predicted position and falls back to the whole frame.
 // No allocation per frame after construction.
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -42,6 +47,12 @@ struct BallDetectorConfig {
   int edge_margin_px = 2;            ///< a blob this close to the image (or ROI) edge counts as cut by it (>= 2)
   double background_rate = 0.0;      ///< running background update rate per update (0: frozen)
   int background_every = 4;          ///< frames between running updates
+  double separation_radius_fraction = 0.9;  ///< disc radius of the opening that separates the ball from thin
+                                            ///< attached objects, as a fraction of the expected ball radius:
+                                            ///< removes parts narrower than 2× this radius (0: no separation)
+  double max_separated_elongation = 1.5;    ///< largest elongation of a ball cut loose by the opening (a ball
+                                            ///< blurred by about one radius): a longer piece is more likely
+                                            ///< a ball with a lump of the object it touches
 };
 
 /// Why a frame gave no ball.
@@ -67,6 +78,7 @@ struct Detection {
   double model_error = 0.0;         ///< relative gap between its area and a blurred ball's with its moments
   double radius_px = 0.0;           ///< radius from its minor axis (px)
   bool from_roi = false;            ///< found in the region of interest
+  bool separated = false;           ///< found only after opening away thin objects attached to it (a flipper)
   int blobs = 0;                    ///< blobs examined (all searches of this frame)
   DetectionMiss miss = DetectionMiss::kNone;  ///< reason when not found
 };
@@ -84,6 +96,8 @@ struct DetectorCounters {
   std::uint64_t rejected_shape = 0;     ///< blobs of the wrong elongation or fill
   std::uint64_t rejected_occluded = 0;  ///< blobs touching an occluder
   std::uint64_t rejected_edge = 0;      ///< blobs touching the image edge
+  std::uint64_t separations = 0;        ///< rejected blobs opened to separate a ball from thin attached objects
+  std::uint64_t found_separated = 0;    ///< frames whose ball was found only after such an opening
   std::uint64_t bad_frames = 0;         ///< frames of the wrong size or type (ignored)
 };
 
@@ -127,10 +141,21 @@ class BallDetector {
     bool occluded = false;
     bool at_region_edge = false;
   };
+  struct Best;  // the best blob of a search so far
+  static constexpr int kMaxSplits = 4;        // rejected blobs opened per search, at most
+  static constexpr int kMaxSplitRadius = 64;  // largest opening disc radius (px)
+
   // Searches `region`; `region_is_roi` marks a blob on the region's border as cut by the ROI.
   bool search(const cv::Rect& region, bool region_is_roi, double t_s, Detection& out);
+  // Tests the blobs of binary_ inside `box` (within `region`); `opened`: the second pass on opened blobs.
+  void scan(const cv::Rect& region, const cv::Rect& box, bool region_is_roi, bool opened, Detection& out, Best& best);
+  // Keeps a rejected blob (its pixels in stack_) for opening.
+  void add_split(const Blob& blob);
+  // Writes into binary_ the opening of split candidate `label` (its pixels in split_label_ inside `box`).
+  void open_split(std::uint8_t label, const cv::Rect& box);
   void fill_blob(int u, int v, const cv::Rect& region, Blob& blob);
-  cv::Point2d weighted_centroid(const Blob& blob);
+  // `opened`: foreground pixels outside the blob (the thin parts the opening removed) get no weight.
+  cv::Point2d weighted_centroid(const Blob& blob, bool opened);
 
   CameraHomography homography_;
   cv::Size size_;
@@ -140,6 +165,11 @@ class BallDetector {
   cv::Mat binary_;     // CV_8U foreground, consumed by the blob fill
   cv::Mat occluder_;   // CV_8U dilated occluder mask (empty: none)
   cv::Mat halo_;       // CV_8U scratch: the accepted blob and its rim, cleared after use
+  cv::Mat split_label_;  // CV_8U scratch: pixels of rejected blobs to open (1..kMaxSplits), cleared after use
+  cv::Mat split_core_;   // CV_8U scratch: a candidate's erosion, cleared after use
+  cv::Mat split_run_;    // CV_16S scratch: horizontal run half-lengths, then distances to the erosion
+  std::array<cv::Rect, kMaxSplits> split_box_{};  // bounding boxes of the split candidates
+  int split_count_ = 0;
   const cv::Mat* frame_ = nullptr;
   std::vector<std::int32_t> stack_;  // flood-fill queue, sized for a whole frame; holds the last blob's pixels
   // Track for the ROI.
