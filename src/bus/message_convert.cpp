@@ -52,6 +52,29 @@ pinball_lcm::lcmt_pinball_projection to_lcm_projection(std::int64_t utime, std::
   return m;
 }
 
+pinball_lcm::lcmt_pinball_driver_status to_lcm_driver_status(std::int64_t utime, std::int64_t seq,
+                                                              firmware::BusState state,
+                                                              const firmware::BoardView& board,
+                                                              const firmware::DriverBusCounters& k) {
+  pinball_lcm::lcmt_pinball_driver_status m{};
+  m.utime = utime;
+  m.seq = seq;
+  m.bus_state = static_cast<std::int8_t>(state);
+  m.board_valid = board.valid;
+  for (int d = 0; board.valid && d < firmware::kMaxDrivers; ++d) {
+    if (board.status.coil(d) != firmware::CoilState::kOff) m.coils_on = static_cast<std::int16_t>(m.coils_on | (1 << d));
+  }
+  m.frames_sent = static_cast<std::int64_t>(k.frames_sent);
+  m.rx_frames = static_cast<std::int64_t>(k.rx_frames);
+  m.rx_bad = static_cast<std::int64_t>(k.rx_bad);
+  m.faults = static_cast<std::int64_t>(k.faults);
+  m.bus_off = static_cast<std::int64_t>(k.bus_off);
+  m.reconnects = static_cast<std::int64_t>(k.reconnects);
+  m.tx_failures = static_cast<std::int64_t>(k.tx_failures);
+  m.release_alls = static_cast<std::int64_t>(k.release_alls);
+  return m;
+}
+
 bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& found, track::Observation& out,
                           track::ContactSensors& contacts) {
   if (m.utime < 0 || m.seq < 0) return false;

@@ -112,6 +112,7 @@ struct Daemon::Impl {
   double start_wall_s = 0.0;
   bool coils_off_at_exit = true;
   std::uint64_t last_coil_on_count = 0;
+  std::int64_t stats_seq = 0;  // PINBALL_STATS sequence (the LCM thread only)
 
   double pipeline_now_s() const {
     if (!sim_mode) return steady_now_s();
@@ -449,27 +450,8 @@ void Daemon::Impl::driver_thread() {
     }
     if (now >= next_status_s) {
       next_status_s = now + 0.1;
-      const firmware::DriverBusCounters k = bus->counters();
-      const firmware::BoardView view = bus->board();
-      pinball_lcm::lcmt_pinball_driver_status m{};
-      m.utime = to_utime(now);
-      m.seq = static_cast<std::int64_t>(status_seq++);
-      m.bus_state = static_cast<std::int8_t>(bus->state());
-      m.board_valid = view.valid;
-      std::int16_t coils = 0;
-      for (int d = 0; d < firmware::kMaxDrivers; ++d) {
-        if (view.valid && view.status.coil(d) != firmware::CoilState::kOff) coils = static_cast<std::int16_t>(coils | (1 << d));
-      }
-      m.coils_on = coils;
-      m.frames_sent = static_cast<std::int64_t>(k.frames_sent);
-      m.rx_frames = static_cast<std::int64_t>(k.rx_frames);
-      m.rx_bad = static_cast<std::int64_t>(k.rx_bad);
-      m.faults = static_cast<std::int64_t>(k.faults);
-      m.bus_off = static_cast<std::int64_t>(k.bus_off);
-      m.reconnects = static_cast<std::int64_t>(k.reconnects);
-      m.tx_failures = static_cast<std::int64_t>(k.tx_failures);
-      m.release_alls = static_cast<std::int64_t>(k.release_alls);
-      lcm->try_publish(m);
+      lcm->try_publish(bus::to_lcm_driver_status(to_utime(now), static_cast<std::int64_t>(status_seq++),
+                                                 bus->state(), bus->board(), bus->counters()));
     }
     if (lockstep) {
       driver_done.store(done, std::memory_order_release);
@@ -543,9 +525,8 @@ DaemonReport Daemon::Impl::report() const {
 void Daemon::Impl::publish_stats(lcm::LCM& l) {
   const DaemonReport r = report();
   pinball_lcm::lcmt_pinball_daemon_stats m;
-  static std::int64_t seq = 0;
   m.utime = to_utime(steady_now_s());
-  m.seq = seq++;
+  m.seq = stats_seq++;
   m.num_stages = kStageCount;
   for (int s = 0; s < kStageCount; ++s) {
     const LatencySummary& x = r.latency[static_cast<std::size_t>(s)];

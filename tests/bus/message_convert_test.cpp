@@ -95,6 +95,25 @@ TEST(MessageConvert, MalformedObservationsAreRefused) {
   EXPECT_TRUE(from_lcm_observation(m, found, o, c));
 }
 
+TEST(MessageConvert, DriverStatusNamesTheCoilsThatAreOn) {
+  firmware::BoardView view;
+  view.valid = true;
+  view.status.coil_states = static_cast<std::uint16_t>(static_cast<unsigned>(firmware::CoilState::kHold) << 2);
+  firmware::DriverBusCounters k;
+  k.frames_sent = 12;
+  k.bus_off = 1;
+  k.reconnects = 1;
+  const auto m = round_trip(to_lcm_driver_status(9, 3, firmware::BusState::kRunning, view, k));
+  EXPECT_EQ(m.coils_on, 0b10);  // driver 1 holds, driver 0 is off
+  EXPECT_EQ(m.bus_state, static_cast<std::int8_t>(firmware::BusState::kRunning));
+  EXPECT_TRUE(m.board_valid);
+  EXPECT_EQ(m.frames_sent, 12);
+  EXPECT_EQ(m.bus_off, 1);
+  EXPECT_EQ(m.reconnects, 1);
+  view.valid = false;
+  EXPECT_EQ(to_lcm_driver_status(9, 4, firmware::BusState::kHandshake, view, k).coils_on, 0);
+}
+
 TEST(MessageConvert, FlipperCommandRange) {
   pinball_lcm::lcmt_pinball_flipper_command m{};
   m.flipper = 1;

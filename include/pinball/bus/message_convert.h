@@ -6,9 +6,11 @@
 
 #include <cstdint>
 
+#include "pinball_lcm/lcmt_pinball_driver_status.hpp"
 #include "pinball_lcm/lcmt_pinball_flipper_command.hpp"
 #include "pinball_lcm/lcmt_pinball_observation.hpp"
 #include "pinball_lcm/lcmt_pinball_projection.hpp"
+#include "pinball/firmware/driver_bus.h"
 #include "pinball/track/observation.h"
 #include "pinball/track/tracker.h"
 
@@ -23,6 +25,13 @@ pinball_lcm::lcmt_pinball_observation to_lcm_observation(std::int64_t utime, std
 pinball_lcm::lcmt_pinball_projection to_lcm_projection(std::int64_t utime, std::int64_t seq,
                                                         std::int64_t observation_seq,
                                                         const track::TrackerOutput& output);
+
+/// A driver status message from the host's view of the link: session state,
+/// the coils the board's last Status reported on, and the bus's counters.
+pinball_lcm::lcmt_pinball_driver_status to_lcm_driver_status(std::int64_t utime, std::int64_t seq,
+                                                              firmware::BusState state,
+                                                              const firmware::BoardView& board,
+                                                              const firmware::DriverBusCounters& counters);
 
 /// The observation inside a message; false when the message is malformed
 /// (non-finite or out-of-range fields, a found ball without a position).
