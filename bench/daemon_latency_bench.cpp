@@ -11,8 +11,9 @@
 namespace pinball::bench {
 namespace {
 
-DaemonLatencyRun run_once(const DaemonLatencyOptions& o, bool realtime) {
+DaemonLatencyRun run_once(const DaemonLatencyOptions& o, bool realtime, const daemon::ThreadSettings& threads) {
   daemon::DaemonConfig c;
+  c.threads = threads;
   c.sim.board = o.board;
   c.controller = o.controller;
   c.sim.seed = o.seed;
@@ -37,6 +38,8 @@ DaemonLatencyRun run_once(const DaemonLatencyOptions& o, bool realtime) {
   run.dropped = r.frames_dropped;
   run.wall_s = r.wall_s;
   run.sim_s = r.sim_s;
+  run.cpus = r.cpus;
+  run.warnings = r.warnings;
   return run;
 }
 
@@ -76,7 +79,7 @@ nlohmann::json run_json(const DaemonLatencyRun& r) {
   return {{"frame_to_can_p50_us", e2e.p50_us}, {"frame_to_can_p99_us", e2e.p99_us},
           {"frame_to_can_max_us", e2e.max_us}, {"frame_to_can_samples", e2e.count},
           {"frames", r.frames}, {"frames_dropped", r.dropped}, {"wall_s", r.wall_s}, {"sim_s", r.sim_s},
-          {"stages", stages}};
+          {"cpus", r.cpus}, {"warnings", r.warnings}, {"stages", stages}};
 }
 
 }  // namespace
@@ -86,17 +89,30 @@ DaemonLatencyReport run_daemon_latency_bench(const DaemonLatencyOptions& options
   DaemonLatencyReport r;
   if (progress) progress("baseline: eventfd wake-up between two threads");
   doorbell_baseline(options.baseline_samples, r.wake_p50_us, r.wake_p99_us);
-  if (progress) progress("pinballd lockstep, " + std::to_string(options.lockstep_balls) + " balls");
-  r.lockstep = run_once(options, false);
-  if (progress) progress("pinballd paced to the wall clock, " + std::to_string(options.realtime_s) + " s");
-  r.realtime = run_once(options, true);
+  const daemon::ThreadSettings defaults;
+  daemon::ThreadSettings unpinned;
+  unpinned.chain_cpu = "off";
+  daemon::ThreadSettings idle_poll;
+  idle_poll.cpu_dma_latency_us = 0;
+  const std::string balls = std::to_string(options.lockstep_balls);
+  const std::string secs = std::to_string(static_cast<int>(options.realtime_s));
+  if (progress) progress("pinballd lockstep, " + balls + " balls, chain on one CPU (default)");
+  r.lockstep = run_once(options, false, defaults);
+  if (progress) progress("pinballd lockstep, " + balls + " balls, threads free to move (baseline)");
+  r.lockstep_unpinned = run_once(options, false, unpinned);
+  if (progress) progress("pinballd paced to the wall clock, " + secs + " s (default)");
+  r.realtime = run_once(options, true, defaults);
+  if (progress) progress("pinballd paced to the wall clock, " + secs + " s, idle cores polling");
+  r.realtime_idle_poll = run_once(options, true, idle_poll);
   return r;
 }
 
 nlohmann::json to_json(const DaemonLatencyReport& r) {
   return {{"fps", r.fps},
           {"lockstep", run_json(r.lockstep)},
+          {"lockstep_unpinned", run_json(r.lockstep_unpinned)},
           {"realtime", run_json(r.realtime)},
+          {"realtime_idle_poll", run_json(r.realtime_idle_poll)},
           {"baseline_wake_p50_us", r.wake_p50_us},
           {"baseline_wake_p99_us", r.wake_p99_us},
           {"target_frame_to_can_p99_us", 1000.0}};

@@ -2,14 +2,19 @@
 // `pinball bench latency`, daemon part: end-to-end frame -> CAN frame written
 // through pinballd's threads at 200 fps in the embedded simulation, per stage,
 // once on the lockstep clock (many balls, the pipeline alone on the CPU) and
-// once paced to the wall clock (the simulator rendering beside it). Baseline
-// measured in the same run: one thread waking another through the same
-// eventfd doorbell, the floor of every hand-off in the chain.
+// once paced to the wall clock (the simulator rendering beside it), each with
+// the default thread placement (the chain on one CPU, threads.chain_cpu) and
+// once more with a variant: on the lockstep clock the threads free to move
+// (chain_cpu off, the baseline), paced to the wall clock idle cores kept
+// polling (cpu_dma_latency_us 0). Baseline measured in the same run: one
+// thread waking another through the same eventfd doorbell, the floor of
+// every hand-off in the chain.
 
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -22,7 +27,7 @@ struct DaemonLatencyOptions {
   std::string board = "boards/mit1993.board";        ///< simulated table
   std::string controller = "controllers/best.json";  ///< controller file
   int lockstep_balls = 100;                          ///< balls on the lockstep clock
-  double realtime_s = 20.0;                          ///< seconds paced to the wall clock
+  double realtime_s = 60.0;                          ///< seconds paced to the wall clock, per run
   int baseline_samples = 5000;                       ///< doorbell wake-ups for the baseline
   std::uint64_t seed = 1;                            ///< launch seed
 };
@@ -34,12 +39,16 @@ struct DaemonLatencyRun {
   std::uint64_t dropped = 0;    ///< frames dropped before the camera thread
   double wall_s = 0.0;          ///< run time (s)
   double sim_s = 0.0;           ///< simulated time (s)
+  std::string cpus;             ///< thread placement (DaemonReport::cpus)
+  std::vector<std::string> warnings;  ///< e.g. cpu_dma_latency refused
 };
 
 /// The measurement.
 struct DaemonLatencyReport {
-  DaemonLatencyRun lockstep;        ///< lockstep clock
-  DaemonLatencyRun realtime;        ///< wall clock
+  DaemonLatencyRun lockstep;           ///< lockstep clock, default threads
+  DaemonLatencyRun lockstep_unpinned;  ///< lockstep clock, threads.chain_cpu off (baseline)
+  DaemonLatencyRun realtime;           ///< wall clock, default threads
+  DaemonLatencyRun realtime_idle_poll; ///< wall clock, threads.cpu_dma_latency_us 0
   double wake_p50_us = 0.0;         ///< baseline: eventfd wake-up of another thread, median (us)
   double wake_p99_us = 0.0;         ///< baseline 99th percentile (us)
   double fps = 200.0;               ///< camera rate

@@ -84,6 +84,7 @@ void DriverBus::stop() {
   wake();
   thread_.join();
   if (!hang_.load()) {
+    const std::lock_guard<std::mutex> lock(io_mutex_);
     make_safe(steady_s());
     set_state(BusState::kStopped);
   }
@@ -241,6 +242,7 @@ void DriverBus::on_message(const Message& m, double now_s) {
 }
 
 void DriverBus::poll_once(double now_s) {
+  const std::lock_guard<std::mutex> lock(io_mutex_);
   // 1. Everything the board said.
   CanFrame f;
   for (int n = 0; n < 256; ++n) {
@@ -308,7 +310,28 @@ void DriverBus::poll_once(double now_s) {
       break;
   }
 
-  // 3. Commands: ReleaseAll first, and it discards what was queued before it.
+  // 3. Commands.
+  send_commands(now_s);
+
+  // 4. The heartbeat.
+  const BusState s = state();
+  if ((s == BusState::kConfiguring || s == BusState::kRunning) &&
+      now_s - last_heartbeat_s_ >= options_.heartbeat_period_s) {
+    last_heartbeat_s_ = now_s;
+    bump(&DriverBusCounters::heartbeats);
+    send(Heartbeat{kProtocolVersion, ++seq_}, now_s);
+  }
+}
+
+bool DriverBus::send_queued(double now_s) {
+  const std::unique_lock<std::mutex> lock(io_mutex_, std::try_to_lock);
+  if (!lock.owns_lock()) return false;  // poll_once is sending: it takes the queue
+  send_commands(now_s);
+  return true;
+}
+
+// ReleaseAll first, and it discards what was queued before it. Called with io_mutex_ held.
+void DriverBus::send_commands(double now_s) {
   const std::uint32_t tail = tail_.load(std::memory_order_acquire);
   std::uint32_t head = head_.load(std::memory_order_relaxed);
   if (release_all_pending_.exchange(false, std::memory_order_acq_rel)) {
@@ -328,15 +351,6 @@ void DriverBus::poll_once(double now_s) {
     }
   }
   head_.store(head, std::memory_order_release);
-
-  // 4. The heartbeat.
-  const BusState s = state();
-  if ((s == BusState::kConfiguring || s == BusState::kRunning) &&
-      now_s - last_heartbeat_s_ >= options_.heartbeat_period_s) {
-    last_heartbeat_s_ = now_s;
-    bump(&DriverBusCounters::heartbeats);
-    send(Heartbeat{kProtocolVersion, ++seq_}, now_s);
-  }
 }
 
 void DriverBus::run() {

@@ -1,5 +1,6 @@
 // `pinball bench KIND`: the measurements behind docs/results.md.
 
+#include <array>
 #include <fstream>
 #include <ostream>
 #include <stdexcept>
@@ -110,11 +111,17 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
       << r.stack_overhead_ratio << "x)\n"
       << "encode+decode per frame " << r.encode_decode_ns << " ns (copy baseline " << r.copy_baseline_ns << " ns)\n"
       << "coil safety violations " << r.coil_violations << "\n";
-  for (const auto* run : {&d.lockstep, &d.realtime}) {
+  const std::array<std::pair<const char*, const bench::DaemonLatencyRun*>, 4> runs{{
+      {"lockstep", &d.lockstep},
+      {"lockstep, threads free to move (baseline)", &d.lockstep_unpinned},
+      {"real-time", &d.realtime},
+      {"real-time, idle cores polling", &d.realtime_idle_poll}}};
+  for (const auto& [name, run] : runs) {
     const daemon::LatencySummary& e2e = run->stages[daemon::kFrameToCan];
-    out << "pinballd " << (run == &d.lockstep ? "lockstep" : "real-time") << " at " << d.fps << " fps, "
-        << run->frames << " frames: frame -> CAN written p50 " << e2e.p50_us << " us, p99 " << e2e.p99_us
-        << " us, max " << e2e.max_us << " us (" << e2e.count << " commands)\n";
+    out << "pinballd " << name << " at " << d.fps << " fps, " << run->frames
+        << " frames: frame -> CAN written p50 " << e2e.p50_us << " us, p99 " << e2e.p99_us << " us, max "
+        << e2e.max_us << " us (" << e2e.count << " commands; " << run->cpus << ")\n";
+    for (const std::string& w : run->warnings) out << "  warning: " << w << "\n";
   }
   out << "  baseline eventfd wake-up of another thread: p50 " << d.wake_p50_us << " us, p99 " << d.wake_p99_us
       << " us\n";

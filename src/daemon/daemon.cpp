@@ -64,6 +64,7 @@ firmware::DriverBusOptions bus_options(const DaemonConfig& c, int drivers) {
 
 struct Daemon::Impl {
   DaemonConfig config;
+  CpuPlan cpus;  // threads.chain_cpu
   bool sim_mode = true;
   bool lockstep = true;
   sim::Board board;
@@ -120,15 +121,20 @@ struct Daemon::Impl {
     return steady_now_s() - wall_offset_s;
   }
 
-  // Names the calling thread and applies its scheduling; a refusal becomes a warning.
+  // Names the calling thread and applies its scheduling and CPUs; a refusal becomes a warning.
   void enter_thread(ThreadId id) {
     std::string why;
-    if (configure_current_thread(id, config.threads.realtime, why,
-                                 config.threads.priorities[static_cast<std::size_t>(id)])) {
-      return;
-    }
+    const bool scheduled = configure_current_thread(id, config.threads.realtime, why,
+                                                    config.threads.priorities[static_cast<std::size_t>(id)]);
+    // On the lockstep clock the world waits for the chain and the chain for
+    // the world: the simulator is one more link of it and runs on its CPU.
+    const bool on_chain = kThreadTable[static_cast<std::size_t>(id)].chain || (id == kSimThread && lockstep);
+    std::string pin_why;
+    const bool pinned = pin_current_thread(on_chain ? cpus.chain : cpus.others, pin_why);
+    if (scheduled && pinned) return;
     const std::lock_guard<std::mutex> lock(warnings_mutex);
-    warnings.push_back(why);
+    if (!scheduled) warnings.push_back(why);
+    if (!pinned) warnings.push_back(pin_why);
   }
   void build();
   void learn_background();
@@ -137,6 +143,7 @@ struct Daemon::Impl {
   void camera_thread();
   void controller_thread();
   void driver_thread();
+  void send_now(ControllerStage::Commands& cmds, int n, double now_s);
   void publish_commands(const ControllerStage::Commands& cmds, int n);
   void publish_stats(lcm::LCM& lcm);
   void shutdown();
@@ -154,6 +161,7 @@ std::string find_data_file(const std::string& path) {
 
 void Daemon::Impl::build() {
   sim_mode = config.mode == "sim";
+  cpus = plan_cpus(config.threads.chain_cpu);
   config.sim.board = find_data_file(config.sim.board);
   config.board = find_data_file(config.board);
   config.controller = find_data_file(config.controller);
@@ -372,6 +380,14 @@ void Daemon::Impl::camera_thread() {
   controller_bell.ring();
 }
 
+// Writes the commands' CAN frames on the controller thread, saving the wake-up
+// of the driver thread; when the driver thread is busy sending, it takes them.
+void Daemon::Impl::send_now(ControllerStage::Commands& cmds, int n, double now_s) {
+  if (n == 0 || !bus->send_queued(now_s)) return;
+  const double written = steady_now_s();
+  for (int i = 0; i < n; ++i) cmds[static_cast<std::size_t>(i)].written_wall_s = written;
+}
+
 void Daemon::Impl::publish_commands(const ControllerStage::Commands& cmds, int n) {
   for (int i = 0; i < n; ++i) {
     const CommandRecord& c = cmds[static_cast<std::size_t>(i)];
@@ -398,6 +414,7 @@ void Daemon::Impl::controller_thread() {
       if (lockstep) virtual_now_s.store(record.t_s, std::memory_order_release);
       const double now = lockstep ? record.t_s : pipeline_now_s();
       const int n = controller_stage->on_record(record, now, steady_now_s(), cmds);
+      send_now(cmds, n, now);
       latency[kProjectionToDecision].record((steady_now_s() - record.projected_wall_s) * 1e6);
       publish_commands(cmds, n);
       records_done.fetch_add(1, std::memory_order_acq_rel);
@@ -408,7 +425,9 @@ void Daemon::Impl::controller_thread() {
     controller_bell.wait(frame_period_s);
     if (!lockstep) {
       HotPathScope hot;
-      const int n = controller_stage->on_idle(pipeline_now_s(), steady_now_s(), cmds);
+      const double now = pipeline_now_s();
+      const int n = controller_stage->on_idle(now, steady_now_s(), cmds);
+      send_now(cmds, n, now);
       if (n > 0) {
         publish_commands(cmds, n);
         driver_bell.ring();
@@ -439,8 +458,9 @@ void Daemon::Impl::driver_thread() {
     }
     const double now = pipeline_now_s();
     bus->poll_once(now);
-    const double written = steady_now_s();
+    const double polled = steady_now_s();
     while (commands.try_pop(c)) {
+      const double written = c.written_wall_s > 0.0 ? c.written_wall_s : polled;  // > 0: sent by the controller thread
       latency[kCommandToCan].record((written - c.command_wall_s) * 1e6);
       if (c.capture_wall_s > 0.0) latency[kFrameToCan].record((written - c.capture_wall_s) * 1e6);
       if (c.energize && c.flipper >= 0) {
@@ -505,6 +525,7 @@ DaemonReport Daemon::Impl::report() const {
     r.warnings = warnings;
   }
   r.coils_off_at_exit = coils_off_at_exit;
+  r.cpus = cpus.describe;
   if (world) {
     r.results = world->results();
     r.board = world->driver_board().counters();
@@ -573,6 +594,16 @@ DaemonReport Daemon::run() {
       throw std::runtime_error("real-time scheduling refused (threads.enforce: true): " + d.warnings.front());
     }
     for (const std::string& w : d.warnings) std::fprintf(stderr, "pinballd: warning: %s; running without it\n", w.c_str());
+  }
+  std::unique_ptr<CpuLatencyRequest> cpu_latency;
+  if (d.config.threads.cpu_dma_latency_us >= 0) {
+    cpu_latency = std::make_unique<CpuLatencyRequest>(d.config.threads.cpu_dma_latency_us);
+    if (!cpu_latency->ok()) {
+      if (d.config.threads.enforce) throw std::runtime_error("threads.cpu_dma_latency_us refused: " + cpu_latency->why());
+      std::fprintf(stderr, "pinballd: warning: %s; running without it\n", cpu_latency->why().c_str());
+      const std::lock_guard<std::mutex> lock(d.warnings_mutex);
+      d.warnings.push_back(cpu_latency->why());
+    }
   }
   if (d.config.camera.source == "file" || d.config.camera.source == "v4l2") {
     vision::CaptureConfig cc;
@@ -660,6 +691,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["coils_off_at_exit"] = r.coils_off_at_exit;
   j["wall_s"] = r.wall_s;
   j["sim_s"] = r.sim_s;
+  j["cpus"] = r.cpus;
   j["warnings"] = r.warnings;
   return j;
 }
@@ -684,6 +716,7 @@ std::string report_to_text(const DaemonReport& r) {
     o << std::left << std::setw(24) << stage_name(s) << std::right << std::setw(10) << x.count << std::setw(10)
       << x.p50_us << std::setw(10) << x.p99_us << std::setw(10) << x.max_us << "\n";
   }
+  o << "threads: " << r.cpus << "\n";
   for (const std::string& w : r.warnings) o << "warning: " << w << "\n";
   return o.str();
 }

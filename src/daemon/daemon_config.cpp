@@ -138,6 +138,8 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
   Section threads = top.child("threads");
   threads.read("realtime", c.threads.realtime);
   threads.read("enforce", c.threads.enforce);
+  threads.read("chain_cpu", c.threads.chain_cpu);
+  threads.read("cpu_dma_latency_us", c.threads.cpu_dma_latency_us);
   Section prio = threads.child("priorities");
   static constexpr std::array<const char*, 5> kNames{"driver", "controller", "camera", "sim", "lcm"};
   for (std::size_t i = 0; i < kNames.size(); ++i) {
@@ -178,6 +180,12 @@ void validate_daemon_config(const DaemonConfig& c, const std::string& s) {
   require(c.sim.actuation_delay_s >= 0.0 && c.sim.actuation_delay_s < 0.1, s, "sim.actuation_delay_s",
           "must be in [0, 0.1) s");
   require(positive(c.sim.max_ball_time_s), s, "sim.max_ball_time_s", "must be > 0");
+  require(c.threads.chain_cpu == "auto" || c.threads.chain_cpu == "off" ||
+              (!c.threads.chain_cpu.empty() && c.threads.chain_cpu.size() <= 4 &&
+               c.threads.chain_cpu.find_first_not_of("0123456789") == std::string::npos),
+          s, "threads.chain_cpu", "must be auto, off or a CPU number");
+  require(c.threads.cpu_dma_latency_us >= -1 && c.threads.cpu_dma_latency_us <= 1'000'000, s,
+          "threads.cpu_dma_latency_us", "must be -1 (leave alone) or in [0, 1000000] us");
   if (c.mode == "sim") {
     require(c.camera.source == "sim", s, "camera.source", "must be sim in mode sim");
     require(c.can.interface == "sim", s, "can.interface", "must be sim in mode sim");

@@ -62,8 +62,9 @@ int main(int argc, char** argv) {
   }
   if (threads) {
     for (const ThreadSpec& t : kThreadTable) {
-      const std::string policy = t.fifo_priority > 0 ? "FIFO " + std::to_string(t.fifo_priority) : "OTHER";
-      std::printf("%-14s %-8s %-48s %s\n", t.name, policy.c_str(), t.period, t.job);
+      const std::string policy = t.fifo_priority > 0 ? "FIFO " + std::to_string(t.fifo_priority)
+                                                     : "OTHER nice " + std::to_string(t.nice);
+      std::printf("%-14s %-14s %-6s %-48s %s\n", t.name, policy.c_str(), t.chain ? "chain" : "", t.period, t.job);
     }
     return 0;
   }

@@ -24,6 +24,8 @@ TEST(DaemonConfig, EmptyFileGivesTheEmbeddedSimulation) {
   EXPECT_EQ(c.lcm_url, "memq://");
   EXPECT_EQ(c.controller, "controllers/best.json");
   EXPECT_FALSE(c.sim.realtime);
+  EXPECT_EQ(c.threads.chain_cpu, "auto");
+  EXPECT_EQ(c.threads.cpu_dma_latency_us, -1);
 }
 
 TEST(DaemonConfig, ReadsEverySection) {
@@ -33,7 +35,7 @@ sim: {balls: 3, seed: 9, realtime: true, actuation_delay_s: 0.002}
 camera: {fps: 300, stall_timeout_s: 0.03}
 can: {board_id: 2, heartbeat_period_s: 0.01, watchdog_timeout_s: 0.05}
 coils: {pulse_ms: 25, hold_duty_pct: 30, max_hold_ms: 4000}
-threads: {realtime: true, enforce: false, priorities: {driver: 95, lcm: 10}}
+threads: {realtime: true, enforce: false, priorities: {driver: 95, lcm: 10}, chain_cpu: 1, cpu_dma_latency_us: 0}
 lcm_url: "udpm://239.255.76.67:7667?ttl=0"
 )", "t.yaml");
   EXPECT_EQ(c.sim.balls, 3);
@@ -48,6 +50,8 @@ lcm_url: "udpm://239.255.76.67:7667?ttl=0"
   EXPECT_EQ(c.threads.priorities[0], 95);
   EXPECT_EQ(c.threads.priorities[1], 85);  // the table's
   EXPECT_EQ(c.threads.priorities[4], 10);
+  EXPECT_EQ(c.threads.chain_cpu, "1");
+  EXPECT_EQ(c.threads.cpu_dma_latency_us, 0);
   EXPECT_EQ(c.lcm_url, "udpm://239.255.76.67:7667?ttl=0");
 }
 
@@ -63,6 +67,10 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
   EXPECT_EQ(error_of("camera: 5"), "t.yaml: camera: must be a mapping");
   EXPECT_EQ(error_of("threads: {priorities: {camera: 120}}"), "t.yaml: threads.priorities.camera: must be in [0, 99]");
   EXPECT_EQ(error_of("threads: {priorities: {gpu: 1}}"), "t.yaml: threads.priorities.gpu: unknown key");
+  EXPECT_EQ(error_of("threads: {chain_cpu: fast}"), "t.yaml: threads.chain_cpu: must be auto, off or a CPU number");
+  EXPECT_EQ(error_of("threads: {chain_cpu: -3}"), "t.yaml: threads.chain_cpu: must be auto, off or a CPU number");
+  EXPECT_EQ(error_of("threads: {cpu_dma_latency_us: -5}"),
+            "t.yaml: threads.cpu_dma_latency_us: must be -1 (leave alone) or in [0, 1000000] us");
   EXPECT_NE(error_of("camera: {fps: [").find("t.yaml:1: not valid YAML"), std::string::npos);
 }
 

@@ -60,6 +60,33 @@ TEST(Daemon, LockstepRunsAreDeterminedByTheSeed) {
   EXPECT_EQ(a.board.watchdog_trips, 0u);
 }
 
+// Where the threads run and who writes the CAN frame change the timing, never the game.
+TEST(Daemon, PinningDoesNotChangeTheGame) {
+  DaemonConfig pinned = sim_config(2, 5);
+  DaemonConfig free = pinned;
+  free.threads.chain_cpu = "off";
+  DaemonReport a, b;
+  {
+    Daemon d(pinned);
+    a = d.run();
+  }
+  {
+    Daemon d(free);
+    b = d.run();
+  }
+  EXPECT_EQ(b.cpus, "not pinned");
+  EXPECT_FALSE(a.cpus.empty());
+  ASSERT_EQ(a.balls, b.balls);
+  for (std::size_t i = 0; i < a.results.size(); ++i) EXPECT_EQ(a.results[i].score, b.results[i].score);
+  EXPECT_EQ(a.commands, b.commands);
+  EXPECT_EQ(a.driver.fires, b.driver.fires);
+  // Every command has its command->CAN latency, but for the shutdown's
+  // release, given after the threads have stopped.
+  EXPECT_GT(a.latency[kFrameToCan].count, 0u);
+  EXPECT_LE(a.latency[kCommandToCan].count, a.commands);
+  EXPECT_GE(a.latency[kCommandToCan].count + 2, a.commands);
+}
+
 TEST(Daemon, FullPathScoresLikeTheFastLearningLoop) {
   // The same controller on the same 20 ball seeds: the daemon (pixels,
   // detector, rings, CAN, virtual board) and the fast loop (camera model,

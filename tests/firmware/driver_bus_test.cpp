@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <linux/can/error.h>
 
+#include <atomic>
 #include <chrono>
 #include <thread>
 
@@ -227,6 +228,78 @@ TEST_F(DriverBusTest, StopSwitchesEveryCoilOff) {
   board_.service(*link_, t_ += 0.001);
   EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
   EXPECT_EQ(board_.counters().watchdog_trips, 0u);
+}
+
+// The controller's fast path: the frame leaves on the caller's thread, with no poll_once.
+TEST_F(DriverBusTest, SendQueuedWritesTheCommandOnTheCallersThread) {
+  DriverBus bus(*host_, bus_options());
+  run(bus, 0.05);
+  ASSERT_EQ(bus.state(), BusState::kRunning);
+  const std::uint64_t sent_before = bus.counters().frames_sent;
+  ASSERT_TRUE(bus.fire(0));
+  EXPECT_TRUE(bus.send_queued(t_));
+  EXPECT_EQ(bus.counters().frames_sent, sent_before + 1);
+  board_.service(*link_, t_ += 0.0005);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kPulse);
+  // Nothing is sent twice: the queue is empty for the next poll.
+  run(bus, 0.001);
+  EXPECT_EQ(board_.counters().fires_accepted, 1u);
+}
+
+TEST_F(DriverBusTest, SendQueuedSendsReleaseAllFirstAndDropsWhenNotRunning) {
+  DriverBus bus(*host_, bus_options());
+  ASSERT_TRUE(bus.fire(0));  // no session yet
+  EXPECT_TRUE(bus.send_queued(t_));
+  EXPECT_EQ(bus.counters().dropped_not_running, 1u);
+  run(bus, 0.05);
+  bus.fire(0);
+  bus.fire(1);
+  bus.release_all();
+  EXPECT_TRUE(bus.send_queued(t_));
+  board_.service(*link_, t_ += 0.0005);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  EXPECT_EQ(board_.coil(1).state, CoilState::kOff);
+  EXPECT_EQ(board_.counters().fires_accepted, 0u);
+}
+
+// A link whose receive() can be held, to catch poll_once in the middle of its work.
+class GatedLink : public CanTransport {
+ public:
+  explicit GatedLink(CanTransport& inner) : inner_(inner) {}
+  TxStatus send(const CanFrame& frame) override { return inner_.send(frame); }
+  RxStatus receive(CanFrame& frame, int timeout_ms) override {
+    if (armed_.exchange(false)) {
+      inside_ = true;
+      while (!open_.load()) std::this_thread::yield();
+    }
+    return inner_.receive(frame, timeout_ms);
+  }
+  int poll_fd() const override { return inner_.poll_fd(); }
+  TransportCounters counters() const override { return inner_.counters(); }
+  std::atomic<bool> armed_{false}, inside_{false}, open_{false};
+
+ private:
+  CanTransport& inner_;
+};
+
+TEST_F(DriverBusTest, SendQueuedNeverWaitsForABusyPoll) {
+  GatedLink gated(*host_);
+  DriverBus bus(gated, bus_options());
+  run(bus, 0.05);
+  ASSERT_EQ(bus.state(), BusState::kRunning);
+  gated.armed_ = true;
+  std::thread poller([&] { bus.poll_once(t_); });
+  while (!gated.inside_.load()) std::this_thread::yield();
+  // poll_once holds the bus: the fast path returns at once and leaves the command queued.
+  ASSERT_TRUE(bus.fire(0));
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(bus.send_queued(t_));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 0.05);
+  gated.open_ = true;
+  poller.join();  // its command step takes the queued fire
+  board_.service(*link_, t_ += 0.0005);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kPulse);
+  EXPECT_EQ(board_.counters().fires_accepted, 1u);
 }
 
 }  // namespace

@@ -68,6 +68,7 @@ struct DaemonReport {
   firmware::BoardCounters board;             ///< virtual board (sim)
   double wall_s = 0.0;                       ///< run time (s)
   double sim_s = 0.0;                        ///< simulated time (s)
+  std::string cpus;                          ///< where the threads ran (threads.chain_cpu)
   bool coils_off_at_exit = true;             ///< sim: every coil of the virtual board was off after shutdown
   std::vector<std::string> warnings;         ///< e.g. real-time scheduling refused
 };

@@ -43,6 +43,14 @@ struct ThreadSettings {
   /// SCHED_FIFO priority (1..99) per thread, in ThreadId order (driver, controller, camera, sim, lcm);
   /// 0 leaves a thread SCHED_OTHER. Defaults: the thread table.
   std::array<int, 5> priorities{90, 85, 80, 70, 0};
+  /// The CPU of the frame -> CAN chain (camera, controller and driver threads):
+  /// "auto" the highest CPU the process may use (the other threads get the
+  /// rest), "off" no pinning, or a CPU number (e.g. one kept free with isolcpus).
+  std::string chain_cpu = "auto";
+  /// Holds /dev/cpu_dma_latency at this many microseconds while running (-1:
+  /// leave it alone). 0 keeps idle cores polling instead of sleeping, so that
+  /// waking a thread costs microseconds, not a deep-idle exit (needs root).
+  int cpu_dma_latency_us = -1;
 };
 
 /// The embedded simulation.

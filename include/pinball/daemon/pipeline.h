@@ -60,6 +60,7 @@ struct CommandRecord {
   double t_s = 0.0;                  ///< pipeline clock (s)
   double capture_wall_s = 0.0;       ///< steady clock of the frame behind it (0: none)
   double command_wall_s = 0.0;       ///< steady clock when DriverBus accepted it
+  double written_wall_s = 0.0;       ///< steady clock when its CAN frame was written (0: not yet)
 };
 
 /// Counters of the camera stage.

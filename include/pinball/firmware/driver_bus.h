@@ -6,11 +6,16 @@
 // Status and Faults. On any failure it makes the coils safe first (ReleaseAll)
 // and counts. Without start(), poll_once(now) runs one iteration on the
 // caller's clock (the simulator's lockstep and deterministic tests).
+// A controller in a hurry may call send_queued(now) after enqueueing: it
+// writes the queue on its own thread unless the bus thread is busy at that
+// moment (a try-lock: it never waits), which saves one thread wake-up
+// between a decision and its CAN frame.
 
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <thread>
 
 #include "pinball/firmware/can_transport.h"
@@ -102,6 +107,13 @@ class DriverBus {
   /// session, send commands and the heartbeat. For use without start().
   void poll_once(double now_s);
 
+  /// Sends what is queued (ReleaseAll first) on the calling thread, unless
+  /// poll_once is running elsewhere at this moment: never blocks on another
+  /// thread. True when the queue was sent (or discarded because the session
+  /// is not running); false when the bus was busy, and the next poll_once
+  /// sends it. At most one caller besides the bus's own thread.
+  bool send_queued(double now_s);
+
   /// Session state.
   BusState state() const { return state_.load(std::memory_order_acquire); }
   /// Counters so far.
@@ -131,6 +143,7 @@ class DriverBus {
   void on_message(const Message& m, double now_s);
   void on_error_frame(const CanFrame& f, double now_s);
   void set_state(BusState s) { state_.store(s, std::memory_order_release); }
+  void send_commands(double now_s);
 
   CanTransport& transport_;
   DriverBusOptions options_;
@@ -141,6 +154,10 @@ class DriverBus {
   std::atomic<std::uint32_t> head_{0};
   std::atomic<std::uint32_t> tail_{0};
   std::atomic<bool> release_all_pending_{false};
+
+  // Serialises every send and the bus-thread state below between poll_once
+  // and send_queued, so that frames leave in the order they were decided.
+  std::mutex io_mutex_;
 
   // Bus-thread state.
   std::uint16_t seq_ = 0;
