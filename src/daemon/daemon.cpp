@@ -65,6 +65,7 @@ firmware::DriverBusOptions bus_options(const DaemonConfig& c, int drivers) {
 struct Daemon::Impl {
   DaemonConfig config;
   CpuPlan cpus;  // threads.chain_cpu
+  bool fifo_allowed = true;  // false once the probe was refused: warned once, not once per thread
   bool sim_mode = true;
   bool lockstep = true;
   sim::Board board;
@@ -124,7 +125,7 @@ struct Daemon::Impl {
   // Names the calling thread and applies its scheduling and CPUs; a refusal becomes a warning.
   void enter_thread(ThreadId id) {
     std::string why;
-    const bool scheduled = configure_current_thread(id, config.threads.realtime, why,
+    const bool scheduled = configure_current_thread(id, config.threads.realtime && fifo_allowed, why,
                                                     config.threads.priorities[static_cast<std::size_t>(id)]);
     // On the lockstep clock the world waits for the chain and the chain for
     // the world: the simulator is one more link of it and runs on its CPU.
@@ -589,7 +590,10 @@ DaemonReport Daemon::run() {
     std::thread([&] {
       configure_current_thread(kDriverThread, true, probe_why, d.config.threads.priorities[kDriverThread]);
     }).join();
-    if (!probe_why.empty()) d.warnings.push_back(probe_why);
+    if (!probe_why.empty()) {
+      d.warnings.push_back(probe_why);
+      d.fifo_allowed = false;
+    }
     if (d.config.threads.enforce && !d.warnings.empty()) {
       throw std::runtime_error("real-time scheduling refused (threads.enforce: true): " + d.warnings.front());
     }

@@ -263,20 +263,63 @@ TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
   EXPECT_NE(err_text.find("frame->can_written"), std::string::npos) << err_text;
 }
 
+// Runs `cmd` through the shell; returns its exit status and what it printed.
+int run_shell(const std::string& cmd, std::string& output) {
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return -1;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) output += buf;
+  const int status = pclose(p);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr) << path;
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+}
+
 TEST(Pinballd, BadConfigExitsOneNamingTheKey) {
   const std::string path = ::testing::TempDir() + "/bad_pinballd.yaml";
-  FILE* f = std::fopen(path.c_str(), "w");
-  std::fputs("camera:\n  fsp: 200\n", f);
-  std::fclose(f);
-  const std::string cmd = std::string(PINBALLD_EXE) + " --config " + path + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
+  write_file(path, "camera:\n  fsp: 200\n");
   std::string text;
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, p) != nullptr) text += buf;
-  const int status = pclose(p);
-  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --config " + path + " 2>&1", text), 1);
   EXPECT_NE(text.find("camera.fsp: unknown key"), std::string::npos) << text;
+}
+
+// An ordinary user (no CAP_SYS_NICE, RLIMIT_RTPRIO 0) asking for real-time
+// scheduling: refused, pinballd warns once and plays; with enforce it exits 1.
+TEST(Pinballd, RealTimeRefusedWarnsAndPlaysOrWithEnforceExitsOne) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to drop to an unprivileged user";
+  if (access("/usr/bin/setpriv", X_OK) != 0) GTEST_SKIP() << "no /usr/bin/setpriv (util-linux)";
+  const std::string unprivileged =
+      "ulimit -r 0; ulimit -l 64; exec /usr/bin/setpriv --reuid=65534 --regid=65534 --clear-groups --inh-caps=-all ";
+  for (const bool enforce : {false, true}) {
+    const std::string path = ::testing::TempDir() + "/pinballd_rt_" + (enforce ? "enforce" : "warn") + ".yaml";
+    write_file(path, "version: 1\nmode: sim\ncontroller: " + kSource + "/controllers/best.json\nsim: {board: " +
+                         kSource + "/boards/mit1993.board, balls: 1}\nthreads: {realtime: true, enforce: " +
+                         (enforce ? "true" : "false") + "}\n");
+    const std::string errors = path + ".err";
+    std::string out;
+    const int status =
+        run_shell("sh -c '" + unprivileged + PINBALLD_EXE + " --config " + path + " --json' 2> " + errors, out);
+    std::string err;
+    run_shell("cat " + errors, err);
+    if (!enforce) {
+      ASSERT_EQ(status, 0) << err;
+      const nlohmann::json j = nlohmann::json::parse(out);
+      EXPECT_EQ(j["balls"].get<int>(), 1);
+      EXPECT_TRUE(j["coils_off_at_exit"].get<bool>());
+      int fifo_warnings = 0;  // one, not one per thread
+      for (const auto& w : j["warnings"]) fifo_warnings += w.get<std::string>().find("SCHED_FIFO") == 0 ? 1 : 0;
+      EXPECT_EQ(fifo_warnings, 1) << j["warnings"].dump();
+      EXPECT_NE(err.find("warning: SCHED_FIFO"), std::string::npos) << err;
+    } else {
+      EXPECT_EQ(status, 1) << err;
+      EXPECT_NE(err.find("real-time scheduling refused (threads.enforce: true)"), std::string::npos) << err;
+    }
+  }
 }
 
 }  // namespace
