@@ -11,21 +11,77 @@
 
 namespace pinball::learn {
 
-std::uint64_t cross_entropy_generation_balls(const CrossEntropyConfig& c) {
+std::uint64_t halving_race_balls(int candidates, std::uint64_t first_round_balls) {
   std::uint64_t total = 0;
-  std::uint64_t balls = static_cast<std::uint64_t>(c.first_round_balls);
-  for (int alive = c.population; alive > 1; alive = (alive + 1) / 2) {
+  std::uint64_t balls = first_round_balls;
+  for (int alive = candidates; alive > 1; alive = (alive + 1) / 2) {
     total += static_cast<std::uint64_t>(alive) * balls;
     balls *= 2;
   }
   return total;
 }
 
+std::uint64_t cross_entropy_generation_balls(const CrossEntropyConfig& c) {
+  return halving_race_balls(c.population, static_cast<std::uint64_t>(c.first_round_balls));
+}
+
+namespace {
+
+// What a sequential-halving race on common random numbers found.
+struct RaceResult {
+  std::vector<std::size_t> ranking;  // best first
+  std::vector<RunningStats> stats;   // per candidate
+  double balls_sum = 0.0;            // sum of every ball's score
+  std::uint64_t balls = 0;           // balls played
+};
+
+// Each round, every candidate still in plays the same fresh balls; the better
+// half goes on with twice the balls.
+RaceResult halving_race(SearchRun& run, const std::vector<control::ControllerSpec>& cand,
+                        std::uint64_t first_round_balls) {
+  RaceResult r;
+  r.stats.resize(cand.size());
+  std::vector<std::size_t> alive(cand.size());
+  std::iota(alive.begin(), alive.end(), 0);
+  std::uint64_t balls = first_round_balls;
+  while (alive.size() > 1) {
+    std::vector<std::uint64_t> seeds;
+    for (std::uint64_t b = 0; b < balls; ++b) seeds.push_back(run.fresh_seed());
+    std::vector<BallTask> tasks;
+    for (std::size_t j : alive) {
+      for (std::uint64_t sd : seeds) tasks.push_back({&cand[j], sd});
+    }
+    const std::vector<BallOutcome> out = run.play(tasks);
+    for (std::size_t a = 0; a < alive.size(); ++a) {
+      for (std::uint64_t b = 0; b < balls; ++b) {
+        const double score = out[a * balls + b].score;
+        r.stats[alive[a]].add(score);
+        r.balls_sum += score;
+        ++r.balls;
+      }
+    }
+    std::stable_sort(alive.begin(), alive.end(),
+                     [&](std::size_t x, std::size_t y) { return r.stats[x].mean() > r.stats[y].mean(); });
+    const std::size_t keep = (alive.size() + 1) / 2;
+    for (std::size_t a = alive.size(); a-- > keep;) r.ranking.push_back(alive[a]);
+    alive.resize(keep);
+    balls *= 2;
+  }
+  r.ranking.push_back(alive[0]);
+  std::reverse(r.ranking.begin(), r.ranking.end());
+  return r;
+}
+
+}  // namespace
+
 SearchResult run_cross_entropy(const BallObjective& objective, const SearchConfig& config,
                                const CrossEntropyConfig& c) {
   if (c.population < 2 || c.first_round_balls < 1 || !(c.elite_fraction > 0.0 && c.elite_fraction <= 1.0) ||
-      !(c.smoothing > 0.0 && c.smoothing <= 1.0) || !(c.initial_sigma > 0.0) || !(c.min_sigma >= 0.0)) {
-    throw std::invalid_argument("cross-entropy: population >= 2, first round balls >= 1, 0 < elite, smoothing <= 1");
+      !(c.smoothing > 0.0 && c.smoothing <= 1.0) || !(c.initial_sigma > 0.0) || !(c.min_sigma >= 0.0) ||
+      !(c.final_race_fraction >= 0.0 && c.final_race_fraction < 1.0) || c.final_race_size < 1) {
+    throw std::invalid_argument(
+        "cross-entropy: population >= 2, first round balls >= 1, 0 < elite, smoothing <= 1, "
+        "0 <= final race fraction < 1, final race size >= 1");
   }
   SearchRun run(objective, config, "cem");
   const control::ControllerSpec prototype = objective.prototype();
@@ -61,7 +117,10 @@ SearchResult run_cross_entropy(const BallObjective& objective, const SearchConfi
   const std::uint64_t per_generation = cross_entropy_generation_balls(c);
   const std::size_t n = static_cast<std::size_t>(c.population);
   const std::size_t elites = std::max<std::size_t>(2, static_cast<std::size_t>(std::lround(c.elite_fraction * c.population)));
-  while (run.balls_left() >= per_generation) {
+  const auto final_race_budget =
+      static_cast<std::uint64_t>(c.final_race_fraction * static_cast<double>(config.budget_balls));
+  std::vector<control::ControllerSpec> winners;  // the latest generations' winners, oldest first
+  while (run.balls_left() >= per_generation + final_race_budget) {
     // Sample the population; the incumbent (best so far) is candidate 0.
     std::vector<Eigen::VectorXd> xs(n);
     std::vector<std::vector<int>> fs(n);
@@ -78,39 +137,9 @@ SearchResult run_cross_entropy(const BallObjective& objective, const SearchConfi
       }
       cand.push_back(decode(xs[j], fs[j]));
     }
-    // Sequential halving on common random numbers.
-    std::vector<RunningStats> stats(n);
-    std::vector<std::size_t> alive(n);
-    std::iota(alive.begin(), alive.end(), 0);
-    std::vector<std::size_t> ranking;  // best first, filled from the back
-    std::uint64_t balls = static_cast<std::uint64_t>(c.first_round_balls);
-    double population_sum = 0.0;
-    std::uint64_t population_balls = 0;
-    while (alive.size() > 1) {
-      std::vector<std::uint64_t> seeds;
-      for (std::uint64_t b = 0; b < balls; ++b) seeds.push_back(run.fresh_seed());
-      std::vector<BallTask> tasks;
-      for (std::size_t j : alive) {
-        for (std::uint64_t sd : seeds) tasks.push_back({&cand[j], sd});
-      }
-      const std::vector<BallOutcome> out = run.play(tasks);
-      for (std::size_t a = 0; a < alive.size(); ++a) {
-        for (std::uint64_t b = 0; b < balls; ++b) {
-          const double score = out[a * balls + b].score;
-          stats[alive[a]].add(score);
-          population_sum += score;
-          ++population_balls;
-        }
-      }
-      std::stable_sort(alive.begin(), alive.end(),
-                       [&](std::size_t x, std::size_t y) { return stats[x].mean() > stats[y].mean(); });
-      const std::size_t keep = (alive.size() + 1) / 2;
-      for (std::size_t a = alive.size(); a-- > keep;) ranking.push_back(alive[a]);
-      alive.resize(keep);
-      balls *= 2;
-    }
-    ranking.push_back(alive[0]);
-    std::reverse(ranking.begin(), ranking.end());
+    const RaceResult race = halving_race(run, cand, static_cast<std::uint64_t>(c.first_round_balls));
+    const std::vector<std::size_t>& ranking = race.ranking;
+    const std::vector<RunningStats>& stats = race.stats;
     const std::size_t winner = ranking[0];
     run.set_best(cand[winner], stats[winner].mean(), static_cast<std::uint64_t>(stats[winner].count()));
     run.count("incumbent_kept", winner == 0 && incumbent ? 1.0 : 0.0);
@@ -129,8 +158,31 @@ SearchResult run_cross_entropy(const BallObjective& objective, const SearchConfi
     mu = (1.0 - c.smoothing) * mu + c.smoothing * mean_e;
     sigma = ((1.0 - c.smoothing) * sigma + c.smoothing * var_e.cwiseSqrt()).cwiseMax(c.min_sigma);
     p_right = ((1.0 - c.smoothing) * p_right + c.smoothing * right_e).cwiseMax(0.05).cwiseMin(0.95);
-    run.end_generation(population_balls > 0 ? population_sum / static_cast<double>(population_balls) : 0.0,
+    winners.push_back(cand[winner]);
+    if (winners.size() > static_cast<std::size_t>(c.final_race_size)) winners.erase(winners.begin());
+    run.end_generation(race.balls > 0 ? race.balls_sum / static_cast<double>(race.balls) : 0.0,
                        stats[winner].mean());
+  }
+  // The final race: the recent winners and the distribution's mean (every
+  // gain at mu, each flipper the likelier one), on as many balls as the rest
+  // of the budget pays for.
+  if (c.final_race_fraction > 0.0 && !winners.empty()) {
+    std::vector<control::ControllerSpec> finalists = winners;
+    std::vector<int> likelier(static_cast<std::size_t>(k));
+    for (int p = 0; p < k; ++p) likelier[static_cast<std::size_t>(p)] = p_right(p) > 0.5 ? 1 : 0;
+    finalists.push_back(decode(mu, likelier));
+    const std::uint64_t unit = halving_race_balls(static_cast<int>(finalists.size()), 1);
+    const std::uint64_t first_round = unit > 0 ? run.balls_left() / unit : 0;
+    if (first_round >= 1) {
+      const RaceResult race = halving_race(run, finalists, first_round);
+      const std::size_t winner = race.ranking[0];
+      run.set_best(finalists[winner], race.stats[winner].mean(),
+                   static_cast<std::uint64_t>(race.stats[winner].count()));
+      run.count("final_race_candidates", static_cast<double>(finalists.size()));
+      run.count("final_race_winner_balls", static_cast<double>(race.stats[winner].count()));
+      run.count("final_race_mean_won", winner + 1 == finalists.size() ? 1.0 : 0.0);
+      run.end_generation(race.balls_sum / static_cast<double>(race.balls), race.stats[winner].mean());
+    }
   }
   return run.finish();
 }
