@@ -313,7 +313,8 @@ CeilingReport run_ceiling_bench(const sim::Board& board, const CeilingBenchOptio
 nlohmann::json to_json(const CeilingReport& r) {
   const CeilingBenchOptions& o = r.options;
   const CeilingPlannerConfig& p = o.planner;
-  return {{"board", r.board},
+  return {{"benchmark", "ceiling"},
+          {"board", r.board},
           {"balls", o.balls},
           {"seed", o.seed},
           {"threads", o.threads},

@@ -134,7 +134,7 @@ TEST(CeilingBench, ReportCountsEveryBallAndPrintsOneJsonObject) {
   EXPECT_GT(r.ceiling.branch_steps_per_ball, 0.0);
   EXPECT_DOUBLE_EQ(r.ceiling_over_spastic, r.ceiling.score.mean() / r.spastic.score.mean());
   const nlohmann::json j = to_json(r);
-  for (const char* k : {"board", "balls", "seed", "planner", "players", "ceiling_over_spastic"}) {
+  for (const char* k : {"benchmark", "board", "balls", "seed", "planner", "players", "ceiling_over_spastic"}) {
     EXPECT_TRUE(j.contains(k)) << k;
   }
   for (const char* p : {"ceiling", "spastic", "no_flipping"}) {
