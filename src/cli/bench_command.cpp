@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "pinball/sim/board_loader.h"
 #include "calibration_bench.h"
+#include "ceiling_bench.h"
 #include "detector_bench.h"
 #include "daemon_latency_bench.h"
 #include "latency_bench.h"
@@ -19,19 +20,26 @@ namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   CLI::App* cmd =
-      app.add_subcommand("bench", "run a benchmark (speed, tracker, latency, detector, calibration, precision)");
-  cmd->add_option("kind", a.which, "which benchmark: speed, tracker, latency, detector, calibration, precision")
+      app.add_subcommand("bench", "run a benchmark (speed, tracker, latency, detector, calibration, precision, ceiling)");
+  cmd->add_option("kind", a.which, "which benchmark: speed, tracker, latency, detector, calibration, precision, ceiling")
       ->required()
-      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration", "precision"}));
+      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration", "precision", "ceiling"}));
   cmd->add_option("--board", a.board, "board file")->check(CLI::ExistingFile);
   cmd->add_option("--steps", a.steps, "steps per timed run")->check(CLI::Range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
       ->check(CLI::Range(10, 1'000'000));
-  cmd->add_option("--seed", a.seed, "tracker, detector, calibration: seed for play, camera noise and placements");
+  cmd->add_option("--seed", a.seed,
+                  "tracker, detector, calibration, ceiling: seed for play, camera noise, placements and balls");
   cmd->add_flag("--quick", a.quick,
-                "tracker, detector, calibration, latency, precision: a short run (fewer approaches, frames, roll "
-                "sets, balls or settings)");
+                "tracker, detector, calibration, latency, precision, ceiling: a short run (fewer approaches, frames, "
+                "roll sets, balls or settings)");
+  cmd->add_option("--balls", a.balls, "ceiling: balls per player (same ball seeds for every player)")
+      ->check(CLI::Range(1, 1'000'000));
+  cmd->add_option("--threads", a.threads, "ceiling: worker threads (results do not depend on it)")
+      ->check(CLI::Range(1, 256));
+  cmd->add_option("--max-ball-time", a.max_ball_time_s, "ceiling: seconds after which a ball still alive is cut")
+      ->check(CLI::Range(1.0, 3600.0));
   cmd->add_option("--csv", a.csv, "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here");
   cmd->add_option("--png", a.png, "precision: write the log-log plot of error against run time here");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
@@ -147,6 +155,22 @@ int run_precision(const BenchArgs& a, const sim::Board& board, std::ostream& out
   return 0;
 }
 
+int run_ceiling(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+  bench::CeilingBenchOptions options = a.quick ? bench::quick_ceiling_bench_options() : bench::CeilingBenchOptions{};
+  if (!a.quick) options.balls = a.balls;
+  options.seed = a.seed;
+  options.threads = a.threads;
+  options.max_ball_time_s = a.max_ball_time_s;
+  const bench::CeilingReport report = bench::run_ceiling_bench(
+      board, options, [&](const std::string& line) { err << "bench ceiling: " << line << "\n"; });
+  if (a.json) {
+    out << bench::to_json(report).dump(2) << "\n";
+  } else {
+    out << bench::to_text(report);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
@@ -156,6 +180,7 @@ int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   if (a.which == "detector") return run_detector(a, board, out, err);
   if (a.which == "calibration") return run_calibration(a, board, out, err);
   if (a.which == "precision") return run_precision(a, board, out, err);
+  if (a.which == "ceiling") return run_ceiling(a, board, out, err);
   bench::SpeedBenchOptions options;
   options.steps = a.steps;
   options.repeats = a.repeats;

@@ -62,13 +62,16 @@ int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 
 /// `pinball bench`
 struct BenchArgs {
-  std::string which;                                 ///< speed | tracker | latency | detector | precision
+  std::string which;                                 ///< speed | tracker | latency | detector | calibration | precision | ceiling
   std::string board = "boards/mit1993.board";        ///< board to measure on
   std::uint64_t steps = 2'000'000;                   ///< steps per timed run
   int repeats = 3;                                   ///< timed runs per configuration
   int approaches = 2000;                             ///< tracker: free-flight approaches
   std::uint64_t seed = 1;                            ///< tracker: approach and noise seed
-  bool quick = false;                                ///< tracker, detector, precision: a short run
+  bool quick = false;                                ///< tracker, detector, precision, ceiling: a short run
+  int balls = 200;                                   ///< ceiling: balls per player
+  int threads = 2;                                   ///< ceiling: worker threads (results do not depend on it)
+  double max_ball_time_s = 60.0;                     ///< ceiling: a ball alive after this is cut
   std::string csv;                                   ///< precision: CSV file to write, or empty
   std::string png;                                   ///< precision: log-log plot to write, or empty
   bool json = false;                                 ///< one JSON object on stdout

@@ -6,7 +6,7 @@
 
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/simulated_player.h"
-#include "pinball/firmware/flipper_actuation.h"
+#include "pinball/learn/delay_line.h"
 #include "pinball/sim/ball_runner.h"
 
 namespace pinball::learn {
@@ -72,31 +72,6 @@ class OpportunityBook final : public control::FlipperController {
   bool approach_open_ = false;
   int partition_ = -1;
   double start_ = 0.0;
-};
-
-// Commands reach the flippers `delay_s` after they are given: the same
-// solenoid model (FlipperActuation) that the CAN path puts behind the board.
-class DelayLine {
- public:
-  DelayLine(std::size_t flippers, double delay_s) : last_(flippers, false) {
-    for (std::size_t i = 0; i < flippers; ++i) actuation_.emplace_back(static_cast<int>(i), delay_s);
-  }
-  void apply(sim::GameState& s) {
-    for (std::size_t i = 0; i < actuation_.size(); ++i) {
-      const bool want = s.flippers[i].energized;
-      if (want != last_[i]) {
-        const firmware::CoilOutput coil{want ? firmware::CoilState::kPulse : firmware::CoilState::kOff,
-                                        want ? 1.0 : 0.0, s.time_s};
-        actuation_[i].on_coil_change(static_cast<int>(i), coil);
-        last_[i] = want;
-      }
-      s.flippers[i].energized = actuation_[i].energized(s.time_s);
-    }
-  }
-
- private:
-  std::vector<firmware::FlipperActuation> actuation_;
-  std::vector<bool> last_;  // command last passed on, per flipper
 };
 
 }  // namespace

@@ -169,6 +169,18 @@ TEST_F(Cli, BenchSpeedJson) {
   EXPECT_GT(j.at("grid_speedup").get<double>(), 0.0);
 }
 
+TEST_F(Cli, BenchCeilingJsonAndBadBallCount) {
+  const CommandResult r = run("bench ceiling --balls 2 --max-ball-time 3 --threads 1 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("benchmark"), "ceiling");
+  EXPECT_EQ(j.at("balls"), 2);
+  EXPECT_EQ(j.at("max_ball_time_s"), 3.0);
+  EXPECT_EQ(j.at("players").size(), 3u);
+  EXPECT_NE(r.err.find("bench ceiling: ceiling: 2/2 balls"), std::string::npos) << r.err;
+  EXPECT_EQ(run("bench ceiling --balls 0").exit_code, 2);
+}
+
 TEST_F(Cli, BenchPrecisionQuickWritesJsonCsvAndPng) {
   const fs::path csv = dir_ / "precision.csv";
   const fs::path png = dir_ / "precision.png";

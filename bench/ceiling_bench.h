@@ -1,0 +1,168 @@
+#pragma once
+// `pinball bench ceiling`: how well a player that CHEATS does on the board, as
+// a ceiling reference for the learned controllers (issue #6), compared in the
+// same run and on the same balls with the spastic flipper and with no flipping.
+//
+// The ceiling player is not a controller: it reads the simulator's true state
+// and looks ahead with the true simulator (a copy of the GameState is a copy of
+// the world). Every 5 ms frame (what a 200 fps camera allows) while the ball is
+// falling within `zone_factor` ball radii of a flipper's rest position and no
+// flip is under way, it plays candidate plans ahead for the flipper nearest the
+// ball: "don't fire", and "fire at frame k (k = 0..K), hold H frames,
+// release" for each hold in `hold_frames`. A branch ends when the ball comes
+// back falling into a decision zone after having left every zone (the next
+// approach), when the ball is lost, or at the horizon; its value is the score
+// gained in it, minus `drain_penalty` if the ball was lost. Receding horizon:
+// only the best plan's first frame is acted on. If the best plan fires now,
+// the player fires and holds for that plan's H frames, then releases and plans
+// again; otherwise it does nothing this frame and plans again at the next.
+// Ties go to the earlier candidate, so "don't fire" wins when nothing is
+// better. Commands pass through the evaluator's 4 ms actuation delay
+// (learn::DelayLine), in the branches as in the real play.
+//
+// Baselines on the same ball seeds (learn::ball_seed(seed, i)): the spastic
+// flipper on the true state (sim::oracle_spastic_policy, every step, same
+// actuation delay), and no flipping. Balls are cut at 60 s as in the evaluator.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "pinball/core/running_stats.h"
+#include "pinball/learn/delay_line.h"
+#include "pinball/sim/board.h"
+#include "pinball/sim/game_state.h"
+#include "pinball/sim/thesis_stepper.h"
+
+namespace pinball::bench {
+
+/// The lookahead planner's settings.
+struct CeilingPlannerConfig {
+  int frame_steps = 10;                  ///< decision period in stepper steps (10 x 0.5 ms = 5 ms)
+  int fire_frames = 8;                   ///< K: fire candidates at frames 0..K from now
+  std::vector<int> hold_frames = {6, 20};  ///< H candidates, in frames (30 ms, 100 ms at 5 ms)
+  double zone_factor = 5.0;              ///< decision zone: ball within this many radii of a flipper's rest segment
+  double falling_speed_mps = 0.05;       ///< the ball counts as falling when vy < -this
+  double horizon_s = 3.0;                ///< longest branch (simulated s)
+  double drain_penalty = 20000.0;        ///< subtracted from a branch in which the ball is lost
+};
+
+/// What to measure.
+struct CeilingBenchOptions {
+  int balls = 200;                  ///< balls per player (same seeds for all three)
+  std::uint64_t seed = 1;           ///< run seed: ball i plays learn::ball_seed(seed, i)
+  int threads = 2;                  ///< worker threads; results do not depend on it
+  double max_ball_time_s = 60.0;    ///< a ball alive after this is cut (a possible cycle)
+  double actuation_delay_s = 0.004; ///< command to flipper motion, as in the evaluator
+  double pull = -1.0;               ///< launcher pull; negative: the board's
+  double spastic_reach_factor = 2.5;///< the spastic baseline's reach (ball radii)
+  double left_outlane_x_m = 0.045;  ///< a drain with x below this went down the left outlane
+  CeilingPlannerConfig planner;     ///< the ceiling player's planner
+};
+
+/// A short run for tests and a first look: 10 balls.
+CeilingBenchOptions quick_ceiling_bench_options();
+
+/// One candidate plan and its branch's outcome.
+struct CeilingCandidate {
+  int fire_frame = -1;      ///< frame (from now) at which the flipper is fired; -1: don't fire
+  int hold_frames = 0;      ///< frames held before release
+  double value = 0.0;       ///< score gained minus the drain penalty if lost
+  double score = 0.0;       ///< score gained in the branch
+  bool lost = false;        ///< the ball was lost within the branch
+  double length_s = 0.0;    ///< simulated length of the branch
+};
+
+/// Plays candidate plans ahead on copies of the state. Holds scratch copies
+/// sized for one board; evaluate() allocates nothing after the first call.
+class CeilingPlanner {
+ public:
+  /// Borrows the stepper (and its board). Throws std::invalid_argument for bad settings.
+  CeilingPlanner(const sim::ThesisStepper& stepper, const CeilingPlannerConfig& config);
+
+  /// The flipper to plan for: the one nearest the ball when the ball is in
+  /// play, falling and within the decision zone; -1 otherwise.
+  int decision_flipper(const sim::GameState& state) const;
+
+  /// Evaluates "don't fire" (index 0) and every fire plan for `flipper` from
+  /// `state` (commands all off from now, `delay` as it stands). Leaves state and delay untouched.
+  const std::vector<CeilingCandidate>& evaluate(const sim::GameState& state, const learn::DelayLine& delay,
+                                                int flipper);
+  /// Index of the best candidate of the last evaluate(): the first of the highest value.
+  std::size_t best() const;
+  /// Stepper steps simulated in branches so far.
+  std::uint64_t branch_steps() const { return branch_steps_; }
+  /// The settings.
+  const CeilingPlannerConfig& config() const { return config_; }
+
+ private:
+  bool in_zone(const sim::GameState& state) const;
+  void play_branch(CeilingCandidate& c, int flipper);
+
+  const sim::ThesisStepper& stepper_;
+  CeilingPlannerConfig config_;
+  std::vector<CeilingCandidate> candidates_;
+  sim::GameState scratch_;
+  learn::DelayLine scratch_delay_;
+  const sim::GameState* origin_ = nullptr;
+  const learn::DelayLine* origin_delay_ = nullptr;
+  std::uint64_t branch_steps_ = 0;
+};
+
+/// Who presses the buttons.
+enum class CeilingPlayerKind { kCeiling, kSpastic, kNoFlipping };
+
+/// One ball's outcome.
+struct CeilingBall {
+  double score = 0.0;             ///< points scored
+  double duration_s = 0.0;        ///< simulated time of the ball
+  int flips = 0;                  ///< flipper activations
+  bool cut = false;               ///< alive at the time limit
+  bool left_table = false;        ///< lost by leaving the table's bounds
+  double drain_x_m = 0.0;         ///< ball x just before it was lost (when not cut)
+  int decisions = 0;              ///< ceiling: frames at which candidates were evaluated
+  std::uint64_t branch_steps = 0; ///< ceiling: stepper steps simulated in lookahead branches
+};
+
+/// Plays ball `ball_seed` with `kind` (the same seed gives the same ball for every kind up to the first flip).
+CeilingBall play_ceiling_bench_ball(const sim::ThesisStepper& stepper, const CeilingBenchOptions& options,
+                                    CeilingPlayerKind kind, std::uint64_t ball_seed);
+
+/// One player's figures.
+struct CeilingPlayerReport {
+  std::string name;               ///< ceiling | spastic | no_flipping
+  RunningStats score;             ///< per ball
+  RunningStats duration_s;        ///< per ball
+  RunningStats flips;             ///< per ball
+  int cut = 0;                    ///< balls cut at the time limit
+  int drains_left_outlane = 0;    ///< lost with x < left_outlane_x_m
+  int drains_elsewhere = 0;       ///< lost anywhere else
+  int left_table = 0;             ///< of the drains, lost by leaving the table's bounds
+  double decisions_per_ball = 0.0;     ///< ceiling: planning frames per ball
+  double branch_steps_per_ball = 0.0;  ///< ceiling: lookahead steps per ball
+  double wall_s = 0.0;            ///< wall time of this player's balls
+};
+
+/// The whole measurement.
+struct CeilingReport {
+  std::string board;              ///< board name
+  CeilingBenchOptions options;    ///< what was run
+  CeilingPlayerReport ceiling;    ///< the cheating lookahead player
+  CeilingPlayerReport spastic;    ///< the spastic flipper on true state (baseline)
+  CeilingPlayerReport no_flipping;///< flippers never move (baseline)
+  double ceiling_over_spastic = 0.0;  ///< ratio of mean scores per ball
+};
+
+/// Runs the three players; `progress` (may be empty) gets a line now and then, from any thread but never two at once.
+CeilingReport run_ceiling_bench(const sim::Board& board, const CeilingBenchOptions& options,
+                                const std::function<void(const std::string&)>& progress);
+
+/// The report as one JSON object.
+nlohmann::json to_json(const CeilingReport& report);
+/// The report as text.
+std::string to_text(const CeilingReport& report);
+
+}  // namespace pinball::bench
