@@ -7,6 +7,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "pinball/daemon/thread_table.h"
+
 namespace pinball::daemon {
 namespace {
 
@@ -184,6 +186,11 @@ void validate_daemon_config(const DaemonConfig& c, const std::string& s) {
               (!c.threads.chain_cpu.empty() && c.threads.chain_cpu.size() <= 4 &&
                c.threads.chain_cpu.find_first_not_of("0123456789") == std::string::npos),
           s, "threads.chain_cpu", "must be auto, off or a CPU number");
+  try {
+    (void)plan_cpus(c.threads.chain_cpu);  // a CPU this process may not use
+  } catch (const ConfigError& e) {
+    throw ConfigError(s + ": " + e.what());
+  }
   require(c.threads.cpu_dma_latency_us >= -1 && c.threads.cpu_dma_latency_us <= 1'000'000, s,
           "threads.cpu_dma_latency_us", "must be -1 (leave alone) or in [0, 1000000] us");
   if (c.mode == "sim") {

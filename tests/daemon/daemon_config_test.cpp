@@ -69,6 +69,9 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
   EXPECT_EQ(error_of("threads: {priorities: {gpu: 1}}"), "t.yaml: threads.priorities.gpu: unknown key");
   EXPECT_EQ(error_of("threads: {chain_cpu: fast}"), "t.yaml: threads.chain_cpu: must be auto, off or a CPU number");
   EXPECT_EQ(error_of("threads: {chain_cpu: -3}"), "t.yaml: threads.chain_cpu: must be auto, off or a CPU number");
+  EXPECT_EQ(error_of("threads: {chain_cpu: 1023}")
+                .rfind("t.yaml: threads.chain_cpu: CPU 1023 is not one this process may use", 0),
+            0u);
   EXPECT_EQ(error_of("threads: {cpu_dma_latency_us: -5}"),
             "t.yaml: threads.cpu_dma_latency_us: must be -1 (leave alone) or in [0, 1000000] us");
   EXPECT_NE(error_of("camera: {fps: [").find("t.yaml:1: not valid YAML"), std::string::npos);
