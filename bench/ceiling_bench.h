@@ -32,23 +32,12 @@
 #include <nlohmann/json.hpp>
 
 #include "pinball/core/running_stats.h"
-#include "pinball/learn/delay_line.h"
+#include "pinball/learn/lookahead_player.h"
 #include "pinball/sim/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
 
 namespace pinball::bench {
-
-/// The lookahead planner's settings.
-struct CeilingPlannerConfig {
-  int frame_steps = 10;                  ///< decision period in stepper steps (10 x 0.5 ms = 5 ms)
-  int fire_frames = 8;                   ///< K: fire candidates at frames 0..K from now
-  std::vector<int> hold_frames = {6, 20};  ///< H candidates, in frames (30 ms, 100 ms at 5 ms)
-  double zone_factor = 5.0;              ///< decision zone: ball within this many radii of a flipper's rest segment
-  double falling_speed_mps = 0.05;       ///< the ball counts as falling when vy < -this
-  double horizon_s = 3.0;                ///< longest branch (simulated s)
-  double drain_penalty = 20000.0;        ///< subtracted from a branch in which the ball is lost
-};
 
 /// What to measure.
 struct CeilingBenchOptions {
@@ -60,57 +49,11 @@ struct CeilingBenchOptions {
   double pull = -1.0;               ///< launcher pull; negative: the board's
   double spastic_reach_factor = 2.5;///< the spastic baseline's reach (ball radii)
   double left_outlane_x_m = 0.045;  ///< a drain with x below this went down the left outlane
-  CeilingPlannerConfig planner;     ///< the ceiling player's planner
+  learn::LookaheadConfig planner;   ///< the ceiling player's planner
 };
 
 /// A short run for tests and a first look: 10 balls.
 CeilingBenchOptions quick_ceiling_bench_options();
-
-/// One candidate plan and its branch's outcome.
-struct CeilingCandidate {
-  int fire_frame = -1;      ///< frame (from now) at which the flipper is fired; -1: don't fire
-  int hold_frames = 0;      ///< frames held before release
-  double value = 0.0;       ///< score gained minus the drain penalty if lost
-  double score = 0.0;       ///< score gained in the branch
-  bool lost = false;        ///< the ball was lost within the branch
-  double length_s = 0.0;    ///< simulated length of the branch
-};
-
-/// Plays candidate plans ahead on copies of the state. Holds scratch copies
-/// sized for one board; evaluate() allocates nothing after the first call.
-class CeilingPlanner {
- public:
-  /// Borrows the stepper (and its board). Throws std::invalid_argument for bad settings.
-  CeilingPlanner(const sim::ThesisStepper& stepper, const CeilingPlannerConfig& config);
-
-  /// The flipper to plan for: the one nearest the ball when the ball is in
-  /// play, falling and within the decision zone; -1 otherwise.
-  int decision_flipper(const sim::GameState& state) const;
-
-  /// Evaluates "don't fire" (index 0) and every fire plan for `flipper` from
-  /// `state` (commands all off from now, `delay` as it stands). Leaves state and delay untouched.
-  const std::vector<CeilingCandidate>& evaluate(const sim::GameState& state, const learn::DelayLine& delay,
-                                                int flipper);
-  /// Index of the best candidate of the last evaluate(): the first of the highest value.
-  std::size_t best() const;
-  /// Stepper steps simulated in branches so far.
-  std::uint64_t branch_steps() const { return branch_steps_; }
-  /// The settings.
-  const CeilingPlannerConfig& config() const { return config_; }
-
- private:
-  bool in_zone(const sim::GameState& state) const;
-  void play_branch(CeilingCandidate& c, int flipper);
-
-  const sim::ThesisStepper& stepper_;
-  CeilingPlannerConfig config_;
-  std::vector<CeilingCandidate> candidates_;
-  sim::GameState scratch_;
-  learn::DelayLine scratch_delay_;
-  const sim::GameState* origin_ = nullptr;
-  const learn::DelayLine* origin_delay_ = nullptr;
-  std::uint64_t branch_steps_ = 0;
-};
 
 /// Who presses the buttons.
 enum class CeilingPlayerKind { kCeiling, kSpastic, kNoFlipping };

@@ -3,88 +3,18 @@
 #include <gtest/gtest.h>
 
 #include "common/thesis_board.h"
-#include "pinball/sim/state_hash.h"
 
 namespace pinball::bench {
 namespace {
 
 using pinball::testing::thesis_board;
 
-// A ball falling onto the left flipper near its tip, towards the gap between the flippers.
-sim::GameState ball_on_left_flipper(const sim::Board& board) {
-  sim::GameState s = sim::make_game_state(board, 3);
-  s.ball_in_play = true;
-  s.ball.position_m = Vec2(0.235, 0.190);
-  s.ball.velocity_mps = Vec2(0.5, -1.5);
-  return s;
-}
-
-CeilingPlannerConfig short_planner() {
-  CeilingPlannerConfig c;
+learn::LookaheadConfig short_planner() {
+  learn::LookaheadConfig c;
   c.fire_frames = 3;
   c.hold_frames = {6, 20};
   c.horizon_s = 1.0;
   return c;
-}
-
-TEST(CeilingPlanner, CandidatesAreDontFireThenEveryFireFrameAndHold) {
-  const sim::ThesisStepper stepper(thesis_board());
-  CeilingPlanner planner(stepper, short_planner());
-  const sim::GameState s = ball_on_left_flipper(thesis_board());
-  ASSERT_EQ(planner.decision_flipper(s), 0);
-  const learn::DelayLine delay(s.flippers.size(), 0.004);
-  const auto& c = planner.evaluate(s, delay, 0);
-  ASSERT_EQ(c.size(), 1u + 4u * 2u);
-  EXPECT_EQ(c[0].fire_frame, -1);
-  EXPECT_EQ(c[1].fire_frame, 0);
-  EXPECT_EQ(c[1].hold_frames, 6);
-  EXPECT_EQ(c[2].hold_frames, 20);
-  EXPECT_EQ(c.back().fire_frame, 3);
-  for (const CeilingCandidate& k : c) {
-    EXPECT_GT(k.length_s, 0.0);
-    EXPECT_LE(k.length_s, 1.0 + 1e-9);
-    EXPECT_DOUBLE_EQ(k.value, k.score - (k.lost ? short_planner().drain_penalty : 0.0));
-  }
-}
-
-TEST(CeilingPlanner, UnflippedBallOnTheFlipperDrainsAndTheBestPlanSavesIt) {
-  const sim::ThesisStepper stepper(thesis_board());
-  CeilingPlanner planner(stepper, short_planner());
-  const sim::GameState s = ball_on_left_flipper(thesis_board());
-  const std::uint64_t before = sim::hash_state(s);
-  const learn::DelayLine delay(s.flippers.size(), 0.004);
-  const auto& c = planner.evaluate(s, delay, 0);
-  EXPECT_EQ(sim::hash_state(s), before) << "evaluate() must play on copies";
-  EXPECT_TRUE(c[0].lost) << "a ball left on the resting flipper rolls off into the drain";
-  const CeilingCandidate& best = c[planner.best()];
-  EXPECT_FALSE(best.lost);
-  EXPECT_GE(best.fire_frame, 0);
-  EXPECT_GT(best.value, c[0].value);
-  for (const CeilingCandidate& k : c) EXPECT_LE(k.value, best.value);
-  EXPECT_GT(planner.branch_steps(), 0u);
-}
-
-TEST(CeilingPlanner, NoDecisionForARisingOrFarBall) {
-  const sim::ThesisStepper stepper(thesis_board());
-  const CeilingPlanner planner(stepper, short_planner());
-  sim::GameState s = ball_on_left_flipper(thesis_board());
-  s.ball.velocity_mps = Vec2(0.0, 1.0);
-  EXPECT_EQ(planner.decision_flipper(s), -1) << "rising";
-  s.ball.velocity_mps = Vec2(0.0, -1.0);
-  s.ball.position_m = Vec2(0.255, 0.8);
-  EXPECT_EQ(planner.decision_flipper(s), -1) << "far up the table";
-  s.ball.position_m = Vec2(0.310, 0.20);
-  EXPECT_EQ(planner.decision_flipper(s), 1) << "over the right flipper";
-}
-
-TEST(CeilingPlanner, RejectsBadSettings) {
-  const sim::ThesisStepper stepper(thesis_board());
-  CeilingPlannerConfig c = short_planner();
-  c.hold_frames.clear();
-  EXPECT_THROW(CeilingPlanner(stepper, c), std::invalid_argument);
-  c = short_planner();
-  c.frame_steps = 0;
-  EXPECT_THROW(CeilingPlanner(stepper, c), std::invalid_argument);
 }
 
 CeilingBenchOptions tiny_bench() {

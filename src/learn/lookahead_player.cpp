@@ -1,0 +1,153 @@
+#include "pinball/learn/lookahead_player.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace pinball::learn {
+
+LookaheadPlanner::LookaheadPlanner(const sim::ThesisStepper& stepper, const LookaheadConfig& config)
+    : stepper_(stepper),
+      config_(config),
+      scratch_(sim::make_game_state(stepper.board(), 0)),
+      scratch_delay_(stepper.board().flippers.size(), 0.0) {
+  if (config.frame_steps < 1) throw std::invalid_argument("ceiling planner: frame_steps must be >= 1");
+  if (config.fire_frames < 0) throw std::invalid_argument("ceiling planner: fire_frames must be >= 0");
+  if (config.hold_frames.empty()) throw std::invalid_argument("ceiling planner: hold_frames must not be empty");
+  for (const int h : config.hold_frames) {
+    if (h < 1) throw std::invalid_argument("ceiling planner: every hold must be >= 1 frame");
+  }
+  if (!(config.zone_factor > 0.0)) throw std::invalid_argument("ceiling planner: zone_factor must be > 0");
+  if (!(config.horizon_s > 0.0)) throw std::invalid_argument("ceiling planner: horizon must be > 0");
+  if (!std::isfinite(config.drain_penalty)) throw std::invalid_argument("ceiling planner: drain penalty must be finite");
+  candidates_.push_back({});  // don't fire
+  for (int k = 0; k <= config.fire_frames; ++k) {
+    for (const int h : config.hold_frames) candidates_.push_back({k, h, 0.0, 0.0, false, 0.0});
+  }
+}
+
+namespace {
+
+// Distance from the ball to the nearest flipper's rest segment, and which flipper.
+std::pair<int, double> nearest_flipper(const sim::Board& board, const sim::GameState& state) {
+  int nearest = -1;
+  double nearest_d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+    const sim::Flipper& f = board.flippers[i];
+    const double d = distance_point_segment(state.ball.position_m, f.pivot, sim::flipper_tip(f, f.theta_min_rad));
+    if (d < nearest_d) {
+      nearest_d = d;
+      nearest = static_cast<int>(i);
+    }
+  }
+  return {nearest, nearest_d};
+}
+
+}  // namespace
+
+bool LookaheadPlanner::in_zone(const sim::GameState& state) const {
+  const sim::Board& board = stepper_.board();
+  return state.ball_in_play && nearest_flipper(board, state).second <= config_.zone_factor * board.ball.radius_m;
+}
+
+int LookaheadPlanner::decision_flipper(const sim::GameState& state) const {
+  if (!in_zone(state) || !(state.ball.velocity_mps.y() < -config_.falling_speed_mps)) return -1;
+  return nearest_flipper(stepper_.board(), state).first;
+}
+
+const std::vector<LookaheadCandidate>& LookaheadPlanner::evaluate(const sim::GameState& state,
+                                                              const DelayLine& delay, int flipper) {
+  if (flipper < 0 || static_cast<std::size_t>(flipper) >= state.flippers.size()) {
+    throw std::invalid_argument("ceiling planner: no flipper " + std::to_string(flipper));
+  }
+  origin_ = &state;
+  origin_delay_ = &delay;
+  for (LookaheadCandidate& c : candidates_) play_branch(c, flipper);
+  return candidates_;
+}
+
+void LookaheadPlanner::play_branch(LookaheadCandidate& c, int flipper) {
+  // Copy-assignment into the scratch objects reuses their storage.
+  scratch_ = *origin_;
+  scratch_delay_ = *origin_delay_;
+  const double score0 = scratch_.score;
+  const double t0 = scratch_.time_s;
+  const double dt = stepper_.dt_s();
+  bool on = false;
+  bool left_zone = false;
+  c.lost = false;
+  for (std::uint64_t j = 0;; ++j) {
+    // Same frame clock as the real player: commands change only at frame starts.
+    if (j % static_cast<std::uint64_t>(config_.frame_steps) == 0) {
+      const auto frame = static_cast<int>(j / static_cast<std::uint64_t>(config_.frame_steps));
+      if (frame == c.fire_frame) on = true;
+      if (c.fire_frame >= 0 && frame == c.fire_frame + c.hold_frames) on = false;
+    }
+    for (std::size_t i = 0; i < scratch_.flippers.size(); ++i) {
+      scratch_.flippers[i].energized = on && static_cast<int>(i) == flipper;
+    }
+    scratch_delay_.apply(scratch_);
+    const sim::StepEvents events = stepper_.step(scratch_);
+    ++branch_steps_;
+    if (events.has(sim::StepEvents::kBallLost)) {
+      c.lost = true;
+      break;
+    }
+    if (scratch_.time_s - t0 >= config_.horizon_s - 0.5 * dt) break;
+    if (!in_zone(scratch_)) {
+      left_zone = true;
+    } else if (left_zone && scratch_.ball.velocity_mps.y() < -config_.falling_speed_mps) {
+      break;  // the next approach: its own decisions start here
+    }
+  }
+  c.score = scratch_.score - score0;
+  c.value = c.score - (c.lost ? config_.drain_penalty : 0.0);
+  c.length_s = scratch_.time_s - t0;
+}
+
+std::size_t LookaheadPlanner::best() const {
+  std::size_t b = 0;
+  for (std::size_t i = 1; i < candidates_.size(); ++i) {
+    if (candidates_[i].value > candidates_[b].value) b = i;
+  }
+  return b;
+}
+
+LookaheadPlayer::LookaheadPlayer(const sim::ThesisStepper& stepper, const LookaheadConfig& config,
+                                 double actuation_delay_s)
+    : planner_(stepper, config),
+      delay_(stepper.board().flippers.size(), actuation_delay_s),
+      command_(stepper.board().flippers.size(), false),
+      frame_s_(stepper.dt_s() * config.frame_steps) {}
+
+void LookaheadPlayer::act(sim::GameState& s) {
+  fired_ = -1;
+  if (step_ % static_cast<std::uint64_t>(planner_.config().frame_steps) == 0) decide(s);
+  ++step_;
+  for (std::size_t i = 0; i < command_.size(); ++i) s.flippers[i].energized = command_[i];
+  delay_.apply(s);
+}
+
+void LookaheadPlayer::decide(const sim::GameState& s) {
+  if (held_ >= 0) {
+    if (--release_in_ > 0) return;
+    command_[static_cast<std::size_t>(held_)] = false;
+    held_ = -1;
+  }
+  const int f = planner_.decision_flipper(s);
+  if (f < 0) return;
+  ++decisions_;
+  const std::vector<LookaheadCandidate>& c = planner_.evaluate(s, delay_, f);
+  const LookaheadCandidate& b = c[planner_.best()];
+  if (b.fire_frame == 0) {
+    command_[static_cast<std::size_t>(f)] = true;
+    held_ = f;
+    release_in_ = b.hold_frames;
+    fired_ = f;
+    fired_hold_s_ = b.hold_frames * frame_s_;
+  }
+}
+
+}  // namespace pinball::learn

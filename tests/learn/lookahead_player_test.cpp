@@ -1,0 +1,116 @@
+#include "pinball/learn/lookahead_player.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common/thesis_board.h"
+#include "pinball/sim/ball_runner.h"
+#include "pinball/sim/state_hash.h"
+
+namespace pinball::learn {
+namespace {
+
+using pinball::testing::thesis_board;
+
+// A ball falling onto the left flipper near its tip, towards the gap between the flippers.
+sim::GameState ball_on_left_flipper(const sim::Board& board) {
+  sim::GameState s = sim::make_game_state(board, 3);
+  s.ball_in_play = true;
+  s.ball.position_m = Vec2(0.235, 0.190);
+  s.ball.velocity_mps = Vec2(0.5, -1.5);
+  return s;
+}
+
+LookaheadConfig short_planner() {
+  LookaheadConfig c;
+  c.fire_frames = 3;
+  c.hold_frames = {6, 20};
+  c.horizon_s = 1.0;
+  return c;
+}
+
+TEST(LookaheadPlanner, CandidatesAreDontFireThenEveryFireFrameAndHold) {
+  const sim::ThesisStepper stepper(thesis_board());
+  LookaheadPlanner planner(stepper, short_planner());
+  const sim::GameState s = ball_on_left_flipper(thesis_board());
+  ASSERT_EQ(planner.decision_flipper(s), 0);
+  const DelayLine delay(s.flippers.size(), 0.004);
+  const auto& c = planner.evaluate(s, delay, 0);
+  ASSERT_EQ(c.size(), 1u + 4u * 2u);
+  EXPECT_EQ(c[0].fire_frame, -1);
+  EXPECT_EQ(c[1].fire_frame, 0);
+  EXPECT_EQ(c[1].hold_frames, 6);
+  EXPECT_EQ(c[2].hold_frames, 20);
+  EXPECT_EQ(c.back().fire_frame, 3);
+  for (const LookaheadCandidate& k : c) {
+    EXPECT_GT(k.length_s, 0.0);
+    EXPECT_LE(k.length_s, 1.0 + 1e-9);
+    EXPECT_DOUBLE_EQ(k.value, k.score - (k.lost ? short_planner().drain_penalty : 0.0));
+  }
+}
+
+TEST(LookaheadPlanner, UnflippedBallOnTheFlipperDrainsAndTheBestPlanSavesIt) {
+  const sim::ThesisStepper stepper(thesis_board());
+  LookaheadPlanner planner(stepper, short_planner());
+  const sim::GameState s = ball_on_left_flipper(thesis_board());
+  const std::uint64_t before = sim::hash_state(s);
+  const DelayLine delay(s.flippers.size(), 0.004);
+  const auto& c = planner.evaluate(s, delay, 0);
+  EXPECT_EQ(sim::hash_state(s), before) << "evaluate() must play on copies";
+  EXPECT_TRUE(c[0].lost) << "a ball left on the resting flipper rolls off into the drain";
+  const LookaheadCandidate& best = c[planner.best()];
+  EXPECT_FALSE(best.lost);
+  EXPECT_GE(best.fire_frame, 0);
+  EXPECT_GT(best.value, c[0].value);
+  for (const LookaheadCandidate& k : c) EXPECT_LE(k.value, best.value);
+  EXPECT_GT(planner.branch_steps(), 0u);
+}
+
+TEST(LookaheadPlanner, NoDecisionForARisingOrFarBall) {
+  const sim::ThesisStepper stepper(thesis_board());
+  const LookaheadPlanner planner(stepper, short_planner());
+  sim::GameState s = ball_on_left_flipper(thesis_board());
+  s.ball.velocity_mps = Vec2(0.0, 1.0);
+  EXPECT_EQ(planner.decision_flipper(s), -1) << "rising";
+  s.ball.velocity_mps = Vec2(0.0, -1.0);
+  s.ball.position_m = Vec2(0.255, 0.8);
+  EXPECT_EQ(planner.decision_flipper(s), -1) << "far up the table";
+  s.ball.position_m = Vec2(0.310, 0.20);
+  EXPECT_EQ(planner.decision_flipper(s), 1) << "over the right flipper";
+}
+
+TEST(LookaheadPlanner, RejectsBadSettings) {
+  const sim::ThesisStepper stepper(thesis_board());
+  LookaheadConfig c = short_planner();
+  c.hold_frames.clear();
+  EXPECT_THROW(LookaheadPlanner(stepper, c), std::invalid_argument);
+  c = short_planner();
+  c.frame_steps = 0;
+  EXPECT_THROW(LookaheadPlanner(stepper, c), std::invalid_argument);
+}
+
+TEST(LookaheadPlayer, ReportsEachFireWithItsHoldAndReleasesAfterIt) {
+  const sim::ThesisStepper stepper(thesis_board());
+  LookaheadPlayer player(stepper, short_planner(), 0.004);
+  sim::GameState s = ball_on_left_flipper(thesis_board());
+  int fires = 0;
+  int steps_held = 0;
+  for (int i = 0; i < 400 && s.ball_in_play; ++i) {
+    player.act(s);
+    if (player.fired_flipper() >= 0) {
+      ++fires;
+      EXPECT_EQ(player.fired_flipper(), 0);
+      EXPECT_TRUE(std::abs(player.fired_hold_s() - 0.030) < 1e-12 || std::abs(player.fired_hold_s() - 0.100) < 1e-12)
+          << player.fired_hold_s();
+    }
+    if (s.flippers[0].energized) ++steps_held;
+    stepper.step(s);
+  }
+  EXPECT_GE(fires, 1) << "the ball on the flipper must be saved";
+  EXPECT_GT(steps_held, 0);
+  EXPECT_GT(player.decisions(), 0);
+}
+
+}  // namespace
+}  // namespace pinball::learn
