@@ -98,6 +98,7 @@ struct LearnArgs {
   double pull = -1.0;                   ///< launcher pull; negative: the board's
   int balls_per_controller = 5;         ///< tournament: b
   int population = 0;                   ///< relay / cem population (0: the method's default)
+  int rounds = 4;                       ///< imitate: rounds (1: the teacher's balls only; more: DAgger)
   double max_ball_time_s = 60.0;        ///< a ball alive after this is cut: a cycle
   double loss_penalty = 500.0;          ///< reward of an opportunity that lost the ball
   double actuation_delay_s = 0.004;     ///< command to flipper motion (s)

@@ -17,6 +17,10 @@
 #include "commands.h"
 #include "pinball/control/launcher_controller.h"
 #include "pinball/control/controller_file.h"
+#include "pinball/control/imitation_controller.h"
+#include "pinball/learn/demonstrations.h"
+#include <functional>
+#include <optional>
 #include "pinball/control/spastic_controller.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/learn/cross_entropy.h"
@@ -37,7 +41,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
                   "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller); "
                   "launcher: the launcher controller's search (20 pulls x 10 launches, thesis 5.1)")
       ->required()
-      ->check(CLI::IsMember({"tournament", "relay", "cem", "none", "spastic", "evaluate", "launcher"}));
+      ->check(CLI::IsMember({"tournament", "relay", "cem", "imitate", "none", "spastic", "evaluate", "launcher"}));
   cmd->add_option("--budget-balls", a.budget_balls, "simulated balls the search may play")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
   cmd->add_option("--seed", a.seed, "random seed; same seed, same result, whatever --threads");
@@ -59,6 +63,10 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--population", a.population, "relay / cem: population size (default 20 / 16)")
       ->check(CLI::Range(2, 100000));
+  cmd->add_option("--rounds", a.rounds,
+                  "imitate: rounds sharing the budget; round 1 the teacher plays, later rounds the learner plays "
+                  "and the teacher labels its approaches (DAgger)")
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball is cut (a cycle)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--loss-penalty", a.loss_penalty, "reward of a flip opportunity that lost the ball (6.3.1)");
@@ -73,6 +81,12 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
 
 namespace {
 
+// No flipping.
+struct IdleController final : control::FlipperController {
+  void update(const track::TrackerOutput&, double, std::array<bool, 2>&) override {}
+  void reset(std::array<bool, 2>& e) override { e = {false, false}; }
+};
+
 struct Evaluation {
   RunningStats score;
   RunningStats duration_s;
@@ -83,7 +97,7 @@ struct Evaluation {
 
 // Plays `balls` fresh balls (seeds apart from any search's) with one controller.
 Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const control::ControllerSpec* spec,
-                    int balls) {
+                    const std::function<std::unique_ptr<control::FlipperController>()>& make_controller, int balls) {
   Evaluation e;
   const auto start = std::chrono::steady_clock::now();
   std::vector<learn::BallOutcome> out;
@@ -93,25 +107,12 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
       tasks.push_back({spec, learn::ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, static_cast<std::uint64_t>(i))});
     }
     out = learn::play_balls(ev, tasks, a.threads);
-  } else {  // a baseline that is no ControllerSpec: none or spastic, one ball per task
+  } else {  // a controller that is no action function (a baseline, the imitation table): one ball per task
     out.resize(static_cast<std::size_t>(balls));
-    std::vector<std::thread> pool;
-    std::atomic<int> next{0};
-    auto worker = [&] {
-      for (int i = next++; i < balls; i = next++) {
-        control::SpasticController spastic;
-        struct Idle final : control::FlipperController {
-          void update(const track::TrackerOutput&, double, std::array<bool, 2>&) override {}
-          void reset(std::array<bool, 2>& e) override { e = {false, false}; }
-        } idle;
-        control::FlipperController& c = a.method == "spastic" ? static_cast<control::FlipperController&>(spastic)
-                                                               : static_cast<control::FlipperController&>(idle);
-        out[static_cast<std::size_t>(i)] =
-            ev.play_with(c, a.pull, learn::ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, static_cast<std::uint64_t>(i)));
-      }
-    };
-    for (int t = 0; t < a.threads; ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
+    learn::parallel_for(static_cast<std::size_t>(balls), a.threads, [&](std::size_t i) {
+      const std::unique_ptr<control::FlipperController> c = make_controller();
+      out[i] = ev.play_with(*c, a.pull, learn::ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i));
+    });
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (const auto& o : out) {
@@ -258,10 +259,40 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     result_spec = control::load_controller(a.controller);
     eval_spec = &result_spec;
     j["controller"] = a.controller;
+  } else if (a.method == "imitate") {
+    learn::ImitationLearningConfig ic;
+    ic.demonstration.camera = a.camera;
+    ic.demonstration.actuation_delay_s = a.actuation_delay_s;
+    ic.demonstration.max_ball_time_s = a.max_ball_time_s;
+    ic.demonstration.pull = a.pull;
+    ic.rounds = a.rounds;
+    const learn::ImitationResult im = learn::learn_by_imitation(
+        board, ic, a.budget_balls, a.seed, a.threads, [&](const std::string& line) { err << "learn imitate: " << line << "\n"; });
+    result_spec = objective.prototype();
+    result_spec.shot_table = im.table;
+    nlohmann::json rounds = nlohmann::json::array();
+    for (const learn::ImitationRound& r : im.rounds) {
+      rounds.push_back({{"round", r.round}, {"player", r.round == 0 ? "teacher" : "learner"}, {"balls", r.balls},
+                        {"examples", r.shots}, {"mean_score_per_ball", r.mean_score},
+                        {"mean_ball_time_s", r.mean_ball_time_s}, {"fires", r.fires},
+                        {"unmatched_fires", r.unmatched_fires}, {"wall_s", r.wall_s}});
+    }
+    j["rounds"] = rounds;
+    j["budget_balls"] = a.budget_balls;
+    result_spec.note = "pinball learn " + a.board + " --method imitate --budget-balls " + std::to_string(a.budget_balls) +
+                       " --rounds " + std::to_string(a.rounds) + " --seed " + std::to_string(a.seed) + ": " +
+                       std::to_string(im.table.examples().size()) +
+                       " shots of a looking-ahead teacher on the true state";
+    if (!a.out.empty()) control::save_controller(result_spec, a.out);
+    eval_spec = &result_spec;
   }
+  std::function<std::unique_ptr<control::FlipperController>()> make_controller = [&]() -> std::unique_ptr<control::FlipperController> {
+    if (a.method == "spastic") return std::make_unique<control::SpasticController>();
+    return std::make_unique<IdleController>();
+  };
   const int eval_balls = a.eval_balls > 0 ? a.eval_balls : (search ? 0 : 1000);
   if (eval_balls > 0) {
-    const Evaluation e = evaluate(objective.ev, a, eval_spec, eval_balls);
+    const Evaluation e = evaluate(objective.ev, a, eval_spec, make_controller, eval_balls);
     j["evaluation"] = to_json(e);
     j["evaluation"]["camera_noise_px"] = a.camera.noise_px;
     j["evaluation"]["actuation_delay_s"] = a.actuation_delay_s;

@@ -109,12 +109,12 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     policy = "controller";
   }
   if (policy == "controller" && a.controller.empty()) throw std::invalid_argument("sim: --policy controller needs --controller FILE");
-  std::optional<control::ActuatorController> learned;
+  std::unique_ptr<control::FlipperController> learned;
   std::optional<control::SimulatedPlayer> learned_player;
   double pull = -1.0;
   if (policy == "controller") {
     const control::ControllerSpec spec = control::load_controller(a.controller);
-    learned.emplace(spec.action_function, spec.actuator);
+    learned = control::make_flipper_controller(spec);
     learned_player.emplace(board, a.camera, *learned, a.seed ^ 0x5DEECE66Dull);
     pull = spec.launcher_pull;
   }

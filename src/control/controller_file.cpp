@@ -37,7 +37,72 @@ std::vector<double> numbers(const json& j, const std::string& source, const std:
   return v;
 }
 
+// Order of a shot's numbers in the file (one short array per shot keeps a
+// table of thousands readable line by line).
+const char* const kShotFields[] = {"flipper",   "rolling",       "angle_rad", "h", "speed_mps",
+                                   "fired_flipper", "d_fire_m", "hold_s"};
+constexpr std::size_t kShotFieldCount = 8;
+
+json shot_table_json(const ShotTable& t) {
+  json shots = json::array();
+  for (const ShotExample& e : t.examples()) {
+    shots.push_back({e.flipper, e.rolling ? 1 : 0, e.angle_rad, e.h, e.speed_mps, e.fired_flipper, e.d_fire_m, e.hold_s});
+  }
+  const ImitationConfig& c = t.config();
+  return {{"neighbours", c.neighbours},
+          {"angle_scale_rad", c.angle_scale_rad},
+          {"h_scale", c.h_scale},
+          {"speed_scale_mps", c.speed_scale_mps},
+          {"max_hold_s", c.max_hold_s},
+          {"lead_s", c.lead_s},
+          {"shot_fields", kShotFields},
+          {"shots", shots}};
+}
+
+ShotTable shot_table_from_json(const json& j, const std::string& src) {
+  if (!j.is_object()) fail(src, "imitation", "must be an object");
+  ImitationConfig c;
+  const json& k = need(j, "neighbours", src, "imitation.");
+  if (!k.is_number_integer()) fail(src, "imitation.neighbours", "must be an integer");
+  c.neighbours = k.get<int>();
+  c.angle_scale_rad = number(need(j, "angle_scale_rad", src, "imitation."), src, "imitation.angle_scale_rad");
+  c.h_scale = number(need(j, "h_scale", src, "imitation."), src, "imitation.h_scale");
+  c.speed_scale_mps = number(need(j, "speed_scale_mps", src, "imitation."), src, "imitation.speed_scale_mps");
+  if (j.contains("max_hold_s")) c.max_hold_s = number(j["max_hold_s"], src, "imitation.max_hold_s");
+  if (j.contains("lead_s")) c.lead_s = number(j["lead_s"], src, "imitation.lead_s");
+  const json& shots = need(j, "shots", src, "imitation.");
+  if (!shots.is_array()) fail(src, "imitation.shots", "must be an array");
+  std::vector<ShotExample> examples;
+  examples.reserve(shots.size());
+  for (std::size_t i = 0; i < shots.size(); ++i) {
+    const std::string where = "imitation.shots[" + std::to_string(i) + "]";
+    const std::vector<double> v = numbers(shots[i], src, where);
+    if (v.size() != kShotFieldCount) fail(src, where, "must have 8 numbers (see imitation.shot_fields)");
+    ShotExample e;
+    e.flipper = static_cast<int>(v[0]);
+    e.rolling = v[1] != 0.0;
+    e.angle_rad = v[2];
+    e.h = v[3];
+    e.speed_mps = v[4];
+    e.fired_flipper = static_cast<int>(v[5]);
+    e.d_fire_m = v[6];
+    e.hold_s = v[7];
+    if (v[0] != e.flipper || v[5] != e.fired_flipper) fail(src, where, "flipper numbers must be integers");
+    examples.push_back(e);
+  }
+  try {
+    return ShotTable(std::move(examples), c);
+  } catch (const std::invalid_argument& e) {
+    fail(src, "imitation", e.what());
+  }
+}
+
 }  // namespace
+
+std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec) {
+  if (spec.shot_table) return std::make_unique<ImitationController>(*spec.shot_table);
+  return std::make_unique<ActuatorController>(spec.action_function, spec.actuator);
+}
 
 std::string controller_to_json(const ControllerSpec& s) {
   const ActionFunction& af = s.action_function;
@@ -67,7 +132,19 @@ std::string controller_to_json(const ControllerSpec& s) {
         {"pull_min", s.launch_pull_min},
         {"pull_max", s.launch_pull_max}}},
   };
-  return j.dump(2) + "\n";
+  if (!s.shot_table) return j.dump(2) + "\n";
+  // One line per shot: the table stays readable (and diffable) at thousands of shots.
+  json table = shot_table_json(*s.shot_table);
+  std::string shots = "[";
+  for (std::size_t i = 0; i < table["shots"].size(); ++i) {
+    shots += (i == 0 ? "\n      " : ",\n      ") + table["shots"][i].dump();
+  }
+  shots += table["shots"].empty() ? "]" : "\n    ]";
+  table["shots"] = "@SHOTS@";
+  j["imitation"] = table;
+  std::string text = j.dump(2);
+  text.replace(text.find("\"@SHOTS@\""), 9, shots);
+  return text + "\n";
 }
 
 ControllerSpec controller_from_json(const std::string& text, const std::string& src) {
@@ -122,6 +199,7 @@ ControllerSpec controller_from_json(const std::string& text, const std::string& 
     for (int k = 0; k < 4; ++k) mc.a[static_cast<std::size_t>(k)] = a[static_cast<std::size_t>(k)];
     mc.flipper = f.get<std::string>() == "left" ? track::kLeftFlipper : track::kRightFlipper;
   }
+  if (j.contains("imitation")) s.shot_table = shot_table_from_json(j["imitation"], src);
   if (j.contains("actuator")) {
     const json& act = j["actuator"];
     if (act.contains("max_hold_s")) s.actuator.max_hold_s = number(act["max_hold_s"], src, "actuator.max_hold_s");

@@ -70,7 +70,7 @@ struct Daemon::Impl {
   bool lockstep = true;
   sim::Board board;
   control::ControllerSpec spec;
-  std::unique_ptr<control::ActuatorController> controller;
+  std::unique_ptr<control::FlipperController> controller;
   // CAN.
   std::unique_ptr<firmware::CanTransport> host_link;
   std::unique_ptr<firmware::StreamTransport> board_link;  // sim: the virtual board's end
@@ -169,7 +169,7 @@ void Daemon::Impl::build() {
   lockstep = sim_mode && !config.sim.realtime;
   board = sim::load_board(sim_mode ? config.sim.board : config.board);
   spec = control::load_controller(config.controller);
-  controller = std::make_unique<control::ActuatorController>(spec.action_function, spec.actuator);
+  controller = control::make_flipper_controller(spec);
   driver_of_flipper = controller_stage_options_for(config, board).driver_of_flipper;
   const int drivers = static_cast<int>(board.flippers.size());
 

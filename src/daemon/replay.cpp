@@ -39,7 +39,7 @@ ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
   if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
   const sim::Board board = sim::load_board(config.mode == "sim" ? config.sim.board : config.board);
   const control::ControllerSpec spec = control::load_controller(config.controller);
-  control::ActuatorController controller(spec.action_function, spec.actuator);
+  const std::unique_ptr<control::FlipperController> controller = control::make_flipper_controller(spec);
   const TrackingSetup setup = tracking_setup_for(config, board);
   track::Tracker tracker(setup.geometry, setup.tracker);
   CameraStage camera(nullptr, tracker, lost_after_s_for(config));
@@ -49,7 +49,7 @@ ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
   firmware::DriverBusOptions bo;
   bo.driver_count = static_cast<int>(board.flippers.size());
   firmware::DriverBus bus(*host, bo);
-  ControllerStage stage(controller, bus, controller_stage_options_for(config, board));
+  ControllerStage stage(*controller, bus, controller_stage_options_for(config, board));
 
   ReplayReport r;
   std::vector<Decision> recorded, replayed;

@@ -98,13 +98,14 @@ control::ControllerSpec PinballEvaluator::prototype() const {
 }
 
 BallOutcome PinballEvaluator::play(const control::ControllerSpec& spec, std::uint64_t seed) const {
-  control::ActuatorController actuator(spec.action_function, spec.actuator);
+  const std::unique_ptr<control::FlipperController> controller = control::make_flipper_controller(spec);
   double pull = spec.launcher_pull;
   if (spec.randomise_launch) {
     Rng rng(seed ^ 0xA5A5A5A5DEADBEEFull);
     pull = rng.uniform(spec.launch_pull_min, spec.launch_pull_max);
   }
-  return run(actuator, &actuator, pull, seed);
+  // Flip opportunities are booked per minicontroller: only the action function has them.
+  return run(*controller, dynamic_cast<const control::ActuatorController*>(controller.get()), pull, seed);
 }
 
 BallOutcome PinballEvaluator::play_with(control::FlipperController& controller, double pull,

@@ -123,9 +123,14 @@ LookaheadPlayer::LookaheadPlayer(const sim::ThesisStepper& stepper, const Lookah
       frame_s_(stepper.dt_s() * config.frame_steps) {}
 
 void LookaheadPlayer::act(sim::GameState& s) {
-  fired_ = -1;
-  if (step_ % static_cast<std::uint64_t>(planner_.config().frame_steps) == 0) decide(s);
+  const bool frame = step_ % static_cast<std::uint64_t>(planner_.config().frame_steps) == 0;
   ++step_;
+  act(s, frame);
+}
+
+void LookaheadPlayer::act(sim::GameState& s, bool frame) {
+  fired_ = -1;
+  if (frame) decide(s);
   for (std::size_t i = 0; i < command_.size(); ++i) s.flippers[i].energized = command_[i];
   delay_.apply(s);
 }

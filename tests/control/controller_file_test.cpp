@@ -71,5 +71,60 @@ TEST(ControllerFile, BadFilesGiveClearErrors) {
   EXPECT_THROW(load_controller("/nonexistent/controller.json"), ControllerFileError);
 }
 
+ControllerSpec with_shots() {
+  ControllerSpec s;
+  ImitationConfig c;
+  c.neighbours = 5;
+  c.angle_scale_rad = 0.07;
+  c.h_scale = 0.2;
+  c.speed_scale_mps = 0.4;
+  c.max_hold_s = 0.8;
+  c.lead_s = 0.001;
+  s.shot_table.emplace(std::vector<ShotExample>{{0, false, -1.0 / 3.0, 0.5, 2.25, 1, 0.0512345678901234, 0.03},
+                                                {1, true, 0.436, 1.3, 1.0, -1, 0.0, 0.0}},
+                       c);
+  return s;
+}
+
+TEST(ControllerFile, ShotTableRoundTripsOneShotPerLine) {
+  const ControllerSpec s = with_shots();
+  const std::string text = controller_to_json(s);
+  EXPECT_NE(text.find("\n      [0,0,"), std::string::npos) << text;
+  const ControllerSpec r = controller_from_json(text, "shots.json");
+  ASSERT_TRUE(r.shot_table.has_value());
+  const ImitationConfig& c = r.shot_table->config();
+  EXPECT_EQ(c.neighbours, 5);
+  EXPECT_EQ(c.angle_scale_rad, 0.07);
+  EXPECT_EQ(c.h_scale, 0.2);
+  EXPECT_EQ(c.speed_scale_mps, 0.4);
+  EXPECT_EQ(c.max_hold_s, 0.8);
+  EXPECT_EQ(c.lead_s, 0.001);
+  ASSERT_EQ(r.shot_table->examples().size(), 2u);
+  const ShotExample& a = r.shot_table->examples()[0];
+  EXPECT_EQ(a.angle_rad, -1.0 / 3.0);  // bit for bit
+  EXPECT_EQ(a.d_fire_m, 0.0512345678901234);
+  EXPECT_EQ(a.fired_flipper, 1);
+  EXPECT_TRUE(r.shot_table->examples()[1].rolling);
+  EXPECT_EQ(controller_to_json(r), text);
+  EXPECT_NE(dynamic_cast<ImitationController*>(make_flipper_controller(r).get()), nullptr);
+  EXPECT_NE(dynamic_cast<ActuatorController*>(make_flipper_controller(ControllerSpec{}).get()), nullptr);
+}
+
+TEST(ControllerFile, BadShotTablesNameTheField) {
+  const std::string good = controller_to_json(with_shots());
+  std::string short_row = good;
+  short_row.replace(short_row.find("[0,0,"), 5, "[0,");
+  expect_error(short_row, "imitation.shots[0]: must have 8 numbers");
+  std::string bad_flipper = good;
+  bad_flipper.replace(bad_flipper.find("[0,0,"), 5, "[7,0,");
+  expect_error(bad_flipper, "imitation: shot table: example 0: flipper");
+  std::string half = good;
+  half.replace(half.find("[0,0,"), 5, "[0.5,0,");
+  expect_error(half, "imitation.shots[0]: flipper numbers must be integers");
+  std::string k = good;
+  k.replace(k.find("\"neighbours\": 5"), 15, "\"neighbours\": 0");
+  expect_error(k, "imitation: shot table: neighbours");
+}
+
 }  // namespace
 }  // namespace pinball::control

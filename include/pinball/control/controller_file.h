@@ -3,11 +3,14 @@
 // version (docs/learning.md). Loading is all or nothing: a bad file throws
 // ControllerFileError naming the file and the field.
 
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "pinball/control/action_function.h"
 #include "pinball/control/actuator_controller.h"
+#include "pinball/control/imitation_controller.h"
 
 namespace pinball::control {
 
@@ -18,12 +21,19 @@ inline constexpr int kControllerFileVersion = 1;
 struct ControllerSpec {
   ActionFunction action_function{uniform_partition(4)};  ///< partitions and minicontrollers
   ActuatorConfig actuator;                            ///< actuator settings
+  /// A shot table learned from a teacher (`pinball learn --method imitate`); when
+  /// set, it drives the flippers instead of the action function.
+  std::optional<ShotTable> shot_table;
   double launcher_pull = -1.0;    ///< launcher pull fraction; negative: the board's
   bool randomise_launch = false;  ///< draw the pull per ball from [launch_pull_min, launch_pull_max] (thesis 7.1)
   double launch_pull_min = 0.5;   ///< lower end of a randomised pull
   double launch_pull_max = 1.0;   ///< upper end of a randomised pull
   std::string note;               ///< free text: how it was produced
 };
+
+/// The flipper controller a spec describes: the imitation controller when it
+/// holds a shot table, the action function's actuator controller otherwise.
+std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec);
 
 /// Bad controller input; what() is "file: field: message".
 class ControllerFileError : public std::runtime_error {

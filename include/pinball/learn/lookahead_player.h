@@ -87,8 +87,11 @@ class LookaheadPlayer {
   /// Borrows the stepper. Throws std::invalid_argument for bad settings.
   LookaheadPlayer(const sim::ThesisStepper& stepper, const LookaheadConfig& config, double actuation_delay_s);
 
-  /// One simulation step: sets the flipper commands in `state` (through the actuation delay).
+  /// One simulation step: sets the flipper commands in `state` (through the
+  /// actuation delay). Decides at every config.frame_steps-th step.
   void act(sim::GameState& state);
+  /// The same, deciding when `frame` is true (e.g. when a camera frame arrived).
+  void act(sim::GameState& state, bool frame);
   /// The flipper fired by the last act() (-1: none), and the hold it chose (s).
   int fired_flipper() const { return fired_; }
   double fired_hold_s() const { return fired_hold_s_; }

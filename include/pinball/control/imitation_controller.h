@@ -1,0 +1,102 @@
+#pragma once
+// A flipper controller that copies a teacher's shots (docs/learning.md,
+// "Learning from a teacher"): it holds the teacher's recorded shots, each the
+// tracker's projection (flipper, θ, h, s, rolling) at the moment the teacher
+// fired, with the projected distance d left at that moment, or a pass when the
+// teacher let the ball go by. For each new projection it takes the k recorded
+// shots nearest in (θ, h, s) on the same flipper line; if most of them fired,
+// d_critical is the median of their d, and it fires once d <= d_critical, as
+// the thesis's actuator does (5.2.3), for the median of their holds. The
+// action function's d_critical (5.2.4) is linear per angle bin; this one is a
+// nearest-neighbour table, so it can follow the sharp, many-valued choices of
+// a teacher that aims. θ is compared modulo π: a ball falling straight down
+// is at −π/2 or +π/2 depending on the sign of a tiny vx.
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "pinball/control/flipper_controller.h"
+#include "pinball/track/projection.h"
+
+namespace pinball::control {
+
+/// One recorded approach: what the tracker projected and what the teacher did.
+struct ShotExample {
+  int flipper = track::kLeftFlipper;  ///< the projection's flipper line (f_impact)
+  bool rolling = false;               ///< the rolling-ball projection (4.1.2)
+  double angle_rad = 0.0;             ///< θ_impact
+  double h = 0.0;                     ///< h_impact (flipper lengths)
+  double speed_mps = 0.0;             ///< s_impact
+  int fired_flipper = -1;             ///< flipper the teacher fired; -1: it let the ball pass
+  double d_fire_m = 0.0;              ///< d_impact when the teacher fired (m)
+  double hold_s = 0.0;                ///< how long the teacher held the flipper up (s)
+};
+
+/// Settings of the nearest-neighbour lookup.
+struct ImitationConfig {
+  int neighbours = 7;             ///< k (1..kMaxNeighbours)
+  double angle_scale_rad = 0.10;  ///< θ distance worth one unit
+  double h_scale = 0.10;          ///< h distance worth one unit
+  double speed_scale_mps = 0.30;  ///< s distance worth one unit
+  double max_hold_s = 1.0;        ///< release a flipper held this long with no launch seen
+  /// Fire when d − s·lead_s <= d_critical: the teacher fired at the frame whose d
+  /// was nearest its choice, so firing at the first frame with d <= d_critical
+  /// would be half a frame late on average. Half a 200 fps frame by default.
+  double lead_s = 0.0025;
+};
+
+/// Largest k the controller supports (it keeps the neighbours in a fixed array).
+inline constexpr int kMaxNeighbours = 32;
+
+/// What the table says for one projection.
+struct ImitationDecision {
+  bool fire = false;         ///< most neighbours fired
+  int flipper = track::kLeftFlipper;  ///< the flipper most firing neighbours fired
+  double d_critical_m = 0.0; ///< median d of the firing neighbours (m)
+  double hold_s = 0.0;       ///< median hold of the firing neighbours (s)
+  int neighbours = 0;        ///< neighbours found (fewer than k when the table is small)
+};
+
+/// The shot table and its lookup. Allocates nothing after construction.
+class ShotTable {
+ public:
+  /// Throws std::invalid_argument for a bad k, a scale <= 0, or an example
+  /// with a bad flipper, non-finite numbers or a negative hold.
+  ShotTable(std::vector<ShotExample> examples, const ImitationConfig& config);
+
+  /// The decision for a projection (valid or not: the caller checks validity).
+  ImitationDecision decide(const track::TrajectoryProjection& p) const;
+
+  const std::vector<ShotExample>& examples() const { return examples_; }
+  const ImitationConfig& config() const { return config_; }
+
+ private:
+  std::vector<ShotExample> examples_;
+  ImitationConfig config_;
+  std::array<std::vector<std::size_t>, 4> by_line_;  // example indices per (flipper, rolling)
+};
+
+/// The table driving the flippers: fires once d <= d_critical, holds for the
+/// table's hold, then releases and may fire again in the same approach; releases
+/// everything on a detected launch or a lost ball.
+class ImitationController final : public FlipperController {
+ public:
+  explicit ImitationController(ShotTable table) : table_(std::move(table)) {}
+
+  void update(const track::TrackerOutput& output, double now_s, std::array<bool, 2>& energized) override;
+  void reset(std::array<bool, 2>& energized) override;
+
+  /// Flips fired since construction.
+  long fires() const { return fires_; }
+  const ShotTable& table() const { return table_; }
+
+ private:
+  ShotTable table_;
+  int held_ = -1;          // flipper up, or -1
+  double release_at_s_ = 0.0;
+  double held_since_s_ = 0.0;
+  long fires_ = 0;
+};
+
+}  // namespace pinball::control

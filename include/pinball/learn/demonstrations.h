@@ -1,0 +1,105 @@
+#pragma once
+// Learning from a teacher (docs/learning.md): the looking-ahead player plays
+// on the simulator's true state while the camera model and the tracker watch,
+// exactly as they would for a real controller; every approach of the ball to
+// the flippers becomes one control::ShotExample: the tracker's projection at
+// the frame the teacher fired, with d then, or the approach's last projection
+// when the teacher let the ball pass. The table of these examples is the
+// imitation controller (control/imitation_controller.h). The teacher cheats;
+// the controller learned from it does not: it sees only the tracker's output.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pinball/control/imitation_controller.h"
+#include "pinball/learn/lookahead_player.h"
+#include "pinball/sim/thesis_stepper.h"
+#include "pinball/track/camera_model.h"
+
+namespace pinball::learn {
+
+/// How the teacher plays and what watches it.
+struct DemonstrationConfig {
+  LookaheadConfig teacher;           ///< the teacher's planner
+  track::CameraModelConfig camera;   ///< the camera the tracker sees through
+  double actuation_delay_s = 0.004;  ///< command to flipper motion (s), as in the evaluator
+  double max_ball_time_s = 60.0;     ///< a teacher's ball alive after this is cut
+  double pull = -1.0;                ///< launcher pull; negative: the board's
+};
+
+/// One teacher ball's examples and figures.
+struct DemonstrationBall {
+  std::vector<control::ShotExample> shots;  ///< one per approach, in order
+  double score = 0.0;        ///< the teacher's score
+  double duration_s = 0.0;   ///< simulated time of the ball
+  bool cut = false;          ///< alive at the time limit
+  int teacher_fires = 0;     ///< flips fired by whoever played (the teacher, or the learner)
+  int unmatched_fires = 0;   ///< of them, fired where no example could be recorded (no hittable
+                             ///< projection in that frame; a learner firing outside the teacher's zone)
+};
+
+/// Plays ball `ball_seed` with the teacher and records its shots.
+DemonstrationBall record_demonstration(const sim::ThesisStepper& stepper, const DemonstrationConfig& config,
+                                       std::uint64_t ball_seed);
+
+/// Everything recorded over many balls.
+struct Demonstrations {
+  std::vector<control::ShotExample> shots;  ///< ball by ball, in ball order
+  int balls = 0;
+  double mean_teacher_score = 0.0;  ///< mean score per ball of whoever played
+  double mean_ball_time_s = 0.0;
+  int cut = 0;
+  long teacher_fires = 0;
+  long unmatched_fires = 0;
+  double wall_s = 0.0;
+};
+
+/// Records `balls` balls (ball i plays ball_seed(seed, i)) on `threads`
+/// threads; the result depends only on the seed. With `learner` null the
+/// teacher plays (record_demonstration); otherwise the imitation controller of
+/// that table plays and the teacher labels the approaches it reaches (DAgger:
+/// the learner's own mistakes get the teacher's answer; record_correction in
+/// the source). `progress` (may be empty) gets a line every tenth of the
+/// balls, never from two threads at once.
+Demonstrations record_demonstrations(const sim::Board& board, const DemonstrationConfig& config, int balls,
+                                     std::uint64_t seed, int threads,
+                                     const std::function<void(const std::string&)>& progress,
+                                     const control::ShotTable* learner = nullptr);
+
+/// Settings of learning by imitation.
+struct ImitationLearningConfig {
+  DemonstrationConfig demonstration;  ///< teacher, camera, delay, time limit
+  control::ImitationConfig table;     ///< the learned table's lookup settings
+  int rounds = 4;                     ///< round 0: the teacher plays; rounds 1..: the learner plays, the teacher labels
+};
+
+/// One round's figures (the player's own balls: the teacher's in round 0, the learner's after).
+struct ImitationRound {
+  int round = 0;
+  int balls = 0;                 ///< balls played in the round
+  std::size_t shots = 0;         ///< examples in the table after the round
+  double mean_score = 0.0;       ///< the round's player, per ball
+  double mean_ball_time_s = 0.0;
+  long fires = 0;
+  long unmatched_fires = 0;
+  double wall_s = 0.0;
+};
+
+/// The learned table and the rounds that made it.
+struct ImitationResult {
+  control::ShotTable table{{}, {}};
+  std::vector<ImitationRound> rounds;
+};
+
+/// Learns a shot table from the teacher in `config.rounds` rounds that share
+/// `budget_balls` (the last round takes the remainder): the table after each
+/// round is trained on every example so far (DAgger). Round r's balls are
+/// ball_seed(ball_seed(seed, r), i). Throws std::invalid_argument for fewer
+/// balls than rounds or rounds < 1.
+ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearningConfig& config,
+                                   std::uint64_t budget_balls, std::uint64_t seed, int threads,
+                                   const std::function<void(const std::string&)>& progress);
+
+}  // namespace pinball::learn

@@ -1,0 +1,275 @@
+#include "pinball/learn/demonstrations.h"
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <stdexcept>
+
+#include "pinball/control/simulated_player.h"
+#include "pinball/learn/evaluator.h"
+#include "pinball/learn/parallel_runner.h"
+#include "pinball/sim/ball_runner.h"
+
+namespace pinball::learn {
+
+namespace {
+
+// Watches the tracker and books one example per approach; never moves a flipper itself.
+class ShotRecorder final : public control::FlipperController {
+ public:
+  explicit ShotRecorder(std::vector<control::ShotExample>& out) : out_(out) {}
+
+  void update(const track::TrackerOutput& o, double now_s, std::array<bool, 2>&) override {
+    if (o.launch.launched || o.launch.lost) {
+      close();
+      return;
+    }
+    if (o.projection.valid && o.projection.hittable) {
+      open_ = true;
+      last_ = o.projection;
+      last_time_s_ = now_s;
+    }
+  }
+  void reset(std::array<bool, 2>&) override { close(); }
+
+  // The approach is open, not yet labelled, and the tracker projected a
+  // hittable impact in this very frame (a controller can act on it now).
+  bool can_label(double now_s) const { return open_ && !fired_ && last_time_s_ == now_s; }
+  // The latest projection.
+  const track::TrajectoryProjection& projection() const { return last_; }
+
+  // The teacher fires `flipper` (tracker index) now, or would once the ball
+  // has come `lead_m` closer: an example if a controller could act in this
+  // frame. Returns false when it could not (nothing is recorded).
+  bool teacher_fired(int flipper, double hold_s, double now_s, double lead_m = 0.0) {
+    if (open_ && fired_ && last_time_s_ == now_s) return true;  // a second flip in one approach: the first is the shot
+    if (!can_label(now_s)) return false;
+    out_.push_back(example(flipper, last_.d_m - lead_m, hold_s));
+    fired_ = true;
+    return true;
+  }
+  // The teacher would let the ball pass: the approach's example is a pass.
+  void teacher_passes(double now_s) {
+    if (!can_label(now_s)) return;
+    out_.push_back(example(-1, 0.0, 0.0));
+    fired_ = true;
+  }
+  // Label this approach no more (the learner acted where the teacher cannot judge).
+  void give_up() { fired_ = true; }
+  void close() {
+    if (open_ && !fired_) out_.push_back(example(-1, 0.0, 0.0));
+    open_ = false;
+    fired_ = false;
+  }
+
+ private:
+  control::ShotExample example(int fired_flipper, double d_m, double hold_s) const {
+    return {last_.flipper, last_.rolling, last_.angle_rad, last_.h, last_.speed_mps, fired_flipper, d_m, hold_s};
+  }
+
+  std::vector<control::ShotExample>& out_;
+  bool open_ = false;
+  bool fired_ = false;  // labelled (fired or passed) in this approach
+  track::TrajectoryProjection last_;
+  double last_time_s_ = -1.0;
+};
+
+// Passes tracker updates to the learner, which acts, and to the recorder, which watches.
+class Tee final : public control::FlipperController {
+ public:
+  Tee(control::FlipperController& acts, control::FlipperController& watches) : acts_(acts), watches_(watches) {}
+  void update(const track::TrackerOutput& o, double now_s, std::array<bool, 2>& energized) override {
+    watches_.update(o, now_s, energized);
+    acts_.update(o, now_s, energized);
+  }
+  void reset(std::array<bool, 2>& energized) override {
+    watches_.reset(energized);
+    acts_.reset(energized);
+  }
+
+ private:
+  control::FlipperController& acts_;
+  control::FlipperController& watches_;
+};
+
+// Board flipper index -> tracker flipper index.
+std::array<int, 2> tracker_index_of(const control::SimulatedPlayer& watcher) {
+  std::array<int, 2> index{};
+  index[static_cast<std::size_t>(watcher.board_index(track::kRightFlipper))] = track::kRightFlipper;
+  index[static_cast<std::size_t>(watcher.board_index(track::kLeftFlipper))] = track::kLeftFlipper;
+  return index;
+}
+
+sim::BallLimits limits_of(const DemonstrationConfig& config) {
+  sim::BallLimits limits;
+  limits.max_ball_time_s = config.max_ball_time_s;
+  limits.pull = config.pull;
+  return limits;
+}
+
+// The learner plays; at each camera frame of an unlabelled approach the
+// teacher judges the true state: "fire now" labels the approach with this
+// frame's d; if the learner fires first, the teacher's best plan from that
+// frame labels it (fire k frames later: d less the ball's travel; no fire: a pass).
+DemonstrationBall record_correction(const sim::ThesisStepper& stepper, const DemonstrationConfig& config,
+                                    const control::ShotTable& learner_table, std::uint64_t seed) {
+  const sim::Board& board = stepper.board();
+  DemonstrationBall ball;
+  ShotRecorder recorder(ball.shots);
+  control::ImitationController learner(learner_table);
+  Tee tee(learner, recorder);
+  control::SimulatedPlayer watcher(board, config.camera, tee, seed ^ 0x5DEECE66Dull);
+  LookaheadPlanner teacher(stepper, config.teacher);
+  const double frame_s = stepper.dt_s() * config.teacher.frame_steps;
+  DelayLine delay(board.flippers.size(), config.actuation_delay_s);
+  const std::array<int, 2> track_index = tracker_index_of(watcher);
+  sim::GameState state = sim::make_game_state(board, seed);
+  bool held = false;  // a learner's flipper was commanded up before this step
+  const sim::BallResult r = sim::play_ball(
+      stepper, state, limits_of(config),
+      [&](sim::GameState& s) {
+        const std::uint64_t before = watcher.observations();
+        const long fires_before = learner.fires();
+        watcher.act(s);
+        const bool learner_fired = learner.fires() != fires_before;
+        if (learner_fired) ++ball.teacher_fires;
+        if (watcher.observations() != before && !held && recorder.can_label(s.time_s)) {
+          const int f = teacher.decision_flipper(s);
+          if (f >= 0) {
+            const std::vector<LookaheadCandidate>& c = teacher.evaluate(s, delay, f);
+            const LookaheadCandidate& best = c[teacher.best()];
+            const int tf = track_index[static_cast<std::size_t>(f)];
+            if (best.fire_frame == 0) {
+              recorder.teacher_fired(tf, best.hold_frames * frame_s, s.time_s);
+            } else if (learner_fired && best.fire_frame > 0) {
+              const double lead_m = recorder.projection().speed_mps * best.fire_frame * frame_s;
+              recorder.teacher_fired(tf, best.hold_frames * frame_s, s.time_s, lead_m);
+            } else if (learner_fired) {
+              recorder.teacher_passes(s.time_s);
+            }
+          } else if (learner_fired) {
+            ++ball.unmatched_fires;  // fired outside the teacher's zone: no judgement
+            recorder.give_up();
+          }
+        }
+        held = s.flippers[0].energized || s.flippers[1].energized;
+        delay.apply(s);
+      },
+      [](const sim::GameState&, const sim::StepEvents&) {});
+  recorder.close();
+  ball.score = r.score;
+  ball.duration_s = r.duration_s;
+  ball.cut = r.cut;
+  return ball;
+}
+
+}  // namespace
+
+DemonstrationBall record_demonstration(const sim::ThesisStepper& stepper, const DemonstrationConfig& config,
+                                       std::uint64_t seed) {
+  const sim::Board& board = stepper.board();
+  DemonstrationBall ball;
+  ShotRecorder recorder(ball.shots);
+  // The same camera and tracker seeds as the evaluator's, so the examples see what a controller would.
+  control::SimulatedPlayer watcher(board, config.camera, recorder, seed ^ 0x5DEECE66Dull);
+  LookaheadPlayer teacher(stepper, config.teacher, config.actuation_delay_s);
+  const std::array<int, 2> track_index = tracker_index_of(watcher);
+  sim::GameState state = sim::make_game_state(board, seed);
+  const sim::BallResult r = sim::play_ball(
+      stepper, state, limits_of(config),
+      [&](sim::GameState& s) {
+        const std::uint64_t before = watcher.observations();
+        watcher.act(s);
+        // The teacher decides at the camera's frames, when a controller can.
+        teacher.act(s, watcher.observations() != before);
+        const int f = teacher.fired_flipper();
+        if (f < 0) return;
+        ++ball.teacher_fires;
+        if (!recorder.teacher_fired(track_index[static_cast<std::size_t>(f)], teacher.fired_hold_s(), s.time_s)) {
+          ++ball.unmatched_fires;
+        }
+      },
+      [](const sim::GameState&, const sim::StepEvents&) {});
+  recorder.close();
+  ball.score = r.score;
+  ball.duration_s = r.duration_s;
+  ball.cut = r.cut;
+  return ball;
+}
+
+Demonstrations record_demonstrations(const sim::Board& board, const DemonstrationConfig& config, int balls,
+                                     std::uint64_t seed, int threads,
+                                     const std::function<void(const std::string&)>& progress,
+                                     const control::ShotTable* learner) {
+  if (balls < 1) throw std::invalid_argument("demonstrations: balls must be >= 1");
+  if (board.flippers.size() != 2) throw std::invalid_argument("demonstrations: the board needs exactly two flippers");
+  const sim::ThesisStepper stepper(board);
+  const auto n = static_cast<std::size_t>(balls);
+  std::vector<DemonstrationBall> played(n);
+  std::atomic<int> done{0};
+  std::mutex progress_mutex;
+  const int every = std::max(1, balls / 10);
+  const auto start = std::chrono::steady_clock::now();
+  parallel_for(n, threads, [&](std::size_t i) {
+    played[i] = learner != nullptr ? record_correction(stepper, config, *learner, ball_seed(seed, i))
+                                   : record_demonstration(stepper, config, ball_seed(seed, i));
+    const int d = ++done;
+    if (progress && (d % every == 0 || d == balls)) {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      progress(std::string(learner != nullptr ? "learner, teacher judging: " : "teacher: ") + std::to_string(d) + "/" + std::to_string(balls) + " balls");
+    }
+  });
+  Demonstrations out;
+  out.balls = balls;
+  double score = 0.0;
+  double time = 0.0;
+  for (const DemonstrationBall& b : played) {
+    out.shots.insert(out.shots.end(), b.shots.begin(), b.shots.end());
+    score += b.score;
+    time += b.duration_s;
+    out.cut += b.cut ? 1 : 0;
+    out.teacher_fires += b.teacher_fires;
+    out.unmatched_fires += b.unmatched_fires;
+  }
+  out.mean_teacher_score = score / balls;
+  out.mean_ball_time_s = time / balls;
+  out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearningConfig& config,
+                                   std::uint64_t budget_balls, std::uint64_t seed, int threads,
+                                   const std::function<void(const std::string&)>& progress) {
+  if (config.rounds < 1) throw std::invalid_argument("imitation: rounds must be >= 1");
+  if (budget_balls < static_cast<std::uint64_t>(config.rounds)) {
+    throw std::invalid_argument("imitation: the budget must give every round a ball");
+  }
+  ImitationResult result;
+  std::vector<control::ShotExample> shots;
+  const std::uint64_t per_round = budget_balls / static_cast<std::uint64_t>(config.rounds);
+  for (int r = 0; r < config.rounds; ++r) {
+    const std::uint64_t balls = r + 1 == config.rounds ? budget_balls - per_round * static_cast<std::uint64_t>(r)
+                                                       : per_round;
+    const Demonstrations d =
+        record_demonstrations(board, config.demonstration, static_cast<int>(balls),
+                              ball_seed(seed, static_cast<std::uint64_t>(r)), threads,
+                              [&](const std::string& line) {
+                                if (progress) progress("round " + std::to_string(r + 1) + "/" +
+                                                       std::to_string(config.rounds) + ": " + line);
+                              },
+                              r == 0 ? nullptr : &result.table);
+    shots.insert(shots.end(), d.shots.begin(), d.shots.end());
+    result.table = control::ShotTable(shots, config.table);
+    result.rounds.push_back({r, d.balls, shots.size(), d.mean_teacher_score, d.mean_ball_time_s, d.teacher_fires,
+                             d.unmatched_fires, d.wall_s});
+    if (progress) {
+      progress("round " + std::to_string(r + 1) + ": " + (r == 0 ? "teacher " : "learner ") +
+               std::to_string(d.mean_teacher_score) + " per ball over " + std::to_string(d.balls) + " balls; " +
+               std::to_string(shots.size()) + " examples");
+    }
+  }
+  return result;
+}
+
+}  // namespace pinball::learn

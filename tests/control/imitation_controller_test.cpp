@@ -1,0 +1,159 @@
+#include "pinball/control/imitation_controller.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace pinball::control {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+track::TrajectoryProjection projection(int flipper, double angle_rad, double h, double speed_mps, double d_m) {
+  track::TrajectoryProjection p;
+  p.valid = true;
+  p.reason = track::NoProjection::kNone;
+  p.hittable = true;
+  p.flipper = flipper;
+  p.angle_rad = angle_rad;
+  p.h = h;
+  p.speed_mps = speed_mps;
+  p.d_m = d_m;
+  return p;
+}
+
+track::TrackerOutput update_of(const track::TrajectoryProjection& p) {
+  track::TrackerOutput o;
+  o.projection = p;
+  return o;
+}
+
+ShotExample fire(int flipper, double angle, double h, double s, double d, int fired = -2, double hold = 0.03) {
+  return {flipper, false, angle, h, s, fired == -2 ? flipper : fired, d, hold};
+}
+ShotExample pass(int flipper, double angle, double h, double s) { return {flipper, false, angle, h, s, -1, 0.0, 0.0}; }
+
+ImitationConfig k_of(int k, double lead_s = 0.0) {
+  ImitationConfig c;
+  c.neighbours = k;
+  c.lead_s = lead_s;
+  return c;
+}
+
+TEST(ShotTable, MajorityOfTheNearestDecidesAndDIsTheirMedian) {
+  // Near (θ=-1, h=0.5, s=2): three fire at 40, 50, 90 mm and one passes; far away, passes only.
+  const ShotTable t({fire(0, -1.0, 0.5, 2.0, 0.050), fire(0, -1.01, 0.5, 2.0, 0.040), fire(0, -1.0, 0.51, 2.0, 0.090),
+                     pass(0, -1.0, 0.5, 2.05), pass(0, 0.5, 1.0, 1.0), pass(0, 0.5, 1.0, 1.1), pass(0, 0.5, 1.0, 1.2)},
+                    k_of(4));
+  const ImitationDecision d = t.decide(projection(0, -1.0, 0.5, 2.0, 0.3));
+  EXPECT_EQ(d.neighbours, 4);
+  EXPECT_TRUE(d.fire);
+  EXPECT_EQ(d.flipper, 0);
+  EXPECT_DOUBLE_EQ(d.d_critical_m, 0.050);  // median of 40, 50, 90
+  EXPECT_DOUBLE_EQ(d.hold_s, 0.03);
+  EXPECT_FALSE(t.decide(projection(0, 0.5, 1.0, 1.1, 0.3)).fire) << "near the passes";
+}
+
+TEST(ShotTable, ATieAndAnEmptyLinePass) {
+  const ShotTable t({fire(0, -1.0, 0.5, 2.0, 0.05), pass(0, -1.0, 0.5, 2.0)}, k_of(2));
+  EXPECT_FALSE(t.decide(projection(0, -1.0, 0.5, 2.0, 0.0)).fire);
+  const ImitationDecision other_line = t.decide(projection(1, -1.0, 0.5, 2.0, 0.0));
+  EXPECT_FALSE(other_line.fire) << "no examples on the right flipper's line";
+  EXPECT_EQ(other_line.neighbours, 0);
+}
+
+TEST(ShotTable, FlipperLinesAndRollingAreSeparateTables) {
+  ShotExample rolling = fire(1, 0.4, 1.3, 1.0, 0.06);
+  rolling.rolling = true;
+  const ShotTable t({fire(0, 0.4, 1.3, 1.0, 0.02), rolling}, k_of(1));
+  track::TrajectoryProjection p = projection(1, 0.4, 1.3, 1.0, 0.0);
+  EXPECT_FALSE(t.decide(p).fire) << "the right line has a rolling example only";
+  p.rolling = true;
+  EXPECT_DOUBLE_EQ(t.decide(p).d_critical_m, 0.06);
+  EXPECT_DOUBLE_EQ(t.decide(projection(0, 0.4, 1.3, 1.0, 0.0)).d_critical_m, 0.02);
+}
+
+TEST(ShotTable, FiringNeighboursChooseTheFlipper) {
+  // A ball heading for the left line that the teacher hit with the right flipper.
+  const ShotTable t({fire(0, 0.3, 1.2, 2.0, 0.05, 1), fire(0, 0.3, 1.2, 2.1, 0.05, 1), fire(0, 0.3, 1.2, 2.2, 0.05, 0)},
+                    k_of(3));
+  EXPECT_EQ(t.decide(projection(0, 0.3, 1.2, 2.0, 0.0)).flipper, 1);
+}
+
+TEST(ShotTable, AnglesCompareModuloPi) {
+  // Straight down is -π/2 or +π/2 by the sign of a tiny vx: the two are neighbours.
+  const ShotTable t({fire(0, kPi / 2 - 0.01, 0.5, 2.0, 0.07), pass(0, 0.0, 0.5, 2.0)}, k_of(1));
+  EXPECT_TRUE(t.decide(projection(0, -kPi / 2 + 0.01, 0.5, 2.0, 0.0)).fire);
+}
+
+TEST(ShotTable, RejectsBadSettingsAndExamples) {
+  EXPECT_THROW(ShotTable({}, k_of(0)), std::invalid_argument);
+  EXPECT_THROW(ShotTable({}, k_of(kMaxNeighbours + 1)), std::invalid_argument);
+  ImitationConfig c;
+  c.h_scale = 0.0;
+  EXPECT_THROW(ShotTable({}, c), std::invalid_argument);
+  c = ImitationConfig{};
+  c.lead_s = -0.001;
+  EXPECT_THROW(ShotTable({}, c), std::invalid_argument);
+  EXPECT_THROW(ShotTable({fire(2, 0, 0, 1, 0.1)}, k_of(1)), std::invalid_argument);
+  EXPECT_THROW(ShotTable({fire(0, 0, 0, 1, 0.1, 3)}, k_of(1)), std::invalid_argument);
+  EXPECT_THROW(ShotTable({fire(0, std::nan(""), 0, 1, 0.1)}, k_of(1)), std::invalid_argument);
+  EXPECT_THROW(ShotTable({fire(0, 0, 0, 1, 0.1, 0, -0.1)}, k_of(1)), std::invalid_argument);
+}
+
+TEST(ImitationController, FiresOnceDWithItsLeadReachesDCriticalAndReleasesAfterTheHold) {
+  ImitationController c(ShotTable({fire(1, -1.0, 0.5, 2.0, 0.050, 1, 0.030)}, k_of(1, 0.0025)));
+  std::array<bool, 2> e{};
+  double t = 0.0;
+  // Lead: fires once d - 2 m/s x 2.5 ms <= 50 mm, i.e. at d <= 55 mm.
+  double fired_at_d = -1.0;
+  for (double d = 0.100; d > 0.0; d -= 0.010, t += 0.005) {
+    c.update(update_of(projection(1, -1.0, 0.5, 2.0, d)), t, e);
+    if (e[1] && fired_at_d < 0.0) fired_at_d = d;
+    if (fired_at_d > 0.0 && t < 0.02) EXPECT_TRUE(e[1]);
+  }
+  EXPECT_NEAR(fired_at_d, 0.050, 1e-9) << "first d <= 55 mm in 10 mm steps from 100 mm";
+  EXPECT_EQ(c.fires(), 1);
+  EXPECT_FALSE(e[0]);
+  // The hold (30 ms) is over by now; the next frame may fire again (the same approach continues).
+  c.update(update_of(projection(1, -1.0, 0.5, 2.0, 0.2)), 1.0, e);
+  EXPECT_FALSE(e[1]);
+}
+
+TEST(ImitationController, ReleasesOnLaunchAndLossAndIgnoresUnhittable) {
+  ImitationController c(ShotTable({fire(0, -1.0, 0.5, 2.0, 0.5, 0, 10.0)}, k_of(1)));
+  std::array<bool, 2> e{};
+  track::TrajectoryProjection unhittable = projection(0, -1.0, 0.5, 2.0, 0.1);
+  unhittable.hittable = false;
+  c.update(update_of(unhittable), 0.0, e);
+  EXPECT_FALSE(e[0]);
+  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.005, e);
+  EXPECT_TRUE(e[0]);
+  track::TrackerOutput launch;
+  launch.launch.launched = true;
+  c.update(launch, 0.010, e);
+  EXPECT_FALSE(e[0]);
+  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.015, e);
+  EXPECT_TRUE(e[0]);
+  track::TrackerOutput lost;
+  lost.launch.lost = true;
+  c.update(lost, 0.020, e);
+  EXPECT_FALSE(e[0]);
+}
+
+TEST(ImitationController, MaxHoldReleasesACradledBall) {
+  ImitationConfig cfg = k_of(1);
+  cfg.max_hold_s = 0.5;
+  ImitationController c(ShotTable({fire(0, -1.0, 0.5, 2.0, 0.5, 0, 10.0)}, cfg));
+  std::array<bool, 2> e{};
+  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.0, e);
+  EXPECT_TRUE(e[0]);
+  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.4, e);
+  EXPECT_TRUE(e[0]);
+  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.6, e);
+  EXPECT_FALSE(e[0]);
+}
+
+}  // namespace
+}  // namespace pinball::control

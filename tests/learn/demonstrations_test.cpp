@@ -1,0 +1,101 @@
+#include "pinball/learn/demonstrations.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "common/thesis_board.h"
+#include "pinball/learn/evaluator.h"
+
+namespace pinball::learn {
+namespace {
+
+using pinball::testing::thesis_board;
+
+DemonstrationConfig short_config() {
+  DemonstrationConfig c;
+  c.teacher.fire_frames = 3;
+  c.teacher.horizon_s = 1.0;
+  c.max_ball_time_s = 6.0;
+  return c;
+}
+
+void expect_sane(const control::ShotExample& e) {
+  EXPECT_TRUE(e.flipper == 0 || e.flipper == 1);
+  EXPECT_TRUE(e.fired_flipper >= -1 && e.fired_flipper <= 1);
+  EXPECT_TRUE(std::isfinite(e.angle_rad) && std::abs(e.angle_rad) <= 1.5707963267948966 + 1e-12);
+  EXPECT_TRUE(std::isfinite(e.h) && e.h >= 0.0);
+  EXPECT_TRUE(std::isfinite(e.speed_mps) && e.speed_mps >= 0.0);
+  if (e.fired_flipper >= 0) {
+    EXPECT_GT(e.hold_s, 0.0);
+  } else {
+    EXPECT_EQ(e.hold_s, 0.0);
+  }
+}
+
+TEST(Demonstrations, TheTeachersShotsAreRecordedOnePerApproach) {
+  const sim::ThesisStepper stepper(thesis_board());
+  const DemonstrationBall b = record_demonstration(stepper, short_config(), ball_seed(3, 0));
+  ASSERT_FALSE(b.shots.empty());
+  int fired = 0;
+  for (const control::ShotExample& e : b.shots) {
+    expect_sane(e);
+    if (e.fired_flipper >= 0) {
+      ++fired;
+      // The teacher's holds are its plans' (30 or 100 ms at 5 ms frames).
+      EXPECT_TRUE(std::abs(e.hold_s - 0.030) < 1e-12 || std::abs(e.hold_s - 0.100) < 1e-12) << e.hold_s;
+    }
+  }
+  EXPECT_GT(fired, 0);
+  EXPECT_LE(fired + b.unmatched_fires, b.teacher_fires) << "at most one example per flip";
+  EXPECT_GT(b.duration_s, 0.0);
+}
+
+TEST(Demonstrations, SameSeedSameExamplesWhateverTheThreads) {
+  const Demonstrations one = record_demonstrations(thesis_board(), short_config(), 3, 11, 1, {});
+  const Demonstrations two = record_demonstrations(thesis_board(), short_config(), 3, 11, 2, {});
+  ASSERT_EQ(one.shots.size(), two.shots.size());
+  for (std::size_t i = 0; i < one.shots.size(); ++i) {
+    EXPECT_EQ(one.shots[i].angle_rad, two.shots[i].angle_rad);
+    EXPECT_EQ(one.shots[i].d_fire_m, two.shots[i].d_fire_m);
+    EXPECT_EQ(one.shots[i].fired_flipper, two.shots[i].fired_flipper);
+  }
+  EXPECT_EQ(one.mean_teacher_score, two.mean_teacher_score);
+  EXPECT_EQ(one.balls, 3);
+}
+
+TEST(Demonstrations, TheTeacherLabelsTheLearnersApproaches) {
+  // A learner that never flips: the teacher, judging the states it reaches, fires to save the ball.
+  const control::ShotTable never({{0, false, 0.0, 0.5, 1.0, -1, 0.0, 0.0}, {1, false, 0.0, 0.5, 1.0, -1, 0.0, 0.0}},
+                                 control::ImitationConfig{});
+  const Demonstrations d = record_demonstrations(thesis_board(), short_config(), 4, 5, 2, {}, &never);
+  ASSERT_FALSE(d.shots.empty());
+  int fired = 0;
+  for (const control::ShotExample& e : d.shots) {
+    expect_sane(e);
+    fired += e.fired_flipper >= 0 ? 1 : 0;
+  }
+  EXPECT_GT(fired, 0) << "the teacher must want to flip where the learner did not";
+  EXPECT_EQ(d.teacher_fires, 0) << "fires count the player's flips: this learner never flips";
+}
+
+TEST(Demonstrations, LearningByImitationSharesTheBudgetOverRounds) {
+  ImitationLearningConfig c;
+  c.demonstration = short_config();
+  c.rounds = 2;
+  std::vector<std::string> lines;
+  const ImitationResult r = learn_by_imitation(thesis_board(), c, 5, 9, 2, [&](const std::string& l) { lines.push_back(l); });
+  ASSERT_EQ(r.rounds.size(), 2u);
+  EXPECT_EQ(r.rounds[0].balls, 2);
+  EXPECT_EQ(r.rounds[1].balls, 3) << "the last round takes the remainder";
+  EXPECT_EQ(r.table.examples().size(), r.rounds[1].shots);
+  EXPECT_GT(r.rounds[1].shots, r.rounds[0].shots);
+  EXPECT_FALSE(lines.empty());
+  EXPECT_THROW(learn_by_imitation(thesis_board(), c, 1, 9, 2, {}), std::invalid_argument);
+  c.rounds = 0;
+  EXPECT_THROW(learn_by_imitation(thesis_board(), c, 5, 9, 2, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pinball::learn
