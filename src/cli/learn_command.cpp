@@ -173,7 +173,9 @@ int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err
 int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   if (a.method == "launcher") return run_launcher_search(a, out, err);
   const bool search = a.method == "tournament" || a.method == "relay" || a.method == "cem";
-  if (search && a.out.empty()) throw std::invalid_argument("learn: --out CONTROLLER is required for a search");
+  if ((search || a.method == "imitate") && a.out.empty()) {
+    throw std::invalid_argument("learn: --out CONTROLLER is required for a search");
+  }
   if (a.method == "evaluate" && a.controller.empty()) throw std::invalid_argument("learn: evaluate needs --controller FILE");
   const sim::Board board = sim::load_board(a.board);
   learn::EvaluatorConfig ec;
@@ -283,8 +285,9 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                        " --rounds " + std::to_string(a.rounds) + " --seed " + std::to_string(a.seed) + ": " +
                        std::to_string(im.table.examples().size()) +
                        " shots of a looking-ahead teacher on the true state";
-    if (!a.out.empty()) control::save_controller(result_spec, a.out);
+    control::save_controller(result_spec, a.out);
     eval_spec = &result_spec;
+    j["out"] = a.out;
   }
   std::function<std::unique_ptr<control::FlipperController>()> make_controller = [&]() -> std::unique_ptr<control::FlipperController> {
     if (a.method == "spastic") return std::make_unique<control::SpasticController>();

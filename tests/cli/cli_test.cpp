@@ -104,6 +104,34 @@ TEST_F(Cli, LauncherSearchTriesTwentyPullsTenTimesEach) {
   EXPECT_GT(best, 0);
 }
 
+TEST_F(Cli, LearnImitateWritesAShotTableThatEvaluateAndSimPlay) {
+  const std::string out = (dir_ / "imitate.json").string();
+  const std::string common = " --seed 3 --threads 2 --max-ball-time 4 --eval-balls 4 --json";
+  const CommandResult r =
+      run("learn boards/mit1993.board --method imitate --budget-balls 3 --rounds 2 --out " + out + common);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("rounds").size(), 2u);
+  EXPECT_EQ(j.at("rounds")[0].at("player"), "teacher");
+  EXPECT_EQ(j.at("rounds")[1].at("player"), "learner");
+  EXPECT_EQ(j.at("rounds")[0].at("balls").get<int>() + j.at("rounds")[1].at("balls").get<int>(), 3);
+  EXPECT_EQ(j.at("evaluation").at("balls"), 4);
+  EXPECT_NE(r.err.find("round 2/2"), std::string::npos) << "progress goes to stderr";
+  const auto file = nlohmann::json::parse(slurp(out));
+  EXPECT_EQ(file.at("imitation").at("shots").size(), j.at("rounds")[1].at("examples").get<std::size_t>());
+  // The saved table plays the same balls to the same score.
+  const CommandResult e = run("learn boards/mit1993.board --method evaluate --controller " + out + common);
+  ASSERT_EQ(e.exit_code, 0) << e.err;
+  EXPECT_EQ(nlohmann::json::parse(e.out).at("evaluation").at("mean_score_per_ball"),
+            j.at("evaluation").at("mean_score_per_ball"));
+  EXPECT_EQ(run("sim boards/mit1993.board --controller " + out + " --balls 2 --max-ball-time 4 --json").exit_code, 0);
+  // Fewer balls than rounds, and no --out, are refused in one line.
+  const CommandResult few = run("learn boards/mit1993.board --method imitate --budget-balls 1 --rounds 2 --out " + out);
+  EXPECT_NE(few.exit_code, 0);
+  EXPECT_NE(few.err.find("every round a ball"), std::string::npos) << few.err;
+  EXPECT_NE(run("learn boards/mit1993.board --method imitate --budget-balls 2").exit_code, 0);
+}
+
 TEST_F(Cli, BadBoardFileIsOneLineNamingFileAndLine) {
   const fs::path bad = dir_ / "bad.board";
   std::ofstream(bad) << "pinball-board 1\nsize 0.5 1\ncirle 0.1 0.1 0.01\n";

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "pinball/core/rng.h"
+
 namespace pinball::control {
 namespace {
 
@@ -100,6 +102,43 @@ TEST(ShotTable, RejectsBadSettingsAndExamples) {
   EXPECT_THROW(ShotTable({fire(0, 0, 0, 1, 0.1, 3)}, k_of(1)), std::invalid_argument);
   EXPECT_THROW(ShotTable({fire(0, std::nan(""), 0, 1, 0.1)}, k_of(1)), std::invalid_argument);
   EXPECT_THROW(ShotTable({fire(0, 0, 0, 1, 0.1, 0, -0.1)}, k_of(1)), std::invalid_argument);
+}
+
+TEST(ShotTable, TheGridSearchFindsExactlyWhatAFullScanFinds) {
+  Rng rng(17);
+  std::vector<ShotExample> examples;
+  for (int i = 0; i < 3000; ++i) {
+    ShotExample e;
+    e.flipper = rng.uniform01() < 0.5 ? 0 : 1;
+    e.rolling = rng.uniform01() < 0.1;
+    e.angle_rad = rng.uniform(-kPi / 2, kPi / 2);
+    e.h = rng.uniform(0.0, 1.3);
+    e.speed_mps = rng.uniform(0.4, 5.0);
+    e.fired_flipper = rng.uniform01() < 0.3 ? -1 : (rng.uniform01() < 0.5 ? 0 : 1);
+    e.d_fire_m = e.fired_flipper < 0 ? 0.0 : rng.uniform(0.0, 0.15);
+    e.hold_s = e.fired_flipper < 0 ? 0.0 : 0.03;
+    // Coarse values make exact distance ties, which both searches break by example index.
+    if (i % 3 == 0) e.h = std::round(e.h * 10.0) / 10.0;
+    examples.push_back(e);
+  }
+  for (const int k : {1, 7, 32}) {
+    ImitationConfig c = k_of(k);
+    c.angle_scale_rad = k == 32 ? 0.7 : 0.1;  // also a coarse θ axis (4 cells)
+    const ShotTable t(examples, c);
+    for (int q = 0; q < 2000; ++q) {
+      // Queries inside and outside the examples' ranges.
+      track::TrajectoryProjection p = projection(q % 2, rng.uniform(-kPi / 2, kPi / 2), rng.uniform(-0.5, 2.0),
+                                                 rng.uniform(0.0, 8.0), 0.0);
+      p.rolling = q % 7 == 0;
+      const ImitationDecision a = t.decide(p);
+      const ImitationDecision b = t.decide_by_scan(p);
+      ASSERT_EQ(a.neighbours, b.neighbours);
+      ASSERT_EQ(a.fire, b.fire) << "k " << k << " query " << q;
+      ASSERT_EQ(a.flipper, b.flipper);
+      ASSERT_EQ(a.d_critical_m, b.d_critical_m);
+      ASSERT_EQ(a.hold_s, b.hold_s);
+    }
+  }
 }
 
 TEST(ImitationController, FiresOnceDWithItsLeadReachesDCriticalAndReleasesAfterTheHold) {

@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "pinball/control/flipper_controller.h"
@@ -58,7 +59,11 @@ struct ImitationDecision {
   int neighbours = 0;        ///< neighbours found (fewer than k when the table is small)
 };
 
-/// The shot table and its lookup. Allocates nothing after construction.
+/// The shot table and its lookup. Allocates nothing after construction. The
+/// examples of each line are bucketed in a grid over (θ, h, s) with cells one
+/// scale wide, searched in growing shells around the query's cell, so a lookup
+/// visits a few cells rather than every example; the answer is the exact k
+/// nearest (ties: the lower example index), the same as a full scan.
 class ShotTable {
  public:
   /// Throws std::invalid_argument for a bad k, a scale <= 0, or an example
@@ -68,13 +73,30 @@ class ShotTable {
   /// The decision for a projection (valid or not: the caller checks validity).
   ImitationDecision decide(const track::TrajectoryProjection& p) const;
 
+  /// The same answer by scanning every example of the line (for tests and the bench).
+  ImitationDecision decide_by_scan(const track::TrajectoryProjection& p) const;
+
   const std::vector<ShotExample>& examples() const { return examples_; }
   const ImitationConfig& config() const { return config_; }
 
  private:
+  // One flipper line's (flipper, rolling) examples in grid cells (compressed rows).
+  struct Line {
+    int n_theta = 1, n_h = 1, n_s = 1;  // cells per axis
+    double h0 = 0.0, s0 = 0.0;          // lower edges of the h and s axes
+    double cell_theta_rad = 0.0;        // θ cell width: π / n_theta, at least one scale
+    std::vector<std::uint32_t> start;   // first item of each cell; size cells + 1
+    std::vector<std::uint32_t> items;   // example indices, cell by cell
+  };
+  struct Neighbours;
+  void build_line(Line& line, const std::vector<std::uint32_t>& members);
+  int cell_of(const Line& line, int it, int ih, int is) const;
+  void consider(std::uint32_t i, const track::TrajectoryProjection& p, Neighbours& n) const;
+  ImitationDecision vote(const Neighbours& n) const;
+
   std::vector<ShotExample> examples_;
   ImitationConfig config_;
-  std::array<std::vector<std::size_t>, 4> by_line_;  // example indices per (flipper, rolling)
+  std::array<Line, 4> lines_;  // by (flipper, rolling)
 };
 
 /// The table driving the flippers: fires once d <= d_critical, holds for the
