@@ -7,10 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <execinfo.h>
 #include <new>
 
+#include "pinball/control/controller_file.h"
+#include "pinball/core/rng.h"
 #include "pinball/daemon/daemon.h"
 #include "pinball/daemon/hot_path.h"
 
@@ -73,8 +76,8 @@ void* memalign(std::size_t align, std::size_t n) {
 namespace pinball::daemon {
 namespace {
 
-TEST(HotPath, CameraAndControllerThreadsAllocateNothingPerFrame) {
-  if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
+// Plays 2 balls with `controller` and counts allocations on the per-frame path.
+void expect_no_allocation_per_frame(const std::string& controller) {
   // The counter sees allocations: check that it does before trusting a zero.
   {
     HotPathScope hot;
@@ -89,7 +92,7 @@ TEST(HotPath, CameraAndControllerThreadsAllocateNothingPerFrame) {
 
   DaemonConfig c;
   c.sim.board = std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board";
-  c.controller = std::string(PINBALL_SOURCE_DIR) + "/controllers/best.json";
+  c.controller = controller;
   c.sim.balls = 2;
   c.sim.seed = 4;
   Daemon d(c);
@@ -98,6 +101,30 @@ TEST(HotPath, CameraAndControllerThreadsAllocateNothingPerFrame) {
   ASSERT_GT(r.frames, 1000u);
   ASSERT_GT(r.commands, 0u);
   EXPECT_EQ(g_hot_allocations.load(), 0) << "allocations on the per-frame path over " << r.frames << " frames";
+}
+
+TEST(HotPath, CameraAndControllerThreadsAllocateNothingPerFrame) {
+  if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
+  expect_no_allocation_per_frame(std::string(PINBALL_SOURCE_DIR) + "/controllers/best.json");
+}
+
+TEST(HotPath, TheImitationControllerAllocatesNothingPerFrame) {
+  if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
+  // A table of random shots, most of them fired, so lookups and flips happen every approach.
+  Rng rng(5);
+  std::vector<control::ShotExample> shots;
+  for (int i = 0; i < 2000; ++i) {
+    const int f = i % 2;
+    const bool fire = rng.uniform01() < 0.8;
+    shots.push_back({f, i % 10 == 0, rng.uniform(-1.57, 1.57), rng.uniform(0.0, 1.3), rng.uniform(0.4, 5.0),
+                     fire ? f : -1, fire ? rng.uniform(0.02, 0.1) : 0.0, fire ? 0.03 : 0.0});
+  }
+  control::ControllerSpec spec;
+  spec.shot_table.emplace(std::move(shots), control::ImitationConfig{});
+  const std::string path = ::testing::TempDir() + "/hot_path_imitation.json";
+  control::save_controller(spec, path);
+  expect_no_allocation_per_frame(path);
+  std::remove(path.c_str());
 }
 
 }  // namespace
