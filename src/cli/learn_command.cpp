@@ -268,15 +268,33 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     ic.demonstration.max_ball_time_s = a.max_ball_time_s;
     ic.demonstration.pull = a.pull;
     ic.rounds = a.rounds;
+    const std::string cycle_path = a.out + ".cycle.json";
+    double cycle_score = -1e300;  // keep the highest-scoring cycle, as the searches do
     const learn::ImitationResult im = learn::learn_by_imitation(
-        board, ic, a.budget_balls, a.seed, a.threads, [&](const std::string& line) { err << "learn imitate: " << line << "\n"; });
+        board, ic, a.budget_balls, a.seed, a.threads,
+        [&](const std::string& line) { err << "learn imitate: " << line << "\n"; },
+        [&](const control::ShotTable& table, double score) {
+          if (score <= cycle_score) return;
+          cycle_score = score;
+          control::ControllerSpec s = objective.prototype();
+          s.shot_table = table;
+          s.note = "cycle found by pinball learn --method imitate --seed " + std::to_string(a.seed) +
+                   ": ball alive at the time limit with score " + std::to_string(score);
+          control::save_controller(s, cycle_path);
+          err << "learn: cycle controller saved to " << cycle_path << "\n";
+        });
+    const learn::SearchResult curve = learn::imitation_curve(im);
+    if (!a.curve.empty()) learn::write_curve_csv(curve, a.curve);
+    if (!a.plot.empty()) learn::plot_curve_png(curve, a.plot);
+    j["cycle_found"] = curve.cycle_found;
+    j["balls_used"] = curve.balls_used;
     result_spec = objective.prototype();
     result_spec.shot_table = im.table;
     nlohmann::json rounds = nlohmann::json::array();
     for (const learn::ImitationRound& r : im.rounds) {
       rounds.push_back({{"round", r.round}, {"player", r.round == 0 ? "teacher" : "learner"}, {"balls", r.balls},
                         {"examples", r.shots}, {"mean_score_per_ball", r.mean_score},
-                        {"mean_ball_time_s", r.mean_ball_time_s}, {"fires", r.fires},
+                        {"mean_ball_time_s", r.mean_ball_time_s}, {"cut", r.cut}, {"fires", r.fires},
                         {"unmatched_fires", r.unmatched_fires}, {"wall_s", r.wall_s}});
     }
     j["rounds"] = rounds;
@@ -310,6 +328,15 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
           << " generations, " << j["search_balls_per_s"] << " balls/s\n"
           << "best estimate    " << j["best_estimated_mean"] << " over " << j["best_estimated_balls"] << " balls\n"
           << "cycle found      " << (j["cycle_found"].get<bool>() ? "yes" : "no") << "\n"
+          << "controller       " << a.out << "\n";
+    }
+    if (j.contains("rounds")) {
+      for (const auto& r : j["rounds"]) {
+        out << "round " << r["round"].get<int>() + 1 << " (" << r["player"].get<std::string>() << ")  "
+            << r["balls"] << " balls, " << r["mean_score_per_ball"] << " per ball, " << r["examples"]
+            << " shots so far, " << r["wall_s"] << " s\n";
+      }
+      out << "cycle found      " << (j["cycle_found"].get<bool>() ? "yes" : "no") << "\n"
           << "controller       " << a.out << "\n";
     }
     if (j.contains("evaluation")) {

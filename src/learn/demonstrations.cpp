@@ -229,6 +229,7 @@ Demonstrations record_demonstrations(const sim::Board& board, const Demonstratio
     score += b.score;
     time += b.duration_s;
     out.cut += b.cut ? 1 : 0;
+    if (b.cut) out.best_cut_score = std::max(out.best_cut_score, b.score);
     out.teacher_fires += b.teacher_fires;
     out.unmatched_fires += b.unmatched_fires;
   }
@@ -240,7 +241,8 @@ Demonstrations record_demonstrations(const sim::Board& board, const Demonstratio
 
 ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearningConfig& config,
                                    std::uint64_t budget_balls, std::uint64_t seed, int threads,
-                                   const std::function<void(const std::string&)>& progress) {
+                                   const std::function<void(const std::string&)>& progress,
+                                   const ImitationCycleHandler& on_cycle) {
   if (config.rounds < 1) throw std::invalid_argument("imitation: rounds must be >= 1");
   if (budget_balls < static_cast<std::uint64_t>(config.rounds)) {
     throw std::invalid_argument("imitation: the budget must give every round a ball");
@@ -259,10 +261,11 @@ ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearn
                                                        std::to_string(config.rounds) + ": " + line);
                               },
                               r == 0 ? nullptr : &result.table);
+    if (r > 0 && d.cut > 0 && on_cycle) on_cycle(result.table, d.best_cut_score);  // the table that played it
     shots.insert(shots.end(), d.shots.begin(), d.shots.end());
     result.table = control::ShotTable(shots, config.table);
-    result.rounds.push_back({r, d.balls, shots.size(), d.mean_teacher_score, d.mean_ball_time_s, d.teacher_fires,
-                             d.unmatched_fires, d.wall_s});
+    result.rounds.push_back({r, d.balls, shots.size(), d.mean_teacher_score, d.mean_ball_time_s, d.cut,
+                             d.teacher_fires, d.unmatched_fires, d.wall_s});
     if (progress) {
       progress("round " + std::to_string(r + 1) + ": " + (r == 0 ? "teacher " : "learner ") +
                std::to_string(d.mean_teacher_score) + " per ball over " + std::to_string(d.balls) + " balls; " +
@@ -270,6 +273,24 @@ ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearn
     }
   }
   return result;
+}
+
+SearchResult imitation_curve(const ImitationResult& result) {
+  SearchResult s;
+  s.method = "imitate";
+  double wall = 0.0;
+  double best = 0.0;
+  for (const ImitationRound& r : result.rounds) {
+    s.balls_used += static_cast<std::uint64_t>(r.balls);
+    wall += r.wall_s;
+    if (r.round > 0) best = std::max(best, r.mean_score);  // learners only: the teacher is no controller
+    s.curve.push_back({r.round + 1, s.balls_used, r.mean_score, r.mean_score, best, wall});
+    s.cycle_found = s.cycle_found || (r.round > 0 && r.cut > 0);
+  }
+  s.generations = static_cast<int>(result.rounds.size());
+  s.best_mean = best;
+  s.wall_s = wall;
+  return s;
 }
 
 }  // namespace pinball::learn

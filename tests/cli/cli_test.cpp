@@ -108,7 +108,8 @@ TEST_F(Cli, LearnImitateWritesAShotTableThatEvaluateAndSimPlay) {
   const std::string out = (dir_ / "imitate.json").string();
   const std::string common = " --seed 3 --threads 2 --max-ball-time 4 --eval-balls 4 --json";
   const CommandResult r =
-      run("learn boards/mit1993.board --method imitate --budget-balls 3 --rounds 2 --out " + out + common);
+      run("learn boards/mit1993.board --method imitate --budget-balls 3 --rounds 2 --out " + out + " --curve " +
+          (dir_ / "imitate.csv").string() + " --plot " + (dir_ / "imitate.png").string() + common);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("rounds").size(), 2u);
@@ -117,6 +118,9 @@ TEST_F(Cli, LearnImitateWritesAShotTableThatEvaluateAndSimPlay) {
   EXPECT_EQ(j.at("rounds")[0].at("balls").get<int>() + j.at("rounds")[1].at("balls").get<int>(), 3);
   EXPECT_EQ(j.at("evaluation").at("balls"), 4);
   EXPECT_NE(r.err.find("round 2/2"), std::string::npos) << "progress goes to stderr";
+  EXPECT_EQ(count_lines(slurp((dir_ / "imitate.csv").string())), 3) << "a header and one row per round";
+  EXPECT_TRUE(fs::exists(dir_ / "imitate.png"));
+  EXPECT_TRUE(j.contains("cycle_found"));
   const auto file = nlohmann::json::parse(slurp(out));
   EXPECT_EQ(file.at("imitation").at("shots").size(), j.at("rounds")[1].at("examples").get<std::size_t>());
   // The saved table plays the same balls to the same score.

@@ -97,5 +97,23 @@ TEST(Demonstrations, LearningByImitationSharesTheBudgetOverRounds) {
   EXPECT_THROW(learn_by_imitation(thesis_board(), c, 5, 9, 2, {}), std::invalid_argument);
 }
 
+TEST(Demonstrations, TheCurveHasOneRowPerRoundAndTheTeacherIsNoBestSoFar) {
+  ImitationResult r;
+  r.rounds = {{0, 10, 80, 70000.0, 50.0, 3, 70, 2, 5.0}, {1, 10, 160, 20000.0, 20.0, 0, 60, 1, 2.0},
+              {2, 12, 250, 18000.0, 18.0, 1, 70, 0, 2.5}};
+  const SearchResult s = imitation_curve(r);
+  EXPECT_EQ(s.method, "imitate");
+  ASSERT_EQ(s.curve.size(), 3u);
+  EXPECT_EQ(s.curve[0].generation, 1);
+  EXPECT_EQ(s.curve[2].balls, 32u);
+  EXPECT_EQ(s.curve[0].population_mean, 70000.0);
+  EXPECT_EQ(s.curve[0].best_so_far, 0.0) << "the teacher cheats: it is not a controller";
+  EXPECT_EQ(s.curve[1].best_so_far, 20000.0);
+  EXPECT_EQ(s.curve[2].best_so_far, 20000.0);
+  EXPECT_DOUBLE_EQ(s.curve[2].wall_s, 9.5);
+  EXPECT_TRUE(s.cycle_found) << "a learner's ball was cut in round 3";
+  EXPECT_EQ(s.balls_used, 32u);
+}
+
 }  // namespace
 }  // namespace pinball::learn

@@ -15,6 +15,7 @@
 
 #include "pinball/control/imitation_controller.h"
 #include "pinball/learn/lookahead_player.h"
+#include "pinball/learn/search.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "pinball/track/camera_model.h"
 
@@ -51,6 +52,7 @@ struct Demonstrations {
   double mean_teacher_score = 0.0;  ///< mean score per ball of whoever played
   double mean_ball_time_s = 0.0;
   int cut = 0;
+  double best_cut_score = 0.0;  ///< highest score of a ball cut at the time limit (0: none cut)
   long teacher_fires = 0;
   long unmatched_fires = 0;
   double wall_s = 0.0;
@@ -82,6 +84,7 @@ struct ImitationRound {
   std::size_t shots = 0;         ///< examples in the table after the round
   double mean_score = 0.0;       ///< the round's player, per ball
   double mean_ball_time_s = 0.0;
+  int cut = 0;                   ///< balls alive at the time limit
   long fires = 0;
   long unmatched_fires = 0;
   double wall_s = 0.0;
@@ -93,13 +96,23 @@ struct ImitationResult {
   std::vector<ImitationRound> rounds;
 };
 
+/// Called when a learner's ball was alive at the time limit (a possible
+/// cycle): the table that played it and that ball's score.
+using ImitationCycleHandler = std::function<void(const control::ShotTable& table, double score)>;
+
 /// Learns a shot table from the teacher in `config.rounds` rounds that share
 /// `budget_balls` (the last round takes the remainder): the table after each
 /// round is trained on every example so far (DAgger). Round r's balls are
-/// ball_seed(ball_seed(seed, r), i). Throws std::invalid_argument for fewer
-/// balls than rounds or rounds < 1.
+/// ball_seed(ball_seed(seed, r), i). `on_cycle` (may be empty) hears of the
+/// highest-scoring cut ball of each learner round that had one, at the end of
+/// that round. Throws std::invalid_argument for fewer balls than rounds or rounds < 1.
 ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearningConfig& config,
                                    std::uint64_t budget_balls, std::uint64_t seed, int threads,
-                                   const std::function<void(const std::string&)>& progress);
+                                   const std::function<void(const std::string&)>& progress,
+                                   const ImitationCycleHandler& on_cycle = {});
+
+/// The rounds as a learning curve (one row per round; see docs/learning.md)
+/// for learn::write_curve_csv and plot_curve_png.
+SearchResult imitation_curve(const ImitationResult& result);
 
 }  // namespace pinball::learn
