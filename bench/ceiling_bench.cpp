@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pinball/control/simulated_player.h"
+#include "pinball/control/spastic_controller.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/sim/ball_runner.h"
@@ -53,6 +55,21 @@ CeilingBall play_ceiling_bench_ball(const sim::ThesisStepper& stepper, const Cei
           delay.apply(s);
         },
         observer);
+  } else if (kind == CeilingPlayerKind::kTrackerSpastic || kind == CeilingPlayerKind::kController) {
+    // The evaluator's own loop and seeds: camera model, tracker, controller, actuation delay.
+    const std::unique_ptr<control::FlipperController> controller =
+        kind == CeilingPlayerKind::kController ? control::make_flipper_controller(*options.controller)
+                                               : std::make_unique<control::SpasticController>();
+    control::SimulatedPlayer player(board, options.camera, *controller, ball_seed ^ 0x5DEECE66Dull);
+    learn::DelayLine delay(board.flippers.size(), options.actuation_delay_s);
+    if (kind == CeilingPlayerKind::kController) limits.pull = options.controller->launcher_pull;
+    r = sim::play_ball(
+        stepper, state, limits,
+        [&](sim::GameState& s) {
+          player.act(s);
+          delay.apply(s);
+        },
+        observer);
   } else {
     r = sim::play_ball(stepper, state, limits, [](sim::GameState&) {}, observer);
   }
@@ -71,6 +88,8 @@ const char* player_name(CeilingPlayerKind kind) {
     case CeilingPlayerKind::kCeiling: return "ceiling";
     case CeilingPlayerKind::kSpastic: return "spastic";
     case CeilingPlayerKind::kNoFlipping: return "no_flipping";
+    case CeilingPlayerKind::kTrackerSpastic: return "tracker_spastic";
+    case CeilingPlayerKind::kController: return "controller";
   }
   return "?";
 }
@@ -149,14 +168,26 @@ CeilingReport run_ceiling_bench(const sim::Board& board, const CeilingBenchOptio
   report.ceiling = run_player(stepper, options, CeilingPlayerKind::kCeiling, progress);
   report.spastic = run_player(stepper, options, CeilingPlayerKind::kSpastic, progress);
   report.no_flipping = run_player(stepper, options, CeilingPlayerKind::kNoFlipping, progress);
-  const double s = report.spastic.score.mean();
-  report.ceiling_over_spastic = s != 0.0 ? report.ceiling.score.mean() / s : 0.0;
+  report.tracker_spastic = run_player(stepper, options, CeilingPlayerKind::kTrackerSpastic, progress);
+  if (options.controller != nullptr) {
+    report.controller = run_player(stepper, options, CeilingPlayerKind::kController, progress);
+  }
+  const auto ratio = [](double a, double b) { return b != 0.0 ? a / b : 0.0; };
+  report.ceiling_over_spastic = ratio(report.ceiling.score.mean(), report.spastic.score.mean());
+  const double ts = report.tracker_spastic.score.mean();
+  report.ceiling_over_tracker_spastic = ratio(report.ceiling.score.mean(), ts);
+  if (report.controller) report.controller_over_tracker_spastic = ratio(report.controller->score.mean(), ts);
   return report;
 }
 
 nlohmann::json to_json(const CeilingReport& r) {
   const CeilingBenchOptions& o = r.options;
   const learn::LookaheadConfig& p = o.planner;
+  nlohmann::json players = {{"ceiling", player_json(r.ceiling)},
+                            {"spastic", player_json(r.spastic)},
+                            {"no_flipping", player_json(r.no_flipping)},
+                            {"tracker_spastic", player_json(r.tracker_spastic)}};
+  if (r.controller) players["controller"] = player_json(*r.controller);
   return {{"benchmark", "ceiling"},
           {"board", r.board},
           {"balls", o.balls},
@@ -174,11 +205,11 @@ nlohmann::json to_json(const CeilingReport& r) {
             {"zone_factor", p.zone_factor},
             {"horizon_s", p.horizon_s},
             {"drain_penalty", p.drain_penalty}}},
-          {"players",
-           {{"ceiling", player_json(r.ceiling)},
-            {"spastic", player_json(r.spastic)},
-            {"no_flipping", player_json(r.no_flipping)}}},
-          {"ceiling_over_spastic", r.ceiling_over_spastic}};
+          {"players", players},
+          {"controller", o.controller_name},
+          {"ceiling_over_spastic", r.ceiling_over_spastic},
+          {"ceiling_over_tracker_spastic", r.ceiling_over_tracker_spastic},
+          {"controller_over_tracker_spastic", r.controller_over_tracker_spastic}};
 }
 
 std::string to_text(const CeilingReport& r) {
@@ -188,7 +219,9 @@ std::string to_text(const CeilingReport& r) {
       << "), cut at " << o.max_ball_time_s << " s, actuation delay " << o.actuation_delay_s * 1e3 << " ms\n"
       << "the ceiling player CHEATS (true state, lookahead with the true simulator): a reference, not a "
          "controller\n";
-  for (const CeilingPlayerReport* p : {&r.ceiling, &r.spastic, &r.no_flipping}) {
+  std::vector<const CeilingPlayerReport*> players = {&r.ceiling, &r.spastic, &r.no_flipping, &r.tracker_spastic};
+  if (r.controller) players.push_back(&*r.controller);
+  for (const CeilingPlayerReport* p : players) {
     out << "  " << p->name << ": " << p->score.mean() << " +- " << p->score.ci95_half_width()
         << " per ball (95 %), " << p->duration_s.mean() << " s per ball, " << p->flips.mean()
         << " flips per ball, " << p->cut << " cut; drains: left outlane " << p->drains_left_outlane << ", elsewhere "
@@ -196,7 +229,12 @@ std::string to_text(const CeilingReport& r) {
   }
   out << "  ceiling planning: " << r.ceiling.decisions_per_ball << " decisions, " << r.ceiling.branch_steps_per_ball
       << " lookahead steps per ball\n"
-      << "ceiling / spastic: " << r.ceiling_over_spastic << "x\n";
+      << "ceiling / spastic: " << r.ceiling_over_spastic << "x; ceiling / spastic through the tracker: "
+      << r.ceiling_over_tracker_spastic << "x\n";
+  if (r.controller) {
+    out << "controller (" << o.controller_name << ") / spastic through the tracker: " << r.controller_over_tracker_spastic
+        << "x\n";
+  }
   return out.str();
 }
 

@@ -26,13 +26,16 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "pinball/core/running_stats.h"
+#include "pinball/control/controller_file.h"
 #include "pinball/learn/lookahead_player.h"
+#include "pinball/track/camera_model.h"
 #include "pinball/sim/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -50,13 +53,20 @@ struct CeilingBenchOptions {
   double spastic_reach_factor = 2.5;///< the spastic baseline's reach (ball radii)
   double left_outlane_x_m = 0.045;  ///< a drain with x below this went down the left outlane
   learn::LookaheadConfig planner;   ///< the ceiling player's planner
+  track::CameraModelConfig camera;  ///< the tracker-side players' camera (the evaluator's)
+  /// A controller to play through the camera model and tracker beside the
+  /// others (`--controller FILE`); null: none.
+  const control::ControllerSpec* controller = nullptr;
+  std::string controller_name;      ///< its file, for the report
 };
 
 /// A short run for tests and a first look: 10 balls.
 CeilingBenchOptions quick_ceiling_bench_options();
 
-/// Who presses the buttons.
-enum class CeilingPlayerKind { kCeiling, kSpastic, kNoFlipping };
+/// Who presses the buttons. The first three read the true state; the last two
+/// see only the tracker's output through the camera model, as the evaluator's
+/// controllers do (the 3x target's spastic baseline is kTrackerSpastic).
+enum class CeilingPlayerKind { kCeiling, kSpastic, kNoFlipping, kTrackerSpastic, kController };
 
 /// One ball's outcome.
 struct CeilingBall {
@@ -96,7 +106,11 @@ struct CeilingReport {
   CeilingPlayerReport ceiling;    ///< the cheating lookahead player
   CeilingPlayerReport spastic;    ///< the spastic flipper on true state (baseline)
   CeilingPlayerReport no_flipping;///< flippers never move (baseline)
+  CeilingPlayerReport tracker_spastic;  ///< the spastic flipper through the tracker (the learning tables' baseline)
+  std::optional<CeilingPlayerReport> controller;  ///< options.controller, through the tracker
   double ceiling_over_spastic = 0.0;  ///< ratio of mean scores per ball
+  double ceiling_over_tracker_spastic = 0.0;     ///< the same against the spastic flipper through the tracker
+  double controller_over_tracker_spastic = 0.0;  ///< the controller's, when one was played
 };
 
 /// Runs the three players; `progress` (may be empty) gets a line now and then, from any thread but never two at once.

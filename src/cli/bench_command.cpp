@@ -8,7 +8,10 @@
 #include "commands.h"
 #include "pinball/sim/board_loader.h"
 #include "calibration_bench.h"
+#include <optional>
+
 #include "ceiling_bench.h"
+#include "pinball/control/controller_file.h"
 #include "detector_bench.h"
 #include "daemon_latency_bench.h"
 #include "latency_bench.h"
@@ -38,6 +41,9 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
       ->check(CLI::Range(1, 1'000'000));
   cmd->add_option("--threads", a.threads, "ceiling: worker threads (results do not depend on it)")
       ->check(CLI::Range(1, 256));
+  cmd->add_option("--controller", a.controller,
+                  "ceiling: also play this controller file through the camera model and tracker")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "ceiling: seconds after which a ball still alive is cut")
       ->check(CLI::Range(1.0, 3600.0));
   cmd->add_option("--csv", a.csv, "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here");
@@ -161,6 +167,12 @@ int run_ceiling(const BenchArgs& a, const sim::Board& board, std::ostream& out, 
   options.seed = a.seed;
   options.threads = a.threads;
   options.max_ball_time_s = a.max_ball_time_s;
+  std::optional<control::ControllerSpec> controller;
+  if (!a.controller.empty()) {
+    controller = control::load_controller(a.controller);
+    options.controller = &*controller;
+    options.controller_name = a.controller;
+  }
   const bench::CeilingReport report = bench::run_ceiling_bench(
       board, options, [&](const std::string& line) { err << "bench ceiling: " << line << "\n"; });
   if (a.json) {

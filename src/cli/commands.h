@@ -72,6 +72,7 @@ struct BenchArgs {
   int balls = 200;                                   ///< ceiling: balls per player
   int threads = 2;                                   ///< ceiling: worker threads (results do not depend on it)
   double max_ball_time_s = 60.0;                     ///< ceiling: a ball alive after this is cut
+  std::string controller;                            ///< ceiling: a controller file to play beside the others
   std::string csv;                                   ///< precision: CSV file to write, or empty
   std::string png;                                   ///< precision: log-log plot to write, or empty
   bool json = false;                                 ///< one JSON object on stdout

@@ -208,7 +208,7 @@ TEST_F(Cli, BenchCeilingJsonAndBadBallCount) {
   EXPECT_EQ(j.at("benchmark"), "ceiling");
   EXPECT_EQ(j.at("balls"), 2);
   EXPECT_EQ(j.at("max_ball_time_s"), 3.0);
-  EXPECT_EQ(j.at("players").size(), 3u);
+  EXPECT_EQ(j.at("players").size(), 4u) << "ceiling, spastic and no flipping on the true state; spastic through the tracker";
   EXPECT_NE(r.err.find("bench ceiling: ceiling: 2/2 balls"), std::string::npos) << r.err;
   EXPECT_EQ(run("bench ceiling --balls 0").exit_code, 2);
 }

@@ -42,7 +42,8 @@ TEST(CeilingBench, SameSeedSameBallWhateverTheThreads) {
   const CeilingReport r1 = run_ceiling_bench(thesis_board(), one, {});
   const CeilingReport r2 = run_ceiling_bench(thesis_board(), o, {});
   for (const auto& [p, q] : {std::pair{&r1.ceiling, &r2.ceiling}, std::pair{&r1.spastic, &r2.spastic},
-                             std::pair{&r1.no_flipping, &r2.no_flipping}}) {
+                             std::pair{&r1.no_flipping, &r2.no_flipping},
+                             std::pair{&r1.tracker_spastic, &r2.tracker_spastic}}) {
     EXPECT_EQ(p->score.mean(), q->score.mean()) << p->name;
     EXPECT_EQ(p->flips.mean(), q->flips.mean()) << p->name;
     EXPECT_EQ(p->cut, q->cut) << p->name;
@@ -51,9 +52,18 @@ TEST(CeilingBench, SameSeedSameBallWhateverTheThreads) {
 
 TEST(CeilingBench, ReportCountsEveryBallAndPrintsOneJsonObject) {
   int lines = 0;
-  const CeilingReport r = run_ceiling_bench(thesis_board(), tiny_bench(), [&](const std::string&) { ++lines; });
-  EXPECT_EQ(lines, 9) << "3 balls x 3 players";
-  for (const CeilingPlayerReport* p : {&r.ceiling, &r.spastic, &r.no_flipping}) {
+  // A controller file's player through the tracker: an action function that fires early on every approach.
+  control::ControllerSpec spec;
+  for (int i = 0; i < spec.action_function.partitions(); ++i) {
+    spec.action_function.minicontroller(i) = control::Minicontroller{{0.0, 0.0, 0.0, 0.05}, i < 4 ? 0 : 1};
+  }
+  CeilingBenchOptions o = tiny_bench();
+  o.controller = &spec;
+  o.controller_name = "early.json";
+  const CeilingReport r = run_ceiling_bench(thesis_board(), o, [&](const std::string&) { ++lines; });
+  EXPECT_EQ(lines, 15) << "3 balls x 5 players";
+  ASSERT_TRUE(r.controller.has_value());
+  for (const CeilingPlayerReport* p : {&r.ceiling, &r.spastic, &r.no_flipping, &r.tracker_spastic, &*r.controller}) {
     EXPECT_EQ(p->score.count(), 3) << p->name;
     EXPECT_EQ(p->cut + p->drains_left_outlane + p->drains_elsewhere, 3) << p->name;
     EXPECT_LE(p->left_table, p->drains_left_outlane + p->drains_elsewhere) << p->name;
@@ -63,17 +73,22 @@ TEST(CeilingBench, ReportCountsEveryBallAndPrintsOneJsonObject) {
   EXPECT_EQ(r.no_flipping.decisions_per_ball, 0.0);
   EXPECT_GT(r.ceiling.branch_steps_per_ball, 0.0);
   EXPECT_DOUBLE_EQ(r.ceiling_over_spastic, r.ceiling.score.mean() / r.spastic.score.mean());
+  EXPECT_DOUBLE_EQ(r.ceiling_over_tracker_spastic, r.ceiling.score.mean() / r.tracker_spastic.score.mean());
+  EXPECT_DOUBLE_EQ(r.controller_over_tracker_spastic, r.controller->score.mean() / r.tracker_spastic.score.mean());
+  EXPECT_GT(r.controller->flips.mean(), 0.0);
   const nlohmann::json j = to_json(r);
   for (const char* k : {"benchmark", "board", "balls", "seed", "planner", "players", "ceiling_over_spastic"}) {
     EXPECT_TRUE(j.contains(k)) << k;
   }
-  for (const char* p : {"ceiling", "spastic", "no_flipping"}) {
+  EXPECT_EQ(j.at("controller"), "early.json");
+  for (const char* p : {"ceiling", "spastic", "no_flipping", "tracker_spastic", "controller"}) {
     for (const char* k : {"mean_score_per_ball", "score_ci95_half_width", "mean_ball_time_s", "flips_per_ball",
                           "balls_cut_at_time_limit", "drains_left_outlane", "drains_elsewhere", "wall_s"}) {
       EXPECT_TRUE(j.at("players").at(p).contains(k)) << p << "." << k;
     }
   }
   EXPECT_NE(to_text(r).find("CHEATS"), std::string::npos);
+  EXPECT_NE(to_text(r).find("controller (early.json) / spastic through the tracker"), std::string::npos);
 }
 
 }  // namespace
