@@ -101,6 +101,14 @@ std::array<int, 2> tracker_index_of(const control::SimulatedPlayer& watcher) {
   return index;
 }
 
+// The ball is over: book the open approach and the ball's figures.
+void finish(DemonstrationBall& ball, ShotRecorder& recorder, const sim::BallResult& r) {
+  recorder.close();
+  ball.score = r.score;
+  ball.duration_s = r.duration_s;
+  ball.cut = r.cut;
+}
+
 sim::BallLimits limits_of(const DemonstrationConfig& config) {
   sim::BallLimits limits;
   limits.max_ball_time_s = config.max_ball_time_s;
@@ -157,10 +165,7 @@ DemonstrationBall record_correction(const sim::ThesisStepper& stepper, const Dem
         delay.apply(s);
       },
       [](const sim::GameState&, const sim::StepEvents&) {});
-  recorder.close();
-  ball.score = r.score;
-  ball.duration_s = r.duration_s;
-  ball.cut = r.cut;
+  finish(ball, recorder, r);
   return ball;
 }
 
@@ -191,10 +196,7 @@ DemonstrationBall record_demonstration(const sim::ThesisStepper& stepper, const 
         }
       },
       [](const sim::GameState&, const sim::StepEvents&) {});
-  recorder.close();
-  ball.score = r.score;
-  ball.duration_s = r.duration_s;
-  ball.cut = r.cut;
+  finish(ball, recorder, r);
   return ball;
 }
 

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/projections.h"
+
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -9,16 +11,7 @@
 namespace pinball::control {
 namespace {
 
-track::TrajectoryProjection projection(int flipper, double angle, double h = 0.5, double s = 1.0) {
-  track::TrajectoryProjection p;
-  p.valid = true;
-  p.hittable = true;
-  p.flipper = flipper;
-  p.angle_rad = angle;
-  p.h = h;
-  p.speed_mps = s;
-  return p;
-}
+using pinball::testing::hittable_projection;
 
 TEST(ActionFunction, UniformBordersSplitTheHalfCircle) {
   const ActionFunctionConfig c = uniform_partition(6);
@@ -40,10 +33,10 @@ TEST(ActionFunction, PartitionLookupAtEveryBorder) {
     EXPECT_EQ(af.angle_bin(std::nextafter(b[i], -10.0)), static_cast<int>(i)) << "just below border " << i;
   }
   // Flipper then angle: left bins 0..3, right bins 4..7.
-  EXPECT_EQ(af.partition_of(projection(track::kLeftFlipper, -1.5)), 0);
-  EXPECT_EQ(af.partition_of(projection(track::kLeftFlipper, 1.5)), 3);
-  EXPECT_EQ(af.partition_of(projection(track::kRightFlipper, -1.5)), 4);
-  EXPECT_EQ(af.partition_of(projection(track::kRightFlipper, b[1])), 6);
+  EXPECT_EQ(af.partition_of(hittable_projection(track::kLeftFlipper, -1.5)), 0);
+  EXPECT_EQ(af.partition_of(hittable_projection(track::kLeftFlipper, 1.5)), 3);
+  EXPECT_EQ(af.partition_of(hittable_projection(track::kRightFlipper, -1.5)), 4);
+  EXPECT_EQ(af.partition_of(hittable_projection(track::kRightFlipper, b[1])), 6);
 }
 
 TEST(ActionFunction, CustomBordersHAndRollingPartitions) {
@@ -53,10 +46,10 @@ TEST(ActionFunction, CustomBordersHAndRollingPartitions) {
   c.rolling_minicontrollers = true;
   const ActionFunction af(c);
   EXPECT_EQ(af.partitions(), 2 * 3 * 2 + 2);
-  EXPECT_EQ(af.partition_of(projection(track::kLeftFlipper, -0.5, 0.99)), 2);  // angle 1, h 0
-  EXPECT_EQ(af.partition_of(projection(track::kLeftFlipper, -0.5, 1.0)), 3);   // angle 1, h 1 (border goes up)
-  EXPECT_EQ(af.partition_of(projection(track::kRightFlipper, 0.2, 0.0)), 6 + 4);
-  track::TrajectoryProjection rolling = projection(track::kRightFlipper, 0.0);
+  EXPECT_EQ(af.partition_of(hittable_projection(track::kLeftFlipper, -0.5, 0.99)), 2);  // angle 1, h 0
+  EXPECT_EQ(af.partition_of(hittable_projection(track::kLeftFlipper, -0.5, 1.0)), 3);   // angle 1, h 1 (border goes up)
+  EXPECT_EQ(af.partition_of(hittable_projection(track::kRightFlipper, 0.2, 0.0)), 6 + 4);
+  track::TrajectoryProjection rolling = hittable_projection(track::kRightFlipper, 0.0);
   rolling.rolling = true;
   EXPECT_EQ(af.partition_of(rolling), 13);
   EXPECT_EQ(af.minicontroller(12).flipper, track::kLeftFlipper);
@@ -80,7 +73,7 @@ TEST(ActionFunction, DCriticalIsEquation51) {
   Minicontroller& m = af.minicontroller(3);  // right flipper, upper angle bin
   m.a = {0.01, -0.02, 0.03, 0.04};
   m.flipper = track::kLeftFlipper;
-  const track::TrajectoryProjection p = projection(track::kRightFlipper, 0.7, 1.2, 2.5);
+  const track::TrajectoryProjection p = hittable_projection(track::kRightFlipper, 0.7, 1.2, 2.5);
   EXPECT_DOUBLE_EQ(af.d_critical(3, p), 0.01 * 0.7 - 0.02 * 1.2 + 0.03 * 2.5 + 0.04);
   const Action act = af.action(p);
   EXPECT_EQ(act.partition, 3);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/projections.h"
 #include "pinball/core/rng.h"
 
 namespace pinball::control {
@@ -12,18 +13,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-track::TrajectoryProjection projection(int flipper, double angle_rad, double h, double speed_mps, double d_m) {
-  track::TrajectoryProjection p;
-  p.valid = true;
-  p.reason = track::NoProjection::kNone;
-  p.hittable = true;
-  p.flipper = flipper;
-  p.angle_rad = angle_rad;
-  p.h = h;
-  p.speed_mps = speed_mps;
-  p.d_m = d_m;
-  return p;
-}
+using pinball::testing::hittable_projection;
 
 track::TrackerOutput update_of(const track::TrajectoryProjection& p) {
   track::TrackerOutput o;
@@ -48,19 +38,19 @@ TEST(ShotTable, MajorityOfTheNearestDecidesAndDIsTheirMedian) {
   const ShotTable t({fire(0, -1.0, 0.5, 2.0, 0.050), fire(0, -1.01, 0.5, 2.0, 0.040), fire(0, -1.0, 0.51, 2.0, 0.090),
                      pass(0, -1.0, 0.5, 2.05), pass(0, 0.5, 1.0, 1.0), pass(0, 0.5, 1.0, 1.1), pass(0, 0.5, 1.0, 1.2)},
                     k_of(4));
-  const ImitationDecision d = t.decide(projection(0, -1.0, 0.5, 2.0, 0.3));
+  const ImitationDecision d = t.decide(hittable_projection(0, -1.0, 0.5, 2.0, 0.3));
   EXPECT_EQ(d.neighbours, 4);
   EXPECT_TRUE(d.fire);
   EXPECT_EQ(d.flipper, 0);
   EXPECT_DOUBLE_EQ(d.d_critical_m, 0.050);  // median of 40, 50, 90
   EXPECT_DOUBLE_EQ(d.hold_s, 0.03);
-  EXPECT_FALSE(t.decide(projection(0, 0.5, 1.0, 1.1, 0.3)).fire) << "near the passes";
+  EXPECT_FALSE(t.decide(hittable_projection(0, 0.5, 1.0, 1.1, 0.3)).fire) << "near the passes";
 }
 
 TEST(ShotTable, ATieAndAnEmptyLinePass) {
   const ShotTable t({fire(0, -1.0, 0.5, 2.0, 0.05), pass(0, -1.0, 0.5, 2.0)}, k_of(2));
-  EXPECT_FALSE(t.decide(projection(0, -1.0, 0.5, 2.0, 0.0)).fire);
-  const ImitationDecision other_line = t.decide(projection(1, -1.0, 0.5, 2.0, 0.0));
+  EXPECT_FALSE(t.decide(hittable_projection(0, -1.0, 0.5, 2.0, 0.0)).fire);
+  const ImitationDecision other_line = t.decide(hittable_projection(1, -1.0, 0.5, 2.0, 0.0));
   EXPECT_FALSE(other_line.fire) << "no examples on the right flipper's line";
   EXPECT_EQ(other_line.neighbours, 0);
 }
@@ -69,24 +59,24 @@ TEST(ShotTable, FlipperLinesAndRollingAreSeparateTables) {
   ShotExample rolling = fire(1, 0.4, 1.3, 1.0, 0.06);
   rolling.rolling = true;
   const ShotTable t({fire(0, 0.4, 1.3, 1.0, 0.02), rolling}, k_of(1));
-  track::TrajectoryProjection p = projection(1, 0.4, 1.3, 1.0, 0.0);
+  track::TrajectoryProjection p = hittable_projection(1, 0.4, 1.3, 1.0, 0.0);
   EXPECT_FALSE(t.decide(p).fire) << "the right line has a rolling example only";
   p.rolling = true;
   EXPECT_DOUBLE_EQ(t.decide(p).d_critical_m, 0.06);
-  EXPECT_DOUBLE_EQ(t.decide(projection(0, 0.4, 1.3, 1.0, 0.0)).d_critical_m, 0.02);
+  EXPECT_DOUBLE_EQ(t.decide(hittable_projection(0, 0.4, 1.3, 1.0, 0.0)).d_critical_m, 0.02);
 }
 
 TEST(ShotTable, FiringNeighboursChooseTheFlipper) {
   // A ball heading for the left line that the teacher hit with the right flipper.
   const ShotTable t({fire(0, 0.3, 1.2, 2.0, 0.05, 1), fire(0, 0.3, 1.2, 2.1, 0.05, 1), fire(0, 0.3, 1.2, 2.2, 0.05, 0)},
                     k_of(3));
-  EXPECT_EQ(t.decide(projection(0, 0.3, 1.2, 2.0, 0.0)).flipper, 1);
+  EXPECT_EQ(t.decide(hittable_projection(0, 0.3, 1.2, 2.0, 0.0)).flipper, 1);
 }
 
 TEST(ShotTable, AnglesCompareModuloPi) {
   // Straight down is -π/2 or +π/2 by the sign of a tiny vx: the two are neighbours.
   const ShotTable t({fire(0, kPi / 2 - 0.01, 0.5, 2.0, 0.07), pass(0, 0.0, 0.5, 2.0)}, k_of(1));
-  EXPECT_TRUE(t.decide(projection(0, -kPi / 2 + 0.01, 0.5, 2.0, 0.0)).fire);
+  EXPECT_TRUE(t.decide(hittable_projection(0, -kPi / 2 + 0.01, 0.5, 2.0, 0.0)).fire);
 }
 
 TEST(ShotTable, RejectsBadSettingsAndExamples) {
@@ -127,7 +117,7 @@ TEST(ShotTable, TheGridSearchFindsExactlyWhatAFullScanFinds) {
     const ShotTable t(examples, c);
     for (int q = 0; q < 2000; ++q) {
       // Queries inside and outside the examples' ranges.
-      track::TrajectoryProjection p = projection(q % 2, rng.uniform(-kPi / 2, kPi / 2), rng.uniform(-0.5, 2.0),
+      track::TrajectoryProjection p = hittable_projection(q % 2, rng.uniform(-kPi / 2, kPi / 2), rng.uniform(-0.5, 2.0),
                                                  rng.uniform(0.0, 8.0), 0.0);
       p.rolling = q % 7 == 0;
       const ImitationDecision a = t.decide(p);
@@ -148,7 +138,7 @@ TEST(ImitationController, FiresOnceDWithItsLeadReachesDCriticalAndReleasesAfterT
   // Lead: fires once d - 2 m/s x 2.5 ms <= 50 mm, i.e. at d <= 55 mm.
   double fired_at_d = -1.0;
   for (double d = 0.100; d > 0.0; d -= 0.010, t += 0.005) {
-    c.update(update_of(projection(1, -1.0, 0.5, 2.0, d)), t, e);
+    c.update(update_of(hittable_projection(1, -1.0, 0.5, 2.0, d)), t, e);
     if (e[1] && fired_at_d < 0.0) fired_at_d = d;
     if (fired_at_d > 0.0 && t < 0.02) EXPECT_TRUE(e[1]);
   }
@@ -156,24 +146,24 @@ TEST(ImitationController, FiresOnceDWithItsLeadReachesDCriticalAndReleasesAfterT
   EXPECT_EQ(c.fires(), 1);
   EXPECT_FALSE(e[0]);
   // The hold (30 ms) is over by now; the next frame may fire again (the same approach continues).
-  c.update(update_of(projection(1, -1.0, 0.5, 2.0, 0.2)), 1.0, e);
+  c.update(update_of(hittable_projection(1, -1.0, 0.5, 2.0, 0.2)), 1.0, e);
   EXPECT_FALSE(e[1]);
 }
 
 TEST(ImitationController, ReleasesOnLaunchAndLossAndIgnoresUnhittable) {
   ImitationController c(ShotTable({fire(0, -1.0, 0.5, 2.0, 0.5, 0, 10.0)}, k_of(1)));
   std::array<bool, 2> e{};
-  track::TrajectoryProjection unhittable = projection(0, -1.0, 0.5, 2.0, 0.1);
+  track::TrajectoryProjection unhittable = hittable_projection(0, -1.0, 0.5, 2.0, 0.1);
   unhittable.hittable = false;
   c.update(update_of(unhittable), 0.0, e);
   EXPECT_FALSE(e[0]);
-  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.005, e);
+  c.update(update_of(hittable_projection(0, -1.0, 0.5, 2.0, 0.1)), 0.005, e);
   EXPECT_TRUE(e[0]);
   track::TrackerOutput launch;
   launch.launch.launched = true;
   c.update(launch, 0.010, e);
   EXPECT_FALSE(e[0]);
-  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.015, e);
+  c.update(update_of(hittable_projection(0, -1.0, 0.5, 2.0, 0.1)), 0.015, e);
   EXPECT_TRUE(e[0]);
   track::TrackerOutput lost;
   lost.launch.lost = true;
@@ -186,11 +176,11 @@ TEST(ImitationController, MaxHoldReleasesACradledBall) {
   cfg.max_hold_s = 0.5;
   ImitationController c(ShotTable({fire(0, -1.0, 0.5, 2.0, 0.5, 0, 10.0)}, cfg));
   std::array<bool, 2> e{};
-  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.0, e);
+  c.update(update_of(hittable_projection(0, -1.0, 0.5, 2.0, 0.1)), 0.0, e);
   EXPECT_TRUE(e[0]);
-  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.4, e);
+  c.update(update_of(hittable_projection(0, -1.0, 0.5, 2.0, 0.1)), 0.4, e);
   EXPECT_TRUE(e[0]);
-  c.update(update_of(projection(0, -1.0, 0.5, 2.0, 0.1)), 0.6, e);
+  c.update(update_of(hittable_projection(0, -1.0, 0.5, 2.0, 0.1)), 0.6, e);
   EXPECT_FALSE(e[0]);
 }
 
