@@ -97,6 +97,30 @@ TEST(Demonstrations, LearningByImitationSharesTheBudgetOverRounds) {
   EXPECT_THROW(learn_by_imitation(thesis_board(), c, 5, 9, 2, {}), std::invalid_argument);
 }
 
+TEST(Demonstrations, TheLearnedTableOutscoresNoFlippingOnFreshBalls) {
+  ImitationLearningConfig c;
+  c.demonstration = short_config();
+  c.demonstration.max_ball_time_s = 20.0;
+  c.rounds = 2;
+  const ImitationResult r = learn_by_imitation(thesis_board(), c, 12, 21, 2, {});
+  control::ControllerSpec spec;
+  spec.shot_table = r.table;
+  EvaluatorConfig ec;
+  ec.max_ball_time_s = 20.0;
+  const PinballEvaluator ev(thesis_board(), ec);
+  struct Idle final : control::FlipperController {
+    void update(const track::TrackerOutput&, double, std::array<bool, 2>&) override {}
+    void reset(std::array<bool, 2>& e) override { e = {false, false}; }
+  } idle;
+  double learned = 0.0;
+  double none = 0.0;
+  for (std::uint64_t i = 0; i < 30; ++i) {  // fresh balls: seeds apart from the rounds'
+    learned += ev.play(spec, ball_seed(99, i)).score;
+    none += ev.play_with(idle, -1.0, ball_seed(99, i)).score;
+  }
+  EXPECT_GT(learned, 1.5 * none) << "learned " << learned / 30 << " per ball, no flipping " << none / 30;
+}
+
 TEST(Demonstrations, TheCurveHasOneRowPerRoundAndTheTeacherIsNoBestSoFar) {
   ImitationResult r;
   r.rounds = {{0, 10, 80, 70000.0, 50.0, 3, 70, 2, 5.0}, {1, 10, 160, 20000.0, 20.0, 0, 60, 1, 2.0},
