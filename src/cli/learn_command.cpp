@@ -277,7 +277,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
           if (score <= cycle_score) return;
           cycle_score = score;
           control::ControllerSpec s = objective.prototype();
-          s.shot_table = table;
+          s.shot_table = std::make_shared<const control::ShotTable>(table);
           s.note = "cycle found by pinball learn --method imitate --seed " + std::to_string(a.seed) +
                    ": ball alive at the time limit with score " + std::to_string(score);
           control::save_controller(s, cycle_path);
@@ -301,7 +301,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     j["budget_balls"] = a.budget_balls;
     result_spec.note = "pinball learn " + a.board + " --method imitate --budget-balls " + std::to_string(a.budget_balls) +
                        " --rounds " + std::to_string(a.rounds) + " --seed " + std::to_string(a.seed) + ": " +
-                       std::to_string(im.table.examples().size()) +
+                       std::to_string(im.table->examples().size()) +
                        " shots of a looking-ahead teacher on the true state";
     control::save_controller(result_spec, a.out);
     eval_spec = &result_spec;

@@ -100,7 +100,7 @@ ShotTable shot_table_from_json(const json& j, const std::string& src) {
 }  // namespace
 
 std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec) {
-  if (spec.shot_table) return std::make_unique<ImitationController>(*spec.shot_table);
+  if (spec.shot_table) return std::make_unique<ImitationController>(spec.shot_table);
   return std::make_unique<ActuatorController>(spec.action_function, spec.actuator);
 }
 
@@ -199,7 +199,7 @@ ControllerSpec controller_from_json(const std::string& text, const std::string& 
     for (int k = 0; k < 4; ++k) mc.a[static_cast<std::size_t>(k)] = a[static_cast<std::size_t>(k)];
     mc.flipper = f.get<std::string>() == "left" ? track::kLeftFlipper : track::kRightFlipper;
   }
-  if (j.contains("imitation")) s.shot_table = shot_table_from_json(j["imitation"], src);
+  if (j.contains("imitation")) s.shot_table = std::make_shared<const ShotTable>(shot_table_from_json(j["imitation"], src));
   if (j.contains("actuator")) {
     const json& act = j["actuator"];
     if (act.contains("max_hold_s")) s.actuator.max_hold_s = number(act["max_hold_s"], src, "actuator.max_hold_s");

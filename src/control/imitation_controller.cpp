@@ -210,6 +210,10 @@ ImitationDecision ShotTable::decide(const track::TrajectoryProjection& p) const 
   return vote(n);
 }
 
+ImitationController::ImitationController(std::shared_ptr<const ShotTable> table) : table_(std::move(table)) {
+  if (table_ == nullptr) throw std::invalid_argument("imitation controller: no shot table");
+}
+
 void ImitationController::reset(std::array<bool, 2>& energized) {
   energized = {false, false};
   held_ = -1;
@@ -221,7 +225,7 @@ void ImitationController::update(const track::TrackerOutput& out, double now_s, 
     return;
   }
   if (held_ >= 0) {
-    const double max_hold = table_.config().max_hold_s;
+    const double max_hold = table_->config().max_hold_s;
     if (now_s + 1e-6 < release_at_s_ && (max_hold <= 0.0 || now_s - held_since_s_ <= max_hold)) return;
     energized[static_cast<std::size_t>(held_)] = false;  // the hold is over: the next decision is a new one
     held_ = -1;
@@ -229,8 +233,8 @@ void ImitationController::update(const track::TrackerOutput& out, double now_s, 
   }
   const track::TrajectoryProjection& p = out.projection;
   if (!p.valid || !p.hittable) return;
-  const ImitationDecision act = table_.decide(p);
-  if (!act.fire || p.d_m - p.speed_mps * table_.config().lead_s > act.d_critical_m) return;
+  const ImitationDecision act = table_->decide(p);
+  if (!act.fire || p.d_m - p.speed_mps * table_->config().lead_s > act.d_critical_m) return;
   energized[static_cast<std::size_t>(act.flipper)] = true;
   held_ = act.flipper;
   held_since_s_ = now_s;

@@ -121,7 +121,8 @@ sim::BallLimits limits_of(const DemonstrationConfig& config) {
 // frame's d; if the learner fires first, the teacher's best plan from that
 // frame labels it (fire k frames later: d less the ball's travel; no fire: a pass).
 DemonstrationBall record_correction(const sim::ThesisStepper& stepper, const DemonstrationConfig& config,
-                                    const control::ShotTable& learner_table, std::uint64_t seed) {
+                                    const std::shared_ptr<const control::ShotTable>& learner_table,
+                                    std::uint64_t seed) {
   const sim::Board& board = stepper.board();
   DemonstrationBall ball;
   ShotRecorder recorder(ball.shots);
@@ -203,7 +204,7 @@ DemonstrationBall record_demonstration(const sim::ThesisStepper& stepper, const 
 Demonstrations record_demonstrations(const sim::Board& board, const DemonstrationConfig& config, int balls,
                                      std::uint64_t seed, int threads,
                                      const std::function<void(const std::string&)>& progress,
-                                     const control::ShotTable* learner) {
+                                     const std::shared_ptr<const control::ShotTable>& learner) {
   if (balls < 1) throw std::invalid_argument("demonstrations: balls must be >= 1");
   if (board.flippers.size() != 2) throw std::invalid_argument("demonstrations: the board needs exactly two flippers");
   const sim::ThesisStepper stepper(board);
@@ -214,7 +215,7 @@ Demonstrations record_demonstrations(const sim::Board& board, const Demonstratio
   const int every = std::max(1, balls / 10);
   const auto start = std::chrono::steady_clock::now();
   parallel_for(n, threads, [&](std::size_t i) {
-    played[i] = learner != nullptr ? record_correction(stepper, config, *learner, ball_seed(seed, i))
+    played[i] = learner != nullptr ? record_correction(stepper, config, learner, ball_seed(seed, i))
                                    : record_demonstration(stepper, config, ball_seed(seed, i));
     const int d = ++done;
     if (progress && (d % every == 0 || d == balls)) {
@@ -262,10 +263,10 @@ ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearn
                                 if (progress) progress("round " + std::to_string(r + 1) + "/" +
                                                        std::to_string(config.rounds) + ": " + line);
                               },
-                              r == 0 ? nullptr : &result.table);
-    if (r > 0 && d.cut > 0 && on_cycle) on_cycle(result.table, d.best_cut_score);  // the table that played it
+                              r == 0 ? nullptr : result.table);
+    if (r > 0 && d.cut > 0 && on_cycle) on_cycle(*result.table, d.best_cut_score);  // the table that played it
     shots.insert(shots.end(), d.shots.begin(), d.shots.end());
-    result.table = control::ShotTable(shots, config.table);
+    result.table = std::make_shared<const control::ShotTable>(shots, config.table);
     result.rounds.push_back({r, d.balls, shots.size(), d.mean_teacher_score, d.mean_ball_time_s, d.cut,
                              d.teacher_fires, d.unmatched_fires, d.wall_s});
     if (progress) {

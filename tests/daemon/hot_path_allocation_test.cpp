@@ -120,7 +120,7 @@ TEST(HotPath, TheImitationControllerAllocatesNothingPerFrame) {
                      fire ? f : -1, fire ? rng.uniform(0.02, 0.1) : 0.0, fire ? 0.03 : 0.0});
   }
   control::ControllerSpec spec;
-  spec.shot_table.emplace(std::move(shots), control::ImitationConfig{});
+  spec.shot_table = std::make_shared<const control::ShotTable>(std::move(shots), control::ImitationConfig{});
   const std::string path = ::testing::TempDir() + "/hot_path_imitation.json";
   control::save_controller(spec, path);
   expect_no_allocation_per_frame(path);

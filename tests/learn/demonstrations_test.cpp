@@ -67,9 +67,10 @@ TEST(Demonstrations, SameSeedSameExamplesWhateverTheThreads) {
 
 TEST(Demonstrations, TheTeacherLabelsTheLearnersApproaches) {
   // A learner that never flips: the teacher, judging the states it reaches, fires to save the ball.
-  const control::ShotTable never({{0, false, 0.0, 0.5, 1.0, -1, 0.0, 0.0}, {1, false, 0.0, 0.5, 1.0, -1, 0.0, 0.0}},
-                                 control::ImitationConfig{});
-  const Demonstrations d = record_demonstrations(thesis_board(), short_config(), 4, 5, 2, {}, &never);
+  const auto never = std::make_shared<const control::ShotTable>(
+      std::vector<control::ShotExample>{{0, false, 0.0, 0.5, 1.0, -1, 0.0, 0.0}, {1, false, 0.0, 0.5, 1.0, -1, 0.0, 0.0}},
+      control::ImitationConfig{});
+  const Demonstrations d = record_demonstrations(thesis_board(), short_config(), 4, 5, 2, {}, never);
   ASSERT_FALSE(d.shots.empty());
   int fired = 0;
   for (const control::ShotExample& e : d.shots) {
@@ -89,7 +90,7 @@ TEST(Demonstrations, LearningByImitationSharesTheBudgetOverRounds) {
   ASSERT_EQ(r.rounds.size(), 2u);
   EXPECT_EQ(r.rounds[0].balls, 2);
   EXPECT_EQ(r.rounds[1].balls, 3) << "the last round takes the remainder";
-  EXPECT_EQ(r.table.examples().size(), r.rounds[1].shots);
+  EXPECT_EQ(r.table->examples().size(), r.rounds[1].shots);
   EXPECT_GT(r.rounds[1].shots, r.rounds[0].shots);
   EXPECT_FALSE(lines.empty());
   EXPECT_THROW(learn_by_imitation(thesis_board(), c, 1, 9, 2, {}), std::invalid_argument);

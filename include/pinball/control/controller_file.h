@@ -4,7 +4,6 @@
 // ControllerFileError naming the file and the field.
 
 #include <memory>
-#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -23,7 +22,8 @@ struct ControllerSpec {
   ActuatorConfig actuator;                            ///< actuator settings
   /// A shot table learned from a teacher (`pinball learn --method imitate`); when
   /// set, it drives the flippers instead of the action function.
-  std::optional<ShotTable> shot_table;
+  /// Shared, not copied, with every controller made from this spec.
+  std::shared_ptr<const ShotTable> shot_table;
   double launcher_pull = -1.0;    ///< launcher pull fraction; negative: the board's
   bool randomise_launch = false;  ///< draw the pull per ball from [launch_pull_min, launch_pull_max] (thesis 7.1)
   double launch_pull_min = 0.5;   ///< lower end of a randomised pull

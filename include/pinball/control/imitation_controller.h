@@ -15,6 +15,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "pinball/control/flipper_controller.h"
@@ -104,17 +105,20 @@ class ShotTable {
 /// everything on a detected launch or a lost ball.
 class ImitationController final : public FlipperController {
  public:
-  explicit ImitationController(ShotTable table) : table_(std::move(table)) {}
+  /// Shares the table: many controllers (one per ball in the evaluator) use one copy.
+  explicit ImitationController(std::shared_ptr<const ShotTable> table);
+  explicit ImitationController(ShotTable table)
+      : ImitationController(std::make_shared<const ShotTable>(std::move(table))) {}
 
   void update(const track::TrackerOutput& output, double now_s, std::array<bool, 2>& energized) override;
   void reset(std::array<bool, 2>& energized) override;
 
   /// Flips fired since construction.
   long fires() const { return fires_; }
-  const ShotTable& table() const { return table_; }
+  const ShotTable& table() const { return *table_; }
 
  private:
-  ShotTable table_;
+  std::shared_ptr<const ShotTable> table_;
   int held_ = -1;          // flipper up, or -1
   double release_at_s_ = 0.0;
   double held_since_s_ = 0.0;

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -68,7 +69,7 @@ struct Demonstrations {
 Demonstrations record_demonstrations(const sim::Board& board, const DemonstrationConfig& config, int balls,
                                      std::uint64_t seed, int threads,
                                      const std::function<void(const std::string&)>& progress,
-                                     const control::ShotTable* learner = nullptr);
+                                     const std::shared_ptr<const control::ShotTable>& learner = nullptr);
 
 /// Settings of learning by imitation.
 struct ImitationLearningConfig {
@@ -92,7 +93,7 @@ struct ImitationRound {
 
 /// The learned table and the rounds that made it.
 struct ImitationResult {
-  control::ShotTable table{{}, {}};
+  std::shared_ptr<const control::ShotTable> table;  ///< after the last round
   std::vector<ImitationRound> rounds;
 };
 
