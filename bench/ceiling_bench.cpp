@@ -8,7 +8,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pinball/control/simulated_player.h"
 #include "pinball/control/spastic_controller.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
@@ -60,16 +59,10 @@ CeilingBall play_ceiling_bench_ball(const sim::ThesisStepper& stepper, const Cei
     const std::unique_ptr<control::FlipperController> controller =
         kind == CeilingPlayerKind::kController ? control::make_flipper_controller(*options.controller)
                                                : std::make_unique<control::SpasticController>();
-    control::SimulatedPlayer player(board, options.camera, *controller, ball_seed ^ 0x5DEECE66Dull);
-    learn::DelayLine delay(board.flippers.size(), options.actuation_delay_s);
     if (kind == CeilingPlayerKind::kController) limits.pull = options.controller->launcher_pull;
-    r = sim::play_ball(
-        stepper, state, limits,
-        [&](sim::GameState& s) {
-          player.act(s);
-          delay.apply(s);
-        },
-        observer);
+    r = learn::play_through_tracker(stepper, state, options.camera,
+                                    track::default_tracker_config(board, options.camera), *controller,
+                                    options.actuation_delay_s, limits, ball_seed, observer);
   } else {
     r = sim::play_ball(stepper, state, limits, [](sim::GameState&) {}, observer);
   }

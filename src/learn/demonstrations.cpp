@@ -128,7 +128,7 @@ DemonstrationBall record_correction(const sim::ThesisStepper& stepper, const Dem
   ShotRecorder recorder(ball.shots);
   control::ImitationController learner(learner_table);
   Tee tee(learner, recorder);
-  control::SimulatedPlayer watcher(board, config.camera, tee, seed ^ 0x5DEECE66Dull);
+  control::SimulatedPlayer watcher(board, config.camera, tee, camera_seed(seed));
   LookaheadPlanner teacher(stepper, config.teacher);
   const double frame_s = stepper.dt_s() * config.teacher.frame_steps;
   DelayLine delay(board.flippers.size(), config.actuation_delay_s);
@@ -178,7 +178,7 @@ DemonstrationBall record_demonstration(const sim::ThesisStepper& stepper, const 
   DemonstrationBall ball;
   ShotRecorder recorder(ball.shots);
   // The same camera and tracker seeds as the evaluator's, so the examples see what a controller would.
-  control::SimulatedPlayer watcher(board, config.camera, recorder, seed ^ 0x5DEECE66Dull);
+  control::SimulatedPlayer watcher(board, config.camera, recorder, camera_seed(seed));
   LookaheadPlayer teacher(stepper, config.teacher, config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
   sim::GameState state = sim::make_game_state(board, seed);

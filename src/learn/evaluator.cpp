@@ -5,9 +5,6 @@
 #include <stdexcept>
 
 #include "pinball/control/actuator_controller.h"
-#include "pinball/control/simulated_player.h"
-#include "pinball/learn/delay_line.h"
-#include "pinball/sim/ball_runner.h"
 
 namespace pinball::learn {
 
@@ -121,18 +118,12 @@ BallOutcome PinballEvaluator::run(control::FlipperController& controller,
   OpportunityBook book(controller, actuator, state.score, outcome.opportunities);
   track::TrackerConfig tracker = track::default_tracker_config(board_, config_.camera);
   tracker.g_mps2 *= config_.gravity_scale;
-  control::SimulatedPlayer player(board_, config_.camera, tracker, book, seed ^ 0x5DEECE66Dull);
-  DelayLine delay(board_.flippers.size(), config_.actuation_delay_s);
   sim::BallLimits limits;
   limits.max_ball_time_s = config_.max_ball_time_s;
   limits.pull = pull;
-  const sim::BallResult r = sim::play_ball(
-      stepper_, state, limits,
-      [&](sim::GameState& s) {
-        player.act(s);
-        delay.apply(s);
-      },
-      [](const sim::GameState&, const sim::StepEvents&) {});
+  const sim::BallResult r =
+      play_through_tracker(stepper_, state, config_.camera, tracker, book, config_.actuation_delay_s, limits, seed,
+                           [](const sim::GameState&, const sim::StepEvents&) {});
   book.finish(!r.cut, config_.loss_penalty);
   outcome.score = r.score;
   outcome.duration_s = r.duration_s;

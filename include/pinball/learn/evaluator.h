@@ -10,6 +10,9 @@
 
 #include "pinball/control/controller_file.h"
 #include "pinball/control/flipper_controller.h"
+#include "pinball/control/simulated_player.h"
+#include "pinball/learn/delay_line.h"
+#include "pinball/sim/ball_runner.h"
 #include "pinball/sim/board.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "pinball/track/camera_model.h"
@@ -57,6 +60,30 @@ struct EvaluatorConfig {
 
 /// Mixes a run seed and a ball index into a ball seed (splitmix64).
 std::uint64_t ball_seed(std::uint64_t run_seed, std::uint64_t index);
+
+/// The camera model's noise seed for a ball: every player that watches ball
+/// `ball_seed` through the camera sees the same noise.
+inline std::uint64_t camera_seed(std::uint64_t ball_seed) { return ball_seed ^ 0x5DEECE66Dull; }
+
+/// One ball of the fast loop: `state` (made for ball `ball_seed`) played by
+/// `controller` behind the camera model and the tracker, its commands reaching
+/// the flippers `actuation_delay_s` later. `observer(state, events)` sees every step.
+template <class Observer>
+sim::BallResult play_through_tracker(const sim::ThesisStepper& stepper, sim::GameState& state,
+                                     const track::CameraModelConfig& camera, const track::TrackerConfig& tracker,
+                                     control::FlipperController& controller, double actuation_delay_s,
+                                     const sim::BallLimits& limits, std::uint64_t ball_seed, Observer&& observer) {
+  const sim::Board& board = stepper.board();
+  control::SimulatedPlayer player(board, camera, tracker, controller, camera_seed(ball_seed));
+  DelayLine delay(board.flippers.size(), actuation_delay_s);
+  return sim::play_ball(
+      stepper, state, limits,
+      [&](sim::GameState& s) {
+        player.act(s);
+        delay.apply(s);
+      },
+      std::forward<Observer>(observer));
+}
 
 /// Plays balls of a board through the camera model and tracker.
 class PinballEvaluator final : public BallObjective {
