@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -30,7 +33,8 @@ DaemonConfig config_for_test() {
 // Records one run once for every test here.
 const std::string& recorded_log() {
   static const std::string path = [] {
-    const std::string p = ::testing::TempDir() + "/pinballd_replay.lcmlog";
+    // ctest runs each test in its own process, two at a time: one log per process.
+    const std::string p = ::testing::TempDir() + "/pinballd_replay_" + std::to_string(getpid()) + ".lcmlog";
     std::remove(p.c_str());
     DaemonConfig c = config_for_test();
     c.lcm_url = "file://" + p + "?mode=w";
@@ -52,7 +56,8 @@ TEST(Replay, ReproducesTheRecordedDecisions) {
 }
 
 TEST(Replay, AnAlteredDecisionIsFoundAndBadMessagesAreSkipped) {
-  const std::string altered = ::testing::TempDir() + "/pinballd_replay_altered.lcmlog";
+  const std::string altered =
+      ::testing::TempDir() + "/pinballd_replay_altered_" + std::to_string(getpid()) + ".lcmlog";
   {
     lcm::LogFile in(recorded_log(), "r");
     lcm::LogFile out(altered, "w");
