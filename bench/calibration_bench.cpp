@@ -27,12 +27,12 @@ double quantile(std::vector<double> v, double q) {
   return v[k];
 }
 
-FlipperErrors errors_of(const calibration::FlipperCalibration& c, const sim::Flipper& truth) {
+FlipperErrors errors_of(const calibration::FlipperCalibration& c, const table::Flipper& truth) {
   FlipperErrors e;
   e.flipper = truth.name;
   e.method = calibration::to_string(c.method);
   e.pivot_mm = (c.pivot_m - truth.pivot).norm() * 1e3;
-  e.tip_mm = (c.tip_m - sim::flipper_tip(truth, truth.theta_min_rad)).norm() * 1e3;
+  e.tip_mm = (c.tip_m - table::flipper_tip(truth, truth.theta_min_rad)).norm() * 1e3;
   e.length_mm = (c.length_m - truth.length_m) * 1e3;
   e.theta_min_deg = (c.theta_min_rad - truth.theta_min_rad) * kDeg;
   e.theta_max_deg = (c.theta_max_rad - truth.theta_max_rad) * kDeg;
@@ -46,7 +46,7 @@ FlipperErrors errors_of(const calibration::FlipperCalibration& c, const sim::Fli
 double h_on(const track::FlipperLine& l, const Vec2& p) { return (p - l.pivot).dot(l.axis()) / l.axis().squaredNorm(); }
 
 TrackerEffect tracker_effect(const std::string& name, const std::vector<TrackerApproach>& approaches,
-                             const sim::Board& truth, const track::FlipperGeometry& true_geometry,
+                             const table::Board& truth, const track::FlipperGeometry& true_geometry,
                              const track::FlipperGeometry& geometry, double g_mps2, std::uint64_t seed) {
   const track::CameraModelConfig camera = TrackerBenchOptions{}.headline_camera;
   track::TrackerConfig config = track::default_tracker_config(truth, camera);
@@ -96,7 +96,7 @@ track::FlipperGeometry geometry_of(const std::vector<calibration::FlipperCalibra
 
 }  // namespace
 
-CalibrationReport run_calibration_bench(const sim::Board& board, const CalibrationBenchOptions& options,
+CalibrationReport run_calibration_bench(const table::Board& board, const CalibrationBenchOptions& options,
                                         const std::function<void(const std::string&)>& progress) {
   const auto start = Clock::now();
   const auto say = [&](const std::string& s) {
@@ -108,7 +108,7 @@ CalibrationReport run_calibration_bench(const sim::Board& board, const Calibrati
   calibration::SimLabOptions lab_options;
   lab_options.seed = options.seed;
   calibration::SimLab lab(board, lab_options);
-  const sim::Board& truth = lab.truth();
+  const table::Board& truth = lab.truth();
   r.true_g_mps2 = truth.gravity_mps2;
 
   // Camera.

@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::bench {
 
@@ -88,7 +88,7 @@ struct CalibrationReport {
 };
 
 /// Runs the measurement; `progress` (may be empty) gets a line per stage.
-CalibrationReport run_calibration_bench(const sim::Board& board, const CalibrationBenchOptions& options,
+CalibrationReport run_calibration_bench(const table::Board& board, const CalibrationBenchOptions& options,
                                         const std::function<void(const std::string&)>& progress);
 
 /// The report as one JSON object.

@@ -12,6 +12,7 @@
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/sim/ball_runner.h"
+#include "pinball/sim/model_world.h"
 #include "pinball/sim/oracle_policy.h"
 
 namespace pinball::bench {
@@ -22,10 +23,11 @@ CeilingBenchOptions quick_ceiling_bench_options() {
   return o;
 }
 
-CeilingBall play_ceiling_bench_ball(const sim::ThesisStepper& stepper, const CeilingBenchOptions& options,
-                                    CeilingPlayerKind kind, std::uint64_t ball_seed) {
-  const sim::Board& board = stepper.board();
-  sim::GameState state = sim::make_game_state(board, ball_seed);
+CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper& model,
+                                    const CeilingBenchOptions& options, CeilingPlayerKind kind,
+                                    std::uint64_t ball_seed) {
+  const table::Board& board = model.board();  // the belief: what the tracker and the planner assume
+  sim::GameState state = sim::make_game_state(world.board(), ball_seed);
   sim::BallLimits limits;
   limits.max_ball_time_s = options.max_ball_time_s;
   limits.pull = options.pull;
@@ -41,16 +43,16 @@ CeilingBall play_ceiling_bench_ball(const sim::ThesisStepper& stepper, const Cei
   };
   sim::BallResult r;
   if (kind == CeilingPlayerKind::kCeiling) {
-    learn::LookaheadPlayer player(stepper, options.planner, options.actuation_delay_s);
-    r = sim::play_ball(stepper, state, limits, [&](sim::GameState& s) { player.act(s); }, observer);
+    learn::LookaheadPlayer player(model, options.planner, options.actuation_delay_s);
+    r = sim::play_ball(world, state, limits, [&](sim::GameState& s) { player.act(s); }, observer);
     ball.decisions = player.decisions();
     ball.branch_steps = player.branch_steps();
   } else if (kind == CeilingPlayerKind::kSpastic) {
     learn::DelayLine delay(board.flippers.size(), options.actuation_delay_s);
     r = sim::play_ball(
-        stepper, state, limits,
+        world, state, limits,
         [&](sim::GameState& s) {
-          sim::oracle_spastic_policy(board, s, options.spastic_reach_factor);
+          sim::oracle_spastic_policy(world.board(), s, options.spastic_reach_factor);
           delay.apply(s);
         },
         observer);
@@ -60,11 +62,11 @@ CeilingBall play_ceiling_bench_ball(const sim::ThesisStepper& stepper, const Cei
         kind == CeilingPlayerKind::kController ? control::make_flipper_controller(*options.controller)
                                                : std::make_unique<control::SpasticController>();
     if (kind == CeilingPlayerKind::kController) limits.pull = options.controller->launcher_pull;
-    r = learn::play_through_tracker(stepper, state, options.camera,
+    r = learn::play_through_tracker(world, board, state, options.camera,
                                     track::default_tracker_config(board, options.camera), *controller,
                                     options.actuation_delay_s, limits, ball_seed, observer);
   } else {
-    r = sim::play_ball(stepper, state, limits, [](sim::GameState&) {}, observer);
+    r = sim::play_ball(world, state, limits, [](sim::GameState&) {}, observer);
   }
   ball.score = r.score;
   ball.duration_s = r.duration_s;
@@ -87,7 +89,8 @@ const char* player_name(CeilingPlayerKind kind) {
   return "?";
 }
 
-CeilingPlayerReport run_player(const sim::ThesisStepper& stepper, const CeilingBenchOptions& options,
+CeilingPlayerReport run_player(const sim::World& world, const sim::ThesisStepper& model,
+                               const CeilingBenchOptions& options,
                                CeilingPlayerKind kind, const std::function<void(const std::string&)>& progress) {
   const auto n = static_cast<std::size_t>(options.balls);
   std::vector<CeilingBall> balls(n);
@@ -96,7 +99,8 @@ CeilingPlayerReport run_player(const sim::ThesisStepper& stepper, const CeilingB
   const int every = std::max(1, options.balls / 10);
   const auto start = std::chrono::steady_clock::now();
   learn::parallel_for(n, options.threads, [&](std::size_t i) {
-    balls[i] = play_ceiling_bench_ball(stepper, options, kind, learn::ball_seed(options.seed, i));
+    const std::unique_ptr<sim::World> ball_world = world.fork();
+    balls[i] = play_ceiling_bench_ball(*ball_world, model, options, kind, learn::ball_seed(options.seed, i));
     const int d = ++done;
     if (progress && (d % every == 0 || d == options.balls)) {
       const std::lock_guard<std::mutex> lock(progress_mutex);
@@ -150,20 +154,24 @@ nlohmann::json player_json(const CeilingPlayerReport& r) {
 
 }  // namespace
 
-CeilingReport run_ceiling_bench(const sim::Board& board, const CeilingBenchOptions& options,
-                                const std::function<void(const std::string&)>& progress) {
+CeilingReport run_ceiling_bench(const table::Board& board, const CeilingBenchOptions& options,
+                                const std::function<void(const std::string&)>& progress, const sim::World* world) {
   if (options.balls < 1) throw std::invalid_argument("ceiling bench: balls must be >= 1");
   if (!(options.max_ball_time_s > 0.0)) throw std::invalid_argument("ceiling bench: max ball time must be > 0");
-  const sim::ThesisStepper stepper(board);
+  const sim::ThesisStepper model(board);
+  const std::unique_ptr<sim::World> world_prototype = world != nullptr ? world->fork() : sim::make_model_world(board);
+  sim::check_same_flippers(world_prototype->board(), board);
   CeilingReport report;
   report.board = board.source;
+  report.world_board = world_prototype->board().source;
+  report.world = std::string(world_prototype->name());
   report.options = options;
-  report.ceiling = run_player(stepper, options, CeilingPlayerKind::kCeiling, progress);
-  report.spastic = run_player(stepper, options, CeilingPlayerKind::kSpastic, progress);
-  report.no_flipping = run_player(stepper, options, CeilingPlayerKind::kNoFlipping, progress);
-  report.tracker_spastic = run_player(stepper, options, CeilingPlayerKind::kTrackerSpastic, progress);
+  report.ceiling = run_player(*world_prototype, model, options, CeilingPlayerKind::kCeiling, progress);
+  report.spastic = run_player(*world_prototype, model, options, CeilingPlayerKind::kSpastic, progress);
+  report.no_flipping = run_player(*world_prototype, model, options, CeilingPlayerKind::kNoFlipping, progress);
+  report.tracker_spastic = run_player(*world_prototype, model, options, CeilingPlayerKind::kTrackerSpastic, progress);
   if (options.controller != nullptr) {
-    report.controller = run_player(stepper, options, CeilingPlayerKind::kController, progress);
+    report.controller = run_player(*world_prototype, model, options, CeilingPlayerKind::kController, progress);
   }
   const auto ratio = [](double a, double b) { return b != 0.0 ? a / b : 0.0; };
   report.ceiling_over_spastic = ratio(report.ceiling.score.mean(), report.spastic.score.mean());
@@ -183,6 +191,8 @@ nlohmann::json to_json(const CeilingReport& r) {
   if (r.controller) players["controller"] = player_json(*r.controller);
   return {{"benchmark", "ceiling"},
           {"board", r.board},
+          {"world_board", r.world_board},
+          {"world", r.world},
           {"balls", o.balls},
           {"seed", o.seed},
           {"threads", o.threads},
@@ -208,7 +218,8 @@ nlohmann::json to_json(const CeilingReport& r) {
 std::string to_text(const CeilingReport& r) {
   std::ostringstream out;
   const CeilingBenchOptions& o = r.options;
-  out << "ceiling reference on " << r.board << ": " << o.balls << " balls per player (seed " << o.seed
+  out << "ceiling reference on " << r.board << " (world: " << r.world_board << " on the " << r.world
+      << " stepper): " << o.balls << " balls per player (seed " << o.seed
       << "), cut at " << o.max_ball_time_s << " s, actuation delay " << o.actuation_delay_s * 1e3 << " ms\n"
       << "the ceiling player CHEATS (true state, lookahead with the true simulator): a reference, not a "
          "controller\n";

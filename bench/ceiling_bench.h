@@ -36,9 +36,10 @@
 #include "pinball/control/controller_file.h"
 #include "pinball/learn/lookahead_player.h"
 #include "pinball/track/camera_model.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/world.h"
 
 namespace pinball::bench {
 
@@ -80,9 +81,13 @@ struct CeilingBall {
   std::uint64_t branch_steps = 0; ///< ceiling: stepper steps simulated in lookahead branches
 };
 
-/// Plays ball `ball_seed` with `kind` (the same seed gives the same ball for every kind up to the first flip).
-CeilingBall play_ceiling_bench_ball(const sim::ThesisStepper& stepper, const CeilingBenchOptions& options,
-                                    CeilingPlayerKind kind, std::uint64_t ball_seed);
+/// Plays ball `ball_seed` in `world` with `kind` (the same seed gives the same
+/// ball for every kind up to the first flip). `model` is the belief: the
+/// tracker's board and the ceiling player's planning model; the true-state
+/// players read the world's state directly.
+CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper& model,
+                                    const CeilingBenchOptions& options, CeilingPlayerKind kind,
+                                    std::uint64_t ball_seed);
 
 /// One player's figures.
 struct CeilingPlayerReport {
@@ -101,7 +106,9 @@ struct CeilingPlayerReport {
 
 /// The whole measurement.
 struct CeilingReport {
-  std::string board;              ///< board name
+  std::string board;              ///< board name (the belief)
+  std::string world_board;        ///< the world's board
+  std::string world;              ///< the world that played: thesis, event (stepper of the model world)
   CeilingBenchOptions options;    ///< what was run
   CeilingPlayerReport ceiling;    ///< the cheating lookahead player
   CeilingPlayerReport spastic;    ///< the spastic flipper on true state (baseline)
@@ -113,9 +120,12 @@ struct CeilingReport {
   double controller_over_tracker_spastic = 0.0;  ///< the controller's, when one was played
 };
 
-/// Runs the three players; `progress` (may be empty) gets a line now and then, from any thread but never two at once.
-CeilingReport run_ceiling_bench(const sim::Board& board, const CeilingBenchOptions& options,
-                                const std::function<void(const std::string&)>& progress);
+/// Runs the players; `progress` (may be empty) gets a line now and then, from
+/// any thread but never two at once. `board` is the belief; balls play in
+/// forks of `world` (null: the model of `board` on the thesis stepper).
+CeilingReport run_ceiling_bench(const table::Board& board, const CeilingBenchOptions& options,
+                                const std::function<void(const std::string&)>& progress,
+                                const sim::World* world = nullptr);
 
 /// The report as one JSON object.
 nlohmann::json to_json(const CeilingReport& report);

@@ -13,7 +13,7 @@
 #include "pinball/core/rng.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/oracle_policy.h"
-#include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/model_world.h"
 
 namespace pinball::bench {
 
@@ -77,8 +77,8 @@ void learn_background(vision::SimCameraSource& camera, vision::BallDetector& det
 // Plays the board with the oracle spastic player and hands every delivered
 // frame (with the camera's truth) to `on_frame` until it returns false.
 template <class OnFrame>
-void play_frames(const sim::Board& board, std::uint64_t seed, vision::SimCameraSource& camera, OnFrame&& on_frame) {
-  const sim::ThesisStepper stepper(board);
+void play_frames(const table::Board& board, std::uint64_t seed, vision::SimCameraSource& camera, OnFrame&& on_frame) {
+  const std::unique_ptr<sim::World> world = sim::make_model_world(board);
   sim::GameState state = sim::make_game_state(board, seed);
   sim::BallLimits limits;
   limits.max_ball_time_s = 60.0;
@@ -87,7 +87,7 @@ void play_frames(const sim::Board& board, std::uint64_t seed, vision::SimCameraS
   double last_t = -1.0;
   for (int ball = 0; more && ball < 1000; ++ball) {
     sim::play_ball(
-        stepper, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+        *world, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
         [&](const sim::GameState& s, const sim::StepEvents&) {
           if (!more) return;
           if (s.time_s < last_t) camera.reset(s.time_s);
@@ -105,7 +105,7 @@ vision::SimCameraConfig sized(const vision::SimCameraConfig& c, cv::Size size) {
   return out;
 }
 
-void measure_accuracy(const sim::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
+void measure_accuracy(const table::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
   vision::SimCameraSource camera(board, o.camera);
   vision::BallDetector detector(camera.homography(), camera.frame_size(), o.detector);
   detector.set_occluder_mask(camera.occluder_mask());
@@ -159,7 +159,7 @@ void measure_accuracy(const sim::Board& board, const DetectorBenchOptions& o, De
   a.median_radius_px = quantile(radius_px, 0.5);
 }
 
-void measure_ball_free(const sim::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
+void measure_ball_free(const table::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
   vision::SimCameraConfig c = o.camera;
   c.seed = o.camera.seed + 1000;
   vision::SimCameraSource camera(board, c);
@@ -180,7 +180,7 @@ void measure_ball_free(const sim::Board& board, const DetectorBenchOptions& o, D
   r.ball_free_rejected_blobs = k.rejected_size + k.rejected_shape + k.rejected_occluded + k.rejected_edge;
 }
 
-void measure_occlusion(const sim::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
+void measure_occlusion(const table::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
   if (o.camera.plastics.empty()) return;
   vision::SimCameraConfig c = o.camera;
   c.seed = o.camera.seed + 2000;
@@ -227,7 +227,7 @@ void measure_occlusion(const sim::Board& board, const DetectorBenchOptions& o, D
   }
 }
 
-void measure_timing(const sim::Board& board, const DetectorBenchOptions& o, cv::Size size, DetectorReport& r) {
+void measure_timing(const table::Board& board, const DetectorBenchOptions& o, cv::Size size, DetectorReport& r) {
   DetectorTiming timing;
   timing.size = size;
   vision::SimCameraSource camera(board, sized(o.camera, size));
@@ -292,7 +292,7 @@ nlohmann::json to_json(const ErrorSummary& s) {
 
 }  // namespace
 
-DetectorReport run_detector_bench(const sim::Board& board, const DetectorBenchOptions& options,
+DetectorReport run_detector_bench(const table::Board& board, const DetectorBenchOptions& options,
                                   const std::function<void(const std::string&)>& progress) {
   auto say = [&](const std::string& line) {
     if (progress) progress(line);

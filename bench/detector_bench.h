@@ -20,7 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/vision/ball_detector.h"
 #include "pinball/vision/sim_camera_source.h"
 
@@ -131,7 +131,7 @@ struct DetectorReport {
 };
 
 /// Runs the measurement; `progress` (may be empty) receives a line per stage.
-DetectorReport run_detector_bench(const sim::Board& board, const DetectorBenchOptions& options,
+DetectorReport run_detector_bench(const table::Board& board, const DetectorBenchOptions& options,
                                   const std::function<void(const std::string&)>& progress);
 
 /// The report as one JSON object.

@@ -19,7 +19,7 @@
 namespace pinball::bench {
 namespace {
 
-using sim::Board;
+using table::Board;
 using sim::GameState;
 
 // The scenes use the table's constants: along-table gravity and ball radius.
@@ -71,8 +71,8 @@ Board scene_base(double width_m, double height_m) {
 }
 
 void add_line(Board& b, const Vec2& p0, const Vec2& p1, double rho) {
-  b.shapes.push_back(sim::make_line_shape(p0, p1));
-  sim::Obstacle o;
+  b.shapes.push_back(table::make_line_shape(p0, p1));
+  table::Obstacle o;
   o.rho = rho;
   o.name = "line";
   b.obstacles.push_back(o);
@@ -225,7 +225,7 @@ PrecisionPoint measure_event(const Scene& scene, const PrecisionBenchOptions& op
 
 void run_scene(const Scene& scene, const PrecisionBenchOptions& options, PrecisionReport& report,
                const std::function<void(const std::string&)>& progress) {
-  const double dt_max = sim::max_stable_dt_s(*scene.board);
+  const double dt_max = table::max_stable_dt_s(*scene.board);
   for (double dt : options.thesis_dt_s) {
     if (dt >= dt_max) continue;  // illegal for this board's flippers
     report.points.push_back(measure_thesis(scene, dt, options.repeats));
@@ -363,8 +363,8 @@ Board precision_scene_board(const std::string& scene) {
   }
   if (scene == "circle_bounce") {
     Board b = scene_base(4.0, 62.0);
-    b.shapes.push_back(sim::make_circle_shape(kCircleC, kCircleR));
-    sim::Obstacle o;
+    b.shapes.push_back(table::make_circle_shape(kCircleC, kCircleR));
+    table::Obstacle o;
     o.rho = kCircleRho;
     o.name = "circle";
     b.obstacles.push_back(o);

@@ -11,7 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::bench {
 
@@ -89,14 +89,14 @@ struct PrecisionReport {
 const std::vector<std::string>& closed_form_scenes();
 
 /// The board of a closed-form scene (exposed for tests).
-sim::Board precision_scene_board(const std::string& scene);
+table::Board precision_scene_board(const std::string& scene);
 
 /// The closed-form ball position of a scene at time t_s (exposed for tests).
 Vec2 precision_scene_exact(const std::string& scene, double t_s);
 
 /// Runs the measurement on the closed-form scenes and on `table` (skipped when
 /// table.source is empty). `progress` (may be empty) receives one line per scene.
-PrecisionReport run_precision_bench(const sim::Board& table, const PrecisionBenchOptions& options,
+PrecisionReport run_precision_bench(const table::Board& table, const PrecisionBenchOptions& options,
                                     const std::function<void(const std::string&)>& progress);
 
 /// log-log interpolation of y(x) through points sorted by x; outside the

@@ -5,15 +5,15 @@
 #include <sstream>
 
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/event_stepper.h"
+#include "pinball/sim/model_world.h"
 #include "pinball/sim/oracle_policy.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
 
 namespace pinball::bench {
 
-sim::Board with_far_obstacles(const sim::Board& board, int copies) {
-  sim::Board crowded = board;
+table::Board with_far_obstacles(const table::Board& board, int copies) {
+  table::Board crowded = board;
   const double stride_m = board.width_m + 0.5;  // well beyond the ball's reach
   const std::size_t n = board.shapes.size();
   crowded.shapes.reserve(n * (copies + 1));
@@ -21,10 +21,10 @@ sim::Board with_far_obstacles(const sim::Board& board, int copies) {
   for (int k = 1; k <= copies; ++k) {
     const Vec2 shift{k * stride_m, 0.0};
     for (std::size_t i = 0; i < n; ++i) {
-      sim::Shape s = board.shapes[i];
+      table::Shape s = board.shapes[i];
       s.p0 += shift;
       s.p1 += shift;
-      sim::Obstacle o = board.obstacles[i];
+      table::Obstacle o = board.obstacles[i];
       o.bank = -1;
       o.name += "+far" + std::to_string(k);
       crowded.shapes.push_back(s);
@@ -44,15 +44,16 @@ struct Timed {
 };
 
 // Plays balls with the spastic policy until `steps` steps have run.
-Timed run_once(const sim::ThesisStepper& stepper, std::uint64_t steps, std::uint64_t seed) {
-  const sim::Board& board = stepper.board();
+// `stepper` is the world's own stepper, asked only for its candidate counts.
+Timed run_once(sim::World& world, const sim::ThesisStepper& stepper, std::uint64_t steps, std::uint64_t seed) {
+  const table::Board& board = stepper.board();
   sim::GameState state = sim::make_game_state(board, seed);
   sim::BallLimits limits;
   limits.max_ball_time_s = 60.0;
   std::uint64_t candidates = 0;
   const auto start = std::chrono::steady_clock::now();
   while (state.steps < steps) {
-    sim::play_ball(stepper, state, limits,
+    sim::play_ball(world, state, limits,
                    [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
                    [&](const sim::GameState&, const sim::StepEvents&) {});
   }
@@ -60,7 +61,7 @@ Timed run_once(const sim::ThesisStepper& stepper, std::uint64_t steps, std::uint
   // Candidate counts come from a second, untimed pass so they cost nothing above.
   sim::GameState replay = sim::make_game_state(board, seed);
   while (replay.steps < std::min<std::uint64_t>(steps, 200'000)) {
-    sim::play_ball(stepper, replay, limits,
+    sim::play_ball(world, replay, limits,
                    [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
                    [&](const sim::GameState& s, const sim::StepEvents& e) {
                      if (e.has(sim::StepEvents::kLaunch)) return;  // not a step
@@ -75,18 +76,19 @@ Timed run_once(const sim::ThesisStepper& stepper, std::uint64_t steps, std::uint
   return t;
 }
 
-SpeedRun measure(const std::string& name, const sim::Board& board, bool use_grid, const SpeedBenchOptions& options,
+SpeedRun measure(const std::string& name, const table::Board& board, bool use_grid, const SpeedBenchOptions& options,
                  const std::function<void(const std::string&)>& progress) {
-  sim::ThesisStepperOptions so;
-  so.use_grid = use_grid;
-  const sim::ThesisStepper stepper(board, so);
+  sim::ModelWorldOptions wo;
+  wo.thesis.use_grid = use_grid;
+  const std::unique_ptr<sim::World> world = sim::make_model_world(board, wo);
+  const sim::ThesisStepper stepper(board, wo.thesis);
   std::vector<double> times;
   SpeedRun run;
   run.name = name;
   run.use_grid = use_grid;
   run.obstacles = board.shapes.size();
   for (int i = 0; i < std::max(1, options.repeats); ++i) {
-    const Timed t = run_once(stepper, options.steps, options.seed);
+    const Timed t = run_once(*world, stepper, options.steps, options.seed);
     times.push_back(t.seconds);
     run.mean_candidates = t.mean_candidates;
     run.final_hash = t.hash;
@@ -105,9 +107,11 @@ SpeedRun measure(const std::string& name, const sim::Board& board, bool use_grid
 }
 
 // Event stepper: the same play, timed the same way.
-EventSpeedRun measure_event(const std::string& name, const sim::Board& board, const SpeedBenchOptions& options,
+EventSpeedRun measure_event(const std::string& name, const table::Board& board, const SpeedBenchOptions& options,
                             const std::function<void(const std::string&)>& progress) {
-  const sim::EventStepper stepper(board);
+  sim::ModelWorldOptions wo;
+  wo.stepper = sim::StepperKind::kEvent;
+  const std::unique_ptr<sim::World> world = sim::make_model_world(board, wo);
   sim::BallLimits limits;
   limits.max_ball_time_s = 60.0;
   std::vector<double> times;
@@ -118,7 +122,7 @@ EventSpeedRun measure_event(const std::string& name, const sim::Board& board, co
     sim::GameState state = sim::make_game_state(board, options.seed);
     const auto start = std::chrono::steady_clock::now();
     while (state.steps < options.steps) {
-      sim::play_ball(stepper, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+      sim::play_ball(*world, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
                      [&](const sim::GameState&, const sim::StepEvents&) {});
     }
     times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -142,12 +146,12 @@ EventSpeedRun measure_event(const std::string& name, const sim::Board& board, co
 
 }  // namespace
 
-SpeedReport run_speed_bench(const sim::Board& board, const SpeedBenchOptions& options,
+SpeedReport run_speed_bench(const table::Board& board, const SpeedBenchOptions& options,
                             const std::function<void(const std::string&)>& progress) {
   SpeedReport report;
   report.board = board.source;
   report.dt_s = board.dt_s;
-  const sim::Board crowded = with_far_obstacles(board, options.crowd_factor);
+  const table::Board crowded = with_far_obstacles(board, options.crowd_factor);
   report.runs.push_back(measure("grid", board, true, options, progress));
   report.runs.push_back(measure("linear", board, false, options, progress));
   report.runs.push_back(measure("grid_crowded", crowded, true, options, progress));

@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::bench {
 
@@ -64,10 +64,10 @@ struct SpeedReport {
 
 /// A copy of `board` with `copies` extra copies of every obstacle placed side
 /// by side to the right of the table, where the ball never goes.
-sim::Board with_far_obstacles(const sim::Board& board, int copies);
+table::Board with_far_obstacles(const table::Board& board, int copies);
 
 /// Runs the measurement; `progress` (may be empty) receives one line per run.
-SpeedReport run_speed_bench(const sim::Board& board, const SpeedBenchOptions& options,
+SpeedReport run_speed_bench(const table::Board& board, const SpeedBenchOptions& options,
                             const std::function<void(const std::string&)>& progress);
 
 /// The report as one JSON object.

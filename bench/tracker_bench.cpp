@@ -12,7 +12,7 @@
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/oracle_policy.h"
 #include "pinball/sim/penetration.h"
-#include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/model_world.h"
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/track/tracker.h"
 #include "pinball/track/trajectory_fit.h"
@@ -40,21 +40,21 @@ constexpr std::size_t kTwoPoint = 1;
 constexpr std::size_t kFreeG = 2;
 constexpr std::array<const char*, 3> kMethodNames{"tracker", "two_point", "free_g"};
 
-bool touches_board(const sim::Board& board, const Vec2& p) {
+bool touches_board(const table::Board& board, const Vec2& p) {
   const double r = board.ball.radius_m;
   // Every obstacle, hidden ones too: an approach must be free flight whatever the flags do.
-  for (const sim::Shape& s : board.shapes) {
+  for (const table::Shape& s : board.shapes) {
     if (sim::shape_penetration_m(s, p, r) > 0.0) return true;
   }
-  for (const sim::Sensor& s : board.sensors) {
-    if (s.kind == sim::SensorKind::kHole && (p - s.shape.p0).norm() < s.shape.radius_m) return true;
+  for (const table::Sensor& s : board.sensors) {
+    if (s.kind == table::SensorKind::kHole && (p - s.shape.p0).norm() < s.shape.radius_m) return true;
   }
   return p.x() < 0.0 || p.x() > board.width_m || p.y() < 0.0 || p.y() > board.height_m;
 }
 
 enum class Verdict { kKept, kNoImpact, kTooShort, kObstacle };
 
-Verdict judge_approach(const sim::Board& board, const track::FlipperGeometry& geometry,
+Verdict judge_approach(const table::Board& board, const track::FlipperGeometry& geometry,
                        const TrackerBenchOptions& options, const Vec2& p, const Vec2& v, TrackerApproach& out) {
   const track::TrajectoryFit fit = track::exact_trajectory(p, v, board.gravity_mps2, 0.0);
   const track::TrajectoryProjection truth = track::project_trajectory(fit, geometry);
@@ -186,7 +186,7 @@ double remaining_distance(const TrackerApproach& a, double t_s) {
   return (p - a.truth.impact_point).norm();
 }
 
-TrackerSetting run_setting(const sim::Board& board, const track::FlipperGeometry& geometry,
+TrackerSetting run_setting(const table::Board& board, const track::FlipperGeometry& geometry,
                            const std::vector<TrackerApproach>& approaches, const TrackerBenchOptions& options,
                            const track::CameraModelConfig& camera, double g_factor) {
   TrackerSetting setting;
@@ -260,7 +260,7 @@ double measure_timer_overhead_ns() {
   return quantile(std::move(d), 0.5);
 }
 
-TrackerCostPoint run_cost_point(const sim::Board& board, const track::FlipperGeometry& geometry,
+TrackerCostPoint run_cost_point(const table::Board& board, const track::FlipperGeometry& geometry,
                                 const std::vector<TrackerApproach>& approaches,
                                 const std::vector<std::vector<track::Observation>>& streams,
                                 const track::CameraModelConfig& camera, const std::string& name, int max_window,
@@ -339,15 +339,15 @@ std::string camera_label(const track::CameraModelConfig& c, double g_factor) {
 
 }  // namespace
 
-std::vector<TrackerApproach> collect_tracker_approaches(const sim::Board& board, const TrackerBenchOptions& options,
+std::vector<TrackerApproach> collect_tracker_approaches(const table::Board& board, const TrackerBenchOptions& options,
                                                         ApproachCounts* counts) {
   if (options.approaches < 0) throw std::invalid_argument("tracker bench: approaches must be >= 0");
   if (!(options.sample_dt_s > 0.0)) throw std::invalid_argument("tracker bench: sample_dt_s must be > 0");
   const track::FlipperGeometry geometry = track::flipper_geometry_from_board(board);
   const double critical_y_m = track::default_tracker_config(board, options.headline_camera).critical_y_m;
-  sim::ThesisStepperOptions so;
-  so.dt_s = options.sim_dt_s;
-  const sim::ThesisStepper stepper(board, so);
+  sim::ModelWorldOptions wo;
+  wo.dt_s = options.sim_dt_s;
+  const std::unique_ptr<sim::World> world = sim::make_model_world(board, wo);
   sim::GameState state = sim::make_game_state(board, options.seed);
   sim::BallLimits limits;
   limits.max_ball_time_s = 120.0;
@@ -390,7 +390,7 @@ std::vector<TrackerApproach> collect_tracker_approaches(const sim::Board& board,
     }
   };
   while (approaches.size() < wanted && state.time_s < options.max_simulated_s) {
-    sim::play_ball(stepper, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+    sim::play_ball(*world, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
                    observer);
   }
   c.simulated_s = state.time_s;
@@ -398,7 +398,7 @@ std::vector<TrackerApproach> collect_tracker_approaches(const sim::Board& board,
   return approaches;
 }
 
-TrackerReport run_tracker_bench(const sim::Board& board, const TrackerBenchOptions& options,
+TrackerReport run_tracker_bench(const table::Board& board, const TrackerBenchOptions& options,
                                 const std::function<void(const std::string&)>& progress) {
   const auto start = Clock::now();
   TrackerReport report;

@@ -21,7 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/track/camera_model.h"
 #include "pinball/track/projection.h"
 
@@ -82,7 +82,7 @@ struct ApproachCounts {
 
 /// Plays the board and collects up to options.approaches approaches, in
 /// game order (deterministic by options.seed).
-std::vector<TrackerApproach> collect_tracker_approaches(const sim::Board& board, const TrackerBenchOptions& options,
+std::vector<TrackerApproach> collect_tracker_approaches(const table::Board& board, const TrackerBenchOptions& options,
                                                         ApproachCounts* counts = nullptr);
 
 /// Median and 90th percentile of one error over the observations that had a projection.
@@ -174,7 +174,7 @@ struct TrackerReport {
 
 /// Runs the measurement; `progress` (may be empty) receives one line after
 /// the approaches are collected, one per camera setting and one per cost point.
-TrackerReport run_tracker_bench(const sim::Board& board, const TrackerBenchOptions& options,
+TrackerReport run_tracker_bench(const table::Board& board, const TrackerBenchOptions& options,
                                 const std::function<void(const std::string&)>& progress);
 
 /// The report as one JSON object.

@@ -41,7 +41,7 @@ void draw_arc(cv::Mat& img, const vision::CameraHomography& h, const Vec2& c, do
 }
 
 // Direction angle (standard, from +x) of a flipper at elevation theta.
-double direction_angle(sim::Side side, double theta) { return side == sim::Side::kLeft ? theta : M_PI - theta; }
+double direction_angle(table::Side side, double theta) { return side == table::Side::kLeft ? theta : M_PI - theta; }
 
 }  // namespace
 

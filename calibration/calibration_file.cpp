@@ -117,7 +117,7 @@ FlipperCalibration read_flipper(const Reader& r, const YAML::Node& n, const std:
   f.name = r.text(n, p, "name");
   const std::string side = r.text(n, p, "side");
   if (side != "left" && side != "right") r.fail(p + ".side", "expected left or right");
-  f.side = side == "left" ? sim::Side::kLeft : sim::Side::kRight;
+  f.side = side == "left" ? table::Side::kLeft : table::Side::kRight;
   const std::string method = r.text(n, p, "method");
   if (method != "markers" && method != "markerless") r.fail(p + ".method", "expected markers or markerless");
   f.method = method == "markers" ? FlipperMethod::kMarkers : FlipperMethod::kMarkerless;
@@ -187,7 +187,7 @@ std::string calibration_to_yaml(const Calibration& c) {
     for (const FlipperCalibration& f : c.flippers) {
       e << YAML::BeginMap;
       e << YAML::Key << "name" << YAML::Value << f.name;
-      e << YAML::Key << "side" << YAML::Value << (f.side == sim::Side::kLeft ? "left" : "right");
+      e << YAML::Key << "side" << YAML::Value << (f.side == table::Side::kLeft ? "left" : "right");
       e << YAML::Key << "method" << YAML::Value << to_string(f.method);
       emit_vec2(e, "pivot_m", f.pivot_m, nullptr);
       emit_vec2(e, "tip_m", f.tip_m, "tip at rest (theta_min)");
@@ -273,8 +273,8 @@ track::FlipperGeometry flipper_geometry_from_calibration(const Calibration& c, c
   const FlipperCalibration* left = nullptr;
   const FlipperCalibration* right = nullptr;
   for (const FlipperCalibration& f : c.flippers) {
-    const FlipperCalibration*& slot = f.side == sim::Side::kLeft ? left : right;
-    if (slot) throw std::runtime_error(name + ":flippers: more than one " + (f.side == sim::Side::kLeft ? "left" : "right") + " flipper");
+    const FlipperCalibration*& slot = f.side == table::Side::kLeft ? left : right;
+    if (slot) throw std::runtime_error(name + ":flippers: more than one " + (f.side == table::Side::kLeft ? "left" : "right") + " flipper");
     slot = &f;
   }
   if (!left || !right) throw std::runtime_error(name + ":flippers: missing (the tracker needs a left and a right flipper)");
@@ -310,10 +310,10 @@ vision::CameraHomography camera_homography(const Calibration& c, const std::stri
   }
 }
 
-void apply_calibration(const Calibration& c, const std::string& name, sim::Board& board) {
+void apply_calibration(const Calibration& c, const std::string& name, table::Board& board) {
   for (const FlipperCalibration& f : c.flippers) {
-    sim::Flipper* target = nullptr;
-    for (sim::Flipper& b : board.flippers) {
+    table::Flipper* target = nullptr;
+    for (table::Flipper& b : board.flippers) {
       if (b.name == f.name) target = &b;
     }
     if (!target) throw std::runtime_error(name + ":flippers: '" + f.name + "' is not a flipper of the board");

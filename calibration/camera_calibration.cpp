@@ -211,7 +211,7 @@ void check_marker_layout(std::span<const Vec2> p, double min_separation_m) {
   throw std::invalid_argument(msg.str());
 }
 
-std::vector<Vec2> default_marker_layout(const sim::Board& board) {
+std::vector<Vec2> default_marker_layout(const table::Board& board) {
   // Fractions of the table; no reflection or rotation maps this set onto itself.
   static constexpr std::array<std::array<double, 2>, 7> kFractions{
       {{0.08, 0.05}, {0.93, 0.07}, {0.06, 0.95}, {0.90, 0.93}, {0.55, 0.30}, {0.25, 0.62}, {0.72, 0.70}}};

@@ -57,18 +57,18 @@ Vec2 to_board(const vision::CameraHomography& h, const cv::Point2d& p) { return 
 
 }  // namespace
 
-double flipper_angle(sim::Side side, const Vec2& pivot, const Vec2& tip) {
+double flipper_angle(table::Side side, const Vec2& pivot, const Vec2& tip) {
   const Vec2 d = tip - pivot;
-  return side == sim::Side::kLeft ? std::atan2(d.y(), d.x()) : std::atan2(d.y(), -d.x());
+  return side == table::Side::kLeft ? std::atan2(d.y(), d.x()) : std::atan2(d.y(), -d.x());
 }
 
-FlipperCalibration calibrate_flipper_markers(const sim::Flipper& f, std::span<const Vec2> down, std::span<const Vec2> up,
+FlipperCalibration calibrate_flipper_markers(const table::Flipper& f, std::span<const Vec2> down, std::span<const Vec2> up,
                                              double tolerance_m) {
   const std::string name = "flipper '" + f.name + "'";
   const Vec2 pivot_down = nearest(down, f.pivot, tolerance_m, name + "'s pivot (flippers down)");
-  const Vec2 tip_down = nearest(down, sim::flipper_tip(f, f.theta_min_rad), tolerance_m, name + "'s tip (flippers down)");
+  const Vec2 tip_down = nearest(down, table::flipper_tip(f, f.theta_min_rad), tolerance_m, name + "'s tip (flippers down)");
   const Vec2 pivot_up = nearest(up, f.pivot, tolerance_m, name + "'s pivot (flippers up)");
-  const Vec2 tip_up = nearest(up, sim::flipper_tip(f, f.theta_max_rad), tolerance_m, name + "'s tip (flippers up)");
+  const Vec2 tip_up = nearest(up, table::flipper_tip(f, f.theta_max_rad), tolerance_m, name + "'s tip (flippers up)");
   FlipperCalibration c;
   c.name = f.name;
   c.side = f.side;
@@ -304,7 +304,7 @@ SweepTrack TipTracker::finish() const {
   return track;
 }
 
-FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const sim::Flipper& nominal, const SweepOptions& options) {
+FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const table::Flipper& nominal, const SweepOptions& options) {
   if (track.blades_board.empty()) {
     track.circle = fit_circle(track.tips_board, options.circle);
   } else {
@@ -342,15 +342,15 @@ FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const sim::Flippe
   }
   c.theta_min_rad = median_of(down);
   c.theta_max_rad = median_of(up);
-  sim::Flipper f = nominal;
+  table::Flipper f = nominal;
   f.pivot = c.pivot_m;
   f.length_m = c.length_m;
-  c.tip_m = sim::flipper_tip(f, c.theta_min_rad);
+  c.tip_m = table::flipper_tip(f, c.theta_min_rad);
   return c;
 }
 
 FlipperCalibration calibrate_flipper_sweep(const FrameSourceFactory& open, const vision::CameraHomography& homography,
-                                           const sim::Flipper& nominal, const SweepOptions& options, SweepTrack* track) {
+                                           const table::Flipper& nominal, const SweepOptions& options, SweepTrack* track) {
   vision::Frame frame;
   std::unique_ptr<vision::FrameSource> first = open();
   TipTracker tracker(first->frame_size(), homography, options);

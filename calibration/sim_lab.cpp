@@ -9,7 +9,7 @@
 #include "pinball/core/rng.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/penetration.h"
-#include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/model_world.h"
 
 namespace pinball::calibration {
 namespace {
@@ -26,7 +26,7 @@ class SweepSource final : public vision::FrameSource {
   SweepSource(const SimLab& lab, std::size_t index)
       : lab_(lab), index_(index), camera_(lab.truth(), camera_config(lab.options())) {
     camera_.set_lamps_blinking(false);  // lamps steady in the lab (attract mode off)
-    for (const sim::Flipper& f : lab.truth().flippers) theta_.push_back(f.theta_min_rad);
+    for (const table::Flipper& f : lab.truth().flippers) theta_.push_back(f.theta_min_rad);
     frames_ = static_cast<std::uint64_t>(std::floor(lab.sweep_duration_s() * camera_.fps()));
   }
   bool read(vision::Frame& out) override {
@@ -57,9 +57,9 @@ class SweepSource final : public vision::FrameSource {
 
 }  // namespace
 
-SimLab::SimLab(const sim::Board& nominal, const SimLabOptions& options)
+SimLab::SimLab(const table::Board& nominal, const SimLabOptions& options)
     : nominal_(nominal), truth_(nominal), options_(options) {
-  for (sim::Flipper& f : truth_.flippers) {
+  for (table::Flipper& f : truth_.flippers) {
     f.pivot += options.pivot_offset_m;
     f.length_m += options.length_offset_m;
     f.theta_min_rad += options.theta_offset_rad;
@@ -71,7 +71,7 @@ SimLab::SimLab(const sim::Board& nominal, const SimLabOptions& options)
 
 cv::Mat SimLab::marker_image(std::span<const Vec2> markers, bool flippers_up) {
   std::vector<double> theta;
-  for (const sim::Flipper& f : truth_.flippers) theta.push_back(flippers_up ? f.theta_max_rad : f.theta_min_rad);
+  for (const table::Flipper& f : truth_.flippers) theta.push_back(flippers_up ? f.theta_max_rad : f.theta_min_rad);
   camera_->set_flipper_angles(theta);
   camera_->set_markers(markers);
   camera_->render({}, 0.0, frame_);
@@ -86,9 +86,9 @@ cv::Mat SimLab::camera_image() {
 
 cv::Mat SimLab::flipper_markers_image(bool flippers_up) {
   std::vector<Vec2> markers;
-  for (const sim::Flipper& f : truth_.flippers) {
+  for (const table::Flipper& f : truth_.flippers) {
     markers.push_back(f.pivot);
-    markers.push_back(sim::flipper_tip(f, flippers_up ? f.theta_max_rad : f.theta_min_rad));
+    markers.push_back(table::flipper_tip(f, flippers_up ? f.theta_max_rad : f.theta_min_rad));
   }
   return marker_image(markers, flippers_up);
 }
@@ -98,7 +98,7 @@ double SimLab::sweep_duration_s() const {
 }
 
 double SimLab::sweep_angle(std::size_t index, double t_s) const {
-  const sim::Flipper& f = truth_.flippers.at(index);
+  const table::Flipper& f = truth_.flippers.at(index);
   const double rest = options_.sweep_rest_s, move = options_.sweep_move_s;
   const double period = 2.0 * (rest + move);
   const double t = std::fmod(std::max(t_s, 0.0), period);
@@ -123,8 +123,7 @@ std::unique_ptr<vision::FrameSource> SimLab::sweep_video(std::size_t index) cons
 
 std::vector<GravityRoll> SimLab::rolls(int count, std::uint64_t stream) const {
   Rng rng(options_.seed * 0x9E3779B97F4A7C15ull + stream + 1);
-  sim::ThesisStepperOptions so;
-  const sim::ThesisStepper stepper(truth_, so);
+  const std::unique_ptr<sim::World> world = sim::make_model_world(truth_);
   const double r = truth_.ball.radius_m;
   constexpr std::uint32_t kContact = sim::StepEvents::kHitObstacle | sim::StepEvents::kHitFlipper |
                                      sim::StepEvents::kFlipperPush | sim::StepEvents::kSensor |
@@ -134,8 +133,8 @@ std::vector<GravityRoll> SimLab::rolls(int count, std::uint64_t stream) const {
     if (attempt > 200 * std::max(count, 1)) throw std::runtime_error("sim lab: no free place to roll a ball from");
     const Vec2 p0{rng.uniform(0.15, 0.85) * truth_.width_m, rng.uniform(0.45, 0.92) * truth_.height_m};
     bool free = true;
-    for (const sim::Shape& s : truth_.shapes) free = free && sim::shape_penetration_m(s, p0, 2.0 * r) <= 0.0;
-    for (const sim::Sensor& s : truth_.sensors) free = free && sim::shape_penetration_m(s.shape, p0, 2.0 * r) <= 0.0;
+    for (const table::Shape& s : truth_.shapes) free = free && sim::shape_penetration_m(s, p0, 2.0 * r) <= 0.0;
+    for (const table::Sensor& s : truth_.sensors) free = free && sim::shape_penetration_m(s.shape, p0, 2.0 * r) <= 0.0;
     if (!free) continue;
     sim::GameState state = sim::make_game_state(truth_, options_.seed);
     state.ball.position_m = p0;
@@ -147,7 +146,7 @@ std::vector<GravityRoll> SimLab::rolls(int count, std::uint64_t stream) const {
     name << "sim roll " << out.size() << " from (" << p0.x() << ", " << p0.y() << ")";
     roll.source = name.str();
     track::Observation o;
-    const double dt = stepper.dt_s();
+    const double dt = world->dt_s();
     for (double t = 0.0; t < options_.roll_hold_s; t += dt) {
       camera.expose(t, p0);
       while (camera.deliver(t, o)) roll.observations.push_back(o);
@@ -156,7 +155,7 @@ std::vector<GravityRoll> SimLab::rolls(int count, std::uint64_t stream) const {
     double contact_s = -1.0;
     Vec2 contact_p = p0;
     while (state.time_s < options_.roll_hold_s + 4.0) {
-      const sim::StepEvents e = stepper.step(state);
+      const sim::StepEvents e = world->step(state);
       camera.expose(state.time_s, state.ball.position_m, state.ball_in_play);
       while (camera.deliver(state.time_s, o)) roll.observations.push_back(o);
       if (contact_s < 0.0 && (e.flags & kContact) != 0) {

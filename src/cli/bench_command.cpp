@@ -6,7 +6,8 @@
 #include <stdexcept>
 
 #include "commands.h"
-#include "pinball/sim/board_loader.h"
+#include "world_options.h"
+#include "pinball/table/board_loader.h"
 #include "calibration_bench.h"
 #include <optional>
 
@@ -48,13 +49,14 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
       ->check(CLI::Range(1.0, 3600.0));
   cmd->add_option("--csv", a.csv, "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here");
   cmd->add_option("--png", a.png, "precision: write the log-log plot of error against run time here");
+  add_world_options(*cmd, a.world);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
 
 namespace {
 
-int run_tracker(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+int run_tracker(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::TrackerBenchOptions options = a.quick ? bench::quick_tracker_bench_options() : bench::TrackerBenchOptions{};
   if (!a.quick) options.approaches = a.approaches;
   options.seed = a.seed;
@@ -68,7 +70,7 @@ int run_tracker(const BenchArgs& a, const sim::Board& board, std::ostream& out, 
   return 0;
 }
 
-int run_detector(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+int run_detector(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::DetectorBenchOptions options = a.quick ? bench::quick_detector_bench_options() : bench::DetectorBenchOptions{};
   options.seed = a.seed;
   const bench::DetectorReport report = bench::run_detector_bench(
@@ -81,7 +83,7 @@ int run_detector(const BenchArgs& a, const sim::Board& board, std::ostream& out,
   return 0;
 }
 
-int run_calibration(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+int run_calibration(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::CalibrationBenchOptions options;
   options.seed = a.seed;
   if (a.quick) {
@@ -142,7 +144,7 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
-int run_precision(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+int run_precision(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   const bench::PrecisionBenchOptions options =
       a.quick ? bench::quick_precision_bench_options() : bench::default_precision_bench_options();
   const bench::PrecisionReport report = bench::run_precision_bench(
@@ -161,7 +163,7 @@ int run_precision(const BenchArgs& a, const sim::Board& board, std::ostream& out
   return 0;
 }
 
-int run_ceiling(const BenchArgs& a, const sim::Board& board, std::ostream& out, std::ostream& err) {
+int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::CeilingBenchOptions options = a.quick ? bench::quick_ceiling_bench_options() : bench::CeilingBenchOptions{};
   if (!a.quick) options.balls = a.balls;
   options.seed = a.seed;
@@ -173,8 +175,9 @@ int run_ceiling(const BenchArgs& a, const sim::Board& board, std::ostream& out, 
     options.controller = &*controller;
     options.controller_name = a.controller;
   }
+  const simlab::OwnedWorld world = simlab::make_world(a.world, board);
   const bench::CeilingReport report = bench::run_ceiling_bench(
-      board, options, [&](const std::string& line) { err << "bench ceiling: " << line << "\n"; });
+      board, options, [&](const std::string& line) { err << "bench ceiling: " << line << "\n"; }, world.world.get());
   if (a.json) {
     out << bench::to_json(report).dump(2) << "\n";
   } else {
@@ -187,7 +190,7 @@ int run_ceiling(const BenchArgs& a, const sim::Board& board, std::ostream& out, 
 
 int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   if (a.which == "latency") return run_latency(a, out, err);
-  const sim::Board board = sim::load_board(a.board);
+  const table::Board board = table::load_board(a.board);
   if (a.which == "tracker") return run_tracker(a, board, out, err);
   if (a.which == "detector") return run_detector(a, board, out, err);
   if (a.which == "calibration") return run_calibration(a, board, out, err);

@@ -16,7 +16,7 @@
 #include "pinball/calibration/flipper_calibration.h"
 #include "pinball/calibration/gravity_calibration.h"
 #include "pinball/calibration/sim_lab.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/track/observation_io.h"
 #include "pinball/vision/capture_source.h"
@@ -75,9 +75,9 @@ nlohmann::json flipper_json(const calibration::FlipperCalibration& f) {
 }
 
 // Errors against the simulated machine's truth.
-nlohmann::json flipper_truth_json(const calibration::FlipperCalibration& f, const sim::Flipper& t) {
+nlohmann::json flipper_truth_json(const calibration::FlipperCalibration& f, const table::Flipper& t) {
   return {{"pivot_error_mm", (f.pivot_m - t.pivot).norm() * 1e3},
-          {"tip_error_mm", (f.tip_m - sim::flipper_tip(t, t.theta_min_rad)).norm() * 1e3},
+          {"tip_error_mm", (f.tip_m - table::flipper_tip(t, t.theta_min_rad)).norm() * 1e3},
           {"length_error_mm", (f.length_m - t.length_m) * 1e3},
           {"theta_min_error_deg", (f.theta_min_rad - t.theta_min_rad) * kDeg},
           {"theta_max_error_deg", (f.theta_max_rad - t.theta_max_rad) * kDeg}};
@@ -86,7 +86,7 @@ nlohmann::json flipper_truth_json(const calibration::FlipperCalibration& f, cons
 struct Context {
   const CalibrateArgs& a;
   std::ostream& err;
-  sim::Board board;
+  table::Board board;
   std::unique_ptr<calibration::SimLab> lab;
   calibration::Calibration cal;
   nlohmann::json report;
@@ -158,7 +158,7 @@ void run_flippers(Context& c) {
   std::vector<calibration::SweepTrack> tracks(c.board.flippers.size());
   nlohmann::json list = nlohmann::json::array();
   for (std::size_t i = 0; i < c.board.flippers.size(); ++i) {
-    const sim::Flipper& f = c.board.flippers[i];
+    const table::Flipper& f = c.board.flippers[i];
     nlohmann::json j = {{"name", f.name}};
     if (markers) {
       by_markers.push_back(calibration::calibrate_flipper_markers(f, down, up));
@@ -187,7 +187,7 @@ void run_flippers(Context& c) {
                            {"theta_min_deg", d.theta_min_rad * kDeg}, {"theta_max_deg", d.theta_max_rad * kDeg}};
     }
     if (c.lab) {
-      const sim::Flipper& t = c.lab->truth().flippers[i];
+      const table::Flipper& t = c.lab->truth().flippers[i];
       if (markers) j["markers"]["truth"] = flipper_truth_json(by_markers[i], t);
       if (sweeps) j["markerless"]["truth"] = flipper_truth_json(markerless[i], t);
     }
@@ -263,7 +263,7 @@ void run_gravity(Context& c) {
 int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) {
   const std::string board_path = a.sim_board.empty() ? a.board : a.sim_board;
   if (board_path.empty()) throw std::runtime_error("calibrate: give --board BOARD (or --sim BOARD)");
-  Context c{a, err, sim::load_board(board_path), nullptr, {}, {}};
+  Context c{a, err, table::load_board(board_path), nullptr, {}, {}};
   if (!a.sim_board.empty()) {
     calibration::SimLabOptions o;
     o.seed = a.seed;

@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pinball/simlab/world_factory.h"
 #include "pinball/track/camera_model.h"
 
 namespace pinball::cli {
@@ -21,8 +22,7 @@ struct SimArgs {
   std::string controller;        ///< controller file (implies policy controller)
   int balls = 1;                 ///< balls to play
   std::uint64_t seed = 1;        ///< launch noise seed
-  std::string stepper = "thesis";///< integrator: thesis | event
-  double dt_s = 0.0;             ///< time step override (0: the board's)
+  simlab::WorldSpec world;       ///< the world (default: the model of `board` on the thesis stepper)
   double max_ball_time_s = 300.0;///< cut a ball still in play after this
   std::string trace;             ///< CSV trace path, or empty
   std::string video;             ///< AVI path, or empty
@@ -75,6 +75,7 @@ struct BenchArgs {
   std::string controller;                            ///< ceiling: a controller file to play beside the others
   std::string csv;                                   ///< precision: CSV file to write, or empty
   std::string png;                                   ///< precision: log-log plot to write, or empty
+  simlab::WorldSpec world;                           ///< ceiling: the world (default: the model of `board`)
   bool json = false;                                 ///< one JSON object on stdout
 };
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& args);
@@ -105,6 +106,7 @@ struct LearnArgs {
   double actuation_delay_s = 0.004;     ///< command to flipper motion (s)
   double gravity_scale = 1.0;           ///< tracker's g / board's g
   track::CameraModelConfig camera;      ///< the camera the tracker sees through
+  simlab::WorldSpec world;              ///< the world (default: the model of `board` on the thesis stepper)
   bool json = false;                    ///< one JSON object on stdout
 };
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& args);

@@ -15,7 +15,7 @@
 
 #include "camera_options.h"
 #include "commands.h"
-#include "pinball/control/launcher_controller.h"
+#include "world_options.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/control/imitation_controller.h"
 #include "pinball/learn/demonstrations.h"
@@ -25,11 +25,12 @@
 #include "pinball/core/running_stats.h"
 #include "pinball/learn/cross_entropy.h"
 #include "pinball/learn/evaluator.h"
+#include "pinball/learn/launcher_search.h"
 #include "pinball/learn/learning_curve.h"
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/learn/relay_race.h"
 #include "pinball/learn/tournament.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::cli {
 
@@ -75,6 +76,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_option("--gravity-scale", a.gravity_scale, "tracker's g over the board's (miscalibration)")
       ->check(CLI::Range(0.1, 10.0));
   add_camera_model_options(*cmd, a.camera);
+  add_world_options(*cmd, a.world);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -140,12 +142,13 @@ nlohmann::json to_json(const Evaluation& e) {
 
 int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   // Thesis 5.1: 20 pull values x 10 launches; keep the one most often hittable.
-  const sim::Board board = sim::load_board(a.board);
-  control::LauncherSearchConfig config;
+  const table::Board board = table::load_board(a.board);  // the belief
+  const simlab::OwnedWorld world = simlab::make_world(a.world, board);
+  learn::LauncherSearchConfig config;
   config.seed = a.seed;
   config.camera = a.camera;
   err << "learn launcher: " << config.pulls << " pulls x " << config.launches_per_pull << " launches\n";
-  const control::LauncherSearchResult r = control::search_launcher(board, config);
+  const learn::LauncherSearchResult r = learn::search_launcher(board, config, world.world.get());
   nlohmann::json tried = nlohmann::json::array();
   for (std::size_t i = 0; i < r.pull.size(); ++i) {
     tried.push_back({{"pull", r.pull[i]}, {"hittable", r.successes[i]}});
@@ -177,7 +180,8 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     throw std::invalid_argument("learn: --out CONTROLLER is required for a search");
   }
   if (a.method == "evaluate" && a.controller.empty()) throw std::invalid_argument("learn: evaluate needs --controller FILE");
-  const sim::Board board = sim::load_board(a.board);
+  const table::Board board = table::load_board(a.board);  // the belief
+  const simlab::OwnedWorld world = simlab::make_world(a.world, board);
   learn::EvaluatorConfig ec;
   ec.camera = a.camera;
   ec.actuation_delay_s = a.actuation_delay_s;
@@ -190,7 +194,8 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
 
   // The prototype carries the launcher settings into every candidate.
   struct Objective final : learn::BallObjective {
-    Objective(const sim::Board& b, const learn::EvaluatorConfig& c, const LearnArgs& args) : ev(b, c), la(args) {}
+    Objective(const table::Board& b, const learn::EvaluatorConfig& c, const sim::World& w, const LearnArgs& args)
+        : ev(b, c, w.fork()), la(args) {}
     learn::BallOutcome play(const control::ControllerSpec& s, std::uint64_t seed) const override { return ev.play(s, seed); }
     control::ControllerSpec prototype() const override {
       control::ControllerSpec s = ev.prototype();
@@ -200,9 +205,14 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     }
     learn::PinballEvaluator ev;
     const LearnArgs& la;
-  } objective(board, ec, a);
+  } objective(board, ec, *world, a);
 
-  nlohmann::json j = {{"board", a.board}, {"method", a.method}, {"seed", a.seed}, {"threads", a.threads}};
+  nlohmann::json j = {{"board", a.board},
+                      {"world_board", a.world.board_path.empty() ? a.board : a.world.board_path},
+                      {"stepper", std::string(sim::stepper_kind_name(a.world.stepper))},
+                      {"method", a.method},
+                      {"seed", a.seed},
+                      {"threads", a.threads}};
   control::ControllerSpec result_spec;
   const control::ControllerSpec* eval_spec = nullptr;
   if (search) {
@@ -282,7 +292,8 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                    ": ball alive at the time limit with score " + std::to_string(score);
           control::save_controller(s, cycle_path);
           err << "learn: cycle controller saved to " << cycle_path << "\n";
-        });
+        },
+        world.world.get());
     const learn::SearchResult curve = learn::imitation_curve(im);
     if (!a.curve.empty()) learn::write_curve_csv(curve, a.curve);
     if (!a.plot.empty()) learn::plot_curve_png(curve, a.plot);
@@ -323,6 +334,10 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     out << j.dump(2) << "\n";
   } else {
     out << "learn " << a.method << " on " << a.board << " (seed " << a.seed << ", " << a.threads << " threads)\n";
+    if (!a.world.board_path.empty() || a.world.stepper != sim::StepperKind::kThesis) {
+      out << "world            " << j["world_board"].get<std::string>() << " on the " << j["stepper"].get<std::string>()
+          << " stepper\n";
+    }
     if (search) {
       out << "balls used       " << j["balls_used"] << " of " << a.budget_balls << " in " << j["generations"]
           << " generations, " << j["search_balls_per_s"] << " balls/s\n"

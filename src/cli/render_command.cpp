@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/renderer.h"
 
@@ -22,7 +22,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& a) {
 }
 
 int run_render(const RenderArgs& a, std::ostream& out, std::ostream&) {
-  const sim::Board board = sim::load_board(a.board);
+  const table::Board board = table::load_board(a.board);
   sim::RenderOptions options;
   options.px_per_m = a.px_per_m;
   options.draw_normals = a.normals;

@@ -15,17 +15,16 @@
 #include "commands.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/control/can_flipper_drive.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/control/simulated_player.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/sim/state_hash.h"
-#include "pinball/sim/event_stepper.h"
-#include "pinball/sim/thesis_stepper.h"
 #include "pinball/sim/video_recorder.h"
 #include "pinball/vision/sim_camera_source.h"
 #include "trace_writer.h"
+#include "world_options.h"
 
 namespace pinball::cli {
 
@@ -50,13 +49,7 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
       ->check(CLI::Range(0.0, 0.1));
   cmd->add_option("--balls", a.balls, "balls to play")->check(CLI::Range(1, 100'000'000));
   cmd->add_option("--seed", a.seed, "random seed (launch noise); same seed, same results");
-  cmd->add_option("--stepper", a.stepper,
-                  "integrator: thesis (fixed-step Euler, Ch. 3) or event (exact between events, docs/physics.md)")
-      ->check(CLI::IsMember({"thesis", "event"}));
-  cmd->add_option("--dt", a.dt_s,
-                  "time step in seconds (default: the board's); for --stepper event the rate at which the "
-                  "policy may change the flipper commands")
-      ->check(CLI::PositiveNumber);
+  add_world_options(*cmd, a.world);
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball still in play is cut")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--trace", a.trace, "write every step to this CSV (t,x,y,vx,vy,event)");
@@ -69,20 +62,11 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
 }
 
 int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
-  const sim::Board board = sim::load_board(a.board);
-  std::optional<sim::ThesisStepper> thesis;
-  std::optional<sim::EventStepper> event;
-  if (a.stepper == "event") {
-    sim::EventStepperOptions options;
-    options.dt_s = a.dt_s;
-    event.emplace(board, options);
-  } else {
-    sim::ThesisStepperOptions options;
-    options.dt_s = a.dt_s;
-    thesis.emplace(board, options);
-  }
-  const double dt_s = event ? event->dt_s() : thesis->dt_s();
-  sim::GameState state = sim::make_game_state(board, a.seed);
+  const table::Board board = table::load_board(a.board);  // the belief
+  const simlab::OwnedWorld world = simlab::make_world(a.world, board);
+  const table::Board& world_board = *world.board;  // what the camera films and the trace records
+  const double dt_s = world->dt_s();
+  sim::GameState state = sim::make_game_state(world_board, a.seed);
 
   std::optional<TraceWriter> trace;
   if (!a.trace.empty()) trace.emplace(a.trace);
@@ -97,10 +81,10 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     cc.fps = a.video_fps;
     cc.exposure_s = std::min(cc.exposure_s, 1.0 / a.video_fps);
     cc.seed = a.seed;
-    camera = std::make_unique<vision::SimCameraSource>(board, cc);
+    camera = std::make_unique<vision::SimCameraSource>(world_board, cc);
     video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, camera->frame_size());
   } else if (!a.video.empty()) {
-    video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(board, render_options));
+    video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(world_board, render_options));
   }
 
   std::string policy = a.policy;
@@ -125,7 +109,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     spastic.emplace(board, a.camera, spastic_config, a.seed ^ 0x5DEECE66Dull);
   }
   std::optional<control::CanFlipperDrive> can_drive;
-  if (a.actuation == "can") can_drive.emplace(board, a.actuation_delay_s);
+  if (a.actuation == "can") can_drive.emplace(world_board, a.actuation_delay_s);
   sim::BallLimits limits;
   limits.max_ball_time_s = a.max_ball_time_s;
   limits.pull = pull;
@@ -140,16 +124,16 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   auto last_progress = start;
 
   const std::uint64_t events_before = state.events;
-  auto play = [&](const auto& stepper) {
+  auto play = [&] {
     return sim::play_ball(
-        stepper, state, limits,
+        *world, state, limits,
         [&](sim::GameState& s) {
           if (spastic) spastic->act(s);
           if (learned_player) learned_player->act(s);
           if (can_drive) can_drive->apply(s);
         },
         [&](const sim::GameState& s, const sim::StepEvents& e) {
-          if (trace) trace->write(board, s, e);
+          if (trace) trace->write(world_board, s, e);
           if (camera) {
             camera->observe(s);
             while (camera->read(camera_frame)) {
@@ -157,13 +141,13 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
               video->write(camera_bgr);
             }
           } else if (video && s.time_s >= next_frame_s) {
-            video->write(sim::render_board(board, &s, render_options));
+            video->write(sim::render_board(world_board, &s, render_options));
             next_frame_s += 1.0 / a.video_fps;
           }
         });
   };
   for (int ball = 0; ball < a.balls; ++ball) {
-    const sim::BallResult r = event ? play(*event) : play(*thesis);
+    const sim::BallResult r = play();
     score.add(r.score);
     ball_time.add(r.duration_s);
     steps += r.steps;
@@ -191,7 +175,8 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"board", a.board},
         {"policy", policy},
         {"controller", a.controller},
-        {"stepper", a.stepper},
+        {"stepper", std::string(sim::stepper_kind_name(a.world.stepper))},
+        {"world_board", a.world.board_path.empty() ? a.board : a.world.board_path},
         {"seed", a.seed},
         {"dt_s", dt_s},
         {"balls", a.balls},
@@ -219,8 +204,9 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     };
     out << j.dump(2) << "\n";
   } else {
+    if (!a.world.board_path.empty()) out << "world board      " << a.world.board_path << "\n";
     out << "board            " << a.board << " (policy " << policy << ", actuation " << a.actuation
-        << ", stepper " << a.stepper << ", dt "
+        << ", stepper " << sim::stepper_kind_name(a.world.stepper) << ", dt "
         << dt_s << " s, seed " << a.seed << ")\n"
         << "balls            " << a.balls << " (" << cut << " cut at " << a.max_ball_time_s << " s, " << left_table
         << " left the table)\n"

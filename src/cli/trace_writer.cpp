@@ -17,7 +17,7 @@ void append_event(std::string& out, const char* kind, const std::string& name) {
 
 }  // namespace
 
-std::string describe_events(const sim::Board& board, const sim::StepEvents& e) {
+std::string describe_events(const table::Board& board, const sim::StepEvents& e) {
   using F = sim::StepEvents;
   std::string out;
   if (e.has(F::kLaunch)) append_event(out, "launch", "");
@@ -41,7 +41,7 @@ TraceWriter::~TraceWriter() {
   if (file_) std::fclose(file_);
 }
 
-void TraceWriter::write(const sim::Board& board, const sim::GameState& state, const sim::StepEvents& events) {
+void TraceWriter::write(const table::Board& board, const sim::GameState& state, const sim::StepEvents& events) {
   char line[256];
   char* p = line;
   char* const end = line + sizeof(line);

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <string>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
 
@@ -13,7 +13,7 @@ namespace pinball::cli {
 
 /// Names what happened in a step, '|'-separated ("hit:wall@12|sensor:lane"),
 /// or an empty string for plain flight.
-std::string describe_events(const sim::Board& board, const sim::StepEvents& events);
+std::string describe_events(const table::Board& board, const sim::StepEvents& events);
 
 /// A CSV trace file.
 class TraceWriter {
@@ -25,7 +25,7 @@ class TraceWriter {
   TraceWriter& operator=(const TraceWriter&) = delete;
 
   /// Appends one row for the state after a step.
-  void write(const sim::Board& board, const sim::GameState& state, const sim::StepEvents& events);
+  void write(const table::Board& board, const sim::GameState& state, const sim::StepEvents& events);
 
   /// Flushes and closes; throws std::runtime_error if the data could not be written.
   void close();

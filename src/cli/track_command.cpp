@@ -8,7 +8,7 @@
 
 #include "commands.h"
 #include "pinball/calibration/calibration_file.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/track/observation_io.h"
 #include "pinball/track/tracker.h"
 
@@ -39,7 +39,7 @@ const char* side_name(int flipper) { return flipper == track::kLeftFlipper ? "le
 }  // namespace
 
 int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
-  const sim::Board board = sim::load_board(a.board);
+  const table::Board board = table::load_board(a.board);
   const std::vector<track::ObservationRow> rows = track::read_observations_csv(a.observations);
   track::TrackerConfig config = track::default_tracker_config(board, track::CameraModelConfig{});
   track::FlipperGeometry geometry = track::flipper_geometry_from_board(board);

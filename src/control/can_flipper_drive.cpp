@@ -4,7 +4,7 @@
 
 namespace pinball::control {
 
-CanFlipperDrive::CanFlipperDrive(const sim::Board& board, double actuation_delay_s) {
+CanFlipperDrive::CanFlipperDrive(const table::Board& board, double actuation_delay_s) {
   const int n = static_cast<int>(board.flippers.size());
   if (n < 1 || n > firmware::kMaxDrivers) {
     throw std::invalid_argument("CAN flipper drive: the board needs 1 to " + std::to_string(firmware::kMaxDrivers) +
@@ -21,7 +21,7 @@ CanFlipperDrive::CanFlipperDrive(const sim::Board& board, double actuation_delay
     board_.add_listener(actuation_.back().get());
   }
   commanded_.assign(static_cast<std::size_t>(n), false);
-  for (const sim::Flipper& f : board.flippers) theta_max_.push_back(f.theta_max_rad);
+  for (const table::Flipper& f : board.flippers) theta_max_.push_back(f.theta_max_rad);
 }
 
 void CanFlipperDrive::apply(sim::GameState& state) {

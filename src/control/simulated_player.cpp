@@ -2,11 +2,11 @@
 
 namespace pinball::control {
 
-SimulatedPlayer::SimulatedPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
+SimulatedPlayer::SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera,
                                  FlipperController& controller, std::uint64_t seed)
     : SimulatedPlayer(board, camera, track::default_tracker_config(board, camera), controller, seed) {}
 
-SimulatedPlayer::SimulatedPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
+SimulatedPlayer::SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera,
                                  const track::TrackerConfig& tracker, FlipperController& controller,
                                  std::uint64_t seed)
     : board_(board),
@@ -14,7 +14,7 @@ SimulatedPlayer::SimulatedPlayer(const sim::Board& board, const track::CameraMod
       tracker_(track::flipper_geometry_from_board(board), tracker),
       controller_(controller) {
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    board_index_[board.flippers[i].side == sim::Side::kLeft ? track::kLeftFlipper : track::kRightFlipper] =
+    board_index_[board.flippers[i].side == table::Side::kLeft ? track::kLeftFlipper : track::kRightFlipper] =
         static_cast<int>(i);
   }
 }

@@ -24,7 +24,8 @@
 #include "pinball/firmware/frame_log.h"
 #include "pinball/firmware/socketcan_transport.h"
 #include "pinball/firmware/stream_transport.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/simlab/world_factory.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/vision/capture_source.h"
 #include "pinball/vision/sim_camera_source.h"
@@ -68,7 +69,7 @@ struct Daemon::Impl {
   bool fifo_allowed = true;  // false once the probe was refused: warned once, not once per thread
   bool sim_mode = true;
   bool lockstep = true;
-  sim::Board board;
+  table::Board board;
   control::ControllerSpec spec;
   std::unique_ptr<control::FlipperController> controller;
   // CAN.
@@ -77,7 +78,8 @@ struct Daemon::Impl {
   std::unique_ptr<firmware::FrameLog> frame_log;  // optional candump log
   std::unique_ptr<firmware::DriverBus> bus;
   // Frames.
-  std::unique_ptr<SimWorld> world;                     // sim
+  simlab::OwnedWorld world_model;                      // sim: the table that is played (sim.world_board)
+  std::unique_ptr<SimWorld> world;                     // sim: that table, its camera and its driver board
   std::unique_ptr<vision::CaptureSource> capture;      // lab: v4l2 / file
   std::unique_ptr<vision::CameraHomography> homography;
   std::unique_ptr<vision::BallDetector> detector;
@@ -164,10 +166,11 @@ void Daemon::Impl::build() {
   sim_mode = config.mode == "sim";
   cpus = plan_cpus(config.threads.chain_cpu);
   config.sim.board = find_data_file(config.sim.board);
+  if (!config.sim.world_board.empty()) config.sim.world_board = find_data_file(config.sim.world_board);
   config.board = find_data_file(config.board);
   config.controller = find_data_file(config.controller);
   lockstep = sim_mode && !config.sim.realtime;
-  board = sim::load_board(sim_mode ? config.sim.board : config.board);
+  board = table::load_board(sim_mode ? config.sim.board : config.board);
   spec = control::load_controller(config.controller);
   controller = control::make_flipper_controller(spec);
   driver_of_flipper = controller_stage_options_for(config, board).driver_of_flipper;
@@ -206,7 +209,11 @@ void Daemon::Impl::build() {
     wo.actuation_delay_s = config.sim.actuation_delay_s;
     wo.max_ball_time_s = config.sim.max_ball_time_s;
     wo.launcher_pull = spec.launcher_pull;
-    world = std::make_unique<SimWorld>(board, *board_link, cc, wo);
+    simlab::WorldSpec ws;
+    ws.board_path = config.sim.world_board;
+    ws.stepper = config.sim.stepper;
+    world_model = simlab::make_world(ws, board);
+    world = std::make_unique<SimWorld>(*world_model, *board_link, cc, wo);
     // A calibration file (e.g. from `pinball calibrate camera --sim`) stands in
     // for the simulated camera's true homography, as it would in the lab.
     homography = std::make_unique<vision::CameraHomography>(setup.homography ? *setup.homography
@@ -528,6 +535,8 @@ DaemonReport Daemon::Impl::report() const {
   r.coils_off_at_exit = coils_off_at_exit;
   r.cpus = cpus.describe;
   if (world) {
+    r.world_board = world_model->board().source;
+    r.world = std::string(world_model->name());
     r.results = world->results();
     r.board = world->driver_board().counters();
     RunningStats score, time;
@@ -659,6 +668,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   nlohmann::json j;
   j["mode"] = r.mode;
   j["clock"] = r.mode == "sim" ? (r.lockstep ? "lockstep" : "realtime") : "steady";
+  if (r.mode == "sim") j["world"] = {{"board", r.world_board}, {"stepper", r.world}};
   j["balls"] = r.balls;
   j["mean_score"] = r.mean_score;
   j["score_ci95"] = r.score_ci95;

@@ -88,6 +88,14 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
 
   Section sim = top.child("sim");
   sim.read("board", c.sim.board);
+  sim.read("world_board", c.sim.world_board);
+  std::string stepper(pinball::sim::stepper_kind_name(c.sim.stepper));
+  sim.read("stepper", stepper);
+  try {
+    c.sim.stepper = pinball::sim::parse_stepper_kind(stepper);
+  } catch (const std::invalid_argument& e) {
+    sim.fail(sim.name("stepper"), e.what());
+  }
   sim.read("balls", c.sim.balls);
   sim.read("seed", c.sim.seed);
   sim.read("realtime", c.sim.realtime);

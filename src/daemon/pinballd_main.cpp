@@ -39,13 +39,19 @@ void install(int sig, void (*handler)(int)) {
 int main(int argc, char** argv) {
   using namespace pinball::daemon;
   CLI::App app("pinballd: the real-time pinball controller (camera -> tracker -> controller -> CAN)");
-  std::string config_path, sim_board, controller, lcm_url, can_log;
+  std::string config_path, sim_board, world_board, stepper, controller, lcm_url, can_log;
   int balls = -1;
   long long seed = -1;
   bool realtime = false, json = false, threads = false;
   app.add_option("--config", config_path, "YAML configuration (config/lab.example.yaml); none: embedded simulation")
       ->check(CLI::ExistingFile);
   app.add_option("--sim", sim_board, "simulate this board (default boards/mit1993.board)")->check(CLI::ExistingFile);
+  app.add_option("--world-board", world_board,
+                 "simulation: the board the table really is (default: the --sim board, which stays the belief of "
+                 "the tracker and the controller); same flippers required")
+      ->check(CLI::ExistingFile);
+  app.add_option("--stepper", stepper, "simulation: the world's integrator, thesis or event (default thesis)")
+      ->check(CLI::IsMember({"thesis", "event"}));
   app.add_option("--controller", controller, "controller file (default controllers/best.json)")
       ->check(CLI::ExistingFile);
   app.add_option("--balls", balls, "balls to play in simulation (default 10)")->check(CLI::Range(0, 1000000));
@@ -80,6 +86,8 @@ int main(int argc, char** argv) {
       config.camera.source = "sim";
       config.can.interface = "sim";
     }
+    if (!world_board.empty()) config.sim.world_board = world_board;
+    if (!stepper.empty()) config.sim.stepper = pinball::sim::parse_stepper_kind(stepper);
     if (!controller.empty()) config.controller = controller;
     if (balls >= 0) config.sim.balls = balls;
     if (seed >= 0) config.sim.seed = static_cast<std::uint64_t>(seed);

@@ -142,7 +142,7 @@ int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, 
   return n;
 }
 
-TrackingSetup tracking_setup_for(const DaemonConfig& config, const sim::Board& board) {
+TrackingSetup tracking_setup_for(const DaemonConfig& config, const table::Board& board) {
   track::CameraModelConfig camera_model;
   camera_model.fps = config.camera.fps;
   TrackingSetup s{track::default_tracker_config(board, camera_model), track::flipper_geometry_from_board(board), {}};
@@ -154,12 +154,12 @@ TrackingSetup tracking_setup_for(const DaemonConfig& config, const sim::Board& b
   return s;
 }
 
-ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const sim::Board& board) {
+ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const table::Board& board) {
   ControllerStageOptions o;
   o.stall_timeout_s = config.camera.stall_timeout_s;
   o.recycle_s = config.coils.recycle_ms * 1e-3;
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    o.driver_of_flipper[board.flippers[i].side == sim::Side::kLeft ? 0 : 1] = static_cast<int>(i);
+    o.driver_of_flipper[board.flippers[i].side == table::Side::kLeft ? 0 : 1] = static_cast<int>(i);
   }
   return o;
 }

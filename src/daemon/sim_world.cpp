@@ -9,7 +9,7 @@
 namespace pinball::daemon {
 namespace {
 
-firmware::VirtualDriverBoardOptions board_options(const sim::Board& board) {
+firmware::VirtualDriverBoardOptions board_options(const table::Board& board) {
   if (board.flippers.empty() || board.flippers.size() > static_cast<std::size_t>(firmware::kMaxDrivers)) {
     throw std::invalid_argument("sim: the board needs 1 to 8 flippers (one driver each)");
   }
@@ -29,20 +29,21 @@ void SimWorld::CoilWatch::on_coil_change(int driver, const firmware::CoilOutput&
   }
 }
 
-SimWorld::SimWorld(const sim::Board& board, firmware::CanTransport& board_link, const vision::SimCameraConfig& camera,
+SimWorld::SimWorld(const sim::World& world, firmware::CanTransport& board_link, const vision::SimCameraConfig& camera,
                    const SimWorldOptions& options)
-    : board_(board),
+    : world_(world.fork()),
+      board_(world_->board()),
       link_(board_link),
       options_(options),
-      stepper_(board),
-      state_(sim::make_game_state(board, options.seed)),
-      camera_(board, camera),
-      driver_board_(board_options(board)) {
+      state_(sim::make_game_state(board_, options.seed)),
+      camera_(board_, camera),
+      driver_board_(board_options(board_)) {
+  const table::Board& board = board_;
   if (options.balls < 0) throw std::invalid_argument("sim: balls must be >= 0");
   if (!(options.max_ball_time_s > 0.0)) throw std::invalid_argument("sim: max ball time must be > 0 s");
   bool left = false, right = false;
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    const bool is_left = board.flippers[i].side == sim::Side::kLeft;
+    const bool is_left = board.flippers[i].side == table::Side::kLeft;
     (is_left ? left : right) = true;
     board_flipper_[is_left ? 0 : 1] = static_cast<int>(i);
     actuation_.push_back(std::make_unique<firmware::FlipperActuation>(static_cast<int>(i), options.actuation_delay_s));
@@ -64,7 +65,7 @@ void SimWorld::render_background(vision::Frame& frame, double t_s) {
 void SimWorld::start_ball() {
   // The same launch noise per ball index as the fast learning loop's evaluator.
   state_.rng = Rng(learn::ball_seed(options_.seed, static_cast<std::uint64_t>(ball_)));
-  sim::begin_ball(board_, state_, pull_);
+  sim::begin_ball(*world_, state_, pull_);
   ball_active_ = true;
   ball_t0_s_ = state_.time_s;
   ball_score0_ = state_.score;
@@ -85,7 +86,7 @@ void SimWorld::idle(double duration_s) {
   const double end_s = state_.time_s + duration_s;
   while (state_.time_s < end_s) {
     drive_flippers();
-    stepper_.step(state_);
+    world_->step(state_);
     camera_.observe(state_);
   }
 }
@@ -106,14 +107,14 @@ bool SimWorld::step(GameEvent* events, int& n) {
   }
   drive_flippers();
   const double score_before = state_.score;
-  const sim::StepEvents ev = stepper_.step(state_);
+  const sim::StepEvents ev = world_->step(state_);
   camera_.observe(state_);
   const double ball_time = state_.time_s - ball_t0_s_;
   if (state_.score > score_before) {
     events[n++] = GameEvent{GameEvent::kScore, ball_, state_.time_s, state_.score - score_before, ball_time};
   }
   const bool lost = ev.has(sim::StepEvents::kBallLost);
-  const bool cut = !lost && ball_time >= options_.max_ball_time_s - 0.5 * stepper_.dt_s();
+  const bool cut = !lost && ball_time >= options_.max_ball_time_s - 0.5 * world_->dt_s();
   if (lost || cut) {
     if (cut) sim::cut_ball(board_, state_);
     SimBallResult r;
@@ -126,7 +127,7 @@ bool SimWorld::step(GameEvent* events, int& n) {
     ++ball_;
     ball_active_ = false;
   } else if (sim::resting_in_launcher(board_, state_)) {
-    sim::launch_ball(board_, state_, pull_);
+    world_->launch(state_, pull_);
   }
   return true;
 }

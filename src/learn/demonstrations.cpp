@@ -10,6 +10,7 @@
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/sim/ball_runner.h"
+#include "pinball/sim/model_world.h"
 
 namespace pinball::learn {
 
@@ -120,23 +121,24 @@ sim::BallLimits limits_of(const DemonstrationConfig& config) {
 // teacher judges the true state: "fire now" labels the approach with this
 // frame's d; if the learner fires first, the teacher's best plan from that
 // frame labels it (fire k frames later: d less the ball's travel; no fire: a pass).
-DemonstrationBall record_correction(const sim::ThesisStepper& stepper, const DemonstrationConfig& config,
+DemonstrationBall record_correction(sim::World& world, const sim::ThesisStepper& model,
+                                    const DemonstrationConfig& config,
                                     const std::shared_ptr<const control::ShotTable>& learner_table,
                                     std::uint64_t seed) {
-  const sim::Board& board = stepper.board();
+  const table::Board& board = model.board();
   DemonstrationBall ball;
   ShotRecorder recorder(ball.shots);
   control::ImitationController learner(learner_table);
   Tee tee(learner, recorder);
   control::SimulatedPlayer watcher(board, config.camera, tee, camera_seed(seed));
-  LookaheadPlanner teacher(stepper, config.teacher);
-  const double frame_s = stepper.dt_s() * config.teacher.frame_steps;
+  LookaheadPlanner teacher(model, config.teacher);
+  const double frame_s = model.dt_s() * config.teacher.frame_steps;
   DelayLine delay(board.flippers.size(), config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
-  sim::GameState state = sim::make_game_state(board, seed);
+  sim::GameState state = sim::make_game_state(world.board(), seed);
   bool held = false;  // a learner's flipper was commanded up before this step
   const sim::BallResult r = sim::play_ball(
-      stepper, state, limits_of(config),
+      world, state, limits_of(config),
       [&](sim::GameState& s) {
         const std::uint64_t before = watcher.observations();
         const long fires_before = learner.fires();
@@ -172,18 +174,18 @@ DemonstrationBall record_correction(const sim::ThesisStepper& stepper, const Dem
 
 }  // namespace
 
-DemonstrationBall record_demonstration(const sim::ThesisStepper& stepper, const DemonstrationConfig& config,
-                                       std::uint64_t seed) {
-  const sim::Board& board = stepper.board();
+DemonstrationBall record_demonstration(sim::World& world, const sim::ThesisStepper& model,
+                                       const DemonstrationConfig& config, std::uint64_t seed) {
+  const table::Board& board = model.board();
   DemonstrationBall ball;
   ShotRecorder recorder(ball.shots);
   // The same camera and tracker seeds as the evaluator's, so the examples see what a controller would.
   control::SimulatedPlayer watcher(board, config.camera, recorder, camera_seed(seed));
-  LookaheadPlayer teacher(stepper, config.teacher, config.actuation_delay_s);
+  LookaheadPlayer teacher(model, config.teacher, config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
-  sim::GameState state = sim::make_game_state(board, seed);
+  sim::GameState state = sim::make_game_state(world.board(), seed);
   const sim::BallResult r = sim::play_ball(
-      stepper, state, limits_of(config),
+      world, state, limits_of(config),
       [&](sim::GameState& s) {
         const std::uint64_t before = watcher.observations();
         watcher.act(s);
@@ -201,13 +203,17 @@ DemonstrationBall record_demonstration(const sim::ThesisStepper& stepper, const 
   return ball;
 }
 
-Demonstrations record_demonstrations(const sim::Board& board, const DemonstrationConfig& config, int balls,
+Demonstrations record_demonstrations(const table::Board& board, const DemonstrationConfig& config, int balls,
                                      std::uint64_t seed, int threads,
                                      const std::function<void(const std::string&)>& progress,
-                                     const std::shared_ptr<const control::ShotTable>& learner) {
+                                     const std::shared_ptr<const control::ShotTable>& learner,
+                                     const sim::World* world) {
   if (balls < 1) throw std::invalid_argument("demonstrations: balls must be >= 1");
   if (board.flippers.size() != 2) throw std::invalid_argument("demonstrations: the board needs exactly two flippers");
-  const sim::ThesisStepper stepper(board);
+  const sim::ThesisStepper model(board);
+  const std::unique_ptr<sim::World> world_prototype =
+      world != nullptr ? world->fork() : sim::make_model_world(board);
+  sim::check_same_flippers(world_prototype->board(), board);
   const auto n = static_cast<std::size_t>(balls);
   std::vector<DemonstrationBall> played(n);
   std::atomic<int> done{0};
@@ -215,8 +221,9 @@ Demonstrations record_demonstrations(const sim::Board& board, const Demonstratio
   const int every = std::max(1, balls / 10);
   const auto start = std::chrono::steady_clock::now();
   parallel_for(n, threads, [&](std::size_t i) {
-    played[i] = learner != nullptr ? record_correction(stepper, config, learner, ball_seed(seed, i))
-                                   : record_demonstration(stepper, config, ball_seed(seed, i));
+    const std::unique_ptr<sim::World> ball_world = world_prototype->fork();
+    played[i] = learner != nullptr ? record_correction(*ball_world, model, config, learner, ball_seed(seed, i))
+                                   : record_demonstration(*ball_world, model, config, ball_seed(seed, i));
     const int d = ++done;
     if (progress && (d % every == 0 || d == balls)) {
       const std::lock_guard<std::mutex> lock(progress_mutex);
@@ -242,10 +249,10 @@ Demonstrations record_demonstrations(const sim::Board& board, const Demonstratio
   return out;
 }
 
-ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearningConfig& config,
+ImitationResult learn_by_imitation(const table::Board& board, const ImitationLearningConfig& config,
                                    std::uint64_t budget_balls, std::uint64_t seed, int threads,
                                    const std::function<void(const std::string&)>& progress,
-                                   const ImitationCycleHandler& on_cycle) {
+                                   const ImitationCycleHandler& on_cycle, const sim::World* world) {
   if (config.rounds < 1) throw std::invalid_argument("imitation: rounds must be >= 1");
   if (budget_balls < static_cast<std::uint64_t>(config.rounds)) {
     throw std::invalid_argument("imitation: the budget must give every round a ball");
@@ -263,7 +270,7 @@ ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearn
                                 if (progress) progress("round " + std::to_string(r + 1) + "/" +
                                                        std::to_string(config.rounds) + ": " + line);
                               },
-                              r == 0 ? nullptr : result.table);
+                              r == 0 ? nullptr : result.table, world);
     if (r > 0 && d.cut > 0 && on_cycle) on_cycle(*result.table, d.best_cut_score);  // the table that played it
     shots.insert(shots.end(), d.shots.begin(), d.shots.end());
     result.table = std::make_shared<const control::ShotTable>(shots, config.table);

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "pinball/control/actuator_controller.h"
+#include "pinball/sim/model_world.h"
 
 namespace pinball::learn {
 
@@ -17,8 +18,8 @@ std::uint64_t ball_seed(std::uint64_t run_seed, std::uint64_t index) {
 
 namespace {
 
-sim::ThesisStepperOptions stepper_options(const EvaluatorConfig& c) {
-  sim::ThesisStepperOptions o;
+sim::ModelWorldOptions world_options(const EvaluatorConfig& c) {
+  sim::ModelWorldOptions o;
   o.dt_s = c.dt_s;
   return o;
 }
@@ -73,8 +74,14 @@ class OpportunityBook final : public control::FlipperController {
 
 }  // namespace
 
-PinballEvaluator::PinballEvaluator(const sim::Board& board, const EvaluatorConfig& config)
-    : board_(board), config_(config), stepper_(board, stepper_options(config)) {
+PinballEvaluator::PinballEvaluator(const table::Board& board, const EvaluatorConfig& config)
+    : PinballEvaluator(board, config, sim::make_model_world(board, world_options(config))) {}
+
+PinballEvaluator::PinballEvaluator(const table::Board& belief, const EvaluatorConfig& config,
+                                   std::unique_ptr<sim::World> world)
+    : board_(belief), config_(config), world_(std::move(world)) {
+  if (world_ == nullptr) throw std::invalid_argument("evaluator: no world");
+  sim::check_same_flippers(world_->board(), belief);
   if (!(config.actuation_delay_s >= 0.0 && config.actuation_delay_s < 1.0)) {
     throw std::invalid_argument("evaluator: actuation delay must be in [0, 1) s");
   }
@@ -114,7 +121,8 @@ BallOutcome PinballEvaluator::run(control::FlipperController& controller,
                                   const control::ActuatorController* actuator, double pull,
                                   std::uint64_t seed) const {
   BallOutcome outcome;
-  sim::GameState state = sim::make_game_state(board_, seed);
+  const std::unique_ptr<sim::World> world = world_->fork();
+  sim::GameState state = sim::make_game_state(world->board(), seed);
   OpportunityBook book(controller, actuator, state.score, outcome.opportunities);
   track::TrackerConfig tracker = track::default_tracker_config(board_, config_.camera);
   tracker.g_mps2 *= config_.gravity_scale;
@@ -122,7 +130,7 @@ BallOutcome PinballEvaluator::run(control::FlipperController& controller,
   limits.max_ball_time_s = config_.max_ball_time_s;
   limits.pull = pull;
   const sim::BallResult r =
-      play_through_tracker(stepper_, state, config_.camera, tracker, book, config_.actuation_delay_s, limits, seed,
+      play_through_tracker(*world, board_, state, config_.camera, tracker, book, config_.actuation_delay_s, limits, seed,
                            [](const sim::GameState&, const sim::StepEvents&) {});
   book.finish(!r.cut, config_.loss_penalty);
   outcome.score = r.score;

@@ -31,12 +31,12 @@ LookaheadPlanner::LookaheadPlanner(const sim::ThesisStepper& stepper, const Look
 namespace {
 
 // Distance from the ball to the nearest flipper's rest segment, and which flipper.
-std::pair<int, double> nearest_flipper(const sim::Board& board, const sim::GameState& state) {
+std::pair<int, double> nearest_flipper(const table::Board& board, const sim::GameState& state) {
   int nearest = -1;
   double nearest_d = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    const sim::Flipper& f = board.flippers[i];
-    const double d = distance_point_segment(state.ball.position_m, f.pivot, sim::flipper_tip(f, f.theta_min_rad));
+    const table::Flipper& f = board.flippers[i];
+    const double d = distance_point_segment(state.ball.position_m, f.pivot, table::flipper_tip(f, f.theta_min_rad));
     if (d < nearest_d) {
       nearest_d = d;
       nearest = static_cast<int>(i);
@@ -48,7 +48,7 @@ std::pair<int, double> nearest_flipper(const sim::Board& board, const sim::GameS
 }  // namespace
 
 bool LookaheadPlanner::in_zone(const sim::GameState& state) const {
-  const sim::Board& board = stepper_.board();
+  const table::Board& board = stepper_.board();
   return state.ball_in_play && nearest_flipper(board, state).second <= config_.zone_factor * board.ball.radius_m;
 }
 

@@ -4,12 +4,12 @@
 
 namespace pinball::sim {
 
-void begin_ball(const Board& board, GameState& state, double pull) {
-  if (state.balls_left <= 0) reset_game(board, state);
-  launch_ball(board, state, pull);
+void begin_ball(World& world, GameState& state, double pull) {
+  if (state.balls_left <= 0) reset_game(world.board(), state);
+  world.launch(state, pull);
 }
 
-bool resting_in_launcher(const Board& board, const GameState& state) {
+bool resting_in_launcher(const table::Board& board, const GameState& state) {
   // "Whenever the ball is in the launch chute" (thesis 5.1): back at the
   // launch point and nearly still.
   constexpr double kStillSpeed_mps = 0.05;
@@ -18,7 +18,7 @@ bool resting_in_launcher(const Board& board, const GameState& state) {
          state.ball.velocity_mps.norm() < kStillSpeed_mps;
 }
 
-void cut_ball(const Board& board, GameState& state) {
+void cut_ball(const table::Board& board, GameState& state) {
   state.ball_in_play = false;
   state.balls_left = std::max(0, state.balls_left - 1);
   state.ball.position_m = board.launcher.position;

@@ -11,8 +11,8 @@ namespace {
 // huge or sparse boards at the price of longer candidate lists.
 constexpr double kMaxCells = 4.0e6;
 
-void shape_bounds(const Shape& s, Vec2& lo, Vec2& hi) {
-  if (s.kind == ShapeKind::kLine) {
+void shape_bounds(const table::Shape& s, Vec2& lo, Vec2& hi) {
+  if (s.kind == table::ShapeKind::kLine) {
     lo = s.p0.cwiseMin(s.p1);
     hi = s.p0.cwiseMax(s.p1);
   } else {
@@ -21,14 +21,14 @@ void shape_bounds(const Shape& s, Vec2& lo, Vec2& hi) {
   }
 }
 
-double distance_shape_box(const Shape& s, const Vec2& lo, const Vec2& hi) {
-  if (s.kind == ShapeKind::kLine) return distance_segment_box(s.p0, s.p1, lo, hi);
+double distance_shape_box(const table::Shape& s, const Vec2& lo, const Vec2& hi) {
+  if (s.kind == table::ShapeKind::kLine) return distance_segment_box(s.p0, s.p1, lo, hi);
   return std::max(0.0, distance_point_box(s.p0, lo, hi) - s.radius_m);
 }
 
 }  // namespace
 
-UniformGrid::UniformGrid(std::span<const Shape> shapes, double reach_m, double cell_m) {
+UniformGrid::UniformGrid(std::span<const table::Shape> shapes, double reach_m, double cell_m) {
   if (!(reach_m >= 0.0) || !(cell_m > 0.0)) throw std::invalid_argument("UniformGrid: reach must be >= 0, cell > 0");
   if (shapes.empty()) {
     cell_start_.assign(1, 0);
@@ -36,7 +36,7 @@ UniformGrid::UniformGrid(std::span<const Shape> shapes, double reach_m, double c
   }
   Vec2 lo = Vec2::Constant(INFINITY);
   Vec2 hi = Vec2::Constant(-INFINITY);
-  for (const Shape& s : shapes) {
+  for (const table::Shape& s : shapes) {
     Vec2 slo, shi;
     shape_bounds(s, slo, shi);
     lo = lo.cwiseMin(slo);
@@ -54,7 +54,7 @@ UniformGrid::UniformGrid(std::span<const Shape> shapes, double reach_m, double c
   // Pass 1 counts, pass 2 fills: shapes visit only the cells their bounds
   // (grown by reach) overlap, and keep those they are truly within reach of.
   std::vector<std::int32_t> count(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
-  auto for_each_cell_in_reach = [&](const Shape& s, auto&& fn) {
+  auto for_each_cell_in_reach = [&](const table::Shape& s, auto&& fn) {
     Vec2 slo, shi;
     shape_bounds(s, slo, shi);
     const int x0 = std::max(0, static_cast<int>(std::floor((slo.x() - reach_m - origin_.x()) * inv_cell_)));
@@ -69,7 +69,7 @@ UniformGrid::UniformGrid(std::span<const Shape> shapes, double reach_m, double c
       }
     }
   };
-  for (const Shape& s : shapes) for_each_cell_in_reach(s, [&](int cell) { ++count[cell + 1]; });
+  for (const table::Shape& s : shapes) for_each_cell_in_reach(s, [&](int cell) { ++count[cell + 1]; });
   for (std::size_t i = 1; i < count.size(); ++i) count[i] += count[i - 1];
   cell_start_ = count;
   entries_.resize(static_cast<std::size_t>(count.back()));

@@ -5,7 +5,7 @@
 
 namespace pinball::sim {
 
-bool line_time_of_impact(const Shape& line, const Vec2& p, const Vec2& v, double r, double t_max, Contact& out) {
+bool line_time_of_impact(const table::Shape& line, const Vec2& p, const Vec2& v, double r, double t_max, Contact& out) {
   const Vec2& n = line.normal;
   const double vn = v.dot(n);
   if (vn >= 0.0) return false;                  // moving along or away from the face
@@ -48,27 +48,27 @@ bool circle_time_of_impact(const Vec2& c, double radius_m, const Vec2& p, const 
   return true;
 }
 
-bool shape_time_of_impact(const Shape& shape, const Vec2& p, const Vec2& v, double r, double t_max, Contact& out) {
-  if (shape.kind == ShapeKind::kLine) return line_time_of_impact(shape, p, v, r, t_max, out);
+bool shape_time_of_impact(const table::Shape& shape, const Vec2& p, const Vec2& v, double r, double t_max, Contact& out) {
+  if (shape.kind == table::ShapeKind::kLine) return line_time_of_impact(shape, p, v, r, t_max, out);
   return circle_time_of_impact(shape.p0, shape.radius_m, p, v, r, t_max, out);
 }
 
-Shape flipper_face(const Flipper& f, double theta_rad, const Vec2& p) {
-  Shape face;
-  face.kind = ShapeKind::kLine;
+table::Shape flipper_face(const table::Flipper& f, double theta_rad, const Vec2& p) {
+  table::Shape face;
+  face.kind = table::ShapeKind::kLine;
   face.p0 = f.pivot;
-  face.p1 = flipper_tip(f, theta_rad);
-  const Vec2 up = flipper_up_normal(f, theta_rad);
+  face.p1 = table::flipper_tip(f, theta_rad);
+  const Vec2 up = table::flipper_up_normal(f, theta_rad);
   face.normal = (p - f.pivot).dot(up) >= 0.0 ? up : Vec2(-up);
   return face;
 }
 
-Vec2 flipper_point_velocity(const Flipper& f, double theta_rad, double omega_rad_s, const Vec2& q) {
-  const double arm_m = (q - f.pivot).dot(flipper_direction(f, theta_rad));
-  return omega_rad_s * arm_m * flipper_up_normal(f, theta_rad);
+Vec2 flipper_point_velocity(const table::Flipper& f, double theta_rad, double omega_rad_s, const Vec2& q) {
+  const double arm_m = (q - f.pivot).dot(table::flipper_direction(f, theta_rad));
+  return omega_rad_s * arm_m * table::flipper_up_normal(f, theta_rad);
 }
 
-Vec2 flipper_response(const Flipper& f, double theta_rad, double omega_rad_s, const Vec2& q, const Vec2& n,
+Vec2 flipper_response(const table::Flipper& f, double theta_rad, double omega_rad_s, const Vec2& q, const Vec2& n,
                       const Vec2& v) {
   Vec2 out = v.dot(n) < 0.0 ? reflect(v, n, f.rho) : v;
   const double face_speed = flipper_point_velocity(f, theta_rad, omega_rad_s, q).dot(n);

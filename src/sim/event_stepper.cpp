@@ -127,7 +127,7 @@ struct EventStepper::Run {
   };
 
   const EventStepper& stepper;
-  const Board& board;
+  const table::Board& board;
   GameState& state;
   StepEvents& events;
   const double r;
@@ -192,7 +192,7 @@ struct EventStepper::Run {
     state.ball.velocity_mps = Vec2::Zero();
     const Vec2& p = state.ball.position_m;
     for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-      const Flipper& f = board.flippers[i];
+      const table::Flipper& f = board.flippers[i];
       FlipperState& fs = state.flippers[i];
       if (fs.omega_rad_s == 0.0) continue;
       if ((p - f.pivot).norm() <= f.length_m + r + stepper.touch_m_) {
@@ -208,7 +208,7 @@ struct EventStepper::Run {
     for (std::size_t i = 0; i < board.flippers.size(); ++i) {
       FlipperState& fs = state.flippers[i];
       if (fs.omega_rad_s == 0.0) continue;
-      const Flipper& f = board.flippers[i];
+      const table::Flipper& f = board.flippers[i];
       fs.theta_rad = std::clamp(fs.theta_rad + fs.omega_rad_s * dt, f.theta_min_rad, f.theta_max_rad);
       if (fs.theta_rad == f.theta_min_rad || fs.theta_rad == f.theta_max_rad) fs.omega_rad_s = 0.0;
     }
@@ -221,7 +221,7 @@ struct EventStepper::Run {
       for (std::size_t i = 0; i < board.flippers.size(); ++i) {
         FlipperState& fs = state.flippers[i];
         if (fs.omega_rad_s == 0.0) continue;
-        const Flipper& f = board.flippers[i];
+        const table::Flipper& f = board.flippers[i];
         fs.theta_rad = std::clamp(fs.theta_rad + fs.omega_rad_s * dt, f.theta_min_rad, f.theta_max_rad);
       }
     }
@@ -292,11 +292,11 @@ struct EventStepper::Run {
     here.count = 1;
     here.for_each([&](std::int32_t i) {
       if (state.visible[i] != kVisible) return;
-      const Shape& s = board.shapes[i];
+      const table::Shape& s = board.shapes[i];
       Touch t;
       t.surface = Surface::kObstacle;
       t.index = i;
-      if (s.kind == ShapeKind::kLine) {
+      if (s.kind == table::ShapeKind::kLine) {
         const double sc = (p - s.p0).dot(s.normal);
         t.gap = sc - r;
         if (sc < 0.0 || std::abs(t.gap) > touch) return;
@@ -321,10 +321,10 @@ struct EventStepper::Run {
     for (std::size_t k = 0; k < board.flippers.size(); ++k) {
       const FlipperState& fs = state.flippers[k];
       if (fs.omega_rad_s != 0.0) continue;  // a moving flipper is never a resting contact
-      const Flipper& f = board.flippers[k];
+      const table::Flipper& f = board.flippers[k];
       const Vec2 rel = p - f.pivot;
       if (rel.squaredNorm() > std::pow(f.length_m + r + touch, 2)) continue;
-      const Vec2 dir = flipper_direction(f, fs.theta_rad);
+      const Vec2 dir = table::flipper_direction(f, fs.theta_rad);
       const double along = rel.dot(dir);
       const double clamped = std::clamp(along, 0.0, f.length_m);
       const Vec2 closest = f.pivot + clamped * dir;
@@ -336,7 +336,7 @@ struct EventStepper::Run {
       if (dist == 0.0 || std::abs(t.gap) > touch) continue;
       if (along > 0.0 && along < f.length_m) {
         t.surface = Surface::kFlipperFace;
-        const Vec2 up = flipper_up_normal(f, fs.theta_rad);
+        const Vec2 up = table::flipper_up_normal(f, fs.theta_rad);
         t.normal = rel.dot(up) >= 0.0 ? up : Vec2(-up);
         t.origin = f.pivot;
         t.tangent = dir;
@@ -389,7 +389,7 @@ struct EventStepper::Run {
     p -= contact.gap * contact.normal;
     v -= v.dot(contact.normal) * contact.normal;
     m.a = gravity - gravity.dot(contact.normal) * contact.normal;
-    if (contact.surface == Surface::kObstacle && board.shapes[contact.index].kind == ShapeKind::kCircle) {
+    if (contact.surface == Surface::kObstacle && board.shapes[contact.index].kind == table::ShapeKind::kCircle) {
       set_circle_range(contact, p);
     } else if (contact.surface == Surface::kFlipperEnd) {
       set_circle_range(contact, p);
@@ -430,7 +430,7 @@ struct EventStepper::Run {
     for (std::size_t i = 0; i < board.flippers.size(); ++i) {
       const FlipperState& fs = state.flippers[i];
       if (fs.omega_rad_s == 0.0) continue;
-      const Flipper& f = board.flippers[i];
+      const table::Flipper& f = board.flippers[i];
       const double stop = fs.omega_rad_s > 0.0 ? f.theta_max_rad : f.theta_min_rad;
       const double t = std::max(0.0, (stop - fs.theta_rad) / fs.omega_rad_s);
       if (t < next.t) next = {t, Kind::kFlipperStop, static_cast<std::int32_t>(i), Vec2::Zero(), Vec2::Zero()};
@@ -445,7 +445,7 @@ struct EventStepper::Run {
   }
 
   // One-sided line: the ball's surface reaches the front face within the segment.
-  bool line_impact(const Shape& s, double horizon, double& t_hit) const {
+  bool line_impact(const table::Shape& s, double horizon, double& t_hit) const {
     const Vec2& n = s.normal;
     const double sc = (m.p - s.p0).dot(n);
     const double gap = sc - r;
@@ -490,9 +490,9 @@ struct EventStepper::Run {
   void find_obstacle_impact(Next& next) const {
     obstacles.for_each([&](std::int32_t i) {
       if (state.visible[i] != kVisible || is_contact(Surface::kObstacle, i)) return;
-      const Shape& s = board.shapes[i];
+      const table::Shape& s = board.shapes[i];
       double t;
-      if (s.kind == ShapeKind::kLine) {
+      if (s.kind == table::ShapeKind::kLine) {
         if (line_impact(s, next.t, t) && t < next.t) next = {t, Kind::kObstacle, i, s.normal, Vec2::Zero()};
       } else {
         Vec2 n;
@@ -522,11 +522,11 @@ struct EventStepper::Run {
   void find_sensor_entry(Next& next) const {
     sensors.for_each([&](std::int32_t i) {
       if (state.sensor_inside[i]) return;
-      const Sensor& sensor = board.sensors[i];
-      const Shape& s = sensor.shape;
+      const table::Sensor& sensor = board.sensors[i];
+      const table::Shape& s = sensor.shape;
       double t = INFINITY;
-      if (sensor.kind == SensorKind::kHole || s.kind == ShapeKind::kCircle) {
-        const double reach = sensor.kind == SensorKind::kHole ? s.radius_m : s.radius_m + r;
+      if (sensor.kind == table::SensorKind::kHole || s.kind == table::ShapeKind::kCircle) {
+        const double reach = sensor.kind == table::SensorKind::kHole ? s.radius_m : s.radius_m + r;
         if (distance_point_box(s.p0, box_lo, box_hi) > reach) return;
         if ((m.p - s.p0).norm() <= reach) {
           t = 0.0;
@@ -565,7 +565,7 @@ struct EventStepper::Run {
 
   void find_flipper_impact(Next& next) const {
     for (std::size_t k = 0; k < board.flippers.size(); ++k) {
-      const Flipper& f = board.flippers[k];
+      const table::Flipper& f = board.flippers[k];
       const FlipperState& fs = state.flippers[k];
       const auto index = static_cast<std::int32_t>(k);
       if (distance_point_box(f.pivot, box_lo, box_hi) > f.length_m + r + stepper.touch_m_) continue;
@@ -579,7 +579,7 @@ struct EventStepper::Run {
       const bool on_end = is_contact(Surface::kFlipperEnd, index);
       double t;
       if (!on_face) {
-        const Shape face = flipper_face(f, fs.theta_rad, m.p);
+        const table::Shape face = flipper_face(f, fs.theta_rad, m.p);
         if (line_impact(face, next.t, t) && t < next.t) {
           const Vec2 q = m.pos(t) - r * face.normal;
           next = {t, Kind::kFlipper, index, face.normal, q};
@@ -587,7 +587,7 @@ struct EventStepper::Run {
       }
       if (on_face || on_end) continue;
       Vec2 n;
-      for (const Vec2& end : {flipper_tip(f, fs.theta_rad), f.pivot}) {
+      for (const Vec2& end : {table::flipper_tip(f, fs.theta_rad), f.pivot}) {
         if (circle_impact(end, r, next.t, t, n) && t < next.t) next = {t, Kind::kFlipper, index, n, end};
       }
     }
@@ -598,7 +598,7 @@ struct EventStepper::Run {
   // D(τ + δ) >= D − B·δ (B bounds |D'|), so a step to the first zero of
   // either bound, allowing at most length_tol of overlap, can never pass a
   // contact. It ends at D <= length_tol with the ball approaching.
-  void moving_flipper_impact(const Flipper& f, const FlipperState& fs, std::int32_t index, Next& next) const {
+  void moving_flipper_impact(const table::Flipper& f, const FlipperState& fs, std::int32_t index, Next& next) const {
     const double w = std::abs(fs.omega_rad_s);
     const double h = next.t;
     const double tol = stepper.length_tol_m_;
@@ -611,14 +611,14 @@ struct EventStepper::Run {
     double t = 0.0;
     for (int it = 0; it < kMaxFlipperIterations; ++it) {
       const double theta = fs.theta_rad + fs.omega_rad_s * t;
-      const Vec2 dir = flipper_direction(f, theta);
+      const Vec2 dir = table::flipper_direction(f, theta);
       const Vec2 q = m.pos(t);
       const double along = std::clamp((q - f.pivot).dot(dir), 0.0, f.length_m);
       const Vec2 closest = f.pivot + along * dir;
       const Vec2 d = q - closest;
       const double dist = d.norm();
       const double gap = dist - r;
-      const Vec2 n = dist > 0.0 ? Vec2(d / dist) : flipper_up_normal(f, theta);
+      const Vec2 n = dist > 0.0 ? Vec2(d / dist) : table::flipper_up_normal(f, theta);
       const double rate = n.dot(m.vel(t) - flipper_point_velocity(f, theta, fs.omega_rad_s, closest));
       if (gap <= tol && rate < 0.0) {
         if (t < next.t) next = {t, Kind::kFlipper, index, n, closest};
@@ -656,7 +656,7 @@ struct EventStepper::Run {
       case Kind::kEdge:
         return;  // the next classification lets it fly
       case Kind::kFlipperStop: {
-        const Flipper& f = board.flippers[next.index];
+        const table::Flipper& f = board.flippers[next.index];
         FlipperState& fs = state.flippers[next.index];
         fs.theta_rad = fs.omega_rad_s > 0.0 ? f.theta_max_rad : f.theta_min_rad;
         fs.omega_rad_s = 0.0;
@@ -689,9 +689,9 @@ struct EventStepper::Run {
     bool found = false;
     obstacles.for_each([&](std::int32_t i) {
       if (found || state.visible[i] != kVisible) return;
-      const Shape& s = board.shapes[i];
+      const table::Shape& s = board.shapes[i];
       Vec2 ns;
-      if (s.kind == ShapeKind::kLine) {
+      if (s.kind == table::ShapeKind::kLine) {
         const double sc = (p - s.p0).dot(s.normal);
         const Vec2 ab = s.p1 - s.p0;
         const double u = (p - s.p0).dot(ab);
@@ -709,7 +709,7 @@ struct EventStepper::Run {
   }
 
   void hit_flipper(const Next& next) {
-    const Flipper& f = board.flippers[next.index];
+    const table::Flipper& f = board.flippers[next.index];
     FlipperState& fs = state.flippers[next.index];
     Vec2& v = state.ball.velocity_mps;
     events.flipper = next.index;
@@ -734,7 +734,7 @@ struct EventStepper::Run {
   }
 };
 
-EventStepper::EventStepper(const Board& board, EventStepperOptions options) : board_(board), options_(options) {
+EventStepper::EventStepper(const table::Board& board, EventStepperOptions options) : board_(board), options_(options) {
   if (options_.dt_s == 0.0) options_.dt_s = board.dt_s;
   auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
   if (!positive(options_.dt_s)) throw std::invalid_argument("event stepper: dt must be a positive number of seconds");
@@ -766,14 +766,14 @@ EventStepper::EventStepper(const Board& board, EventStepperOptions options) : bo
     hi = hi.cwiseMax(b);
     coord = std::max({coord, a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff()});
   };
-  for (const Shape& s : board.shapes) {
-    if (s.kind == ShapeKind::kCircle) {
+  for (const table::Shape& s : board.shapes) {
+    if (s.kind == table::ShapeKind::kCircle) {
       cover(s.p0 - Vec2::Constant(s.radius_m), s.p0 + Vec2::Constant(s.radius_m));
     } else {
       cover(s.p0.cwiseMin(s.p1), s.p0.cwiseMax(s.p1));
     }
   }
-  for (const Flipper& f : board.flippers) {
+  for (const table::Flipper& f : board.flippers) {
     cover(f.pivot - Vec2::Constant(f.length_m), f.pivot + Vec2::Constant(f.length_m));
   }
   const double extent = lo.x() <= hi.x() ? std::max((hi - lo).norm(), 2.0 * r) : table;
@@ -800,7 +800,7 @@ EventStepper::EventStepper(const Board& board, EventStepperOptions options) : bo
 StepEvents EventStepper::step(GameState& state) const {
   StepEvents events;
   for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
-    const Flipper& f = board_.flippers[i];
+    const table::Flipper& f = board_.flippers[i];
     FlipperState& fs = state.flippers[i];
     const double omega = rules::take_command(f, fs, state.flips);
     const bool at_stop = omega > 0.0 ? fs.theta_rad >= f.theta_max_rad : fs.theta_rad <= f.theta_min_rad;

@@ -7,7 +7,7 @@
 
 namespace pinball::sim::rules {
 
-void lose_ball(const Board& board, GameState& state, StepEvents& events) {
+void lose_ball(const table::Board& board, GameState& state, StepEvents& events) {
   events.flags |= StepEvents::kBallLost;
   state.ball_in_play = false;
   state.balls_left = std::max(0, state.balls_left - 1);
@@ -16,20 +16,20 @@ void lose_ball(const Board& board, GameState& state, StepEvents& events) {
   for (auto& f : state.flippers) f.ball_contact = false;
 }
 
-void raise_flags(const Board& board, GameState& state, double clear_m) {
-  for (const Bank& bank : board.banks) {
+void raise_flags(const table::Board& board, GameState& state, double clear_m) {
+  for (const table::Bank& bank : board.banks) {
     for (const std::int32_t m : bank.members) {
       if (state.visible[m] != kRising) continue;
-      if (state.ball_in_play && distance_to_shape(board.shapes[m], state.ball.position_m) < clear_m) continue;
+      if (state.ball_in_play && table::distance_to_shape(board.shapes[m], state.ball.position_m) < clear_m) continue;
       state.visible[m] = kVisible;
       --state.rising_flags;
     }
   }
 }
 
-void hit_obstacle(const Board& board, GameState& state, std::int32_t index, const Vec2& normal,
+void hit_obstacle(const table::Board& board, GameState& state, std::int32_t index, const Vec2& normal,
                   StepEvents& events, double clear_m) {
-  const Obstacle& o = board.obstacles[index];
+  const table::Obstacle& o = board.obstacles[index];
   Vec2& v = state.ball.velocity_mps;
   v = reflect(v, normal, o.rho);
   v += o.action.kick_mps * normal;
@@ -40,7 +40,7 @@ void hit_obstacle(const Board& board, GameState& state, std::int32_t index, cons
   if (o.bank >= 0) {
     // A flag falls (every shape of its statement); when the whole bank is
     // down it pays and resets (thesis 3.4).
-    const Bank& bank = board.banks[o.bank];
+    const table::Bank& bank = board.banks[o.bank];
     for (const std::int32_t m : bank.members) {
       const bool same_flag = m == index || (o.source_line > 0 && board.obstacles[m].source_line == o.source_line);
       if (same_flag) state.visible[m] = kHidden;
@@ -62,8 +62,8 @@ void hit_obstacle(const Board& board, GameState& state, std::int32_t index, cons
   if (o.action.eats_ball) lose_ball(board, state, events);
 }
 
-void fire_sensor(const Board& board, GameState& state, std::int32_t index, StepEvents& events) {
-  const Sensor& sensor = board.sensors[index];
+void fire_sensor(const table::Board& board, GameState& state, std::int32_t index, StepEvents& events) {
+  const table::Sensor& sensor = board.sensors[index];
   if (events.sensor < 0) events.sensor = index;
   events.flags |= StepEvents::kSensor;
   state.score += sensor.action.score;
@@ -79,47 +79,47 @@ void fire_sensor(const Board& board, GameState& state, std::int32_t index, StepE
   }
 }
 
-double take_command(const Flipper& f, FlipperState& fs, std::uint64_t& flips) {
+double take_command(const table::Flipper& f, FlipperState& fs, std::uint64_t& flips) {
   if (fs.energized && !fs.was_energized) ++flips;
   fs.was_energized = fs.energized;
   return fs.energized ? f.omega_rad_s : -f.omega_rad_s;
 }
 
-bool on_sensor(const Sensor& sensor, const Vec2& p, double r) {
-  const Shape& shape = sensor.shape;
-  if (sensor.kind == SensorKind::kHole) return (p - shape.p0).norm() <= shape.radius_m;
-  if (shape.kind == ShapeKind::kLine) return distance_point_segment(p, shape.p0, shape.p1) <= r;
+bool on_sensor(const table::Sensor& sensor, const Vec2& p, double r) {
+  const table::Shape& shape = sensor.shape;
+  if (sensor.kind == table::SensorKind::kHole) return (p - shape.p0).norm() <= shape.radius_m;
+  if (shape.kind == table::ShapeKind::kLine) return distance_point_segment(p, shape.p0, shape.p1) <= r;
   return (p - shape.p0).norm() <= r + shape.radius_m;
 }
 
-void update_contacts(const Board& board, GameState& state, std::span<const std::int32_t> candidates, double touch_m,
+void update_contacts(const table::Board& board, GameState& state, std::span<const std::int32_t> candidates, double touch_m,
                      double dt_s, bool has_contact_score, StepEvents& events) {
   const Vec2& p = state.ball.position_m;
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    const Flipper& f = board.flippers[i];
+    const table::Flipper& f = board.flippers[i];
     state.flippers[i].ball_contact =
-        distance_point_segment(p, f.pivot, flipper_tip(f, state.flippers[i].theta_rad)) <= touch_m;
+        distance_point_segment(p, f.pivot, table::flipper_tip(f, state.flippers[i].theta_rad)) <= touch_m;
   }
   if (!has_contact_score) return;
   for (const std::int32_t i : candidates) {
     const double rate = board.obstacles[i].action.contact_score_per_s;
     if (rate <= 0.0 || state.visible[i] != kVisible) continue;
-    if (distance_to_shape(board.shapes[i], p) <= touch_m) {
+    if (table::distance_to_shape(board.shapes[i], p) <= touch_m) {
       state.score += rate * dt_s;
       events.score_gained += rate * dt_s;
     }
   }
 }
 
-bool has_contact_score(const Board& board) {
+bool has_contact_score(const table::Board& board) {
   return std::any_of(board.obstacles.begin(), board.obstacles.end(),
-                     [](const Obstacle& o) { return o.action.contact_score_per_s > 0.0; });
+                     [](const table::Obstacle& o) { return o.action.contact_score_per_s > 0.0; });
 }
 
-std::vector<Shape> sensor_shapes(const Board& board) {
-  std::vector<Shape> shapes;
+std::vector<table::Shape> sensor_shapes(const table::Board& board) {
+  std::vector<table::Shape> shapes;
   shapes.reserve(board.sensors.size());
-  for (const Sensor& s : board.sensors) shapes.push_back(s.shape);
+  for (const table::Sensor& s : board.sensors) shapes.push_back(s.shape);
   return shapes;
 }
 

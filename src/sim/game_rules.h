@@ -8,48 +8,48 @@
 #include <vector>
 
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
 
 namespace pinball::sim::rules {
 
 /// The ball is lost: back to the launcher, out of play, one ball fewer.
-void lose_ball(const Board& board, GameState& state, StepEvents& events);
+void lose_ball(const table::Board& board, GameState& state, StepEvents& events);
 
 /// Raises the flags waiting in state kRising whose shape is at least clear_m
 /// from the ball (a flag never rises into the ball).
-void raise_flags(const Board& board, GameState& state, double clear_m);
+void raise_flags(const table::Board& board, GameState& state, double clear_m);
 
 /// The ball strikes obstacle `index` with contact normal `normal`: reflection
 /// with ρ, the kick, the score, the bank flag falling (and the bank's bonus),
 /// the ball eaten. clear_m as for raise_flags.
-void hit_obstacle(const Board& board, GameState& state, std::int32_t index, const Vec2& normal,
+void hit_obstacle(const table::Board& board, GameState& state, std::int32_t index, const Vec2& normal,
                   StepEvents& events, double clear_m);
 
 /// The ball entered sensor `index`: score, eat, or the hole's kickout.
-void fire_sensor(const Board& board, GameState& state, std::int32_t index, StepEvents& events);
+void fire_sensor(const table::Board& board, GameState& state, std::int32_t index, StepEvents& events);
 
 /// Reads a flipper's command at the start of a step: counts a press (rising
 /// edge) in `flips`, remembers the command, and returns the commanded θ̇
 /// (+θ̇₀ energised, −θ̇₀ released).
-double take_command(const Flipper& f, FlipperState& fs, std::uint64_t& flips);
+double take_command(const table::Flipper& f, FlipperState& fs, std::uint64_t& flips);
 
 /// True while a ball of radius r at p is on the sensor (touching it; for a
 /// hole, its centre inside).
-bool on_sensor(const Sensor& sensor, const Vec2& p, double r);
+bool on_sensor(const table::Sensor& sensor, const Vec2& p, double r);
 
 /// The flippers' contact sensors (ball within touch_m of the segment) and the
 /// contact scores (rate·dt for each listed obstacle within touch_m) at the
 /// ball's current position.
-void update_contacts(const Board& board, GameState& state, std::span<const std::int32_t> candidates, double touch_m,
+void update_contacts(const table::Board& board, GameState& state, std::span<const std::int32_t> candidates, double touch_m,
                      double dt_s, bool has_contact_score, StepEvents& events);
 
 /// Whether any obstacle pays for contact time.
-bool has_contact_score(const Board& board);
+bool has_contact_score(const table::Board& board);
 
 /// The sensors' shapes, same index as Board::sensors (for a sensor grid).
-std::vector<Shape> sensor_shapes(const Board& board);
+std::vector<table::Shape> sensor_shapes(const table::Board& board);
 
 /// 0, 1, ..., n − 1 (the candidate list of a linear scan).
 std::vector<std::int32_t> all_indices(std::size_t n);

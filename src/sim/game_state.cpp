@@ -4,7 +4,7 @@
 
 namespace pinball::sim {
 
-GameState make_game_state(const Board& board, std::uint64_t seed) {
+GameState make_game_state(const table::Board& board, std::uint64_t seed) {
   GameState s;
   s.rng = Rng(seed);
   s.flippers.resize(board.flippers.size());
@@ -14,7 +14,7 @@ GameState make_game_state(const Board& board, std::uint64_t seed) {
   return s;
 }
 
-void reset_game(const Board& board, GameState& state) {
+void reset_game(const table::Board& board, GameState& state) {
   state.score = 0.0;
   state.balls_left = board.balls_per_game;
   state.ball_in_play = false;
@@ -30,7 +30,7 @@ void reset_game(const Board& board, GameState& state) {
   std::fill(state.sensor_inside.begin(), state.sensor_inside.end(), std::uint8_t{0});
 }
 
-void launch_ball(const Board& board, GameState& state, double pull) {
+void launch_ball(const table::Board& board, GameState& state, double pull) {
   const double r = state.rng.uniform(0.0, board.launcher.noise_max);
   state.ball.position_m = board.launcher.position;
   state.ball.velocity_mps = Vec2{0.0, pull * (1.0 - r) * board.ball.speed_max_mps};

@@ -4,13 +4,13 @@
 
 namespace pinball::sim {
 
-void oracle_spastic_policy(const Board& board, GameState& state, double reach_factor) {
+void oracle_spastic_policy(const table::Board& board, GameState& state, double reach_factor) {
   int nearest = -1;
   double nearest_d = std::numeric_limits<double>::infinity();
   if (state.ball_in_play) {
     for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-      const Flipper& f = board.flippers[i];
-      const double d = distance_point_segment(state.ball.position_m, f.pivot, flipper_tip(f, f.theta_min_rad));
+      const table::Flipper& f = board.flippers[i];
+      const double d = distance_point_segment(state.ball.position_m, f.pivot, table::flipper_tip(f, f.theta_min_rad));
       if (d < nearest_d) {
         nearest_d = d;
         nearest = static_cast<int>(i);

@@ -4,8 +4,8 @@
 
 namespace pinball::sim {
 
-double shape_penetration_m(const Shape& shape, const Vec2& p, double r) {
-  if (shape.kind == ShapeKind::kCircle) return std::max(0.0, r + shape.radius_m - (p - shape.p0).norm());
+double shape_penetration_m(const table::Shape& shape, const Vec2& p, double r) {
+  if (shape.kind == table::ShapeKind::kCircle) return std::max(0.0, r + shape.radius_m - (p - shape.p0).norm());
   const double s = (p - shape.p0).dot(shape.normal);
   if (s < 0.0 || s >= r) return 0.0;
   const Vec2 ab = shape.p1 - shape.p0;
@@ -13,7 +13,7 @@ double shape_penetration_m(const Shape& shape, const Vec2& p, double r) {
   return (u < 0.0 || u > 1.0) ? 0.0 : r - s;
 }
 
-double obstacle_penetration_m(const Board& board, const GameState& state, std::span<const std::int32_t> candidates,
+double obstacle_penetration_m(const table::Board& board, const GameState& state, std::span<const std::int32_t> candidates,
                               const Vec2& p) {
   double depth = 0.0;
   for (const std::int32_t i : candidates) {
@@ -23,17 +23,17 @@ double obstacle_penetration_m(const Board& board, const GameState& state, std::s
   return depth;
 }
 
-double flipper_penetration_m(const Board& board, const GameState& state, const Vec2& p) {
+double flipper_penetration_m(const table::Board& board, const GameState& state, const Vec2& p) {
   double depth = 0.0;
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    const Flipper& f = board.flippers[i];
-    const double d = distance_point_segment(p, f.pivot, flipper_tip(f, state.flippers[i].theta_rad));
+    const table::Flipper& f = board.flippers[i];
+    const double d = distance_point_segment(p, f.pivot, table::flipper_tip(f, state.flippers[i].theta_rad));
     depth = std::max(depth, board.ball.radius_m - d);
   }
   return depth;
 }
 
-double max_penetration_m(const Board& board, const GameState& state) {
+double max_penetration_m(const table::Board& board, const GameState& state) {
   double depth = flipper_penetration_m(board, state, state.ball.position_m);
   for (std::size_t i = 0; i < board.shapes.size(); ++i) {
     if (state.visible[i] != kVisible) continue;

@@ -61,7 +61,7 @@ cv::Scalar brighten(const cv::Scalar& c, double t) {
 cv::Scalar darken(const cv::Scalar& c, double f) { return {c[0] * f, c[1] * f, c[2] * f}; }
 
 // Colour of a reflecting obstacle by what it does (ignores visibility).
-cv::Scalar obstacle_colour(const Obstacle& o) {
+cv::Scalar obstacle_colour(const table::Obstacle& o) {
   cv::Scalar c = kWall;
   if (o.action.eats_ball) {
     c = kEater;
@@ -113,22 +113,22 @@ void draw_dashed_circle(cv::Mat& image, const cv::Point2d& c_px, double r_px, co
   }
 }
 
-void draw_playfield(cv::Mat& image, const Board& board, const RenderOptions& options) {
+void draw_playfield(cv::Mat& image, const table::Board& board, const RenderOptions& options) {
   const cv::Point2d top_left = board_to_pixel(board, options, Vec2{0.0, board.height_m});
   const cv::Point2d bottom_right = board_to_pixel(board, options, Vec2{board.width_m, 0.0});
   cv::rectangle(image, to_fixed(top_left), to_fixed(bottom_right), kPlayfield, cv::FILLED, cv::LINE_8, kShift);
   cv::rectangle(image, to_fixed(top_left), to_fixed(bottom_right), kOutline, 1, cv::LINE_AA, kShift);
 }
 
-void draw_sensors(cv::Mat& image, const Board& board, const RenderOptions& options) {
-  for (const Sensor& s : board.sensors) {
+void draw_sensors(cv::Mat& image, const table::Board& board, const RenderOptions& options) {
+  for (const table::Sensor& s : board.sensors) {
     const cv::Point2d p0 = board_to_pixel(board, options, s.shape.p0);
-    if (s.shape.kind == ShapeKind::kLine) {
+    if (s.shape.kind == table::ShapeKind::kLine) {
       draw_line(image, p0, board_to_pixel(board, options, s.shape.p1), kSensor, kSensorThickness_px);
       continue;
     }
     const double r_px = s.shape.radius_m * options.px_per_m;
-    if (s.kind == SensorKind::kHole) {
+    if (s.kind == table::SensorKind::kHole) {
       cv::circle(image, to_fixed(p0), to_fixed(std::max(r_px, 1.0)), kHole, cv::FILLED, cv::LINE_AA, kShift);
     }
     if (r_px > 0.0) {
@@ -140,18 +140,18 @@ void draw_sensors(cv::Mat& image, const Board& board, const RenderOptions& optio
   }
 }
 
-void draw_obstacles(cv::Mat& image, const Board& board, const GameState* state, const RenderOptions& options) {
+void draw_obstacles(cv::Mat& image, const table::Board& board, const GameState* state, const RenderOptions& options) {
   assert(board.shapes.size() == board.obstacles.size());
   const std::size_t n = std::min(board.shapes.size(), board.obstacles.size());
   for (std::size_t i = 0; i < n; ++i) {
-    const Shape& shape = board.shapes[i];
-    const Obstacle& obstacle = board.obstacles[i];
+    const table::Shape& shape = board.shapes[i];
+    const table::Obstacle& obstacle = board.obstacles[i];
     const bool visible =
         state != nullptr && i < state->visible.size() ? state->visible[i] == kVisible : obstacle.visible;
     const cv::Scalar colour = visible ? obstacle_colour(obstacle) : kHidden;
     const cv::Point2d p0 = board_to_pixel(board, options, shape.p0);
 
-    if (shape.kind == ShapeKind::kLine) {
+    if (shape.kind == table::ShapeKind::kLine) {
       const cv::Point2d p1 = board_to_pixel(board, options, shape.p1);
       if (visible) {
         draw_line(image, p0, p1, colour, kLineThickness_px);
@@ -174,24 +174,24 @@ void draw_obstacles(cv::Mat& image, const Board& board, const GameState* state, 
   }
 }
 
-void draw_normals(cv::Mat& image, const Board& board, const RenderOptions& options) {
-  for (const Shape& shape : board.shapes) {
-    if (shape.kind != ShapeKind::kLine) continue;
+void draw_normals(cv::Mat& image, const table::Board& board, const RenderOptions& options) {
+  for (const table::Shape& shape : board.shapes) {
+    if (shape.kind != table::ShapeKind::kLine) continue;
     const Vec2 mid = 0.5 * (shape.p0 + shape.p1);
     draw_line(image, board_to_pixel(board, options, mid),
               board_to_pixel(board, options, mid + kNormalTick_m * shape.normal), kNormal, 1);
   }
 }
 
-void draw_flippers(cv::Mat& image, const Board& board, const GameState* state, const RenderOptions& options) {
+void draw_flippers(cv::Mat& image, const table::Board& board, const GameState* state, const RenderOptions& options) {
   const int width_px = std::max(3, static_cast<int>(std::lround(kFlipperWidth_m * options.px_per_m)));
   for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    const Flipper& f = board.flippers[i];
+    const table::Flipper& f = board.flippers[i];
     const bool has_state = state != nullptr && i < state->flippers.size();
     const double theta_rad = has_state ? state->flippers[i].theta_rad : f.theta_min_rad;
     const bool up = has_state && state->flippers[i].energized;
     const cv::Point2d pivot_px = board_to_pixel(board, options, f.pivot);
-    const cv::Point2d tip_px = board_to_pixel(board, options, flipper_tip(f, theta_rad));
+    const cv::Point2d tip_px = board_to_pixel(board, options, table::flipper_tip(f, theta_rad));
     // OpenCV draws thick lines with round caps.
     draw_line(image, pivot_px, tip_px, up ? kFlipperUp : kFlipper, width_px);
     cv::circle(image, to_fixed(pivot_px), to_fixed(static_cast<double>(kPointRadius_px)), kBackground, cv::FILLED,
@@ -199,7 +199,7 @@ void draw_flippers(cv::Mat& image, const Board& board, const GameState* state, c
   }
 }
 
-void draw_launcher(cv::Mat& image, const Board& board, const RenderOptions& options) {
+void draw_launcher(cv::Mat& image, const table::Board& board, const RenderOptions& options) {
   const cv::Point2d c_px = board_to_pixel(board, options, board.launcher.position);
   const double h_px = std::max(3.0, board.ball.radius_m * options.px_per_m);
   cv::rectangle(image, to_fixed(c_px - cv::Point2d{h_px, h_px}), to_fixed(c_px + cv::Point2d{h_px, h_px}),
@@ -207,7 +207,7 @@ void draw_launcher(cv::Mat& image, const Board& board, const RenderOptions& opti
   draw_line(image, c_px + cv::Point2d{0.0, h_px}, c_px + cv::Point2d{0.0, 2.5 * h_px}, kLauncher, 1);
 }
 
-void draw_ball(cv::Mat& image, const Board& board, const GameState& state, const RenderOptions& options) {
+void draw_ball(cv::Mat& image, const table::Board& board, const GameState& state, const RenderOptions& options) {
   const cv::Point2d c_px = board_to_pixel(board, options, state.ball.position_m);
   const double r_px = std::max(2.0, board.ball.radius_m * options.px_per_m);
   cv::circle(image, to_fixed(c_px), to_fixed(r_px), kBall, cv::FILLED, cv::LINE_AA, kShift);
@@ -237,18 +237,18 @@ void draw_hud(cv::Mat& image, const GameState& state) {
 
 }  // namespace
 
-cv::Size render_size(const Board& board, const RenderOptions& options) {
+cv::Size render_size(const table::Board& board, const RenderOptions& options) {
   const int w_px = static_cast<int>(std::lround(board.width_m * options.px_per_m)) + 2 * options.margin_px;
   const int h_px = static_cast<int>(std::lround(board.height_m * options.px_per_m)) + 2 * options.margin_px;
   return {w_px, h_px};
 }
 
-cv::Point2d board_to_pixel(const Board& board, const RenderOptions& options, const Vec2& p_board) {
+cv::Point2d board_to_pixel(const table::Board& board, const RenderOptions& options, const Vec2& p_board) {
   return {options.margin_px + p_board.x() * options.px_per_m,
           options.margin_px + (board.height_m - p_board.y()) * options.px_per_m};
 }
 
-cv::Mat render_board(const Board& board, const GameState* state, const RenderOptions& options) {
+cv::Mat render_board(const table::Board& board, const GameState* state, const RenderOptions& options) {
   if (!(options.px_per_m > 0.0) || options.margin_px < 0 || !(board.width_m > 0.0) || !(board.height_m > 0.0)) {
     throw std::invalid_argument("render_board: needs px_per_m > 0, margin_px >= 0 and a board of positive size");
   }

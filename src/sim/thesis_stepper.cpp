@@ -27,12 +27,12 @@ void clamp_speed(Vec2& v, double speed_max) {
 
 }  // namespace
 
-ThesisStepper::ThesisStepper(const Board& board, ThesisStepperOptions options) : board_(board), options_(options) {
+ThesisStepper::ThesisStepper(const table::Board& board, ThesisStepperOptions options) : board_(board), options_(options) {
   if (options_.dt_s == 0.0) options_.dt_s = board.dt_s;
   if (!(options_.dt_s > 0.0) || !std::isfinite(options_.dt_s)) {
     throw std::invalid_argument("time step must be a positive number of seconds");
   }
-  check_flipper_time_step(board, options_.dt_s);
+  table::check_flipper_time_step(board, options_.dt_s);
   // Within one step the centre moves at most speed_max·dt, and a contact
   // counts within contact_tolerance of the surface.
   reach_m_ = board.ball.radius_m + board.ball.speed_max_mps * options_.dt_s + options_.contact_tolerance_m +
@@ -64,7 +64,7 @@ void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const 
   const double dt = options_.dt_s;
   const double r = board_.ball.radius_m;
   for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
-    const Flipper& f = board_.flippers[i];
+    const table::Flipper& f = board_.flippers[i];
     FlipperState& fs = state.flippers[i];
     const double omega = rules::take_command(f, fs, state.flips);
     const double theta_old = fs.theta_rad;
@@ -82,9 +82,9 @@ void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const 
     const Vec2 rel = p - f.pivot;
     if (rel.squaredNorm() > (f.length_m + r) * (f.length_m + r)) continue;
     const double front = omega > 0.0 ? 1.0 : -1.0;  // the face that moves toward the ball
-    if (front * rel.dot(flipper_up_normal(f, theta_old)) < 0.0) continue;  // ball behind: face moves away
-    const Vec2 dir = flipper_direction(f, theta_new);
-    const Vec2 n_face = front * flipper_up_normal(f, theta_new);
+    if (front * rel.dot(table::flipper_up_normal(f, theta_old)) < 0.0) continue;  // ball behind: face moves away
+    const Vec2 dir = table::flipper_direction(f, theta_new);
+    const Vec2 n_face = front * table::flipper_up_normal(f, theta_new);
     const double along = rel.dot(dir);
     if (along <= 0.0) continue;  // the pivot does not move
     Vec2 pushed, normal, contact;
@@ -149,7 +149,7 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
       }
     }
     for (std::size_t i = 0; i < board_.flippers.size(); ++i) {
-      const Flipper& f = board_.flippers[i];
+      const table::Flipper& f = board_.flippers[i];
       const double theta = state.flippers[i].theta_rad;
       if ((start - f.pivot).squaredNorm() > std::pow(f.length_m + flipper_reach, 2)) continue;
       // The flipper is a two-sided segment with a point at each end (thesis 3.2.4).
@@ -159,7 +159,7 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
         hit_obstacle = -1;
         hit_flipper = static_cast<std::int32_t>(i);
       }
-      for (const Vec2& end : {flipper_tip(f, theta), f.pivot}) {
+      for (const Vec2& end : {table::flipper_tip(f, theta), f.pivot}) {
         if (circle_time_of_impact(end, 0.0, p, v, r, remaining, c) && c.t_s < best.t_s) {
           best = c;
           hit_obstacle = -1;
@@ -180,7 +180,7 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
     if (hit_obstacle >= 0) {
       apply_obstacle_hit(state, hit_obstacle, best.normal, events);
     } else {
-      const Flipper& f = board_.flippers[hit_flipper];
+      const table::Flipper& f = board_.flippers[hit_flipper];
       const FlipperState& fs = state.flippers[hit_flipper];
       v = flipper_response(f, fs.theta_rad, fs.omega_rad_s, best.point, best.normal, v);
       events.flags |= StepEvents::kHitFlipper;
@@ -212,15 +212,15 @@ void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvent
   const double r = board_.ball.radius_m;
   const auto candidates = options_.use_grid ? sensor_grid_.candidates(from) : std::span<const std::int32_t>(all_sensors_);
   for (const std::int32_t i : candidates) {
-    const Sensor& sensor = board_.sensors[i];
+    const table::Sensor& sensor = board_.sensors[i];
     const Vec2& to = state.ball.position_m;
     // Swept over the whole move so that a fast ball cannot skip a sensor.
     bool touched = false;
     const bool inside = rules::on_sensor(sensor, to, r);
-    const Shape& shape = sensor.shape;
-    if (sensor.kind == SensorKind::kHole) {
+    const table::Shape& shape = sensor.shape;
+    if (sensor.kind == table::SensorKind::kHole) {
       touched = distance_point_segment(shape.p0, from, to) <= shape.radius_m;
-    } else if (shape.kind == ShapeKind::kLine) {
+    } else if (shape.kind == table::ShapeKind::kLine) {
       touched = distance_segment_segment(from, to, shape.p0, shape.p1) <= r;
     } else {
       touched = distance_point_segment(shape.p0, from, to) <= r + shape.radius_m;

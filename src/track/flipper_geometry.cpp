@@ -24,17 +24,17 @@ FlipperGeometry make_flipper_geometry(const FlipperLine& left, const FlipperLine
   return g;
 }
 
-FlipperGeometry flipper_geometry_from_board(const sim::Board& board) {
-  const sim::Flipper* left = nullptr;
-  const sim::Flipper* right = nullptr;
-  for (const sim::Flipper& f : board.flippers) {
-    const sim::Flipper*& slot = f.side == sim::Side::kLeft ? left : right;
+FlipperGeometry flipper_geometry_from_board(const table::Board& board) {
+  const table::Flipper* left = nullptr;
+  const table::Flipper* right = nullptr;
+  for (const table::Flipper& f : board.flippers) {
+    const table::Flipper*& slot = f.side == table::Side::kLeft ? left : right;
     if (slot) throw std::invalid_argument("board '" + board.source + "' has more than one flipper on a side");
     slot = &f;
   }
   if (!left || !right) throw std::invalid_argument("board '" + board.source + "' needs a left and a right flipper");
-  return make_flipper_geometry({left->pivot, sim::flipper_tip(*left, left->theta_min_rad)},
-                               {right->pivot, sim::flipper_tip(*right, right->theta_min_rad)});
+  return make_flipper_geometry({left->pivot, table::flipper_tip(*left, left->theta_min_rad)},
+                               {right->pivot, table::flipper_tip(*right, right->theta_min_rad)});
 }
 
 bool above_flippers(const FlipperGeometry& g, const Vec2& p) {

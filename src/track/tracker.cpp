@@ -6,12 +6,12 @@
 
 namespace pinball::track {
 
-TrackerConfig default_tracker_config(const sim::Board& board, const CameraModelConfig& camera) {
+TrackerConfig default_tracker_config(const table::Board& board, const CameraModelConfig& camera) {
   TrackerConfig c;
   c.g_mps2 = board.gravity_mps2;
   double length = 0.0;
   double pivot_y = 0.0;
-  for (const sim::Flipper& f : board.flippers) {
+  for (const table::Flipper& f : board.flippers) {
     length = std::max(length, f.length_m);
     pivot_y = std::max(pivot_y, f.pivot.y());
   }

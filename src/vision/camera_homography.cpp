@@ -67,7 +67,7 @@ CameraHomography CameraHomography::from_points(const std::array<Vec2, 4>& p_boar
   return CameraHomography(h);
 }
 
-CameraHomography CameraHomography::default_view(const sim::Board& board, cv::Size image_size, const CameraView& view) {
+CameraHomography CameraHomography::default_view(const table::Board& board, cv::Size image_size, const CameraView& view) {
   if (image_size.width <= 0 || image_size.height <= 0 || !(board.width_m > 0.0) || !(board.height_m > 0.0)) {
     throw std::invalid_argument("camera homography: default view needs a positive image size and board");
   }

@@ -26,7 +26,7 @@ std::uint8_t playfield_gray() {
 }
 
 // Board (m) -> drawing (px) of sim::render_board for `options` as a 3x3 matrix, and its inverse.
-cv::Matx33d render_from_board(const sim::Board& board, const sim::RenderOptions& o) {
+cv::Matx33d render_from_board(const table::Board& board, const sim::RenderOptions& o) {
   return {o.px_per_m, 0.0, static_cast<double>(o.margin_px), 0.0, -o.px_per_m,
           o.margin_px + board.height_m * o.px_per_m, 0.0, 0.0, 1.0};
 }
@@ -70,7 +70,7 @@ std::vector<SimPlastic> SimCameraConfig::default_plastics() {
   return {a, b};
 }
 
-SimCameraSource::SimCameraSource(const sim::Board& board, const SimCameraConfig& config)
+SimCameraSource::SimCameraSource(const table::Board& board, const SimCameraConfig& config)
     : board_(board),
       config_(config),
       homography_(CameraHomography::default_view(board, cv::Size(std::max(config.width_px, 1),
@@ -109,7 +109,7 @@ SimCameraSource::SimCameraSource(const sim::Board& board, const SimCameraConfig&
   require(c.marker_radius_m > 0.0 && c.marker_ring_m >= c.marker_radius_m && c.marker_gray >= 0.0 &&
               c.marker_gray <= 255.0 && c.marker_ring_gray >= 0.0 && c.marker_ring_gray <= 255.0,
           "markers need 0 < marker_radius_m <= marker_ring_m and grays in [0, 255]");
-  for (const sim::Flipper& f : board.flippers) flipper_theta_.push_back(f.theta_min_rad);
+  for (const table::Flipper& f : board.flippers) flipper_theta_.push_back(f.theta_min_rad);
   period_s_ = 1.0 / c.fps;
   next_exposure_s_ = c.first_exposure_s;
   build_floor();
@@ -133,7 +133,7 @@ void SimCameraSource::build_floor() {
   ro.margin_px = 12 * config_.supersample;
   ro.draw_hud = false;
   // Flippers move: they are drawn per frame at their angle, not into the floor.
-  sim::Board without_flippers = board_;
+  table::Board without_flippers = board_;
   without_flippers.flippers.clear();
   const cv::Mat drawing = sim::render_board(without_flippers, nullptr, ro);
   cv::Mat gray;
@@ -278,9 +278,9 @@ void SimCameraSource::draw_flippers(cv::Mat& image) const {
     return cv::Point(static_cast<int>(std::lround(p.x * kScale)), static_cast<int>(std::lround(p.y * kScale)));
   };
   for (std::size_t i = 0; i < flipper_theta_.size(); ++i) {
-    const sim::Flipper& f = board_.flippers[i];
+    const table::Flipper& f = board_.flippers[i];
     const cv::Point2d a = homography_.image_from_board(f.pivot);
-    const cv::Point2d b = homography_.image_from_board(sim::flipper_tip(f, flipper_theta_[i]));
+    const cv::Point2d b = homography_.image_from_board(table::flipper_tip(f, flipper_theta_[i]));
     const int width_px = std::max(1, static_cast<int>(std::lround(config_.flipper_width_m * homography_.px_per_m_at(f.pivot))));
     cv::line(image, fixed(a), fixed(b), cv::Scalar(config_.flipper_gray), width_px, cv::LINE_AA, kShift);
   }

@@ -3,13 +3,13 @@
 #include <gtest/gtest.h>
 
 #include "pinball/calibration/sim_lab.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::calibration {
 namespace {
 
 TEST(CalibrationFigure, DrawsEachKind) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   SimLab lab(board);
   const cv::Mat image = lab.camera_image();
   const HomographyFit fit = calibrate_camera(image, default_marker_layout(board));
@@ -23,8 +23,8 @@ TEST(CalibrationFigure, DrawsEachKind) {
   cv::split(around, channels);
   EXPECT_GT(cv::norm(channels[0], channels[2], cv::NORM_INF), 100.0);
 
-  FlipperCalibration f = calibrate_flipper_markers(board.flippers[0], std::vector<Vec2>{lab.truth().flippers[0].pivot, sim::flipper_tip(lab.truth().flippers[0], lab.truth().flippers[0].theta_min_rad)},
-                                                   std::vector<Vec2>{lab.truth().flippers[0].pivot, sim::flipper_tip(lab.truth().flippers[0], lab.truth().flippers[0].theta_max_rad)});
+  FlipperCalibration f = calibrate_flipper_markers(board.flippers[0], std::vector<Vec2>{lab.truth().flippers[0].pivot, table::flipper_tip(lab.truth().flippers[0], lab.truth().flippers[0].theta_min_rad)},
+                                                   std::vector<Vec2>{lab.truth().flippers[0].pivot, table::flipper_tip(lab.truth().flippers[0], lab.truth().flippers[0].theta_max_rad)});
   const std::vector<FlipperFigureItem> items{{nullptr, &f, nullptr}};
   EXPECT_EQ(draw_flipper_figure(image, lab.true_homography(), items).size(), cam.size());
 

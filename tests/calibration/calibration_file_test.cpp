@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::calibration {
 namespace {
@@ -25,7 +25,7 @@ Calibration sample() {
   c.camera = k;
   FlipperCalibration l;
   l.name = "left_flipper";
-  l.side = sim::Side::kLeft;
+  l.side = table::Side::kLeft;
   l.pivot_m = {0.168, 0.158};
   l.tip_m = {0.239, 0.1259};
   l.length_m = 0.078;
@@ -38,7 +38,7 @@ Calibration sample() {
   l.disagreement = d;
   FlipperCalibration r = l;
   r.name = "right_flipper";
-  r.side = sim::Side::kRight;
+  r.side = table::Side::kRight;
   r.method = FlipperMethod::kMarkerless;
   r.pivot_m = {0.348, 0.158};
   r.tip_m = {0.2768, 0.1259};
@@ -72,7 +72,7 @@ TEST(CalibrationFile, RoundTripKeepsEveryField) {
   EXPECT_EQ(b.camera->markers_used, 7);
   ASSERT_EQ(b.flippers.size(), 2u);
   EXPECT_EQ(b.flippers[1].name, "right_flipper");
-  EXPECT_EQ(b.flippers[1].side, sim::Side::kRight);
+  EXPECT_EQ(b.flippers[1].side, table::Side::kRight);
   EXPECT_EQ(b.flippers[1].method, FlipperMethod::kMarkerless);
   EXPECT_EQ(b.flippers[0].pivot_m, a.flippers[0].pivot_m);
   EXPECT_EQ(b.flippers[0].theta_max_rad, a.flippers[0].theta_max_rad);
@@ -118,7 +118,7 @@ TEST(CalibrationFile, ErrorsNameFileAndKey) {
 
 TEST(CalibrationFile, AppliesToTrackerAndBoard) {
   const Calibration c = sample();
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   track::TrackerConfig config = track::default_tracker_config(board, track::CameraModelConfig{});
   track::FlipperGeometry geometry = track::flipper_geometry_from_board(board);
   apply_calibration(c, "lab.yaml", config, geometry);
@@ -126,7 +126,7 @@ TEST(CalibrationFile, AppliesToTrackerAndBoard) {
   EXPECT_EQ(geometry.lines[track::kLeftFlipper].pivot, c.flippers[0].pivot_m);
   EXPECT_EQ(geometry.lines[track::kRightFlipper].tip, c.flippers[1].tip_m);
   EXPECT_NEAR(config.window_distance_m, 0.039, 1e-12);
-  sim::Board b = board;
+  table::Board b = board;
   apply_calibration(c, "lab.yaml", b);
   EXPECT_EQ(b.flippers[0].pivot, c.flippers[0].pivot_m);
   EXPECT_EQ(b.gravity_mps2, 1.1083);

@@ -6,14 +6,14 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pinball/core/rng.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/vision/camera_homography.h"
 
 namespace pinball::calibration {
 namespace {
 
-sim::Board table() {
-  sim::Board b;
+table::Board table() {
+  table::Board b;
   b.width_m = 0.51;
   b.height_m = 1.07;
   return b;
@@ -34,7 +34,7 @@ std::vector<DetectedMarker> seen(const vision::CameraHomography& h, const std::v
 }
 
 TEST(CameraCalibration, RecoversTheHomographyFromExactMarkers) {
-  const sim::Board b = table();
+  const table::Board b = table();
   const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
   const std::vector<Vec2> layout = default_marker_layout(b);
   const HomographyFit fit = fit_homography(seen(truth, layout, 0.0, 1), layout, cv::Size(640, 480));
@@ -47,7 +47,7 @@ TEST(CameraCalibration, RecoversTheHomographyFromExactMarkers) {
 }
 
 TEST(CameraCalibration, NoisyMarkersGiveSubMillimetreHomography) {
-  const sim::Board b = table();
+  const table::Board b = table();
   const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
   const std::vector<Vec2> layout = default_marker_layout(b);
   const HomographyFit fit = fit_homography(seen(truth, layout, 0.2, 7), layout, cv::Size(640, 480));
@@ -83,7 +83,7 @@ TEST(CameraCalibration, DegenerateLayoutsAreRefused) {
 }
 
 TEST(CameraCalibration, SymmetricLayoutIsAmbiguous) {
-  const sim::Board b = table();
+  const table::Board b = table();
   const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
   // A rectangle with its centre: a half turn maps it onto itself.
   const std::vector<Vec2> layout{{0.05, 0.05}, {0.45, 0.05}, {0.45, 1.0}, {0.05, 1.0}, {0.25, 0.525}};
@@ -91,7 +91,7 @@ TEST(CameraCalibration, SymmetricLayoutIsAmbiguous) {
 }
 
 TEST(CameraCalibration, TooFewDetectionsIsAnError) {
-  const sim::Board b = table();
+  const table::Board b = table();
   const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
   const std::vector<Vec2> layout = default_marker_layout(b);
   std::vector<DetectedMarker> det = seen(truth, layout, 0.0, 1);

@@ -7,19 +7,19 @@
 #include <gtest/gtest.h>
 
 #include "pinball/calibration/sim_lab.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::calibration {
 namespace {
 
-sim::Flipper flipper(sim::Side side, Vec2 pivot) {
-  sim::Flipper f;
+table::Flipper flipper(table::Side side, Vec2 pivot) {
+  table::Flipper f;
   f.side = side;
   f.pivot = pivot;
   f.length_m = 0.078;
   f.theta_min_rad = -0.42;
   f.theta_max_rad = 0.54;
-  f.name = side == sim::Side::kLeft ? "left" : "right";
+  f.name = side == table::Side::kLeft ? "left" : "right";
   return f;
 }
 
@@ -28,7 +28,7 @@ sim::Flipper flipper(sim::Side side, Vec2 pivot) {
 // and a radial bias from bias_down_m (down stop) to bias_up_m (up stop); with
 // `lines`, each frame also has the blade's centre line, moved 0.1 mm across
 // and turned 0.1° at random.
-SweepTrack synthetic_sweep(const sim::Flipper& f, int n, double noise_m, double bias_down_m, double bias_up_m,
+SweepTrack synthetic_sweep(const table::Flipper& f, int n, double noise_m, double bias_down_m, double bias_up_m,
                            bool lines, std::uint64_t seed) {
   SweepTrack track;
   Rng rng(seed);
@@ -36,7 +36,7 @@ SweepTrack synthetic_sweep(const sim::Flipper& f, int n, double noise_m, double 
     const double phase = static_cast<double>(k) / n;
     const double up = phase < 0.3 ? 0.0 : phase < 0.5 ? (phase - 0.3) / 0.2 : phase < 0.8 ? 1.0 : 1.0 - (phase - 0.8) / 0.2;
     const double theta = f.theta_min_rad + up * (f.theta_max_rad - f.theta_min_rad);
-    const Vec2 tip = sim::flipper_tip(f, theta);
+    const Vec2 tip = table::flipper_tip(f, theta);
     const Vec2 d = (tip - f.pivot).normalized();
     track.t_s.push_back(k / 200.0);
     track.tips_board.push_back(tip + (bias_down_m + up * (bias_up_m - bias_down_m)) * d +
@@ -50,18 +50,18 @@ SweepTrack synthetic_sweep(const sim::Flipper& f, int n, double noise_m, double 
 }
 
 TEST(FlipperCalibration, AngleFollowsTheBoardConvention) {
-  EXPECT_NEAR(flipper_angle(sim::Side::kLeft, {0, 0}, {1, 1}), std::numbers::pi / 4, 1e-12);
-  EXPECT_NEAR(flipper_angle(sim::Side::kRight, {0, 0}, {-1, 1}), std::numbers::pi / 4, 1e-12);
-  EXPECT_NEAR(flipper_angle(sim::Side::kRight, {0, 0}, {-1, -1}), -std::numbers::pi / 4, 1e-12);
+  EXPECT_NEAR(flipper_angle(table::Side::kLeft, {0, 0}, {1, 1}), std::numbers::pi / 4, 1e-12);
+  EXPECT_NEAR(flipper_angle(table::Side::kRight, {0, 0}, {-1, 1}), std::numbers::pi / 4, 1e-12);
+  EXPECT_NEAR(flipper_angle(table::Side::kRight, {0, 0}, {-1, -1}), -std::numbers::pi / 4, 1e-12);
 }
 
 TEST(FlipperCalibration, MarkersGivePivotTipAndStops) {
-  const sim::Flipper nominal = flipper(sim::Side::kRight, {0.345, 0.16});
-  sim::Flipper real = nominal;
+  const table::Flipper nominal = flipper(table::Side::kRight, {0.345, 0.16});
+  table::Flipper real = nominal;
   real.pivot += Vec2{0.004, -0.003};
   real.theta_min_rad -= 0.02;
-  const std::vector<Vec2> down{real.pivot, sim::flipper_tip(real, real.theta_min_rad), Vec2{0.1, 0.1}};
-  const std::vector<Vec2> up{real.pivot, sim::flipper_tip(real, real.theta_max_rad)};
+  const std::vector<Vec2> down{real.pivot, table::flipper_tip(real, real.theta_min_rad), Vec2{0.1, 0.1}};
+  const std::vector<Vec2> up{real.pivot, table::flipper_tip(real, real.theta_max_rad)};
   const FlipperCalibration c = calibrate_flipper_markers(nominal, down, up);
   EXPECT_LT((c.pivot_m - real.pivot).norm(), 1e-12);
   EXPECT_NEAR(c.length_m, 0.078, 1e-12);
@@ -80,7 +80,7 @@ TEST(FlipperCalibration, MarkersGivePivotTipAndStops) {
 
 TEST(FlipperCalibration, SweepTrackGivesPivotLengthAndStops) {
   // Tips of a right flipper resting on both stops and moving between them, 0.2 mm noise.
-  const sim::Flipper f = flipper(sim::Side::kRight, {0.345, 0.16});
+  const table::Flipper f = flipper(table::Side::kRight, {0.345, 0.16});
   SweepTrack track = synthetic_sweep(f, 400, 0.0002, 0.0, 0.0, false, 4);
   const FlipperCalibration c = flipper_from_sweep_track(track, f, SweepOptions{});
   EXPECT_EQ(c.method, FlipperMethod::kMarkerless);
@@ -88,7 +88,7 @@ TEST(FlipperCalibration, SweepTrackGivesPivotLengthAndStops) {
   EXPECT_NEAR(c.length_m, f.length_m, 0.001);
   EXPECT_NEAR(c.theta_min_rad, f.theta_min_rad, 0.5 * std::numbers::pi / 180);
   EXPECT_NEAR(c.theta_max_rad, f.theta_max_rad, 0.5 * std::numbers::pi / 180);
-  EXPECT_LT((c.tip_m - sim::flipper_tip(f, f.theta_min_rad)).norm(), 0.001);
+  EXPECT_LT((c.tip_m - table::flipper_tip(f, f.theta_min_rad)).norm(), 0.001);
   const FlipperDisagreement d = compare_flippers(c, c);
   EXPECT_EQ(d.pivot_m, 0.0);
 }
@@ -98,7 +98,7 @@ TEST(FlipperCalibration, SweepTrackWithBladeLinesTakesThePivotFromTheLines) {
   // −1.2 mm): a circle through them moves its centre by about 0.65 mm.
   // The blade's centre lines still pass through the pivot, so the pivot is
   // exact and only the length takes the (median) bias.
-  const sim::Flipper f = flipper(sim::Side::kLeft, {0.165, 0.16});
+  const table::Flipper f = flipper(table::Side::kLeft, {0.165, 0.16});
   SweepTrack track = synthetic_sweep(f, 300, 0.0, -0.0006, -0.0012, true, 5);
   SweepTrack circle_only = track;
   circle_only.blades_board.clear();
@@ -113,27 +113,27 @@ TEST(FlipperCalibration, SweepTrackWithBladeLinesTakesThePivotFromTheLines) {
 }
 
 TEST(FlipperCalibration, SweepVideoOfTheSimulatedLab) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   SimLabOptions o;
   o.sweeps = 1;
   const SimLab lab(board, o);
   SweepTrack track;
   const FlipperCalibration c =
       calibrate_flipper_sweep([&] { return lab.sweep_video(0); }, lab.true_homography(), board.flippers[0], {}, &track);
-  const sim::Flipper& t = lab.truth().flippers[0];
+  const table::Flipper& t = lab.truth().flippers[0];
   // The tip's end fits a circle in (nearly) every frame of the 1.75 s video.
   EXPECT_GT(track.tips_board.size(), 330u);
   EXPECT_EQ(track.blades_board.size(), track.tips_board.size());
   // The targets (thesis 4.1.3; docs/results.md has what the bench measures).
   EXPECT_LT((c.pivot_m - t.pivot).norm(), 0.001);
-  EXPECT_LT((c.tip_m - sim::flipper_tip(t, t.theta_min_rad)).norm(), 0.001);
+  EXPECT_LT((c.tip_m - table::flipper_tip(t, t.theta_min_rad)).norm(), 0.001);
   EXPECT_NEAR(c.length_m, t.length_m, 0.001);
   EXPECT_NEAR(c.theta_min_rad, t.theta_min_rad, 0.5 * std::numbers::pi / 180);
   EXPECT_NEAR(c.theta_max_rad, t.theta_max_rad, 0.5 * std::numbers::pi / 180);
 }
 
 TEST(FlipperCalibration, StillFlipperIsRefused) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   const SimLab lab(board);
   const cv::Mat frame = SimLab(board).flipper_markers_image(false);
   TipTracker t(frame.size(), lab.true_homography());

@@ -3,13 +3,13 @@
 #include <gtest/gtest.h>
 
 #include "pinball/calibration/camera_calibration.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::calibration {
 namespace {
 
 TEST(SimLab, TheMachineDiffersFromItsBoardFile) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   SimLab lab(board);
   EXPECT_NEAR((lab.truth().flippers[0].pivot - board.flippers[0].pivot).norm(), 0.0036, 1e-4);
   EXPECT_EQ(lab.image_size(), cv::Size(640, 480));
@@ -23,7 +23,7 @@ TEST(SimLab, TheMachineDiffersFromItsBoardFile) {
 }
 
 TEST(SimLab, SweepVideosRepeatAndRollsStartAtRest) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   const SimLab lab(board);
   vision::Frame a, b;
   auto first = lab.sweep_video(1);

@@ -7,7 +7,7 @@
 #include <map>
 #include <sstream>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/penetration.h"
 
 namespace pinball::bench {
@@ -15,7 +15,7 @@ namespace {
 
 TEST(PrecisionBench, ClosedFormsStartWhereTheScenesStartAndStayOutOfTheirObstacles) {
   for (const std::string& name : closed_form_scenes()) {
-    const sim::Board b = precision_scene_board(name);
+    const table::Board b = precision_scene_board(name);
     sim::GameState s = sim::make_game_state(b, 1);
     s.ball_in_play = true;
     for (double t = 0.0; t <= 10.0; t += 0.01) {
@@ -53,7 +53,7 @@ TEST(PrecisionBench, LogLogInterpolationIsExactOnAPowerLaw) {
 }
 
 TEST(PrecisionBench, QuickRunErrorsAreSane) {
-  const sim::Board table = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board table = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   const PrecisionBenchOptions options = quick_precision_bench_options();
   int lines = 0;
   const PrecisionReport r = run_precision_bench(table, options, [&](const std::string&) { ++lines; });

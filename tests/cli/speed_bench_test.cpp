@@ -2,14 +2,14 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::bench {
 namespace {
 
 TEST(SpeedBench, FarObstaclesAreCopiesOutOfTheTable) {
-  const sim::Board b = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  const sim::Board crowded = with_far_obstacles(b, 10);
+  const table::Board b = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board crowded = with_far_obstacles(b, 10);
   ASSERT_EQ(crowded.shapes.size(), 11 * b.shapes.size());
   ASSERT_EQ(crowded.obstacles.size(), crowded.shapes.size());
   for (std::size_t i = b.shapes.size(); i < crowded.shapes.size(); ++i) {
@@ -19,7 +19,7 @@ TEST(SpeedBench, FarObstaclesAreCopiesOutOfTheTable) {
 }
 
 TEST(SpeedBench, ReportComparesGridWithLinearScanOnTheSameRun) {
-  const sim::Board b = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board b = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   SpeedBenchOptions options;
   options.steps = 20'000;
   options.repeats = 1;
@@ -38,7 +38,7 @@ TEST(SpeedBench, ReportComparesGridWithLinearScanOnTheSameRun) {
 }
 
 TEST(SpeedBench, EventStepperRunsOnBothBoards) {
-  const sim::Board b = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board b = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   SpeedBenchOptions options;
   options.steps = 20'000;
   options.repeats = 1;

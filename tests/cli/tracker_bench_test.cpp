@@ -4,13 +4,13 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/track/flipper_geometry.h"
 
 namespace pinball::bench {
 namespace {
 
-sim::Board mit1993() { return sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board"); }
+table::Board mit1993() { return table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board"); }
 
 // A tiny run: 60 approaches, the headline camera with and without noise plus a
 // 1 px camera, one miscalibrated g, two window caps.
@@ -38,7 +38,7 @@ const MethodErrors& method(const TrackerSetting& s, const std::string& name) {
 }
 
 TEST(TrackerBench, ApproachesAreExactFreeFlightToTheV) {
-  const sim::Board b = mit1993();
+  const table::Board b = mit1993();
   TrackerBenchOptions o = tiny();
   o.approaches = 30;
   ApproachCounts counts;

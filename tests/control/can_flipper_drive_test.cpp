@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "common/thesis_board.h"
 
@@ -51,7 +51,7 @@ TEST(CanFlipperDrive, CommandsReachTheFlipperThroughTheBoardAfterTheDelay) {
 }
 
 TEST(CanFlipperDrive, RefusesBoardsItCannotDrive) {
-  sim::Board none = thesis_board();
+  table::Board none = thesis_board();
   none.flippers.clear();
   EXPECT_THROW(CanFlipperDrive(none, 0.004), std::invalid_argument);
   EXPECT_THROW(CanFlipperDrive(thesis_board(), -1.0), std::invalid_argument);

@@ -6,8 +6,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "pinball/sim/model_world.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "common/thesis_board.h"
 
@@ -33,13 +34,13 @@ struct Totals {
 
 // One ball per seed, seeds 1..kBalls, with the tracked spastic player.
 Totals play_tracked(const track::CameraModelConfig& camera) {
-  const sim::ThesisStepper stepper(thesis_board());
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
   Totals t;
   for (int seed = 1; seed <= kBalls; ++seed) {
     sim::GameState s = sim::make_game_state(thesis_board(), static_cast<std::uint64_t>(seed));
     SimulatedSpasticPlayer player(thesis_board(), camera, SpasticConfig{}, static_cast<std::uint64_t>(seed));
     const sim::BallResult r = sim::play_ball(
-        stepper, s, limits(), [&](sim::GameState& st) { player.act(st); },
+        *world, s, limits(), [&](sim::GameState& st) { player.act(st); },
         [](const sim::GameState&, const sim::StepEvents&) {});
     t.score += r.score;
     t.flips += r.flips;
@@ -51,12 +52,12 @@ Totals play_tracked(const track::CameraModelConfig& camera) {
 
 // The same balls with nobody at the buttons.
 Totals play_idle() {
-  const sim::ThesisStepper stepper(thesis_board());
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
   Totals t;
   for (int seed = 1; seed <= kBalls; ++seed) {
     sim::GameState s = sim::make_game_state(thesis_board(), static_cast<std::uint64_t>(seed));
     const sim::BallResult r = sim::play_ball(
-        stepper, s, limits(), [](sim::GameState&) {}, [](const sim::GameState&, const sim::StepEvents&) {});
+        *world, s, limits(), [](sim::GameState&) {}, [](const sim::GameState&, const sim::StepEvents&) {});
     t.score += r.score;
     t.flips += r.flips;
     t.time_s += r.duration_s;
@@ -91,7 +92,7 @@ TEST(SimulatedSpasticPlayer, SeesTheBallOnlyThroughTheCamera) {
   // Two identical players: one acts on the true state, the other on a copy
   // whose velocity (which no camera measures) is NaN. Their commands must
   // agree at every step: nothing but the position reaches the tracker.
-  const sim::ThesisStepper stepper(thesis_board());
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
   track::CameraModelConfig camera;
   camera.latency_s = 0.010;
   for (int seed = 1; seed <= 3; ++seed) {
@@ -103,7 +104,7 @@ TEST(SimulatedSpasticPlayer, SeesTheBallOnlyThroughTheCamera) {
     long energized_steps = 0;
     sim::GameState shadow = s;
     sim::play_ball(
-        stepper, s, limits(),
+        *world, s, limits(),
         [&](sim::GameState& st) {
           shadow = st;
           shadow.ball.velocity_mps = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -126,7 +127,7 @@ TEST(SimulatedSpasticPlayer, SeesTheBallOnlyThroughTheCamera) {
 }
 
 TEST(SimulatedSpasticPlayer, BallOutOfPlayReleasesTheFlippersAndSeesNothing) {
-  const sim::Board& b = thesis_board();
+  const table::Board& b = thesis_board();
   sim::GameState s = sim::make_game_state(b, 1);
   SimulatedSpasticPlayer player(b, track::CameraModelConfig{}, SpasticConfig{}, 1);
   ASSERT_FALSE(s.ball_in_play);
@@ -143,7 +144,7 @@ TEST(SimulatedSpasticPlayer, BadSettingsThrow) {
   track::CameraModelConfig bad;
   bad.fps = 0.0;
   EXPECT_THROW(SimulatedSpasticPlayer(thesis_board(), bad, SpasticConfig{}, 1), std::invalid_argument);
-  sim::Board one = thesis_board();
+  table::Board one = thesis_board();
   one.flippers.pop_back();
   EXPECT_THROW(SimulatedSpasticPlayer(one, track::CameraModelConfig{}, SpasticConfig{}, 1), std::invalid_argument);
 }

@@ -20,7 +20,7 @@
 #include "pinball/control/controller_file.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/learn/evaluator.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::daemon {
 namespace {
@@ -99,7 +99,7 @@ TEST(Daemon, FullPathScoresLikeTheFastLearningLoop) {
   RunningStats daemon_scores;
   for (const SimBallResult& b : r.results) daemon_scores.add(b.score);
 
-  const sim::Board board = sim::load_board(kSource + "/boards/mit1993.board");
+  const table::Board board = table::load_board(kSource + "/boards/mit1993.board");
   const control::ControllerSpec spec = control::load_controller(kSource + "/controllers/best.json");
   learn::EvaluatorConfig ec;
   ec.actuation_delay_s = 0.004;

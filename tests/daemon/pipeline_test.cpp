@@ -8,7 +8,7 @@
 
 #include "pinball/firmware/stream_transport.h"
 #include "pinball/firmware/virtual_driver_board.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/track/flipper_geometry.h"
 
 namespace pinball::daemon {
@@ -188,7 +188,7 @@ TEST(ControllerStage, BusOffIsSurvivedAndCounted) {
 }
 
 TEST(CameraStage, ForgetsABallOutOfSightAndSaysSo) {
-  const sim::Board board = sim::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  const table::Board board = table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
   track::Tracker tracker(track::flipper_geometry_from_board(board), track::TrackerConfig{});
   CameraStage stage(nullptr, tracker, 0.02);
   ProjectionRecord r;

@@ -7,7 +7,7 @@
 #include "board_harness.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/flipper_actuation.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
 
@@ -17,7 +17,7 @@ namespace {
 using SimIntegrationTest = testing::BoardTest;
 
 TEST_F(SimIntegrationTest, FireRaisesTheSimulatedFlipperAfterTheActuationDelay) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/scenes/flipper.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/scenes/flipper.board");
   ASSERT_EQ(board.flippers.size(), 1u);
   const sim::ThesisStepper stepper(board);
   sim::GameState state = sim::make_game_state(board, 1);

@@ -1,5 +1,7 @@
 #include "ceiling_bench.h"
 
+#include "pinball/sim/model_world.h"
+
 #include <gtest/gtest.h>
 
 #include "common/thesis_board.h"
@@ -27,10 +29,11 @@ CeilingBenchOptions tiny_bench() {
 }
 
 TEST(CeilingBench, SameSeedSameBallWhateverTheThreads) {
-  const sim::ThesisStepper stepper(thesis_board());
+  const sim::ThesisStepper model(thesis_board());
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
   const CeilingBenchOptions o = tiny_bench();
-  const CeilingBall a = play_ceiling_bench_ball(stepper, o, CeilingPlayerKind::kCeiling, 17);
-  const CeilingBall b = play_ceiling_bench_ball(stepper, o, CeilingPlayerKind::kCeiling, 17);
+  const CeilingBall a = play_ceiling_bench_ball(*world, model, o, CeilingPlayerKind::kCeiling, 17);
+  const CeilingBall b = play_ceiling_bench_ball(*world->fork(), model, o, CeilingPlayerKind::kCeiling, 17);
   EXPECT_EQ(a.score, b.score);
   EXPECT_EQ(a.duration_s, b.duration_s);
   EXPECT_EQ(a.flips, b.flips);

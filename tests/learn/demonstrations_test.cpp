@@ -7,6 +7,7 @@
 
 #include "common/thesis_board.h"
 #include "pinball/learn/evaluator.h"
+#include "pinball/sim/model_world.h"
 
 namespace pinball::learn {
 namespace {
@@ -35,8 +36,9 @@ void expect_sane(const control::ShotExample& e) {
 }
 
 TEST(Demonstrations, TheTeachersShotsAreRecordedOnePerApproach) {
-  const sim::ThesisStepper stepper(thesis_board());
-  const DemonstrationBall b = record_demonstration(stepper, short_config(), ball_seed(3, 0));
+  const sim::ThesisStepper model(thesis_board());
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
+  const DemonstrationBall b = record_demonstration(*world, model, short_config(), ball_seed(3, 0));
   ASSERT_FALSE(b.shots.empty());
   int fired = 0;
   for (const control::ShotExample& e : b.shots) {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "pinball/control/spastic_controller.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "common/thesis_board.h"
 
 namespace pinball::learn {

@@ -14,7 +14,7 @@ namespace {
 using pinball::testing::thesis_board;
 
 // A ball falling onto the left flipper near its tip, towards the gap between the flippers.
-sim::GameState ball_on_left_flipper(const sim::Board& board) {
+sim::GameState ball_on_left_flipper(const table::Board& board) {
   sim::GameState s = sim::make_game_state(board, 3);
   s.ball_in_play = true;
   s.ball.position_m = Vec2(0.235, 0.190);

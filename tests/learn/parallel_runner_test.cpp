@@ -2,13 +2,13 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::learn {
 namespace {
 
 TEST(ParallelRunner, ResultsDoNotDependOnTheThreadCount) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   const PinballEvaluator ev(board, EvaluatorConfig{});
   std::vector<control::ControllerSpec> specs(3, ev.prototype());
   Rng rng(9);

@@ -9,14 +9,14 @@
 namespace pinball::sim::testing {
 namespace {
 
-Board shifted(const Board& board, const Vec2& d) {
-  Board b = board;
-  for (Shape& s : b.shapes) {
+table::Board shifted(const table::Board& board, const Vec2& d) {
+  table::Board b = board;
+  for (table::Shape& s : b.shapes) {
     s.p0 += d;
     s.p1 += d;
   }
-  for (Flipper& f : b.flippers) f.pivot += d;
-  for (Sensor& s : b.sensors) {
+  for (table::Flipper& f : b.flippers) f.pivot += d;
+  for (table::Sensor& s : b.sensors) {
     s.shape.p0 += d;
     s.shape.p1 += d;
   }
@@ -27,8 +27,8 @@ Board shifted(const Board& board, const Vec2& d) {
 }
 
 // In a closed box: a Zeno bounce on a line, a slide down a 10° incline, a drop into a 45° V.
-Board scene(int which) {
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+table::Board scene(int which) {
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
   add_box(b, 1.0, 1.0, 0.5);  // nothing leaves the table
   if (which == 0) add_line(b, {0.0, 0.1}, {1.0, 0.1}, 0.5);
   if (which == 1) add_line(b, {0.0, 0.5}, {0.9, 0.5 - 0.9 * std::tan(0.1745)}, 0.5);
@@ -57,8 +57,8 @@ TYPED_TEST(FarOriginTest, BoardShiftedAKilometreFromTheOrigin) {
     // bounds start at the origin, so the far board needs them): only the
     // coordinates differ. The event stepper's root tolerance scales with
     // what is on the table (1.4 m here), not with the coordinates.
-    Board near = scene(which);
-    const Board far = shifted(near, d);
+    table::Board near = scene(which);
+    const table::Board far = shifted(near, d);
     near.width_m = far.width_m;
     near.height_m = far.height_m;
     const auto near_stepper = Traits::make(near, 5e-4);

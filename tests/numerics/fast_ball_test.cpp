@@ -17,7 +17,7 @@ TYPED_TEST_SUITE(FastBallTest, Steppers, StepperNames);
 TYPED_TEST(FastBallTest, NeverCrossesAZeroThicknessWallAt500mps) {
   using Traits = StepperTraits<TypeParam>;
   for (double deg : {0.0, 17.0, 45.0, 80.0, -33.0}) {
-    Board b = box_board(1.0, 1.11, 5e-4);
+    table::Board b = box_board(1.0, 1.11, 5e-4);
     b.ball.speed_max_mps = 1000.0;
     add_wall(b, {0.3, 0.0}, {0.3, b.height_m}, 1.0);  // floor to roof: no way round
     const auto stepper = Traits::make(b, 5e-4);

@@ -14,13 +14,13 @@ TYPED_TEST_SUITE(FlipperRestTest, Steppers, StepperNames);
 
 TYPED_TEST(FlipperRestTest, RollsDownARaisedFlipperAndOff) {
   using Traits = StepperTraits<TypeParam>;
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
-  const int fl = add_flipper(b, Side::kLeft, {0.3, 0.3}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
-  const Flipper& f = b.flippers[fl];
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  const int fl = add_flipper(b, table::Side::kLeft, {0.3, 0.3}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
+  const table::Flipper& f = b.flippers[fl];
   const auto stepper = Traits::make(b, 5e-4);
   const double start_along = 0.06;
   GameState s = state_with_ball(
-      b, f.pivot + start_along * flipper_direction(f, f.theta_max_rad) + kBallR * flipper_up_normal(f, f.theta_max_rad),
+      b, f.pivot + start_along * table::flipper_direction(f, f.theta_max_rad) + kBallR * table::flipper_up_normal(f, f.theta_max_rad),
       Vec2::Zero());
   s.flippers[fl].theta_rad = f.theta_max_rad;
   s.flippers[fl].energized = true;
@@ -33,8 +33,8 @@ TYPED_TEST(FlipperRestTest, RollsDownARaisedFlipperAndOff) {
   ASSERT_TRUE(run_checked(stepper, s, static_cast<long>(1.5 / 5e-4), check, [](GameState&, long) {},
                           [&](const GameState& st, long i) {
                             const Vec2 rel = st.ball.position_m - f.pivot;
-                            const double along = rel.dot(flipper_direction(f, f.theta_max_rad));
-                            const double height = rel.dot(flipper_up_normal(f, f.theta_max_rad)) - kBallR;
+                            const double along = rel.dot(table::flipper_direction(f, f.theta_max_rad));
+                            const double height = rel.dot(table::flipper_up_normal(f, f.theta_max_rad)) - kBallR;
                             if (along > 0.0 && left_at < 0.0) max_gap_on_face = std::max(max_gap_on_face, height);
                             if (along < -kBallR && left_at < 0.0) left_at = (i + 1) * 5e-4;
                           }));
@@ -52,7 +52,7 @@ TYPED_TEST(FlipperRestTest, SlidesOffTheFreeEndOfAnIncline) {
   // The static counterpart: a ball sliding down a 10° line leaves its free
   // lower end and falls; it must not stop at the edge.
   using Traits = StepperTraits<TypeParam>;
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
   add_box(b, 1.0, 1.0, 0.5);  // catches it afterwards
   const double slope = 0.1745;  // 10°
   const Vec2 p0{0.0, 0.5}, p1{0.9, 0.5 - 0.9 * std::tan(slope)};

@@ -9,8 +9,8 @@
 namespace pinball::sim::testing {
 namespace {
 
-Board gravity_board(double g) {
-  Board b = box_board(0.9, g, 5e-4);
+table::Board gravity_board(double g) {
+  table::Board b = box_board(0.9, g, 5e-4);
   b.ball.speed_max_mps = 50.0;
   add_circle(b, {0.15, 0.70}, 0.03, 1.0);
   add_circle(b, {0.35, 0.72}, 0.03, 0.8);
@@ -28,7 +28,7 @@ TYPED_TEST_SUITE(GravityTest, Steppers, StepperNames);
 TYPED_TEST(GravityTest, ZeroAndTenTimesGravity) {
   using Traits = StepperTraits<TypeParam>;
   for (double g : {0.0, 11.1}) {
-    const Board b = gravity_board(g);
+    const table::Board b = gravity_board(g);
     const auto stepper = Traits::make(b, 5e-4);
     GameState s = state_with_ball(b, {0.25, 0.9}, {1.3, -0.7});
     Checker<TypeParam> check(stepper, s, false, 5000);

@@ -20,7 +20,7 @@ TYPED_TEST(GrazeTest, TangentToACircleAtTheApex) {
   const double g = 1.11, vx = 1.0, circle_r = 0.03;
   const Vec2 c{0.5, 0.4};
   for (double offset : {-1e-6, -1e-9, 0.0, 1e-9, 1e-6}) {
-    Board b = empty_board(1.0, 1.0, g, 5e-4);
+    table::Board b = empty_board(1.0, 1.0, g, 5e-4);
     add_circle(b, c, circle_r, 1.0);
     const auto stepper = Traits::make(b, 5e-4);
     // Apex above the centre at height R + r + offset, reached at t = 0.2 s.

@@ -17,7 +17,7 @@ TYPED_TEST_SUITE(KickersTest, Steppers, StepperNames);
 TYPED_TEST(KickersTest, TwoKickersFacingEachOther) {
   using Traits = StepperTraits<TypeParam>;
   for (const bool circles : {false, true}) {
-    Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+    table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
     b.ball.speed_max_mps = 5.0;
     if (circles) {
       add_circle(b, {0.3, 0.5}, 0.03, 1.5);

@@ -15,7 +15,7 @@
 #include <cstdio>
 #include <string>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/event_stepper.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -38,7 +38,7 @@ struct StepperTraits<ThesisStepper> {
   static constexpr bool kExact = false;
   /// It stops 1 µm (its separation) short of every contact.
   static constexpr double kMaxDepth_m = 1e-6;
-  static ThesisStepper make(const Board& b, double dt_s) {
+  static ThesisStepper make(const table::Board& b, double dt_s) {
     ThesisStepperOptions o;
     o.dt_s = dt_s;
     return ThesisStepper(b, o);
@@ -59,7 +59,7 @@ struct StepperTraits<EventStepper> {
   static constexpr bool kExact = true;
   /// Roots are found to 1e-12 of the board's size; 1 nm leaves a thousandfold margin.
   static constexpr double kMaxDepth_m = 1e-9;
-  static EventStepper make(const Board& b, double dt_s) {
+  static EventStepper make(const table::Board& b, double dt_s) {
     EventStepperOptions o;
     o.dt_s = dt_s;
     return EventStepper(b, o);
@@ -83,7 +83,7 @@ struct StepperNames {
 };
 
 /// Mechanical energy per unit mass: ½|v|² + g·y.
-inline double energy(const Board& b, const GameState& s) {
+inline double energy(const table::Board& b, const GameState& s) {
   return 0.5 * s.ball.velocity_mps.squaredNorm() + b.gravity_mps2 * s.ball.position_m.y();
 }
 
@@ -115,7 +115,7 @@ class Checker {
 
   /// Checks the state after step `step`; records a failure and returns false on the first violation.
   bool operator()(const GameState& s, long step) {
-    const Board& b = stepper_.board();
+    const table::Board& b = stepper_.board();
     if (!invariants_hold(b, s, step, Traits::kMaxDepth_m)) return false;
     max_speed_ = std::max(max_speed_, s.ball.velocity_mps.norm());
     // A velocity change beyond what gravity does in one step is a contact.

@@ -17,14 +17,14 @@ TYPED_TEST_SUITE(PinchTest, Steppers, StepperNames);
 
 TYPED_TEST(PinchTest, FlipperPinchesTheBallAgainstAWall) {
   using Traits = StepperTraits<TypeParam>;
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
   b.ball.speed_max_mps = 5.0;
-  const int fl = add_flipper(b, Side::kLeft, {0.3, 0.3}, 0.076, -0.4, 0.6, 33.0, 0.5, 1.0);
+  const int fl = add_flipper(b, table::Side::kLeft, {0.3, 0.3}, 0.076, -0.4, 0.6, 33.0, 0.5, 1.0);
   const FlipperPocket pocket = add_flipper_pocket(b, fl);
-  const Flipper& f = b.flippers[fl];
+  const table::Flipper& f = b.flippers[fl];
   const auto stepper = Traits::make(b, 5e-4);
   GameState s = state_with_ball(
-      b, f.pivot + 0.05 * flipper_direction(f, f.theta_min_rad) + (kBallR + 1e-6) * flipper_up_normal(f, f.theta_min_rad),
+      b, f.pivot + 0.05 * table::flipper_direction(f, f.theta_min_rad) + (kBallR + 1e-6) * table::flipper_up_normal(f, f.theta_min_rad),
       Vec2::Zero());
   // The flipper supplies energy; the bound is on events: 3 s of squeezing.
   Checker<TypeParam> check(stepper, s, true, 30000);

@@ -17,10 +17,10 @@ TYPED_TEST_SUITE(TimeStepTest, Steppers, StepperNames);
 
 TYPED_TEST(TimeStepTest, FromOneMicrosecondToTheLargestLegalStep) {
   using Traits = StepperTraits<TypeParam>;
-  const double dt_max = max_stable_dt_s(box_with_bumpers_and_flippers());
+  const double dt_max = table::max_stable_dt_s(box_with_bumpers_and_flippers());
   ASSERT_TRUE(std::isfinite(dt_max));
   for (double dt : {1e-6, 1e-5, 1e-4, 1e-3, 0.999 * dt_max}) {
-    const Board b = box_with_bumpers_and_flippers(dt);
+    const table::Board b = box_with_bumpers_and_flippers(dt);
     const auto stepper = Traits::make(b, dt);
     GameState s = state_with_ball(b, {0.3, 0.6}, {0.8, -0.5});
     const double seconds = dt < 5e-6 ? 0.2 : 3.0;
@@ -48,8 +48,8 @@ TYPED_TEST(TimeStepTest, FromOneMicrosecondToTheLargestLegalStep) {
 }
 
 TEST(TimeStepLimits, ThesisStepperRefusesAStepPastTheFlipperCondition) {
-  const Board b = box_with_bumpers_and_flippers();
-  const double dt_max = max_stable_dt_s(b);
+  const table::Board b = box_with_bumpers_and_flippers();
+  const double dt_max = table::max_stable_dt_s(b);
   ThesisStepperOptions o;
   o.dt_s = 1.01 * dt_max;
   EXPECT_THROW(ThesisStepper(b, o), std::invalid_argument);

@@ -20,7 +20,7 @@ TYPED_TEST(WedgeTest, SettlesInVCornersWithoutEscaping) {
     const double half = 0.5 * opening_deg * std::numbers::pi / 180.0;
     const double wedge_h = kBallR / std::sin(half);  // centre height above the apex where the V is one ball wide
     const double len = opening_deg < 10.0 ? 2.0 : 0.4;
-    Board b = empty_board(1.0, 2.5, 1.11, 5e-4);
+    table::Board b = empty_board(1.0, 2.5, 1.11, 5e-4);
     const Vec2 apex{0.5, 0.1};
     add_wall(b, apex, apex + len * Vec2{-std::sin(half), std::cos(half)}, 0.5);
     add_wall(b, apex, apex + len * Vec2{std::sin(half), std::cos(half)}, 0.5);

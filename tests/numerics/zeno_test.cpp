@@ -16,7 +16,7 @@ TYPED_TEST_SUITE(ZenoTest, Steppers, StepperNames);
 TYPED_TEST(ZenoTest, BouncesToRestOnAFlatLine) {
   using Traits = StepperTraits<TypeParam>;
   for (double rho : {0.5, 0.9}) {
-    Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+    table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
     add_line(b, {0.0, 0.1}, {1.0, 0.1}, rho);
     const auto stepper = Traits::make(b, 5e-4);
     GameState s = state_with_ball(b, {0.5, 0.1 + kBallR + 0.2}, Vec2::Zero());

@@ -1,3 +1,4 @@
+#include "pinball/sim/model_world.h"
 #include "pinball/sim/ball_runner.h"
 
 #include <gtest/gtest.h>
@@ -17,10 +18,10 @@ auto none_policy = [](GameState&) {};
 auto no_observer = [](const GameState&, const StepEvents&) {};
 
 // A small closed table whose floor eats the ball; launcher in the middle.
-Board drain_board() {
-  Board b = empty_board(0.4, 0.6, 1.11, 5e-4);
+table::Board drain_board() {
+  table::Board b = empty_board(0.4, 0.6, 1.11, 5e-4);
   b.ball.speed_max_mps = 2.0;
-  Action drain;
+  table::Action drain;
   drain.eats_ball = true;
   add_line(b, {0.0, 0.0}, {0.4, 0.0}, 1.0, drain, "drain");
   add_line(b, {0.4, 0.0}, {0.4, 0.6}, 1.0);
@@ -32,14 +33,14 @@ Board drain_board() {
 }
 
 TEST(PlayBall, NonePolicyLosesBallInDrain) {
-  const Board b = drain_board();
-  const ThesisStepper stepper(b);
+  const table::Board b = drain_board();
+  const std::unique_ptr<World> world = make_model_world(b);
   GameState s = make_game_state(b, 5);
   BallLimits limits;
   limits.max_ball_time_s = 60.0;
   int observed_steps = 0;
   bool saw_loss = false;
-  const BallResult r = play_ball(stepper, s, limits, none_policy, [&](const GameState&, const StepEvents& ev) {
+  const BallResult r = play_ball(*world, s, limits, none_policy, [&](const GameState&, const StepEvents& ev) {
     if (ev.has(StepEvents::kLaunch)) return;  // launches are reported to the observer too
     ++observed_steps;
     saw_loss = saw_loss || ev.has(StepEvents::kBallLost);
@@ -61,21 +62,21 @@ TEST(PlayBall, NonePolicyLosesBallInDrain) {
   const double h = 0.1 - kR;
   EXPECT_GT(r.duration_s, (v_lo + std::sqrt(v_lo * v_lo + 2.0 * g * h)) / g - 0.01);
   EXPECT_LT(r.duration_s, (v_hi + std::sqrt(v_hi * v_hi + 2.0 * g * h)) / g + 0.01);
-  EXPECT_NEAR(r.duration_s, r.steps * stepper.dt_s(), 1e-9);
+  EXPECT_NEAR(r.duration_s, r.steps * world->dt_s(), 1e-9);
   EXPECT_EQ(r.score, 0.0);
 }
 
 TEST(PlayBall, BouncyFloorWithoutDrainIsCut) {
-  Board b = drain_board();
+  table::Board b = drain_board();
   b.obstacles[0].action.eats_ball = false;  // a plain floor, rho 1
-  const ThesisStepper stepper(b);
+  const std::unique_ptr<World> world = make_model_world(b);
   GameState s = make_game_state(b, 5);
   BallLimits limits;
   limits.max_ball_time_s = 3.0;
-  const BallResult r = play_ball(stepper, s, limits, none_policy, no_observer);
+  const BallResult r = play_ball(*world, s, limits, none_policy, no_observer);
   EXPECT_TRUE(r.cut);
   EXPECT_FALSE(r.left_table);
-  EXPECT_NEAR(r.duration_s, 3.0, stepper.dt_s() + 1e-9);
+  EXPECT_NEAR(r.duration_s, 3.0, world->dt_s() + 1e-9);
   EXPECT_GE(r.duration_s, 3.0);
   EXPECT_FALSE(s.ball_in_play);
   EXPECT_EQ(s.balls_left, b.balls_per_game - 1);
@@ -85,18 +86,18 @@ TEST(PlayBall, BouncyFloorWithoutDrainIsCut) {
 TEST(PlayBall, WeakLaunchRollsBackAndIsRelaunched) {
   // A vertical chute with a damped floor just under the launcher: a weak
   // launch rises 3 cm and falls back to rest in the launcher.
-  Board b = empty_board(0.4, 0.6, 1.11, 5e-4);
+  table::Board b = empty_board(0.4, 0.6, 1.11, 5e-4);
   b.ball.speed_max_mps = 5.0;
   add_line(b, {0.25, 0.0}, {0.35, 0.0}, 0.2, {}, "chute floor");
   add_wall(b, {0.2865 - 0.001, 0.0}, {0.2865 - 0.001, 0.5}, 0.5);
   add_wall(b, {0.3135 + 0.001, 0.0}, {0.3135 + 0.001, 0.5}, 0.5);
   b.launcher.position = {0.3, kR + 1e-6};
   b.launcher.pull = 0.05;  // 0.25 m/s
-  const ThesisStepper stepper(b);
+  const std::unique_ptr<World> world = make_model_world(b);
   GameState s = make_game_state(b, 5);
   BallLimits limits;
   limits.max_ball_time_s = 5.0;
-  const BallResult r = play_ball(stepper, s, limits, none_policy, no_observer);
+  const BallResult r = play_ball(*world, s, limits, none_policy, no_observer);
   EXPECT_GT(r.launches, 1);
   EXPECT_TRUE(r.cut);
   // Each launch lasts at least the flight 2·v/g = 0.44 s, so at most ~12 in 5 s.
@@ -104,11 +105,11 @@ TEST(PlayBall, WeakLaunchRollsBackAndIsRelaunched) {
 }
 
 TEST(PlayBall, FlipsCountRisingEdges) {
-  Board b = drain_board();
+  table::Board b = drain_board();
   b.obstacles[0].action.eats_ball = false;
-  add_flipper(b, Side::kLeft, {0.1, 0.3}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
-  add_flipper(b, Side::kRight, {0.3, 0.3}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
-  const ThesisStepper stepper(b);
+  add_flipper(b, table::Side::kLeft, {0.1, 0.3}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
+  add_flipper(b, table::Side::kRight, {0.3, 0.3}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
+  const std::unique_ptr<World> world = make_model_world(b);
   GameState s = make_game_state(b, 5);
   BallLimits limits;
   limits.max_ball_time_s = 2.0;
@@ -117,7 +118,7 @@ TEST(PlayBall, FlipsCountRisingEdges) {
   bool prev0 = false;
   bool prev1 = false;
   const BallResult r = play_ball(
-      stepper, s, limits,
+      *world, s, limits,
       [&](GameState& st) {
         // Left: pressed 30 steps of every 100. Right: held from step 500 on, never released.
         const bool on0 = step % 100 < 30;
@@ -142,11 +143,11 @@ TEST(PlayBall, FlipsCountRisingEdges) {
 }
 
 TEST(BallRunner, BeginBallStartsNewGameWhenNoneLeft) {
-  const Board b = drain_board();
+  const table::Board b = drain_board();
   GameState s = make_game_state(b, 1);
   s.balls_left = 0;
   s.score = 99.0;
-  begin_ball(b, s, 0.5);
+  begin_ball(*make_model_world(b), s, 0.5);
   EXPECT_EQ(s.balls_left, b.balls_per_game);
   EXPECT_EQ(s.score, 0.0);
   EXPECT_TRUE(s.ball_in_play);
@@ -154,7 +155,7 @@ TEST(BallRunner, BeginBallStartsNewGameWhenNoneLeft) {
 }
 
 TEST(BallRunner, RestingInLauncher) {
-  const Board b = drain_board();
+  const table::Board b = drain_board();
   GameState s = make_game_state(b, 1);
   s.ball_in_play = true;
   s.ball.position_m = b.launcher.position + Vec2{0.005, 0.0};

@@ -14,9 +14,9 @@ namespace pinball::sim {
 namespace {
 
 // 200 random lines and circles (some points) on a 1 m x 1 m table.
-std::vector<Shape> random_shapes(std::uint64_t seed, int n) {
+std::vector<table::Shape> random_shapes(std::uint64_t seed, int n) {
   Rng rng(seed);
-  Board b;
+  table::Board b;
   for (int i = 0; i < n; ++i) {
     const Vec2 a{rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0)};
     const double kind = rng.uniform01();
@@ -34,18 +34,18 @@ std::vector<Shape> random_shapes(std::uint64_t seed, int n) {
 }
 
 TEST(DistanceToShape, LinesAndCircles) {
-  Board b;
+  table::Board b;
   testing::add_line(b, {0.0, 0.0}, {1.0, 0.0});
   testing::add_circle(b, {0.0, 0.0}, 0.5);
-  EXPECT_DOUBLE_EQ(distance_to_shape(b.shapes[0], {0.5, 0.25}), 0.25);
-  EXPECT_DOUBLE_EQ(distance_to_shape(b.shapes[0], {0.5, -0.25}), 0.25);  // either side
-  EXPECT_DOUBLE_EQ(distance_to_shape(b.shapes[0], {-3.0, 4.0}), 5.0);
-  EXPECT_DOUBLE_EQ(distance_to_shape(b.shapes[1], {3.0, 4.0}), 4.5);
-  EXPECT_DOUBLE_EQ(distance_to_shape(b.shapes[1], {0.3, 0.0}), -0.2);  // inside: negative
+  EXPECT_DOUBLE_EQ(table::distance_to_shape(b.shapes[0], {0.5, 0.25}), 0.25);
+  EXPECT_DOUBLE_EQ(table::distance_to_shape(b.shapes[0], {0.5, -0.25}), 0.25);  // either side
+  EXPECT_DOUBLE_EQ(table::distance_to_shape(b.shapes[0], {-3.0, 4.0}), 5.0);
+  EXPECT_DOUBLE_EQ(table::distance_to_shape(b.shapes[1], {3.0, 4.0}), 4.5);
+  EXPECT_DOUBLE_EQ(table::distance_to_shape(b.shapes[1], {0.3, 0.0}), -0.2);  // inside: negative
 }
 
 TEST(UniformGrid, CandidatesAreSupersetOfShapesInReach) {
-  const std::vector<Shape> shapes = random_shapes(2024, 200);
+  const std::vector<table::Shape> shapes = random_shapes(2024, 200);
   const double reach = 0.02;
   const UniformGrid grid(shapes, reach, 0.025);
   Rng rng(7);
@@ -57,10 +57,10 @@ TEST(UniformGrid, CandidatesAreSupersetOfShapesInReach) {
     ASSERT_TRUE(std::is_sorted(cand.begin(), cand.end()));
     ASSERT_EQ(std::adjacent_find(cand.begin(), cand.end()), cand.end()) << "duplicate candidate";
     for (std::size_t i = 0; i < shapes.size(); ++i) {
-      if (distance_to_shape(shapes[i], p) <= reach) {
+      if (table::distance_to_shape(shapes[i], p) <= reach) {
         ++total_in_reach;
         ASSERT_TRUE(std::binary_search(cand.begin(), cand.end(), static_cast<std::int32_t>(i)))
-            << "shape " << i << " at distance " << distance_to_shape(shapes[i], p) << " of (" << p.x() << ", "
+            << "shape " << i << " at distance " << table::distance_to_shape(shapes[i], p) << " of (" << p.x() << ", "
             << p.y() << ") missing";
       }
     }
@@ -69,7 +69,7 @@ TEST(UniformGrid, CandidatesAreSupersetOfShapesInReach) {
       ASSERT_GE(i, 0);
       ASSERT_LT(i, 200);
       // No shape farther than reach + one cell diagonal from the query can be listed.
-      EXPECT_LE(distance_to_shape(shapes[i], p), reach + 0.025 * std::sqrt(2.0) + 1e-12);
+      EXPECT_LE(table::distance_to_shape(shapes[i], p), reach + 0.025 * std::sqrt(2.0) + 1e-12);
     }
   }
   EXPECT_GT(total_in_reach, 1000u);  // the test exercised real hits
@@ -80,7 +80,7 @@ TEST(UniformGrid, CandidatesAreSupersetOfShapesInReach) {
 }
 
 TEST(UniformGrid, EmptyFarAway) {
-  const std::vector<Shape> shapes = random_shapes(3, 50);
+  const std::vector<table::Shape> shapes = random_shapes(3, 50);
   const UniformGrid grid(shapes, 0.02, 0.03);
   EXPECT_TRUE(grid.candidates({-5.0, 0.5}).empty());
   EXPECT_TRUE(grid.candidates({0.5, 50.0}).empty());
@@ -89,7 +89,7 @@ TEST(UniformGrid, EmptyFarAway) {
 }
 
 TEST(UniformGrid, FarObstacleNotListed) {
-  Board b;
+  table::Board b;
   testing::add_circle(b, {0.1, 0.1}, 0.02);      // 0
   testing::add_line(b, {0.8, 0.1}, {0.9, 0.2});  // 1
   testing::add_point(b, {0.5, 0.9});              // 2
@@ -106,18 +106,18 @@ TEST(UniformGrid, FarObstacleNotListed) {
 }
 
 TEST(UniformGrid, NoShapesAndBadArguments) {
-  const std::vector<Shape> none;
+  const std::vector<table::Shape> none;
   const UniformGrid empty(none, 0.02, 0.02);
   EXPECT_TRUE(empty.candidates({0.0, 0.0}).empty());
   EXPECT_EQ(empty.entry_count(), 0u);
-  const std::vector<Shape> shapes = random_shapes(1, 3);
+  const std::vector<table::Shape> shapes = random_shapes(1, 3);
   EXPECT_THROW(UniformGrid(shapes, -1.0, 0.02), std::invalid_argument);
   EXPECT_THROW(UniformGrid(shapes, 0.02, 0.0), std::invalid_argument);
 }
 
 TEST(UniformGrid, HugeBoardStaysBounded) {
   // Cells would number 1e10 at this size: the grid must coarsen, not explode.
-  Board b;
+  table::Board b;
   testing::add_line(b, {0.0, 0.0}, {1000.0, 0.0});
   testing::add_point(b, {1000.0, 1000.0});
   const UniformGrid grid(b.shapes, 0.01, 0.01);

@@ -16,10 +16,10 @@ using testing::empty_board;
 
 constexpr double kR = 0.0135;
 
-Shape floor_line() { return make_line_shape({0.0, 0.0}, {1.0, 0.0}); }
+table::Shape floor_line() { return table::make_line_shape({0.0, 0.0}, {1.0, 0.0}); }
 
 TEST(LineTimeOfImpact, FallingBallHitsAtHeightMinusRadiusOverSpeed) {
-  const Shape line = floor_line();
+  const table::Shape line = floor_line();
   ASSERT_NEAR(line.normal.y(), 1.0, 1e-15);
   const double h = 0.2;
   const double speed = 1.7;
@@ -40,7 +40,7 @@ TEST(LineTimeOfImpact, FallingBallHitsAtHeightMinusRadiusOverSpeed) {
 TEST(LineTimeOfImpact, SlantedLine) {
   // Line through the origin at 30 degrees; ball on its normal at distance d moving straight at it.
   const double a = std::numbers::pi / 6.0;
-  const Shape line = make_line_shape({0.0, 0.0}, {std::cos(a), std::sin(a)});
+  const table::Shape line = table::make_line_shape({0.0, 0.0}, {std::cos(a), std::sin(a)});
   const Vec2 n = line.normal;
   const Vec2 foot = 0.5 * Vec2{std::cos(a), std::sin(a)};
   const double d = 0.3;
@@ -63,7 +63,7 @@ TEST(LineTimeOfImpact, BackSidePassesThrough) {
   // Below it and moving down (away from the back): nothing either.
   EXPECT_FALSE(line_time_of_impact(floor_line(), {0.4, -0.005}, {0.0, -1.0}, kR, 1.0, c));
   // The reversed line (normal -y) is hit by the ball from below.
-  const Shape back = make_line_shape({1.0, 0.0}, {0.0, 0.0});
+  const table::Shape back = table::make_line_shape({1.0, 0.0}, {0.0, 0.0});
   ASSERT_TRUE(line_time_of_impact(back, {0.4, -0.2}, {0.0, 1.0}, kR, 1.0, c));
   EXPECT_NEAR(c.t_s, 0.2 - kR, 1e-15);
   EXPECT_NEAR(c.normal.y(), -1.0, 1e-15);
@@ -159,8 +159,8 @@ TEST(CircleTimeOfImpact, PointIsRadiusZero) {
   EXPECT_NEAR(c.normal.x(), -std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(c.normal.y(), std::sqrt(0.5), 1e-12);
   // shape_time_of_impact dispatches on the kind.
-  Shape s;
-  s.kind = ShapeKind::kCircle;
+  table::Shape s;
+  s.kind = table::ShapeKind::kCircle;
   s.p0 = pt;
   Contact d;
   ASSERT_TRUE(shape_time_of_impact(s, {0.3, 0.6}, {0.0, -1.5}, kR, 1.0, d));
@@ -212,17 +212,17 @@ class FlipperResponseTest : public ::testing::Test {
  protected:
   FlipperResponseTest() {
     board_ = empty_board();
-    add_flipper(board_, Side::kLeft, {0.1, 0.2}, 0.08, -0.5, 0.5, 30.0, 0.5, 0.8);
-    add_flipper(board_, Side::kRight, {0.4, 0.2}, 0.08, -0.5, 0.5, 30.0, 0.5, 0.8);
+    add_flipper(board_, table::Side::kLeft, {0.1, 0.2}, 0.08, -0.5, 0.5, 30.0, 0.5, 0.8);
+    add_flipper(board_, table::Side::kRight, {0.4, 0.2}, 0.08, -0.5, 0.5, 30.0, 0.5, 0.8);
   }
-  Board board_;
+  table::Board board_;
 };
 
 TEST_F(FlipperResponseTest, BallAtRestGetsMuOmegaArm) {
-  for (const Flipper& f : board_.flippers) {
+  for (const table::Flipper& f : board_.flippers) {
     const double theta = 0.2;
-    const Vec2 dir = flipper_direction(f, theta);
-    const Vec2 up = flipper_up_normal(f, theta);
+    const Vec2 dir = table::flipper_direction(f, theta);
+    const Vec2 up = table::flipper_up_normal(f, theta);
     for (double arm : {0.01, 0.04, 0.079}) {
       const Vec2 q = f.pivot + arm * dir;
       const Vec2 out = flipper_response(f, theta, f.omega_rad_s, q, up, Vec2::Zero());
@@ -232,10 +232,10 @@ TEST_F(FlipperResponseTest, BallAtRestGetsMuOmegaArm) {
 }
 
 TEST_F(FlipperResponseTest, ImpulseGrowsWithMomentArm) {
-  const Flipper& f = board_.flippers[0];
+  const table::Flipper& f = board_.flippers[0];
   const double theta = -0.3;
-  const Vec2 dir = flipper_direction(f, theta);
-  const Vec2 up = flipper_up_normal(f, theta);
+  const Vec2 dir = table::flipper_direction(f, theta);
+  const Vec2 up = table::flipper_up_normal(f, theta);
   const Vec2 v_in = -0.4 * up + 0.2 * dir;  // falling onto the face
   const Vec2 near_pivot = flipper_response(f, theta, f.omega_rad_s, f.pivot + 0.01 * dir, up, v_in);
   const Vec2 near_tip = flipper_response(f, theta, f.omega_rad_s, f.pivot + 0.075 * dir, up, v_in);
@@ -250,10 +250,10 @@ TEST_F(FlipperResponseTest, ImpulseGrowsWithMomentArm) {
 }
 
 TEST_F(FlipperResponseTest, NoImpulseWhenFaceMovesAway) {
-  for (const Flipper& f : board_.flippers) {
+  for (const table::Flipper& f : board_.flippers) {
     const double theta = 0.1;
-    const Vec2 dir = flipper_direction(f, theta);
-    const Vec2 up = flipper_up_normal(f, theta);
+    const Vec2 dir = table::flipper_direction(f, theta);
+    const Vec2 up = table::flipper_up_normal(f, theta);
     const Vec2 q = f.pivot + 0.06 * dir;
     // Flipper falling, ball at rest on the upper face: unchanged.
     EXPECT_EQ(flipper_response(f, theta, -f.omega_rad_s, q, up, Vec2::Zero()), Vec2(Vec2::Zero()));
@@ -270,16 +270,16 @@ TEST_F(FlipperResponseTest, NoImpulseWhenFaceMovesAway) {
 }
 
 TEST_F(FlipperResponseTest, FlipperFacePicksTheBallsSide) {
-  const Flipper& f = board_.flippers[1];
+  const table::Flipper& f = board_.flippers[1];
   const double theta = 0.25;
-  const Vec2 up = flipper_up_normal(f, theta);
-  const Vec2 mid = f.pivot + 0.04 * flipper_direction(f, theta);
-  const Shape above = flipper_face(f, theta, mid + 0.02 * up);
-  const Shape below = flipper_face(f, theta, mid - 0.02 * up);
+  const Vec2 up = table::flipper_up_normal(f, theta);
+  const Vec2 mid = f.pivot + 0.04 * table::flipper_direction(f, theta);
+  const table::Shape above = flipper_face(f, theta, mid + 0.02 * up);
+  const table::Shape below = flipper_face(f, theta, mid - 0.02 * up);
   EXPECT_NEAR((above.normal - up).norm(), 0.0, 1e-15);
   EXPECT_NEAR((below.normal + up).norm(), 0.0, 1e-15);
   EXPECT_EQ(above.p0, f.pivot);
-  EXPECT_NEAR((above.p1 - flipper_tip(f, theta)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((above.p1 - table::flipper_tip(f, theta)).norm(), 0.0, 1e-15);
 }
 
 }  // namespace

@@ -3,8 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include "pinball/sim/model_world.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/oracle_policy.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -17,24 +18,24 @@ using pinball::testing::thesis_board;
 
 // Plays `seconds` of game with the spastic flipper, relaunching lost balls,
 // and folds every step's state into one hash.
-std::uint64_t hash_game(const ThesisStepper& stepper, GameState& state, double seconds) {
-  const Board& board = stepper.board();
+std::uint64_t hash_game(World& world, GameState& state, double seconds) {
+  const table::Board& board = world.board();
   std::uint64_t h = hash_state(state);
   while (state.time_s < seconds) {
-    if (!state.ball_in_play) begin_ball(board, state, board.launcher.pull);
+    if (!state.ball_in_play) begin_ball(world, state, board.launcher.pull);
     oracle_spastic_policy(board, state);
-    stepper.step(state);
+    world.step(state);
     h = hash_combine_state(h, state);
   }
   return h;
 }
 
 TEST(Determinism, SixtySecondGameIsBitIdenticalAcrossRuns) {
-  const ThesisStepper stepper(thesis_board());
+  const std::unique_ptr<World> world = make_model_world(thesis_board());
   GameState a = make_game_state(thesis_board(), 7);
   GameState b = make_game_state(thesis_board(), 7);
-  const std::uint64_t ha = hash_game(stepper, a, 60.0);
-  const std::uint64_t hb = hash_game(stepper, b, 60.0);
+  const std::uint64_t ha = hash_game(*world, a, 60.0);
+  const std::uint64_t hb = hash_game(*world, b, 60.0);
   EXPECT_EQ(ha, hb);
   EXPECT_GE(a.steps, 120'000u);
   EXPECT_GT(a.flips, 0u) << "the spastic flipper should have flipped in a minute of play";
@@ -42,28 +43,28 @@ TEST(Determinism, SixtySecondGameIsBitIdenticalAcrossRuns) {
 }
 
 TEST(Determinism, DifferentSeedsDiverge) {
-  const ThesisStepper stepper(thesis_board());
+  const std::unique_ptr<World> world = make_model_world(thesis_board());
   GameState a = make_game_state(thesis_board(), 7);
   GameState b = make_game_state(thesis_board(), 8);
-  EXPECT_NE(hash_game(stepper, a, 10.0), hash_game(stepper, b, 10.0));
+  EXPECT_NE(hash_game(*world, a, 10.0), hash_game(*world, b, 10.0));
 }
 
 TEST(Determinism, ACopiedStateContinuesIdentically) {
-  const ThesisStepper stepper(thesis_board());
+  const std::unique_ptr<World> world = make_model_world(thesis_board());
   GameState a = make_game_state(thesis_board(), 11);
-  hash_game(stepper, a, 20.0);
+  hash_game(*world, a, 20.0);
   GameState b = a;  // the random stream is part of the state
-  EXPECT_EQ(hash_game(stepper, a, 40.0), hash_game(stepper, b, 40.0));
+  EXPECT_EQ(hash_game(*world, a, 40.0), hash_game(*world, b, 40.0));
 }
 
 TEST(Determinism, GridAndLinearScanGiveTheSameGame) {
-  ThesisStepperOptions linear;
-  linear.use_grid = false;
-  const ThesisStepper with_grid(thesis_board());
-  const ThesisStepper without_grid(thesis_board(), linear);
+  ModelWorldOptions linear;
+  linear.thesis.use_grid = false;
+  const std::unique_ptr<World> with_grid = make_model_world(thesis_board());
+  const std::unique_ptr<World> without_grid = make_model_world(thesis_board(), linear);
   GameState a = make_game_state(thesis_board(), 3);
   GameState b = make_game_state(thesis_board(), 3);
-  EXPECT_EQ(hash_game(with_grid, a, 30.0), hash_game(without_grid, b, 30.0));
+  EXPECT_EQ(hash_game(*with_grid, a, 30.0), hash_game(*without_grid, b, 30.0));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // circle; flippers (rolling off a raised one, striking a resting ball); the
 // energy invariant; and agreement with the thesis stepper at a tiny dt.
 
+#include "pinball/sim/model_world.h"
 #include "pinball/sim/event_stepper.h"
 
 #include <gtest/gtest.h>
@@ -11,7 +12,7 @@
 #include <numbers>
 
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/oracle_policy.h"
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -24,12 +25,12 @@ using namespace pinball::sim::testing;
 
 constexpr double kR = 0.0135;
 
-double energy(const Board& b, const GameState& s) {
+double energy(const table::Board& b, const GameState& s) {
   return 0.5 * s.ball.velocity_mps.squaredNorm() + b.gravity_mps2 * s.ball.position_m.y();
 }
 
 TEST(EventStepper, RejectsBadSettings) {
-  const Board b = box_board();
+  const table::Board b = box_board();
   EventStepperOptions o;
   o.dt_s = -1.0;
   EXPECT_THROW(EventStepper(b, o), std::invalid_argument);
@@ -45,7 +46,7 @@ TEST(EventStepper, RejectsBadSettings) {
 TEST(EventStepper, FreeFlightIsTheParabola) {
   // The step horizon is not an integration step: the only error is the
   // round-off of storing the state once per step.
-  Board b = empty_board(10.0, 30.0, 1.11, 1e-2);
+  table::Board b = empty_board(10.0, 30.0, 1.11, 1e-2);
   const Vec2 p0{5.0, 5.0}, v0{0.3, 5.55};
   for (const double dt : {1e-2, 5e-4}) {
     EventStepperOptions o;
@@ -70,7 +71,7 @@ TEST(EventStepper, FreeFlightIsTheParabola) {
 
 TEST(EventStepper, BouncesOnAFloorFollowTheGeometricSeriesThenRest) {
   const double g = 1.11, rho = 0.8, h0 = 0.3;
-  Board b = empty_board(1.0, 1.0, g, 5e-4);
+  table::Board b = empty_board(1.0, 1.0, g, 5e-4);
   add_line(b, {-1.0, 0.0}, {2.0, 0.0}, rho);
   const EventStepper stepper(b);
   GameState s = state_with_ball(b, {0.5, kR + h0}, Vec2::Zero());
@@ -111,9 +112,9 @@ TEST(EventStepper, LooseTolerancesCostPrecisionNotPhysics) {
   // same bounces must happen. (A touch speed once derived from it reached
   // metres per second at 1e-6 and turned real bounces into slides.)
   const double g = 1.11, h0 = 0.3, rho = 0.8;
-  Board floor = empty_board(1.0, 1.0, g, 5e-4);
+  table::Board floor = empty_board(1.0, 1.0, g, 5e-4);
   add_line(floor, {0.0, 0.0}, {1.0, 0.0}, rho);  // size: 1 m
-  const Board box = box_board(1.0, g, 5e-4);    // elastic, 0.51 x 1.07 m
+  const table::Board box = box_board(1.0, g, 5e-4);    // elastic, 0.51 x 1.07 m
   for (const double tol : {1e-6, 1e-8, 1e-10}) {
     EventStepperOptions o;
     o.relative_tolerance = tol;
@@ -146,11 +147,11 @@ TEST(EventStepper, LooseTolerancesCostPrecisionNotPhysics) {
 
 TEST(EventStepper, SlidesDownAnInclineUniformlyAccelerated) {
   const double g = 1.11, alpha = 0.3;
-  Board b = empty_board(2.0, 2.0, g, 5e-4);
+  table::Board b = empty_board(2.0, 2.0, g, 5e-4);
   const Vec2 a{0.0, 1.5}, c{2.0, 1.5 - 2.0 * std::tan(alpha)};
   add_line(b, a, c, 0.5);
   const EventStepper stepper(b);
-  const Shape& line = b.shapes[0];
+  const table::Shape& line = b.shapes[0];
   const Vec2 tangent = (c - a).normalized();
   const Vec2 start = a + 0.1 * tangent + kR * line.normal;
   GameState s = state_with_ball(b, start, Vec2::Zero());
@@ -166,7 +167,7 @@ TEST(EventStepper, SlidesDownAnInclineUniformlyAccelerated) {
 
 TEST(EventStepper, ElasticBoxIsPeriodic) {
   const double g = 1.11;
-  Board b = box_board(1.0, g, 5e-4);
+  table::Board b = box_board(1.0, g, 5e-4);
   const EventStepper stepper(b);
   // Dropped from rest 0.5 m above the floor: period 2·sqrt(2h/g).
   const double h = 0.5;
@@ -201,7 +202,7 @@ TEST(EventStepper, ElasticBoxIsPeriodic) {
 }
 
 TEST(EventStepper, BounceOffACircleIsTheReflectedRay) {
-  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
   const Vec2 c{0.5, 0.5};
   const double radius = 0.05;
   add_circle(b, c, radius, 1.0);
@@ -223,22 +224,22 @@ TEST(EventStepper, BounceOffACircleIsTheReflectedRay) {
   EXPECT_EQ(s.events, 1u);
 }
 
-Board flipper_board() {
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+table::Board flipper_board() {
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
   add_line(b, {-1.0, 0.0}, {2.0, 0.0}, 0.5);  // a floor far below
-  add_flipper(b, Side::kLeft, {0.3, 0.4}, 0.076, -0.5, 0.5, 33.0, 0.6, 1.6);
+  add_flipper(b, table::Side::kLeft, {0.3, 0.4}, 0.076, -0.5, 0.5, 33.0, 0.6, 1.6);
   return b;
 }
 
 TEST(EventStepper, BallOnARaisedFlipperRollsOff) {
-  const Board b = flipper_board();
-  const Flipper& f = b.flippers[0];
+  const table::Board b = flipper_board();
+  const table::Flipper& f = b.flippers[0];
   const EventStepper stepper(b);
   GameState s = make_game_state(b, 1);
   s.flippers[0].theta_rad = f.theta_max_rad;
   s.flippers[0].energized = s.flippers[0].was_energized = true;
-  const Vec2 start = f.pivot + 0.06 * flipper_direction(f, f.theta_max_rad) +
-                     kR * flipper_up_normal(f, f.theta_max_rad);
+  const Vec2 start = f.pivot + 0.06 * table::flipper_direction(f, f.theta_max_rad) +
+                     kR * table::flipper_up_normal(f, f.theta_max_rad);
   s.ball_in_play = true;
   s.ball.position_m = start;
   s.ball.velocity_mps = Vec2::Zero();
@@ -256,9 +257,9 @@ TEST(EventStepper, BallOnARaisedFlipperRollsOff) {
 }
 
 TEST(EventStepper, FlipperStrikesARestingBallWithTheThesisImpulse) {
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
-  add_flipper(b, Side::kLeft, {0.3, 0.4}, 0.076, 0.0, 0.5, 33.0, 0.6, 1.6);  // rests horizontal
-  const Flipper& f = b.flippers[0];
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  add_flipper(b, table::Side::kLeft, {0.3, 0.4}, 0.076, 0.0, 0.5, 33.0, 0.6, 1.6);  // rests horizontal
+  const table::Flipper& f = b.flippers[0];
   const EventStepper stepper(b);
   GameState s = make_game_state(b, 1);
   const double arm = 0.05;
@@ -278,7 +279,7 @@ TEST(EventStepper, FlipperStrikesARestingBallWithTheThesisImpulse) {
 }
 
 TEST(EventStepper, EnergyNeverGrowsWithoutKickersOrFlippers) {
-  Board b = box_board(0.9, 1.11, 5e-4);
+  table::Board b = box_board(0.9, 1.11, 5e-4);
   add_circle(b, {0.15, 0.70}, 0.03, 0.95);
   add_circle(b, {0.35, 0.72}, 0.03, 1.0);
   add_point(b, {0.40, 0.45}, 0.9);
@@ -293,7 +294,7 @@ TEST(EventStepper, EnergyNeverGrowsWithoutKickersOrFlippers) {
     GameState s = state_with_ball(b, {rng.uniform(0.1, 0.4), rng.uniform(0.5, 1.0)},
                                   {rng.uniform(-3.0, 3.0), rng.uniform(-3.0, 3.0)});
     bool clear = true;
-    for (const Shape& shape : b.shapes) clear = clear && distance_to_shape(shape, s.ball.position_m) > kR;
+    for (const table::Shape& shape : b.shapes) clear = clear && table::distance_to_shape(shape, s.ball.position_m) > kR;
     if (!clear) continue;  // a start inside an obstacle
     double e = energy(b, s);
     for (int i = 0; i < 20000; ++i) {
@@ -314,7 +315,7 @@ TEST(EventStepper, WedgesHoldTheBallStillWithoutChatter) {
   // 2 m long meeting at a point; the ball dropped into them off-centre.
   for (const double opening_deg : {1.0, 45.0, 179.0}) {
     const double half = 0.5 * opening_deg * std::numbers::pi / 180.0;
-    Board b = empty_board(4.0, 3.0, 1.11, 5e-4);
+    table::Board b = empty_board(4.0, 3.0, 1.11, 5e-4);
     const Vec2 vertex{2.0, 0.2};
     const Vec2 left = vertex + 2.0 * Vec2{-std::sin(half), std::cos(half)};
     const Vec2 right = vertex + 2.0 * Vec2{std::sin(half), std::cos(half)};
@@ -326,8 +327,8 @@ TEST(EventStepper, WedgesHoldTheBallStillWithoutChatter) {
     const double dx = opening_deg < 10.0 ? 1e-3 : 0.1;
     const double h0 = std::min(1.9 * std::cos(half), dx / std::tan(half) + 2.0 * kR / std::sin(half));
     GameState s = state_with_ball(b, vertex + Vec2{dx, h0}, Vec2::Zero());
-    ASSERT_GT(distance_to_shape(b.shapes[0], s.ball.position_m), kR);
-    ASSERT_GT(distance_to_shape(b.shapes[1], s.ball.position_m), kR);
+    ASSERT_GT(table::distance_to_shape(b.shapes[0], s.ball.position_m), kR);
+    ASSERT_GT(table::distance_to_shape(b.shapes[1], s.ball.position_m), kR);
     double e = energy(b, s);
     std::uint64_t events_at_19s = 0;
     for (int i = 0; i < 40000; ++i) {  // 20 s
@@ -345,8 +346,8 @@ TEST(EventStepper, WedgesHoldTheBallStillWithoutChatter) {
       // Nearly flat and frictionless: the ball slides to and fro across the
       // vertex, losing only the normal speed of the 1° turn there; it stays
       // on the lines and inside its first swing.
-      const double d0 = distance_to_shape(b.shapes[0], s.ball.position_m);
-      const double d1 = distance_to_shape(b.shapes[1], s.ball.position_m);
+      const double d0 = table::distance_to_shape(b.shapes[0], s.ball.position_m);
+      const double d1 = table::distance_to_shape(b.shapes[1], s.ball.position_m);
       EXPECT_NEAR(std::min(d0, d1), kR, 1e-9);
       EXPECT_LE(std::abs(s.ball.position_m.x() - vertex.x()), dx + 1e-9);
       continue;
@@ -354,13 +355,13 @@ TEST(EventStepper, WedgesHoldTheBallStillWithoutChatter) {
     EXPECT_LT(s.ball.velocity_mps.norm(), 1e-9) << opening_deg << " deg: at rest";
     EXPECT_EQ(s.events, events_at_19s) << opening_deg << " deg: no events while resting";
     // Held by both lines, on the axis.
-    EXPECT_NEAR(distance_to_shape(b.shapes[0], s.ball.position_m), kR, 1e-9) << opening_deg << " deg";
-    EXPECT_NEAR(distance_to_shape(b.shapes[1], s.ball.position_m), kR, 1e-9) << opening_deg << " deg";
+    EXPECT_NEAR(table::distance_to_shape(b.shapes[0], s.ball.position_m), kR, 1e-9) << opening_deg << " deg";
+    EXPECT_NEAR(table::distance_to_shape(b.shapes[1], s.ball.position_m), kR, 1e-9) << opening_deg << " deg";
   }
 }
 
 TEST(EventStepper, AgreesWithTheThesisStepperAtTinyDt) {
-  const Board b = load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  const table::Board b = table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
   ThesisStepperOptions to;
   to.dt_s = 1e-5;
   const ThesisStepper thesis(b, to);
@@ -385,14 +386,16 @@ TEST(EventStepper, AgreesWithTheThesisStepperAtTinyDt) {
 }
 
 TEST(EventStepper, PlaysBallsOnMit1993WithoutPenetration) {
-  const Board b = load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
-  const EventStepper stepper(b);
+  const table::Board b = table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  ModelWorldOptions event;
+  event.stepper = StepperKind::kEvent;
+  const std::unique_ptr<World> world = make_model_world(b, event);
   GameState s = make_game_state(b, 11);
   BallLimits limits;
   limits.max_ball_time_s = 60.0;
   double worst = 0.0;
   for (int ball = 0; ball < 4; ++ball) {
-    play_ball(stepper, s, limits, [&](GameState& st) { oracle_spastic_policy(b, st); },
+    play_ball(*world, s, limits, [&](GameState& st) { oracle_spastic_policy(b, st); },
               [&](const GameState& st, const StepEvents&) {
                 ASSERT_TRUE(finite(st.ball.position_m) && finite(st.ball.velocity_mps));
                 if (st.ball_in_play) worst = std::max(worst, max_penetration_m(b, st));

@@ -9,16 +9,16 @@ namespace {
 
 using namespace pinball::sim::testing;
 
-Board small_board() {
-  Board b = box_board();
+table::Board small_board() {
+  table::Board b = box_board();
   add_circle(b, {0.2, 0.6}, 0.03);
   add_circle(b, {0.3, 0.6}, 0.03);
   b.obstacles.back().visible = false;
-  add_flipper(b, Side::kLeft, {0.15, 0.2}, 0.076, -0.4, 0.5);
-  add_flipper(b, Side::kRight, {0.36, 0.2}, 0.076, -0.45, 0.5);
-  Sensor s;
-  s.kind = SensorKind::kProximity;
-  s.shape.kind = ShapeKind::kCircle;
+  add_flipper(b, table::Side::kLeft, {0.15, 0.2}, 0.076, -0.4, 0.5);
+  add_flipper(b, table::Side::kRight, {0.36, 0.2}, 0.076, -0.45, 0.5);
+  table::Sensor s;
+  s.kind = table::SensorKind::kProximity;
+  s.shape.kind = table::ShapeKind::kCircle;
   s.shape.p0 = {0.25, 0.8};
   s.shape.radius_m = 0.02;
   b.sensors.push_back(s);
@@ -28,7 +28,7 @@ Board small_board() {
 }
 
 TEST(MakeGameState, SizesAndInitialValues) {
-  const Board b = small_board();
+  const table::Board b = small_board();
   const GameState s = make_game_state(b, 9);
   ASSERT_EQ(s.flippers.size(), 2u);
   ASSERT_EQ(s.visible.size(), b.obstacles.size());
@@ -59,7 +59,7 @@ TEST(MakeGameState, SizesAndInitialValues) {
 }
 
 TEST(ResetGame, RestoresVisibilityBallsScoreAndFlippers) {
-  const Board b = small_board();
+  const table::Board b = small_board();
   GameState s = make_game_state(b, 3);
   s.score = 1234.0;
   s.balls_left = 1;
@@ -90,7 +90,7 @@ TEST(ResetGame, RestoresVisibilityBallsScoreAndFlippers) {
 }
 
 TEST(LaunchBall, PlacesBallAndDrawsSpeed) {
-  const Board b = small_board();
+  const table::Board b = small_board();
   GameState s = make_game_state(b, 3);
   s.ball.position_m = {0.2, 0.2};
   Rng mirror = s.rng;

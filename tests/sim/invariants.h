@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/penetration.h"
 #include "test_boards.h"
@@ -19,7 +19,7 @@ constexpr double kDefaultMaxDepth_m = 1e-6;
 
 /// True when the ball and flippers are finite and the ball overlaps nothing
 /// deeper than max_depth_m; otherwise records a failure naming the step.
-inline bool invariants_hold(const Board& b, const GameState& s, long step, double max_depth_m = kDefaultMaxDepth_m) {
+inline bool invariants_hold(const table::Board& b, const GameState& s, long step, double max_depth_m = kDefaultMaxDepth_m) {
   if (!finite(s.ball.position_m) || !finite(s.ball.velocity_mps)) {
     ADD_FAILURE() << "non-finite ball state at step " << step;
     return false;

@@ -9,15 +9,15 @@ namespace {
 
 using namespace pinball::sim::testing;
 
-Board two_flippers() {
-  Board b = empty_board(0.51, 1.07);
-  add_flipper(b, Side::kLeft, {0.165, 0.16});
-  add_flipper(b, Side::kRight, {0.345, 0.16});
+table::Board two_flippers() {
+  table::Board b = empty_board(0.51, 1.07);
+  add_flipper(b, table::Side::kLeft, {0.165, 0.16});
+  add_flipper(b, table::Side::kRight, {0.345, 0.16});
   return b;
 }
 
 TEST(OracleSpasticPolicy, FlipsOnlyTheNearerFlipperForAFallingBallInReach) {
-  const Board b = two_flippers();
+  const table::Board b = two_flippers();
   GameState s = state_with_ball(b, {0.21, 0.16}, {0.0, -1.0});  // just above the left flipper
   oracle_spastic_policy(b, s);
   EXPECT_TRUE(s.flippers[0].energized);
@@ -30,7 +30,7 @@ TEST(OracleSpasticPolicy, FlipsOnlyTheNearerFlipperForAFallingBallInReach) {
 }
 
 TEST(OracleSpasticPolicy, ReleasesForBallsOutOfReachRisingOrCradled) {
-  const Board b = two_flippers();
+  const table::Board b = two_flippers();
   GameState s = state_with_ball(b, {0.20, 0.60}, {0.0, -1.0});  // far above
   for (auto& f : s.flippers) f.energized = true;
   oracle_spastic_policy(b, s);

@@ -19,9 +19,9 @@ using testing::empty_board;
 constexpr double kR = 0.0135;
 
 TEST(ShapePenetration, LineFrontFaceOnly) {
-  Board b = empty_board();
+  table::Board b = empty_board();
   add_line(b, {0.0, 0.0}, {1.0, 0.0});  // normal +y
-  const Shape& s = b.shapes[0];
+  const table::Shape& s = b.shapes[0];
   EXPECT_DOUBLE_EQ(shape_penetration_m(s, {0.5, 0.01}, kR), kR - 0.01);
   EXPECT_DOUBLE_EQ(shape_penetration_m(s, {0.5, 0.0}, kR), kR);
   EXPECT_EQ(shape_penetration_m(s, {0.5, kR}, kR), 0.0);        // touching
@@ -32,7 +32,7 @@ TEST(ShapePenetration, LineFrontFaceOnly) {
 }
 
 TEST(ShapePenetration, CircleAndPoint) {
-  Board b = empty_board();
+  table::Board b = empty_board();
   add_circle(b, {0.5, 0.5}, 0.03);
   add_point(b, {0.2, 0.2});
   EXPECT_NEAR(shape_penetration_m(b.shapes[0], {0.5, 0.54}, kR), 0.03 + kR - 0.04, 1e-15);
@@ -42,7 +42,7 @@ TEST(ShapePenetration, CircleAndPoint) {
 }
 
 TEST(ObstaclePenetration, HiddenObstaclesAndCandidatesOnly) {
-  Board b = empty_board();
+  table::Board b = empty_board();
   add_circle(b, {0.5, 0.5}, 0.03);   // 0: depth 0.0135 - 0.005 at the probe
   add_circle(b, {0.5, 0.45}, 0.03);  // 1: deeper
   GameState s = make_game_state(b, 1);
@@ -60,8 +60,8 @@ TEST(ObstaclePenetration, HiddenObstaclesAndCandidatesOnly) {
 }
 
 TEST(FlipperPenetration, TwoSidedAtCurrentAngle) {
-  Board b = empty_board();
-  add_flipper(b, Side::kLeft, {0.1, 0.2}, 0.08, -0.5, 0.5, 30.0);
+  table::Board b = empty_board();
+  add_flipper(b, table::Side::kLeft, {0.1, 0.2}, 0.08, -0.5, 0.5, 30.0);
   GameState s = make_game_state(b, 1);
   s.flippers[0].theta_rad = 0.0;  // horizontal from (0.1, 0.2) to (0.18, 0.2)
   EXPECT_NEAR(flipper_penetration_m(b, s, {0.14, 0.205}), kR - 0.005, 1e-15);

@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 
 namespace pinball::sim {
@@ -31,8 +31,8 @@ RenderOptions test_options() {
 }
 
 // A 0.5 x 1.0 m table with nothing on it.
-Board empty_board() {
-  Board b;
+table::Board empty_board() {
+  table::Board b;
   b.width_m = 0.5;
   b.height_m = 1.0;
   b.ball.radius_m = 0.015;
@@ -40,9 +40,9 @@ Board empty_board() {
   return b;
 }
 
-void add_line(Board& b, const Vec2& p0, const Vec2& p1, const Obstacle& o = Obstacle{}) {
-  Shape s;
-  s.kind = ShapeKind::kLine;
+void add_line(table::Board& b, const Vec2& p0, const Vec2& p1, const table::Obstacle& o = table::Obstacle{}) {
+  table::Shape s;
+  s.kind = table::ShapeKind::kLine;
   s.p0 = p0;
   s.p1 = p1;
   s.normal = perp_left((p1 - p0).normalized());
@@ -50,9 +50,9 @@ void add_line(Board& b, const Vec2& p0, const Vec2& p1, const Obstacle& o = Obst
   b.obstacles.push_back(o);
 }
 
-void add_circle(Board& b, const Vec2& c, double r_m, const Obstacle& o = Obstacle{}) {
-  Shape s;
-  s.kind = ShapeKind::kCircle;
+void add_circle(table::Board& b, const Vec2& c, double r_m, const table::Obstacle& o = table::Obstacle{}) {
+  table::Shape s;
+  s.kind = table::ShapeKind::kCircle;
   s.p0 = c;
   s.radius_m = r_m;
   b.shapes.push_back(s);
@@ -60,13 +60,13 @@ void add_circle(Board& b, const Vec2& c, double r_m, const Obstacle& o = Obstacl
 }
 
 // One horizontal wall across the middle of the table, at y = 0.5 m.
-Board line_board() {
-  Board b = empty_board();
+table::Board line_board() {
+  table::Board b = empty_board();
   add_line(b, Vec2{0.1, 0.5}, Vec2{0.4, 0.5});
   return b;
 }
 
-cv::Point pixel_of(const Board& b, const Vec2& p_board) {
+cv::Point pixel_of(const table::Board& b, const Vec2& p_board) {
   const cv::Point2d uv = board_to_pixel(b, test_options(), p_board);
   return {static_cast<int>(std::lround(uv.x)), static_cast<int>(std::lround(uv.y))};
 }
@@ -105,27 +105,27 @@ class RendererFileTest : public ::testing::Test {
 };
 
 TEST(RendererTest, RenderSizeIsScaledTableWithMargins) {
-  const Board b = empty_board();
+  const table::Board b = empty_board();
   const cv::Size size = render_size(b, test_options());
   EXPECT_EQ(size.width, 100 + 2 * kMargin);
   EXPECT_EQ(size.height, 200 + 2 * kMargin);
 
   RenderOptions big;  // defaults: 800 px/m, 12 px margin
-  Board thesis;       // default 0.51 x 1.07 m table
+  table::Board thesis;       // default 0.51 x 1.07 m table
   const cv::Size s2 = render_size(thesis, big);
   EXPECT_EQ(s2.width, static_cast<int>(std::lround(0.51 * 800.0)) + 24);
   EXPECT_EQ(s2.height, static_cast<int>(std::lround(1.07 * 800.0)) + 24);
 }
 
 TEST(RendererTest, RenderBoardReturnsBgrImageOfRenderSize) {
-  const Board b = line_board();
+  const table::Board b = line_board();
   const cv::Mat image = render_board(b, nullptr, test_options());
   EXPECT_EQ(image.size(), render_size(b, test_options()));
   EXPECT_EQ(image.type(), CV_8UC3);
 }
 
 TEST(RendererTest, BoardToPixelFlipsYAndAddsMargin) {
-  const Board b = empty_board();
+  const table::Board b = empty_board();
   const RenderOptions o = test_options();
   const cv::Point2d origin = board_to_pixel(b, o, Vec2{0.0, 0.0});
   EXPECT_DOUBLE_EQ(origin.x, kMargin);
@@ -143,7 +143,7 @@ TEST(RendererTest, BoardToPixelFlipsYAndAddsMargin) {
 }
 
 TEST(RendererTest, HorizontalLineIsBrightAlongItsRowAndDarkElsewhere) {
-  const Board b = line_board();
+  const table::Board b = line_board();
   const cv::Mat image = render_board(b, nullptr, test_options());
   const int v_line = pixel_of(b, Vec2{0.0, 0.5}).y;
   ASSERT_EQ(v_line, kMargin + 100);
@@ -165,7 +165,7 @@ TEST(RendererTest, HorizontalLineIsBrightAlongItsRowAndDarkElsewhere) {
 }
 
 TEST(RendererTest, PlayfieldOutlineIsDrawn) {
-  const Board b = empty_board();
+  const table::Board b = empty_board();
   const cv::Mat image = render_board(b, nullptr, test_options());
   const cv::Point top_mid = pixel_of(b, Vec2{0.25, 1.0});
   const cv::Point left_mid = pixel_of(b, Vec2{0.0, 0.5});
@@ -177,7 +177,7 @@ TEST(RendererTest, PlayfieldOutlineIsDrawn) {
 }
 
 TEST(RendererTest, BallIsDrawnAtItsPositionOnlyWhenInPlay) {
-  const Board b = line_board();
+  const table::Board b = line_board();
   GameState state = make_game_state(b, 7);
   const Vec2 ball{0.25, 0.3};
   state.ball.position_m = ball;
@@ -206,7 +206,7 @@ TEST(RendererTest, BallIsDrawnAtItsPositionOnlyWhenInPlay) {
 }
 
 TEST(RendererTest, HiddenObstacleIsDrawnDifferently) {
-  const Board b = line_board();
+  const table::Board b = line_board();
   GameState state = make_game_state(b, 1);
   ASSERT_EQ(state.visible.size(), 1u);
   ASSERT_EQ(state.visible[0], 1);
@@ -230,20 +230,20 @@ TEST(RendererTest, HiddenObstacleIsDrawnDifferently) {
   EXPECT_GT(gaps, 5);
 
   // The board's own flag stands in when there is no state.
-  Board b_hidden = b;
+  table::Board b_hidden = b;
   b_hidden.obstacles[0].visible = false;
   EXPECT_TRUE(same_image(render_board(b_hidden, nullptr, test_options()), hidden));
   EXPECT_TRUE(same_image(render_board(b, nullptr, test_options()), shown));
 }
 
 TEST(RendererTest, ObstacleColourFollowsWhatItDoes) {
-  Board b = empty_board();
-  Obstacle wall;
-  Obstacle kicker;
+  table::Board b = empty_board();
+  table::Obstacle wall;
+  table::Obstacle kicker;
   kicker.rho = 1.5;
-  Obstacle eater;
+  table::Obstacle eater;
   eater.action.eats_ball = true;
-  Obstacle scorer;
+  table::Obstacle scorer;
   scorer.action.score = 100.0;
   add_line(b, Vec2{0.1, 0.2}, Vec2{0.4, 0.2}, wall);
   add_line(b, Vec2{0.1, 0.4}, Vec2{0.4, 0.4}, kicker);
@@ -269,7 +269,7 @@ TEST(RendererTest, ObstacleColourFollowsWhatItDoes) {
 }
 
 TEST(RendererTest, CirclesAreFilledAndPointsAreDots) {
-  Board b = empty_board();
+  table::Board b = empty_board();
   add_circle(b, Vec2{0.25, 0.6}, 0.04);  // 8 px radius
   add_circle(b, Vec2{0.25, 0.3}, 0.0);   // a point
   const cv::Mat image = render_board(b, nullptr, test_options());
@@ -285,7 +285,7 @@ TEST(RendererTest, CirclesAreFilledAndPointsAreDots) {
 }
 
 TEST(RendererTest, HiddenCircleIsNotFilled) {
-  Board b = empty_board();
+  table::Board b = empty_board();
   add_circle(b, Vec2{0.25, 0.6}, 0.04);
   b.obstacles[0].visible = false;
   const cv::Mat image = render_board(b, nullptr, test_options());
@@ -296,15 +296,15 @@ TEST(RendererTest, HiddenCircleIsNotFilled) {
 }
 
 TEST(RendererTest, SensorsAreDrawnAndHolesAreDark) {
-  Board b = empty_board();
-  Sensor line;
-  line.kind = SensorKind::kProximity;
-  line.shape.kind = ShapeKind::kLine;
+  table::Board b = empty_board();
+  table::Sensor line;
+  line.kind = table::SensorKind::kProximity;
+  line.shape.kind = table::ShapeKind::kLine;
   line.shape.p0 = Vec2{0.1, 0.3};
   line.shape.p1 = Vec2{0.4, 0.3};
-  Sensor hole;
-  hole.kind = SensorKind::kHole;
-  hole.shape.kind = ShapeKind::kCircle;
+  table::Sensor hole;
+  hole.kind = table::SensorKind::kHole;
+  hole.shape.kind = table::ShapeKind::kCircle;
   hole.shape.p0 = Vec2{0.25, 0.7};
   hole.shape.radius_m = 0.03;
   b.sensors = {line, hole};
@@ -324,17 +324,17 @@ TEST(RendererTest, SensorsAreDrawnAndHolesAreDark) {
 }
 
 TEST(RendererTest, FlipperIsDrawnAtItsAngle) {
-  Board b = empty_board();
-  Flipper f;
-  f.side = Side::kLeft;
+  table::Board b = empty_board();
+  table::Flipper f;
+  f.side = table::Side::kLeft;
   f.pivot = Vec2{0.1, 0.2};
   f.length_m = 0.1;
   f.theta_min_rad = -0.5;
   f.theta_max_rad = 0.5;
   f.omega_rad_s = 20.0;
   b.flippers.push_back(f);
-  const Vec2 mid_down = 0.5 * (f.pivot + flipper_tip(f, f.theta_min_rad));
-  const Vec2 mid_up = 0.5 * (f.pivot + flipper_tip(f, f.theta_max_rad));
+  const Vec2 mid_down = 0.5 * (f.pivot + table::flipper_tip(f, f.theta_min_rad));
+  const Vec2 mid_up = 0.5 * (f.pivot + table::flipper_tip(f, f.theta_max_rad));
 
   const cv::Mat rest = render_board(b, nullptr, test_options());
   EXPECT_GT(brightness(rest, pixel_of(b, mid_down)), 140);
@@ -353,14 +353,14 @@ TEST(RendererTest, FlipperIsDrawnAtItsAngle) {
 }
 
 TEST(RendererTest, LauncherIsMarked) {
-  const Board b = empty_board();
-  Board moved = b;
+  const table::Board b = empty_board();
+  table::Board moved = b;
   moved.launcher.position = Vec2{0.25, 0.5};
   EXPECT_FALSE(same_image(render_board(b, nullptr, test_options()), render_board(moved, nullptr, test_options())));
 }
 
 TEST(RendererTest, NormalsAreDrawnOnTheNormalSide) {
-  const Board b = line_board();  // normal points +y (up the table, up the image)
+  const table::Board b = line_board();  // normal points +y (up the table, up the image)
   RenderOptions o = test_options();
   const cv::Mat plain = render_board(b, nullptr, o);
   o.draw_normals = true;
@@ -372,7 +372,7 @@ TEST(RendererTest, NormalsAreDrawnOnTheNormalSide) {
 }
 
 TEST(RendererTest, HudNeedsAStateAndTheOption) {
-  const Board b = line_board();
+  const table::Board b = line_board();
   GameState state = make_game_state(b, 5);
   state.score = 12345.0;
   state.time_s = 3.25;
@@ -397,7 +397,7 @@ TEST(RendererTest, HudNeedsAStateAndTheOption) {
 }
 
 TEST(RendererTest, SameInputSameImage) {
-  Board b = line_board();
+  table::Board b = line_board();
   add_circle(b, Vec2{0.2, 0.8}, 0.03);
   GameState state = make_game_state(b, 9);
   state.ball_in_play = true;
@@ -408,7 +408,7 @@ TEST(RendererTest, SameInputSameImage) {
 }
 
 TEST(RendererTest, RejectsBadOptions) {
-  const Board b = line_board();
+  const table::Board b = line_board();
   RenderOptions o = test_options();
   o.px_per_m = 0.0;
   EXPECT_THROW(render_board(b, nullptr, o), std::invalid_argument);
@@ -418,7 +418,7 @@ TEST(RendererTest, RejectsBadOptions) {
 }
 
 TEST_F(RendererFileTest, WritePngRoundTrips) {
-  const Board b = line_board();
+  const table::Board b = line_board();
   const cv::Mat image = render_board(b, nullptr, test_options());
   const std::string path = (dir_ / "board.png").string();
   write_png(image, path);

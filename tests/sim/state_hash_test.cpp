@@ -12,7 +12,7 @@ namespace {
 using namespace pinball::sim::testing;
 
 TEST(StateHash, EqualStatesHashEqualAndEveryFieldCounts) {
-  Board b = box_with_bumpers_and_flippers();
+  table::Board b = box_with_bumpers_and_flippers();
   const GameState base = state_with_ball(b, {0.3, 0.5}, {1.0, -0.5});
   const std::uint64_t h = hash_state(base);
   EXPECT_EQ(h, hash_state(GameState(base)));
@@ -33,7 +33,7 @@ TEST(StateHash, EqualStatesHashEqualAndEveryFieldCounts) {
 }
 
 TEST(StateHash, CombiningIsOrderSensitive) {
-  Board b = box_board();
+  table::Board b = box_board();
   const GameState a = state_with_ball(b, {0.3, 0.5}, {1.0, 0.0});
   const GameState c = state_with_ball(b, {0.4, 0.5}, {1.0, 0.0});
   EXPECT_NE(hash_combine_state(hash_state(a), c), hash_combine_state(hash_state(c), a));

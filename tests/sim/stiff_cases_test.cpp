@@ -10,8 +10,9 @@
 #include <vector>
 
 #include "pinball/core/rng.h"
+#include "pinball/sim/model_world.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "invariants.h"
@@ -29,7 +30,7 @@ TEST(StiffCases, FastBallAgainstThinWall) {
   // A vertical two-sided wall at x = 0.5; the ball at 50 m/s (10x a real
   // table's speeds) moves 2.5 cm per step, nearly its own diameter.
   for (double deg : {0.0, 15.0, 30.0, 45.0, 60.0, 75.0, -40.0}) {
-    Board b = empty_board(1.0, 2.0, 1.11, 5e-4);
+    table::Board b = empty_board(1.0, 2.0, 1.11, 5e-4);
     b.ball.speed_max_mps = 50.0;
     add_wall(b, {0.5, 0.2}, {0.5, 1.8}, 1.0);
     const ThesisStepper stepper(b);
@@ -53,7 +54,7 @@ TEST(StiffCases, FastBallAgainstThinWall) {
 TEST(StiffCases, FastBallAtWallEndPoints) {
   // Aimed near the wall's ends, where the end points must catch it.
   for (double offset : {-0.012, -0.005, 0.0, 0.005, 0.012}) {
-    Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+    table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
     b.ball.speed_max_mps = 50.0;
     add_wall(b, {0.2, 0.5}, {0.8, 0.5}, 1.0);  // horizontal thin wall
     const ThesisStepper stepper(b);
@@ -71,7 +72,7 @@ TEST(StiffCases, FastBallAtWallEndPoints) {
 
 TEST(StiffCases, BallWedgedInNarrowV) {
   for (double rho : {0.5, 1.0}) {
-    Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+    table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
     b.ball.speed_max_mps = 5.0;
     const double a = 10.0 * std::numbers::pi / 180.0;
     const Vec2 apex{0.5, 0.1};
@@ -108,12 +109,12 @@ TEST(StiffCases, FlipperStallsAgainstWallAbove) {
   // face and the wall near the tip. Energising the flipper squeezes the ball
   // into the wall: the flipper must stall (hold its angle) rather than push
   // the ball through. Frictionless, the ball may then squirt out sideways.
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
-  const int fl = add_flipper(b, Side::kLeft, {0.3, 0.3}, 0.076, -0.4, 0.6, 33.0, 0.5, 1.0);
-  const Flipper& f = b.flippers[fl];
-  const Vec2 p = f.pivot + 0.05 * flipper_direction(f, f.theta_min_rad) +
-                 (kR + 1e-6) * flipper_up_normal(f, f.theta_min_rad);
-  const double wall_y = flipper_tip(f, f.theta_max_rad).y() + 0.007;
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  const int fl = add_flipper(b, table::Side::kLeft, {0.3, 0.3}, 0.076, -0.4, 0.6, 33.0, 0.5, 1.0);
+  const table::Flipper& f = b.flippers[fl];
+  const Vec2 p = f.pivot + 0.05 * table::flipper_direction(f, f.theta_min_rad) +
+                 (kR + 1e-6) * table::flipper_up_normal(f, f.theta_min_rad);
+  const double wall_y = table::flipper_tip(f, f.theta_max_rad).y() + 0.007;
   ASSERT_GT(wall_y - p.y(), kR + 0.03);  // the ball starts well clear of it
   add_wall(b, {0.2, wall_y}, {0.5, wall_y}, 0.5);
   const ThesisStepper stepper(b);
@@ -139,14 +140,14 @@ TEST(StiffCases, FlipperJammedInClosedPocketStaysStalled) {
   // raised flipper 20 mm above its face (less than the ball's 27 mm
   // diameter), and walls at the pivot and just beyond the tip. The flipper
   // can never reach its up stop; it must stall every time it tries.
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
-  const int fl = add_flipper(b, Side::kLeft, {0.3, 0.3}, 0.076, -0.4, 0.6, 33.0, 0.5, 1.0);
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  const int fl = add_flipper(b, table::Side::kLeft, {0.3, 0.3}, 0.076, -0.4, 0.6, 33.0, 0.5, 1.0);
   const FlipperPocket pocket = add_flipper_pocket(b, fl);
-  const Flipper& f = b.flippers[fl];
+  const table::Flipper& f = b.flippers[fl];
   const double left_x = pocket.left_x, right_x = pocket.right_x;
   const Vec2 roof0 = pocket.roof0, roof1 = pocket.roof1;
-  const Vec2 p = f.pivot + 0.05 * flipper_direction(f, f.theta_min_rad) +
-                 (kR + 1e-6) * flipper_up_normal(f, f.theta_min_rad);
+  const Vec2 p = f.pivot + 0.05 * table::flipper_direction(f, f.theta_min_rad) +
+                 (kR + 1e-6) * table::flipper_up_normal(f, f.theta_min_rad);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, p, Vec2::Zero());
   ASSERT_EQ(max_penetration_m(b, s), 0.0);
@@ -166,7 +167,7 @@ TEST(StiffCases, FlipperJammedInClosedPocketStaysStalled) {
 }
 
 TEST(StiffCases, BallComesToRestOnFlatLine) {
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
   add_line(b, {0.0, 0.1}, {1.0, 0.1}, 0.5);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.5, 0.3}, {0.0, 0.0});
@@ -183,24 +184,24 @@ TEST(StiffCases, BallComesToRestOnFlatLine) {
 }
 
 // A small table: box, walls, a bumper and a left flipper at the bottom.
-Board dt_sweep_board(double dt) {
-  Board b = box_board(0.8, 1.11, dt);
+table::Board dt_sweep_board(double dt) {
+  table::Board b = box_board(0.8, 1.11, dt);
   b.ball.speed_max_mps = 5.0;
   add_wall(b, {0.0, 0.25}, {0.12, 0.18}, 0.5);  // inlane guide down to the flipper
   add_wall(b, {0.51, 0.25}, {0.35, 0.18}, 0.5);
   add_circle(b, {0.25, 0.7}, 0.03, 1.2);
   add_wall(b, {0.1, 0.85}, {0.2, 0.95}, 0.9);
-  add_flipper(b, Side::kLeft, {0.13, 0.17}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
-  add_flipper(b, Side::kRight, {0.34, 0.17}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
+  add_flipper(b, table::Side::kLeft, {0.13, 0.17}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
+  add_flipper(b, table::Side::kRight, {0.34, 0.17}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
   return b;
 }
 
 TEST(StiffCases, TimeStepSweep) {
-  const double dt_max = max_stable_dt_s(dt_sweep_board(1e-4));
+  const double dt_max = table::max_stable_dt_s(dt_sweep_board(1e-4));
   ASSERT_TRUE(std::isfinite(dt_max));
   for (double dt : {1e-5, 1e-4, 5e-4, 2e-3, 0.99 * dt_max}) {
     if (dt > 0.99 * dt_max) continue;
-    const Board b = dt_sweep_board(dt);
+    const table::Board b = dt_sweep_board(dt);
     const ThesisStepper stepper(b);
     GameState s = state_with_ball(b, {0.2, 0.9}, {0.8, -0.5});
     const double seconds = dt < 5e-5 ? 2.0 : 4.0;
@@ -221,7 +222,7 @@ TEST(StiffCases, TimeStepSweep) {
 
 TEST(StiffCases, MillionRandomSteps) {
   Rng rng(20240601);
-  Board b = box_board(0.9, 1.11, 5e-4);
+  table::Board b = box_board(0.9, 1.11, 5e-4);
   b.ball.speed_max_mps = 5.0;
   // Random bumpers and short walls in the upper part of the table, clear of the flippers.
   for (int i = 0; i < 12; ++i) {
@@ -232,8 +233,8 @@ TEST(StiffCases, MillionRandomSteps) {
     const double ang = rng.uniform(0.0, 2.0 * std::numbers::pi);
     add_wall(b, a, a + rng.uniform(0.02, 0.1) * Vec2{std::cos(ang), std::sin(ang)}, rng.uniform(0.4, 1.0));
   }
-  add_flipper(b, Side::kLeft, {0.14, 0.15}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
-  add_flipper(b, Side::kRight, {0.37, 0.15}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
+  add_flipper(b, table::Side::kLeft, {0.14, 0.15}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
+  add_flipper(b, table::Side::kRight, {0.37, 0.15}, 0.076, -0.5, 0.5, 33.0, 0.5, 1.0);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.25, 0.9}, {1.0, 0.3});
   // The box walls are one-sided lines with inward normals: the ball must stay inside.
@@ -270,8 +271,8 @@ TEST(StiffCases, MillionRandomSteps) {
 // The "a million random steps on the full table": the thesis board,
 // flippers pressed at random, balls relaunched as they drain.
 TEST(StiffCases, MillionRandomStepsOnTheThesisTable) {
-  const Board b = load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  const ThesisStepper stepper(b);
+  const table::Board b = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const std::unique_ptr<World> world = make_model_world(b);
   GameState s = make_game_state(b, 99);
   Rng rng(4242);
   long launches = 0;
@@ -280,13 +281,13 @@ TEST(StiffCases, MillionRandomStepsOnTheThesisTable) {
     // the million steps cover many different trajectories.
     if (i % 100000 == 0 && s.ball_in_play) cut_ball(b, s);
     if (!s.ball_in_play) {
-      begin_ball(b, s, rng.uniform(0.5, 1.0));
+      begin_ball(*world, s, rng.uniform(0.5, 1.0));
       ++launches;
     }
     if (rng.uniform01() < 0.02) {
       for (auto& fs : s.flippers) fs.energized = rng.uniform01() < 0.5;
     }
-    const StepEvents ev = stepper.step(s);
+    const StepEvents ev = world->step(s);
     ASSERT_FALSE(ev.has(StepEvents::kLeftTable)) << "step " << i;
     ASSERT_TRUE(invariants_hold(b, s, i));
   }

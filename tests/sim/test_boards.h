@@ -9,23 +9,23 @@
 
 #include "pinball/core/geometry.h"
 #include "pinball/core/rng.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 
 namespace pinball::sim::testing {
 
 /// Obstacle attributes with reflectivity rho and everything else default.
-inline Obstacle obstacle_with_rho(double rho) {
-  Obstacle o;
+inline table::Obstacle obstacle_with_rho(double rho) {
+  table::Obstacle o;
   o.rho = rho;
   return o;
 }
 
 /// Adds a one-sided line p0 -> p1 (normal = unit left perpendicular of p1 - p0); returns its index.
-inline int add_line(Board& board, const Vec2& p0, const Vec2& p1, double rho = 1.0, Action action = {},
+inline int add_line(table::Board& board, const Vec2& p0, const Vec2& p1, double rho = 1.0, table::Action action = {},
                     const std::string& name = "line") {
-  const Shape s = make_line_shape(p0, p1);
-  Obstacle o = obstacle_with_rho(rho);
+  const table::Shape s = table::make_line_shape(p0, p1);
+  table::Obstacle o = obstacle_with_rho(rho);
   o.action = action;
   o.name = name;
   board.shapes.push_back(s);
@@ -34,10 +34,10 @@ inline int add_line(Board& board, const Vec2& p0, const Vec2& p1, double rho = 1
 }
 
 /// Adds a circle of radius_m (0: a point) around c; returns its index.
-inline int add_circle(Board& board, const Vec2& c, double radius_m, double rho = 1.0, Action action = {},
+inline int add_circle(table::Board& board, const Vec2& c, double radius_m, double rho = 1.0, table::Action action = {},
                       const std::string& name = "circle") {
-  const Shape s = make_circle_shape(c, radius_m);
-  Obstacle o = obstacle_with_rho(rho);
+  const table::Shape s = table::make_circle_shape(c, radius_m);
+  table::Obstacle o = obstacle_with_rho(rho);
   o.action = action;
   o.name = name;
   board.shapes.push_back(s);
@@ -46,13 +46,13 @@ inline int add_circle(Board& board, const Vec2& c, double radius_m, double rho =
 }
 
 /// Adds a point (a circle of radius 0) at c; returns its index.
-inline int add_point(Board& board, const Vec2& c, double rho = 1.0, Action action = {}) {
+inline int add_point(table::Board& board, const Vec2& c, double rho = 1.0, table::Action action = {}) {
   return add_circle(board, c, 0.0, rho, action, "point");
 }
 
 /// Adds a thin two-sided wall a-b: the lines a->b and b->a and a point at each
 /// end. Returns the index of the first of its four obstacles.
-inline int add_wall(Board& board, const Vec2& a, const Vec2& b, double rho = 1.0) {
+inline int add_wall(table::Board& board, const Vec2& a, const Vec2& b, double rho = 1.0) {
   const int first = add_line(board, a, b, rho, {}, "wall");
   add_line(board, b, a, rho, {}, "wall");
   add_point(board, a, rho);
@@ -61,10 +61,10 @@ inline int add_wall(Board& board, const Vec2& a, const Vec2& b, double rho = 1.0
 }
 
 /// Adds a flipper; returns its index.
-inline int add_flipper(Board& board, Side side, const Vec2& pivot, double length_m = 0.076,
+inline int add_flipper(table::Board& board, table::Side side, const Vec2& pivot, double length_m = 0.076,
                        double theta_min_rad = -0.5, double theta_max_rad = 0.5, double omega_rad_s = 33.0,
                        double rho = 0.5, double mu = 1.0) {
-  Flipper f;
+  table::Flipper f;
   f.side = side;
   f.pivot = pivot;
   f.length_m = length_m;
@@ -73,7 +73,7 @@ inline int add_flipper(Board& board, Side side, const Vec2& pivot, double length
   f.omega_rad_s = omega_rad_s;
   f.rho = rho;
   f.mu = mu;
-  f.name = side == Side::kLeft ? "left" : "right";
+  f.name = side == table::Side::kLeft ? "left" : "right";
   board.flippers.push_back(f);
   return static_cast<int>(board.flippers.size()) - 1;
 }
@@ -81,9 +81,9 @@ inline int add_flipper(Board& board, Side side, const Vec2& pivot, double length
 /// An empty table of the given size: ball radius 13.5 mm, the given gravity
 /// and dt, a large speed clamp (so that it does not interfere unless a test
 /// lowers it), launcher in the lower right.
-inline Board empty_board(double width_m = 1.0, double height_m = 1.0, double gravity_mps2 = 1.11,
+inline table::Board empty_board(double width_m = 1.0, double height_m = 1.0, double gravity_mps2 = 1.11,
                          double dt_s = 5e-4) {
-  Board b;
+  table::Board b;
   b.source = "test";
   b.width_m = width_m;
   b.height_m = height_m;
@@ -100,7 +100,7 @@ inline Board empty_board(double width_m = 1.0, double height_m = 1.0, double gra
 
 /// Adds a closed box [0, w] x [0, h] of one-sided lines whose normals point
 /// inwards (counter-clockwise order). Returns the index of the floor line.
-inline int add_box(Board& board, double w, double h, double rho = 1.0) {
+inline int add_box(table::Board& board, double w, double h, double rho = 1.0) {
   const int floor = add_line(board, {0.0, 0.0}, {w, 0.0}, rho, {}, "floor");
   add_line(board, {w, 0.0}, {w, h}, rho, {}, "right");
   add_line(board, {w, h}, {0.0, h}, rho, {}, "top");
@@ -109,15 +109,15 @@ inline int add_box(Board& board, double w, double h, double rho = 1.0) {
 }
 
 /// A box board of the table's size with inward walls.
-inline Board box_board(double rho = 1.0, double gravity_mps2 = 1.11, double dt_s = 5e-4) {
-  Board b = empty_board(0.51, 1.07, gravity_mps2, dt_s);
+inline table::Board box_board(double rho = 1.0, double gravity_mps2 = 1.11, double dt_s = 5e-4) {
+  table::Board b = empty_board(0.51, 1.07, gravity_mps2, dt_s);
   add_box(b, b.width_m, b.height_m, rho);
   return b;
 }
 
 /// A box board with interior bumpers and walls and two flippers near the bottom.
-inline Board box_with_bumpers_and_flippers(double dt_s = 5e-4) {
-  Board b = box_board(0.9, 1.11, dt_s);
+inline table::Board box_with_bumpers_and_flippers(double dt_s = 5e-4) {
+  table::Board b = box_board(0.9, 1.11, dt_s);
   b.ball.speed_max_mps = 5.0;
   add_circle(b, {0.15, 0.70}, 0.03, 1.3);
   add_circle(b, {0.35, 0.72}, 0.03, 1.3);
@@ -126,8 +126,8 @@ inline Board box_with_bumpers_and_flippers(double dt_s = 5e-4) {
   add_wall(b, {0.05, 0.40}, {0.15, 0.30}, 0.7);
   add_wall(b, {0.46, 0.40}, {0.36, 0.30}, 0.7);
   add_wall(b, {0.20, 0.90}, {0.30, 0.95}, 1.0);
-  add_flipper(b, Side::kLeft, {0.15, 0.20}, 0.076, -0.5, 0.5, 33.0, 0.6, 1.0);
-  add_flipper(b, Side::kRight, {0.36, 0.20}, 0.076, -0.5, 0.5, 33.0, 0.6, 1.0);
+  add_flipper(b, table::Side::kLeft, {0.15, 0.20}, 0.076, -0.5, 0.5, 33.0, 0.6, 1.0);
+  add_flipper(b, table::Side::kRight, {0.36, 0.20}, 0.076, -0.5, 0.5, 33.0, 0.6, 1.0);
   return b;
 }
 
@@ -143,10 +143,10 @@ struct FlipperPocket {
 };
 
 /// Adds the walls of a FlipperPocket round left flipper `fl`.
-inline FlipperPocket add_flipper_pocket(Board& b, int fl) {
-  const Flipper f = b.flippers[fl];
-  const Vec2 up_max = flipper_up_normal(f, f.theta_max_rad);
-  const Vec2 dir_max = flipper_direction(f, f.theta_max_rad);
+inline FlipperPocket add_flipper_pocket(table::Board& b, int fl) {
+  const table::Flipper f = b.flippers[fl];
+  const Vec2 up_max = table::flipper_up_normal(f, f.theta_max_rad);
+  const Vec2 dir_max = table::flipper_direction(f, f.theta_max_rad);
   FlipperPocket p;
   p.roof0 = f.pivot + 0.020 * up_max - 0.01 * dir_max;
   p.roof1 = f.pivot + 0.020 * up_max + 0.15 * dir_max;
@@ -160,7 +160,7 @@ inline FlipperPocket add_flipper_pocket(Board& b, int fl) {
 }
 
 /// A fresh state with the ball in play at p with velocity v.
-inline GameState state_with_ball(const Board& board, const Vec2& p, const Vec2& v, std::uint64_t seed = 1) {
+inline GameState state_with_ball(const table::Board& board, const Vec2& p, const Vec2& v, std::uint64_t seed = 1) {
   GameState s = make_game_state(board, seed);
   s.ball_in_play = true;
   s.ball.position_m = p;

@@ -22,7 +22,7 @@ constexpr double kR = 0.0135;
 TEST(ThesisStepper, FreeFlightIsSemiImplicitEuler) {
   const double g = 1.11;
   const double dt = 5e-4;
-  Board b = empty_board(10.0, 10.0, g, dt);
+  table::Board b = empty_board(10.0, 10.0, g, dt);
   const ThesisStepper stepper(b);
   const Vec2 p0{2.0, 5.0};
   const Vec2 v0{0.3, 1.2};
@@ -47,7 +47,7 @@ TEST(ThesisStepper, FreeFlightIsSemiImplicitEuler) {
 }
 
 TEST(ThesisStepper, BallOutOfPlayDoesNotMove) {
-  Board b = empty_board();
+  table::Board b = empty_board();
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.5, 0.5}, {1.0, 1.0});
   s.ball_in_play = false;
@@ -58,7 +58,7 @@ TEST(ThesisStepper, BallOutOfPlayDoesNotMove) {
 
 TEST(ThesisStepper, ReflectionOffHorizontalLineScalesNormalSpeedByRho) {
   for (double rho : {0.5, 1.0, 1.5}) {
-    Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+    table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
     const int floor = add_line(b, {0.0, 0.2}, {1.0, 0.2}, rho);
     const ThesisStepper stepper(b);
     const double vx = 0.7;
@@ -97,7 +97,7 @@ TEST(ThesisStepper, ReflectionOffHorizontalLineScalesNormalSpeedByRho) {
 TEST(ThesisStepper, ReflectionUsesVelocityAfterGravityUpdate) {
   const double g = 9.81;
   const double dt = 1e-3;
-  Board b = empty_board(1.0, 1.0, g, dt);
+  table::Board b = empty_board(1.0, 1.0, g, dt);
   add_line(b, {0.0, 0.0}, {1.0, 0.0}, 0.5);
   const ThesisStepper stepper(b);
   // Reaches the line within the first step: incoming vy = -1 - g·dt.
@@ -108,7 +108,7 @@ TEST(ThesisStepper, ReflectionUsesVelocityAfterGravityUpdate) {
 }
 
 TEST(ThesisStepper, BallBouncesUpOffTheTipOfAVerticalWall) {
-  Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+  table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
   add_wall(b, {0.5, 0.0}, {0.5, 0.3}, 1.0);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.5, 0.4}, {0.0, -1.0});
@@ -118,7 +118,7 @@ TEST(ThesisStepper, BallBouncesUpOffTheTipOfAVerticalWall) {
     ASSERT_LT(max_penetration_m(b, s), 1e-6);
     if (ev.has(StepEvents::kHitObstacle) && !hit) {
       hit = true;
-      EXPECT_EQ(b.shapes[ev.obstacle].kind, ShapeKind::kCircle);  // the end point, not the faces
+      EXPECT_EQ(b.shapes[ev.obstacle].kind, table::ShapeKind::kCircle);  // the end point, not the faces
       EXPECT_GT(s.ball.velocity_mps.y(), 0.9);
       EXPECT_NEAR(s.ball.velocity_mps.x(), 0.0, 1e-12);
     }
@@ -130,7 +130,7 @@ TEST(ThesisStepper, BallBouncesUpOffTheTipOfAVerticalWall) {
 
 TEST(ThesisStepper, BallLeftOfTheTipBouncesLeft) {
   for (double side : {-1.0, 1.0}) {
-    Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
+    table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
     add_wall(b, {0.5, 0.0}, {0.5, 0.3}, 1.0);
     const ThesisStepper stepper(b);
     GameState s = state_with_ball(b, {0.5 + side * 0.004, 0.4}, {0.0, -1.0});
@@ -148,7 +148,7 @@ TEST(ThesisStepper, BallLeftOfTheTipBouncesLeft) {
 }
 
 TEST(ThesisStepper, BallBehindOneSidedLinePassesThrough) {
-  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
   add_line(b, {0.0, 0.5}, {1.0, 0.5}, 1.0);  // normal +y: hit from above only
   const ThesisStepper stepper(b);
   const Vec2 v{0.2, 1.5};
@@ -163,7 +163,7 @@ TEST(ThesisStepper, BallBehindOneSidedLinePassesThrough) {
 }
 
 TEST(ThesisStepper, SpeedClampHoldsEveryStep) {
-  Board b = empty_board(1.0, 50.0, 9.81, 5e-4);
+  table::Board b = empty_board(1.0, 50.0, 9.81, 5e-4);
   b.ball.speed_max_mps = 2.0;
   add_line(b, {0.0, 0.0}, {1.0, 0.0}, 1.0);
   add_line(b, {1.0, 0.0}, {1.0, 50.0}, 1.0);
@@ -182,7 +182,7 @@ TEST(ThesisStepper, SpeedClampHoldsEveryStep) {
 }
 
 TEST(LaunchBall, SpeedWithinNoiseBand) {
-  Board b = empty_board();
+  table::Board b = empty_board();
   b.ball.speed_max_mps = 5.0;
   b.launcher.noise_max = 0.03;
   GameState s = make_game_state(b, 17);
@@ -211,15 +211,15 @@ TEST(LaunchBall, SpeedWithinNoiseBand) {
 
 // A ball falling onto a horizontal line at y = 0.2 with the given action.
 struct DropOnLine {
-  explicit DropOnLine(Action action, double rho = 1.0) : board(empty_board(1.0, 1.0, 0.0, 5e-4)) {
+  explicit DropOnLine(table::Action action, double rho = 1.0) : board(empty_board(1.0, 1.0, 0.0, 5e-4)) {
     line = add_line(board, {0.0, 0.2}, {1.0, 0.2}, rho, action);
   }
-  Board board;
+  table::Board board;
   int line = -1;
 };
 
 TEST(ThesisStepperActions, KickAddsSpeedAlongNormal) {
-  Action a;
+  table::Action a;
   a.kick_mps = 1.25;
   DropOnLine d(a, 0.8);
   const ThesisStepper stepper(d.board);
@@ -232,10 +232,10 @@ TEST(ThesisStepperActions, KickAddsSpeedAlongNormal) {
 }
 
 TEST(ThesisStepperActions, ScoreEachHit) {
-  Action a;
+  table::Action a;
   a.score = 50.0;
   DropOnLine d(a, 1.0);
-  Board& b = d.board;
+  table::Board& b = d.board;
   add_line(b, {1.0, 0.5}, {0.0, 0.5}, 1.0);  // ceiling (normal -y), no score
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.5, 0.35}, {0.0, -1.0});
@@ -252,7 +252,7 @@ TEST(ThesisStepperActions, ScoreEachHit) {
 }
 
 TEST(ThesisStepperActions, EatsBallEndsIt) {
-  Action a;
+  table::Action a;
   a.eats_ball = true;
   DropOnLine d(a);
   const ThesisStepper stepper(d.board);
@@ -270,7 +270,7 @@ TEST(ThesisStepperActions, EatsBallEndsIt) {
 }
 
 TEST(ThesisStepperActions, LeavingTheTableLosesTheBall) {
-  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.5, 0.5}, {0.0, -3.0});
   StepEvents last;
@@ -282,8 +282,8 @@ TEST(ThesisStepperActions, LeavingTheTableLosesTheBall) {
 }
 
 TEST(ThesisStepperActions, BankFlagsHideAndReappearWithBonus) {
-  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
-  Action flag_action;
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  table::Action flag_action;
   flag_action.score = 10.0;
   const int f0 = add_line(b, {0.1, 0.2}, {0.3, 0.2}, 1.0, flag_action, "flag0");
   const int f1 = add_line(b, {0.6, 0.2}, {0.8, 0.2}, 1.0, flag_action, "flag1");
@@ -292,7 +292,7 @@ TEST(ThesisStepperActions, BankFlagsHideAndReappearWithBonus) {
   // Each flag is its own statement of the board file (a flag falls as a whole statement).
   b.obstacles[f0].source_line = 11;
   b.obstacles[f1].source_line = 12;
-  Bank bank;
+  table::Bank bank;
   bank.name = "bank";
   bank.bonus = 500.0;
   bank.members = {f0, f1};
@@ -335,10 +335,10 @@ TEST(ThesisStepperActions, BankFlagsHideAndReappearWithBonus) {
 }
 
 TEST(ThesisStepperSensors, ProximityFiresOncePerEntryWithoutChangingVelocity) {
-  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
-  Sensor sensor;
-  sensor.kind = SensorKind::kProximity;
-  sensor.shape.kind = ShapeKind::kCircle;
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  table::Sensor sensor;
+  sensor.kind = table::SensorKind::kProximity;
+  sensor.shape.kind = table::ShapeKind::kCircle;
   sensor.shape.p0 = {0.5, 0.5};
   sensor.shape.radius_m = 0.03;
   sensor.action.score = 7.0;
@@ -368,11 +368,11 @@ TEST(ThesisStepperSensors, ProximityFiresOncePerEntryWithoutChangingVelocity) {
 }
 
 TEST(ThesisStepperSensors, FastBallCannotSkipALineSensor) {
-  Board b = empty_board(1.0, 1.0, 0.0, 1e-3);
+  table::Board b = empty_board(1.0, 1.0, 0.0, 1e-3);
   b.ball.speed_max_mps = 50.0;
-  Sensor sensor;
-  sensor.kind = SensorKind::kProximity;
-  sensor.shape.kind = ShapeKind::kLine;
+  table::Sensor sensor;
+  sensor.kind = table::SensorKind::kProximity;
+  sensor.shape.kind = table::ShapeKind::kLine;
   sensor.shape.p0 = {0.5, 0.0};
   sensor.shape.p1 = {0.5, 1.0};
   sensor.shape.normal = {-1.0, 0.0};
@@ -385,10 +385,10 @@ TEST(ThesisStepperSensors, FastBallCannotSkipALineSensor) {
 }
 
 TEST(ThesisStepperSensors, HoleWithKickoutPlacesBallAtCentre) {
-  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
-  Sensor hole;
-  hole.kind = SensorKind::kHole;
-  hole.shape.kind = ShapeKind::kCircle;
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  table::Sensor hole;
+  hole.kind = table::SensorKind::kHole;
+  hole.shape.kind = table::ShapeKind::kCircle;
   hole.shape.p0 = {0.5, 0.5};
   hole.shape.radius_m = 0.01;
   hole.action.score = 100.0;
@@ -418,10 +418,10 @@ TEST(ThesisStepperSensors, HoleWithKickoutPlacesBallAtCentre) {
 }
 
 TEST(ThesisStepperSensors, HoleWithoutKickoutEatsBall) {
-  Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
-  Sensor hole;
-  hole.kind = SensorKind::kHole;
-  hole.shape.kind = ShapeKind::kCircle;
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  table::Sensor hole;
+  hole.kind = table::SensorKind::kHole;
+  hole.shape.kind = table::ShapeKind::kCircle;
   hole.shape.p0 = {0.5, 0.5};
   hole.shape.radius_m = 0.01;
   hole.action.eats_ball = true;
@@ -439,8 +439,8 @@ TEST(ThesisStepperSensors, HoleWithoutKickoutEatsBall) {
 }
 
 TEST(ThesisStepperActions, ContactScoreAccumulatesWhileRolling) {
-  Board b = empty_board(2.0, 1.0, 1.11, 5e-4);
-  Action a;
+  table::Board b = empty_board(2.0, 1.0, 1.11, 5e-4);
+  table::Action a;
   a.contact_score_per_s = 40.0;
   add_line(b, {0.0, 0.1}, {2.0, 0.1}, 0.5, a);
   const ThesisStepper stepper(b);
@@ -460,7 +460,7 @@ TEST(ThesisStepperActions, ContactScoreAccumulatesWhileRolling) {
 // the surface is that of a frictionless slide (thesis eq. 3.1-3.2 between
 // contacts, the reflection only touching the normal component).
 TEST(ThesisStepperResting, BallSlidesAlongFlatLine) {
-  Board b = empty_board(2.0, 1.0, 1.11, 5e-4);
+  table::Board b = empty_board(2.0, 1.0, 1.11, 5e-4);
   add_line(b, {0.0, 0.1}, {2.0, 0.1}, 0.5);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.2, 0.1 + kR + 1e-6}, {0.3, 0.0});
@@ -477,7 +477,7 @@ TEST(ThesisStepperResting, BallSlidesAlongFlatLine) {
 TEST(ThesisStepperResting, BallSlidesDownSlope) {
   const double a = 20.0 * M_PI / 180.0;
   const double g = 1.11;
-  Board b = empty_board(3.0, 3.0, g, 5e-4);
+  table::Board b = empty_board(3.0, 3.0, g, 5e-4);
   const Vec2 p0{0.1, 2.0};
   const Vec2 p1{2.9, 2.0 - 2.8 * std::tan(a)};
   add_line(b, p0, p1, 0.5);
@@ -501,14 +501,14 @@ TEST(ThesisStepperResting, BallSlidesDownSlope) {
 
 struct FlipperBoard {
   FlipperBoard(double gravity = 0.0, double theta_min = -0.5) : board(empty_board(1.0, 1.0, gravity, 5e-4)) {
-    add_flipper(board, Side::kLeft, {0.3, 0.3}, 0.076, theta_min, 0.5, 33.0, 0.5, 1.0);
+    add_flipper(board, table::Side::kLeft, {0.3, 0.3}, 0.076, theta_min, 0.5, 33.0, 0.5, 1.0);
   }
-  Board board;
+  table::Board board;
 };
 
 TEST(ThesisStepperFlippers, EnergisedRisesAtOmegaAndStops) {
   FlipperBoard fb;
-  const Flipper& f = fb.board.flippers[0];
+  const table::Flipper& f = fb.board.flippers[0];
   const ThesisStepper stepper(fb.board);
   GameState s = make_game_state(fb.board, 1);
   const double dt = stepper.dt_s();
@@ -544,10 +544,10 @@ TEST(ThesisStepperFlippers, EnergisedRisesAtOmegaAndStops) {
 // after the flipper fires (no gravity, no obstacles).
 double launch_speed(double arm) {
   FlipperBoard fb;
-  const Flipper& f = fb.board.flippers[0];
+  const table::Flipper& f = fb.board.flippers[0];
   const ThesisStepper stepper(fb.board);
   const double theta = f.theta_min_rad;
-  const Vec2 p = f.pivot + arm * flipper_direction(f, theta) + (kR + 1e-6) * flipper_up_normal(f, theta);
+  const Vec2 p = f.pivot + arm * table::flipper_direction(f, theta) + (kR + 1e-6) * table::flipper_up_normal(f, theta);
   GameState s = state_with_ball(fb.board, p, Vec2::Zero());
   s.flippers[0].energized = true;
   bool pushed = false;
@@ -573,7 +573,7 @@ TEST(ThesisStepperFlippers, BallNearTipLaunchedFasterThanNearPivot) {
 
 TEST(ThesisStepperFlippers, ContactSensorWhenBallRestsOnFlipper) {
   FlipperBoard fb(1.11, 0.0);  // horizontal at rest
-  const Flipper& f = fb.board.flippers[0];
+  const table::Flipper& f = fb.board.flippers[0];
   const ThesisStepper stepper(fb.board);
   GameState s = state_with_ball(fb.board, f.pivot + Vec2{0.04, kR + 1e-6}, Vec2::Zero());
   for (int i = 0; i < 2000; ++i) {
@@ -590,10 +590,10 @@ TEST(ThesisStepperFlippers, ContactSensorWhenBallRestsOnFlipper) {
 
 TEST(ThesisStepperFlippers, FallingFlipperDoesNotPushBallAbove) {
   FlipperBoard fb(0.0);
-  const Flipper& f = fb.board.flippers[0];
+  const table::Flipper& f = fb.board.flippers[0];
   const ThesisStepper stepper(fb.board);
   const double theta = f.theta_max_rad;
-  const Vec2 p = f.pivot + 0.05 * flipper_direction(f, theta) + (kR + 1e-6) * flipper_up_normal(f, theta);
+  const Vec2 p = f.pivot + 0.05 * table::flipper_direction(f, theta) + (kR + 1e-6) * table::flipper_up_normal(f, theta);
   GameState s = state_with_ball(fb.board, p, Vec2::Zero());
   s.flippers[0].theta_rad = theta;
   for (int i = 0; i < 100; ++i) {  // a full stroke takes 1 / (33 * 5e-4) = 61 steps
@@ -608,7 +608,7 @@ TEST(ThesisStepperFlippers, FallingFlipperDoesNotPushBallAbove) {
 // --- Grid on / off ----------------------------------------------------------
 
 TEST(ThesisStepper, GridOnAndOffAreBitIdentical) {
-  const Board b = box_with_bumpers_and_flippers();
+  const table::Board b = box_with_bumpers_and_flippers();
   ThesisStepperOptions on;
   on.use_grid = true;
   ThesisStepperOptions off;
@@ -650,8 +650,8 @@ TEST(ThesisStepper, GridOnAndOffAreBitIdentical) {
 // --- Constructor -------------------------------------------------------------
 
 TEST(ThesisStepper, ConstructorChecksTimeStep) {
-  Board b = box_with_bumpers_and_flippers();
-  const double dt_max = max_stable_dt_s(b);
+  table::Board b = box_with_bumpers_and_flippers();
+  const double dt_max = table::max_stable_dt_s(b);
   ASSERT_TRUE(std::isfinite(dt_max));
   // Violates l·sin(omega·dt/2) < r.
   const double dt_bad = 1.01 * dt_max;

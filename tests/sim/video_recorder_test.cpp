@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/renderer.h"
 
@@ -76,8 +76,8 @@ TEST_F(VideoRecorderTest, WritesFramesThatVideoCaptureReadsBack) {
 }
 
 TEST_F(VideoRecorderTest, RecordsRenderedBoardFrames) {
-  Board b;
-  Shape s;
+  table::Board b;
+  table::Shape s;
   s.p0 = Vec2{0.1, 0.5};
   s.p1 = Vec2{0.4, 0.5};
   s.normal = Vec2{0.0, 1.0};

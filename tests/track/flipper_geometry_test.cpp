@@ -6,7 +6,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "common/thesis_board.h"
 
 namespace pinball::track {
@@ -68,7 +68,7 @@ TEST(FlipperGeometryFromBoard, Mit1993) {
 }
 
 TEST(FlipperGeometryFromBoard, AssignsSidesWhateverTheFileOrder) {
-  sim::Board b = thesis_board();
+  table::Board b = thesis_board();
   std::swap(b.flippers[0], b.flippers[1]);  // right first
   const FlipperGeometry g = flipper_geometry_from_board(b);
   EXPECT_NEAR(g.lines[kLeftFlipper].pivot.x(), 0.165, 1e-12);
@@ -76,13 +76,13 @@ TEST(FlipperGeometryFromBoard, AssignsSidesWhateverTheFileOrder) {
 }
 
 TEST(FlipperGeometryFromBoard, NeedsOneFlipperPerSide) {
-  sim::Board one = thesis_board();
+  table::Board one = thesis_board();
   one.flippers.pop_back();
   EXPECT_THROW(flipper_geometry_from_board(one), std::invalid_argument);
-  sim::Board two_left = thesis_board();
-  two_left.flippers[1].side = sim::Side::kLeft;
+  table::Board two_left = thesis_board();
+  two_left.flippers[1].side = table::Side::kLeft;
   EXPECT_THROW(flipper_geometry_from_board(two_left), std::invalid_argument);
-  sim::Board three = thesis_board();
+  table::Board three = thesis_board();
   three.flippers.push_back(three.flippers[0]);
   EXPECT_THROW(flipper_geometry_from_board(three), std::invalid_argument);
 }

@@ -6,7 +6,7 @@
 #include <numbers>
 
 #include "pinball/core/rng.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::track {
 namespace {
@@ -15,7 +15,7 @@ constexpr double kPi = std::numbers::pi;
 
 FlipperEllipse mit1993_ellipse() {
   static const FlipperEllipse e =
-      flipper_ellipse(flipper_geometry_from_board(sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board")));
+      flipper_ellipse(flipper_geometry_from_board(table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board")));
   return e;
 }
 

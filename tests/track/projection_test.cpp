@@ -8,7 +8,7 @@
 #include <string>
 
 #include "pinball/core/rng.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::track {
 namespace {
@@ -209,7 +209,7 @@ TEST(ProjectTrajectory, InvalidFitHasTooFewPoints) {
 TEST(ProjectTrajectory, GravityOffByHalfStillProjects) {
   // Thesis 4.1.1: g 50 % off still plays well. On the real flippers, a ball
   // falling at the left flipper projects finitely for g ± 50 %.
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   const FlipperGeometry g = flipper_geometry_from_board(board);
   const Vec2 p0{0.20, 0.35};
   const Vec2 v0{0.05, -0.6};
@@ -227,7 +227,7 @@ TEST(ProjectTrajectory, GravityOffByHalfStillProjects) {
 }
 
 TEST(ProjectTrajectory, RandomFitsNeverGiveNaN) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   const FlipperGeometry g = flipper_geometry_from_board(board);
   Rng rng(11);
   int valid = 0;

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pinball/core/rng.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "common/thesis_board.h"
 
 namespace pinball::track {

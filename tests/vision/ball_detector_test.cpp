@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "pinball/core/rng.h"
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/vision/sim_camera_source.h"
 #include "common/thesis_board.h"
@@ -65,7 +65,7 @@ double p99(std::vector<double> v) {
 template <class F>
 void for_clear_points(Scene& s, int n, std::uint64_t seed, F&& f) {
   Rng rng(seed);
-  const sim::Board& b = thesis_board();
+  const table::Board& b = thesis_board();
   int done = 0;
   while (done < n) {
     const Vec2 p{rng.uniform(0.02, b.width_m - 0.02), rng.uniform(0.02, b.height_m - 0.02)};
@@ -113,7 +113,7 @@ TEST(BallDetector, MovingBallWithMotionBlurMeetsTheTargets) {
 
 TEST(BallDetector, BallNearTheTableEdgeIsFoundAccurately) {
   Scene s;
-  const sim::Board& b = thesis_board();
+  const table::Board& b = thesis_board();
   const double r = b.ball.radius_m;
   int found = 0;
   for (const Vec2& p : {Vec2{r, 0.5}, Vec2{b.width_m - r, 0.45}, Vec2{0.3, r + 0.001}, Vec2{0.2, b.height_m - r},
@@ -278,8 +278,8 @@ TEST(BallDetector, ARaisedFlipperIsNeverTakenForTheBall) {
 
 // Board point `off_m` from flipper `f` (at theta) on its upper side, `along`
 // of the way from the pivot to the tip.
-Vec2 beside_flipper(const sim::Flipper& f, double theta_rad, double along, double off_m) {
-  const Vec2 tip = sim::flipper_tip(f, theta_rad);
+Vec2 beside_flipper(const table::Flipper& f, double theta_rad, double along, double off_m) {
+  const Vec2 tip = table::flipper_tip(f, theta_rad);
   const Vec2 d = (tip - f.pivot).normalized();
   Vec2 n{-d.y(), d.x()};
   if (n.y() < 0.0) n = -n;
@@ -288,13 +288,13 @@ Vec2 beside_flipper(const sim::Flipper& f, double theta_rad, double along, doubl
 
 TEST(BallDetector, ABallTouchingARaisedFlipperIsFoundAndCentred) {
   Scene s;  // background learned with the flippers down
-  const sim::Board& b = thesis_board();
+  const table::Board& b = thesis_board();
   std::vector<double> up;
-  for (const sim::Flipper& f : b.flippers) up.push_back(f.theta_max_rad);
+  for (const table::Flipper& f : b.flippers) up.push_back(f.theta_max_rad);
   s.camera.set_flipper_angles(up);
   const double touch_m = b.ball.radius_m + 0.5 * s.camera.config().flipper_width_m;
   std::vector<double> errors;
-  for (const sim::Flipper& f : b.flippers) {
+  for (const table::Flipper& f : b.flippers) {
     for (double along : {0.35, 0.5, 0.65, 0.8}) {
       const Detection d = s.shoot(beside_flipper(f, f.theta_max_rad, along, touch_m));
       if (!d.found) continue;  // a miss is allowed, a wrong centre is not
@@ -311,9 +311,9 @@ TEST(BallDetector, ABallTouchingARaisedFlipperIsFoundAndCentred) {
 
 TEST(BallDetector, ABlurredBallTouchingAMovingFlipperIsFound) {
   Scene s;
-  const sim::Board& b = thesis_board();
+  const table::Board& b = thesis_board();
   std::vector<double> mid;  // half way up: the flippers are moving
-  for (const sim::Flipper& f : b.flippers) mid.push_back(0.5 * (f.theta_min_rad + f.theta_max_rad));
+  for (const table::Flipper& f : b.flippers) mid.push_back(0.5 * (f.theta_min_rad + f.theta_max_rad));
   s.camera.set_flipper_angles(mid);
   const double touch_m = b.ball.radius_m + 0.5 * s.camera.config().flipper_width_m;
   std::vector<double> errors;
@@ -334,11 +334,11 @@ TEST(BallDetector, ABlurredBallTouchingAMovingFlipperIsFound) {
 
 TEST(BallDetector, AFlipperAloneIsNeverTakenForTheBallAtAnyAngle) {
   Scene s;  // background learned with the flippers down
-  const sim::Board& b = thesis_board();
+  const table::Board& b = thesis_board();
   std::vector<double> theta(b.flippers.size());
   for (int k = 1; k <= 40; ++k) {
     for (std::size_t i = 0; i < theta.size(); ++i) {
-      const sim::Flipper& f = b.flippers[i];
+      const table::Flipper& f = b.flippers[i];
       theta[i] = f.theta_min_rad + (f.theta_max_rad - f.theta_min_rad) * (k / 40.0);
     }
     s.camera.set_flipper_angles(theta);

@@ -4,15 +4,15 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::vision {
 namespace {
 
-sim::Board table() { return sim::Board{}; }  // 0.51 x 1.07 m
+table::Board table() { return table::Board{}; }  // 0.51 x 1.07 m
 
 TEST(CameraHomography, DefaultViewRoundTripsAndKeepsTheTableInTheImage) {
-  const sim::Board board = table();
+  const table::Board board = table();
   const CameraHomography h = CameraHomography::default_view(board, {640, 480});
   for (const Vec2& p : {Vec2{0.0, 0.0}, Vec2{board.width_m, 0.0}, Vec2{board.width_m, board.height_m},
                         Vec2{0.0, board.height_m}, Vec2{0.2, 0.7}}) {

@@ -10,7 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/vision/ball_detector.h"
 #include "pinball/vision/sim_camera_source.h"
 
@@ -75,7 +75,7 @@ TEST(CaptureSource, ReadsARealCameraWhenThereIsOne) {
 }
 
 TEST(CaptureSource, VideoFileGivesTheSameDetectionsAsTheFramesItCameFrom) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   SimCameraConfig c;
   c.lamp_toggle_probability = 0.0;
   SimCameraSource camera(board, c);

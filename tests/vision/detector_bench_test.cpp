@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::bench {
 namespace {
@@ -14,7 +14,7 @@ const DetectorReport& quick_report() {
     o.ball_free_frames = 200;
     o.occlusion_frames = 40;
     o.timing_frames = 40;
-    return run_detector_bench(sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board"), o, nullptr);
+    return run_detector_bench(table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board"), o, nullptr);
   }();
   return report;
 }

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 #include "common/thesis_board.h"
 
 namespace pinball::vision {

@@ -13,7 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/track/tracker.h"
 #include "pinball/vision/camera_homography.h"
@@ -51,7 +51,7 @@ struct FlipperDisagreement {
 /// One flipper as measured.
 struct FlipperCalibration {
   std::string name;                        ///< the board's flipper name
-  sim::Side side = sim::Side::kLeft;       ///< left flippers point right
+  table::Side side = table::Side::kLeft;       ///< left flippers point right
   FlipperMethod method = FlipperMethod::kMarkers;  ///< how
   Vec2 pivot_m = Vec2::Zero();             ///< pivot (m, board frame)
   Vec2 tip_m = Vec2::Zero();               ///< tip at rest, θ_min (m)
@@ -118,6 +118,6 @@ vision::CameraHomography camera_homography(const Calibration& calibration, const
 /// Copies the calibrated flippers into a board (pivot, length, stops, by
 /// name), for the simulator and the daemon. Throws std::runtime_error naming a
 /// calibrated flipper the board lacks.
-void apply_calibration(const Calibration& calibration, const std::string& name, sim::Board& board);
+void apply_calibration(const Calibration& calibration, const std::string& name, table::Board& board);
 
 }  // namespace pinball::calibration

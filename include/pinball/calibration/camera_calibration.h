@@ -16,7 +16,7 @@
 
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::calibration {
 
@@ -50,7 +50,7 @@ void check_marker_layout(std::span<const Vec2> board_points, double min_separati
 
 /// A layout for `board`: seven markers spread over the table, no symmetry
 /// that would make the matching ambiguous (m, board frame).
-std::vector<Vec2> default_marker_layout(const sim::Board& board);
+std::vector<Vec2> default_marker_layout(const table::Board& board);
 
 /// Reads marker board positions from a CSV with header x,y (m). Throws
 /// std::runtime_error "file:line: what".

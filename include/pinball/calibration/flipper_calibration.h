@@ -27,20 +27,20 @@
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/calibration/circle_fit.h"
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/vision/camera_homography.h"
 #include "pinball/vision/frame_source.h"
 
 namespace pinball::calibration {
 
 /// Elevation θ (rad) of a flipper of `side` whose tip is at `tip` (the board's convention).
-double flipper_angle(sim::Side side, const Vec2& pivot, const Vec2& tip);
+double flipper_angle(table::Side side, const Vec2& pivot, const Vec2& tip);
 
 /// Marker method: `down` and `up` are the markers seen (board frame, m) with
 /// the flippers down and held up. The markers of `nominal` are those nearest
 /// to its nominal pivot and tips, within tolerance_m. Throws
 /// std::runtime_error naming the flipper and the marker that is missing.
-FlipperCalibration calibrate_flipper_markers(const sim::Flipper& nominal, std::span<const Vec2> down,
+FlipperCalibration calibrate_flipper_markers(const table::Flipper& nominal, std::span<const Vec2> down,
                                              std::span<const Vec2> up, double tolerance_m = 0.03);
 
 /// Markerless method settings.
@@ -106,13 +106,13 @@ using FrameSourceFactory = std::function<std::unique_ptr<vision::FrameSource>()>
 /// Markerless method on a sweep video of flipper `nominal` (its name and side
 /// only). `track` (may be null) receives the tips, the centre lines and the fits.
 FlipperCalibration calibrate_flipper_sweep(const FrameSourceFactory& open, const vision::CameraHomography& homography,
-                                           const sim::Flipper& nominal, const SweepOptions& options = {},
+                                           const table::Flipper& nominal, const SweepOptions& options = {},
                                            SweepTrack* track = nullptr);
 
 /// The fit of a sweep track alone (for tests and for tracks from elsewhere):
 /// the pivot where track.blades_board meet, or, when the track has no lines
 /// (tips tracked some other way), the centre of the circle fitted to the tips.
-FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const sim::Flipper& nominal, const SweepOptions& options);
+FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const table::Flipper& nominal, const SweepOptions& options);
 
 /// How `a` differs from `b` (a minus b; distances for the points).
 FlipperDisagreement compare_flippers(const FlipperCalibration& a, const FlipperCalibration& b);

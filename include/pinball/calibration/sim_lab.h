@@ -15,7 +15,7 @@
 
 #include "pinball/calibration/gravity_calibration.h"
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/track/camera_model.h"
 #include "pinball/vision/frame_source.h"
 #include "pinball/vision/sim_camera_source.h"
@@ -43,14 +43,14 @@ class SimLab {
  public:
   /// Builds the machine from the nominal board. Throws std::invalid_argument
   /// for a bad camera setting.
-  explicit SimLab(const sim::Board& nominal, const SimLabOptions& options = {});
+  explicit SimLab(const table::Board& nominal, const SimLabOptions& options = {});
   SimLab(const SimLab&) = delete;             ///< the camera refers to the machine's board
   SimLab& operator=(const SimLab&) = delete;
 
   /// The board file's description.
-  const sim::Board& nominal() const { return nominal_; }
+  const table::Board& nominal() const { return nominal_; }
   /// The machine as it really is (the truth the bench measures against).
-  const sim::Board& truth() const { return truth_; }
+  const table::Board& truth() const { return truth_; }
   /// The camera's true homography.
   const vision::CameraHomography& true_homography() const { return camera_->homography(); }
   /// Image size (px).
@@ -78,8 +78,8 @@ class SimLab {
   std::vector<GravityRoll> rolls(int count, std::uint64_t stream = 0) const;
 
  private:
-  sim::Board nominal_;
-  sim::Board truth_;
+  table::Board nominal_;
+  table::Board truth_;
   SimLabOptions options_;
   std::unique_ptr<vision::SimCameraSource> camera_;
   vision::Frame frame_;

@@ -12,7 +12,7 @@
 #include "pinball/firmware/flipper_actuation.h"
 #include "pinball/firmware/stream_transport.h"
 #include "pinball/firmware/virtual_driver_board.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 
 namespace pinball::control {
@@ -22,7 +22,7 @@ class CanFlipperDrive {
  public:
   /// Throws std::invalid_argument for a board with no flipper or more than
   /// the protocol's drivers per board, or a negative delay.
-  CanFlipperDrive(const sim::Board& board, double actuation_delay_s);
+  CanFlipperDrive(const table::Board& board, double actuation_delay_s);
 
   /// Call once per step, after the controller has set the commands in
   /// state.flippers[i].energized: sends the changes through the bus, runs the

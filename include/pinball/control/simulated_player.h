@@ -9,7 +9,7 @@
 
 #include "pinball/control/flipper_controller.h"
 #include "pinball/control/spastic_controller.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/track/camera_model.h"
 #include "pinball/track/tracker.h"
@@ -23,9 +23,9 @@ class SimulatedPlayer {
   /// std::invalid_argument for a board without a left and a right flipper or
   /// a bad camera setting. `tracker` overrides the tracker settings derived
   /// from the board and camera (e.g. a miscalibrated g).
-  SimulatedPlayer(const sim::Board& board, const track::CameraModelConfig& camera, FlipperController& controller,
+  SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera, FlipperController& controller,
                   std::uint64_t seed);
-  SimulatedPlayer(const sim::Board& board, const track::CameraModelConfig& camera, const track::TrackerConfig& tracker,
+  SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera, const track::TrackerConfig& tracker,
                   FlipperController& controller, std::uint64_t seed);
 
   /// One simulation step: expose the camera, feed delivered observations to
@@ -40,7 +40,7 @@ class SimulatedPlayer {
   int board_index(int f) const { return board_index_[static_cast<std::size_t>(f)]; }
 
  private:
-  const sim::Board& board_;
+  const table::Board& board_;
   track::CameraModel camera_;
   track::Tracker tracker_;
   FlipperController& controller_;
@@ -56,7 +56,7 @@ class SimulatedSpasticPlayer {
  public:
   /// Throws std::invalid_argument for a board without a left and a right
   /// flipper or a bad camera setting.
-  SimulatedSpasticPlayer(const sim::Board& board, const track::CameraModelConfig& camera,
+  SimulatedSpasticPlayer(const table::Board& board, const track::CameraModelConfig& camera,
                          const SpasticConfig& spastic, std::uint64_t seed)
       : spastic_(spastic), player_(board, camera, spastic_, seed) {}
 

@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pinball/sim/world.h"
+
 #include "pinball/firmware/messages.h"
 
 namespace pinball::daemon {
@@ -55,7 +57,9 @@ struct ThreadSettings {
 
 /// The embedded simulation.
 struct SimSettings {
-  std::string board = "boards/mit1993.board";  ///< board file
+  std::string board = "boards/mit1993.board";  ///< board file: the belief, and the world unless world_board is set
+  std::string world_board;                     ///< the world's own board file (empty: `board`); same flippers
+  sim::StepperKind stepper = sim::StepperKind::kThesis;  ///< the world's integrator (YAML: thesis | event)
   int balls = 10;                              ///< balls to play
   std::uint64_t seed = 1;                      ///< launch noise seed (ball i uses ball_seed(seed, i))
   bool realtime = false;                       ///< pace to the wall clock (default: lockstep, as fast as possible)

@@ -13,7 +13,7 @@
 #include "pinball/control/flipper_controller.h"
 #include "pinball/daemon/daemon_config.h"
 #include "pinball/firmware/driver_bus.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/track/observation.h"
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/track/tracker.h"
@@ -179,9 +179,9 @@ struct TrackingSetup {
 };
 /// The setup for `config` on `board` (the table's board file). Throws
 /// std::runtime_error naming the calibration file and key when it is bad.
-TrackingSetup tracking_setup_for(const DaemonConfig& config, const sim::Board& board);
+TrackingSetup tracking_setup_for(const DaemonConfig& config, const table::Board& board);
 /// The controller stage's settings for `config` on `board`.
-ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const sim::Board& board);
+ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const table::Board& board);
 /// How long the camera stage keeps an unseen ball before forgetting it (s).
 double lost_after_s_for(const DaemonConfig& config);
 

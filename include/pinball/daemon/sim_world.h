@@ -1,6 +1,6 @@
 #pragma once
 // The world of the embedded simulation, run by the daemon's simulator thread:
-// the table (thesis stepper), the camera that films it (SimCameraSource), and
+// the table (any sim::World), the camera that films it (SimCameraSource), and
 // the far end of the CAN link (the reference VirtualDriverBoard, whose coils
 // move the simulated flippers after the solenoid's delay). The daemon sees it
 // only through frames and CAN frames, exactly as it sees the lab machine.
@@ -13,9 +13,9 @@
 #include "pinball/firmware/can_transport.h"
 #include "pinball/firmware/flipper_actuation.h"
 #include "pinball/firmware/virtual_driver_board.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
-#include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/world.h"
 #include "pinball/track/observation.h"
 #include "pinball/vision/sim_camera_source.h"
 
@@ -52,9 +52,10 @@ struct GameEvent {
 /// The table, its camera and its driver board.
 class SimWorld {
  public:
-  /// Borrows the board and the board's end of the CAN link. Throws
-  /// std::invalid_argument for a board without two flippers or bad options.
-  SimWorld(const sim::Board& board, firmware::CanTransport& board_link, const vision::SimCameraConfig& camera,
+  /// Plays a fork of `world` (whose board must outlive this) and borrows the
+  /// board's end of the CAN link. Throws std::invalid_argument for a board
+  /// without two flippers or bad options.
+  SimWorld(const sim::World& world, firmware::CanTransport& board_link, const vision::SimCameraConfig& camera,
            const SimWorldOptions& options);
 
   /// Ball-free frames for the detector's background (lamps still, glare off).
@@ -102,10 +103,10 @@ class SimWorld {
   void drive_flippers();
   void start_ball();
 
-  const sim::Board& board_;
+  std::unique_ptr<sim::World> world_;
+  const table::Board& board_;  // the world's
   firmware::CanTransport& link_;
   SimWorldOptions options_;
-  sim::ThesisStepper stepper_;
   sim::GameState state_;
   vision::SimCameraSource camera_;
   firmware::VirtualDriverBoard driver_board_;

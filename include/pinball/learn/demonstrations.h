@@ -18,6 +18,7 @@
 #include "pinball/learn/lookahead_player.h"
 #include "pinball/learn/search.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/world.h"
 #include "pinball/track/camera_model.h"
 
 namespace pinball::learn {
@@ -42,9 +43,10 @@ struct DemonstrationBall {
                              ///< projection in that frame; a learner firing outside the teacher's zone)
 };
 
-/// Plays ball `ball_seed` with the teacher and records its shots.
-DemonstrationBall record_demonstration(const sim::ThesisStepper& stepper, const DemonstrationConfig& config,
-                                       std::uint64_t ball_seed);
+/// Plays ball `ball_seed` in `world` with the teacher, which plans on
+/// `model` (its board is the belief the tracker watches with), and records its shots.
+DemonstrationBall record_demonstration(sim::World& world, const sim::ThesisStepper& model,
+                                       const DemonstrationConfig& config, std::uint64_t ball_seed);
 
 /// Everything recorded over many balls.
 struct Demonstrations {
@@ -65,11 +67,14 @@ struct Demonstrations {
 /// that table plays and the teacher labels the approaches it reaches (DAgger:
 /// the learner's own mistakes get the teacher's answer; record_correction in
 /// the source). `progress` (may be empty) gets a line every tenth of the
-/// balls, never from two threads at once.
-Demonstrations record_demonstrations(const sim::Board& board, const DemonstrationConfig& config, int balls,
+/// balls, never from two threads at once. `board` is the belief (the
+/// teacher's model and the tracker's table); the balls are played in forks of
+/// `world`, or in the model of `board` when it is null.
+Demonstrations record_demonstrations(const table::Board& board, const DemonstrationConfig& config, int balls,
                                      std::uint64_t seed, int threads,
                                      const std::function<void(const std::string&)>& progress,
-                                     const std::shared_ptr<const control::ShotTable>& learner = nullptr);
+                                     const std::shared_ptr<const control::ShotTable>& learner = nullptr,
+                                     const sim::World* world = nullptr);
 
 /// Settings of learning by imitation.
 struct ImitationLearningConfig {
@@ -106,11 +111,13 @@ using ImitationCycleHandler = std::function<void(const control::ShotTable& table
 /// round is trained on every example so far (DAgger). Round r's balls are
 /// ball_seed(ball_seed(seed, r), i). `on_cycle` (may be empty) hears of the
 /// highest-scoring cut ball of each learner round that had one, at the end of
-/// that round. Throws std::invalid_argument for fewer balls than rounds or rounds < 1.
-ImitationResult learn_by_imitation(const sim::Board& board, const ImitationLearningConfig& config,
+/// that round. `board` is the belief; balls play in forks of `world` (null:
+/// the model of `board`). Throws std::invalid_argument for fewer balls than
+/// rounds or rounds < 1.
+ImitationResult learn_by_imitation(const table::Board& board, const ImitationLearningConfig& config,
                                    std::uint64_t budget_balls, std::uint64_t seed, int threads,
                                    const std::function<void(const std::string&)>& progress,
-                                   const ImitationCycleHandler& on_cycle = {});
+                                   const ImitationCycleHandler& on_cycle = {}, const sim::World* world = nullptr);
 
 /// The rounds as a learning curve (one row per round; see docs/learning.md)
 /// for learn::write_curve_csv and plot_curve_png.

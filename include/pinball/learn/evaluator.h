@@ -5,6 +5,7 @@
 // and the ball's seed, so balls can be played on any thread in any order.
 
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -13,8 +14,8 @@
 #include "pinball/control/simulated_player.h"
 #include "pinball/learn/delay_line.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/board.h"
-#include "pinball/sim/thesis_stepper.h"
+#include "pinball/table/board.h"
+#include "pinball/sim/world.h"
 #include "pinball/track/camera_model.h"
 
 namespace pinball::learn {
@@ -65,19 +66,19 @@ std::uint64_t ball_seed(std::uint64_t run_seed, std::uint64_t index);
 /// `ball_seed` through the camera sees the same noise.
 inline std::uint64_t camera_seed(std::uint64_t ball_seed) { return ball_seed ^ 0x5DEECE66Dull; }
 
-/// One ball of the fast loop: `state` (made for ball `ball_seed`) played by
-/// `controller` behind the camera model and the tracker, its commands reaching
-/// the flippers `actuation_delay_s` later. `observer(state, events)` sees every step.
+/// One ball of the fast loop: `state` (made for ball `ball_seed`) played in
+/// `world` by `controller` behind the camera model and the tracker, which
+/// believe the table is `belief`; its commands reach the flippers
+/// `actuation_delay_s` later. `observer(state, events)` sees every step.
 template <class Observer>
-sim::BallResult play_through_tracker(const sim::ThesisStepper& stepper, sim::GameState& state,
+sim::BallResult play_through_tracker(sim::World& world, const table::Board& belief, sim::GameState& state,
                                      const track::CameraModelConfig& camera, const track::TrackerConfig& tracker,
                                      control::FlipperController& controller, double actuation_delay_s,
                                      const sim::BallLimits& limits, std::uint64_t ball_seed, Observer&& observer) {
-  const sim::Board& board = stepper.board();
-  control::SimulatedPlayer player(board, camera, tracker, controller, camera_seed(ball_seed));
-  DelayLine delay(board.flippers.size(), actuation_delay_s);
+  control::SimulatedPlayer player(belief, camera, tracker, controller, camera_seed(ball_seed));
+  DelayLine delay(world.board().flippers.size(), actuation_delay_s);
   return sim::play_ball(
-      stepper, state, limits,
+      world, state, limits,
       [&](sim::GameState& s) {
         player.act(s);
         delay.apply(s);
@@ -85,11 +86,17 @@ sim::BallResult play_through_tracker(const sim::ThesisStepper& stepper, sim::Gam
       std::forward<Observer>(observer));
 }
 
-/// Plays balls of a board through the camera model and tracker.
+/// Plays balls in a world through the camera model and the tracker, which
+/// believe the table is a board (by default the world is that board's model).
 class PinballEvaluator final : public BallObjective {
  public:
+  /// The world is the model of `board` on the thesis stepper at config.dt_s.
   /// Borrows the board. Throws std::invalid_argument for bad settings.
-  PinballEvaluator(const sim::Board& board, const EvaluatorConfig& config);
+  PinballEvaluator(const table::Board& board, const EvaluatorConfig& config);
+  /// Plays in `world` (each ball in a fork of it) while the tracker and the
+  /// controller believe `belief`. Throws std::invalid_argument for bad
+  /// settings or a world whose flippers are not the belief's.
+  PinballEvaluator(const table::Board& belief, const EvaluatorConfig& config, std::unique_ptr<sim::World> world);
 
   BallOutcome play(const control::ControllerSpec& spec, std::uint64_t ball_seed) const override;
   control::ControllerSpec prototype() const override;
@@ -97,17 +104,18 @@ class PinballEvaluator final : public BallObjective {
   /// Plays one ball with any flipper controller (the baselines); `pull` < 0 takes the board's.
   BallOutcome play_with(control::FlipperController& controller, double pull, std::uint64_t ball_seed) const;
 
-  /// The settings and the board.
+  /// The settings, the belief and the world.
   const EvaluatorConfig& config() const { return config_; }
-  const sim::Board& board() const { return board_; }
+  const table::Board& board() const { return board_; }
+  const sim::World& world() const { return *world_; }
 
  private:
   BallOutcome run(control::FlipperController& controller, const control::ActuatorController* actuator, double pull,
                   std::uint64_t seed) const;
 
-  const sim::Board& board_;
+  const table::Board& board_;
   EvaluatorConfig config_;
-  sim::ThesisStepper stepper_;
+  std::unique_ptr<sim::World> world_;  // forked per ball
 };
 
 }  // namespace pinball::learn

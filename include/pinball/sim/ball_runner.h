@@ -1,5 +1,5 @@
 #pragma once
-// Plays whole balls on a stepper: launch, step until the ball is lost or a
+// Plays whole balls in a world: launch, step until the ball is lost or a
 // time limit cuts it, relaunch a ball that falls back into the launcher. The
 // policy (who presses the flipper buttons) and the observer (traces, video)
 // are passed in, so the same loop serves the CLI, the tests and benchmarks.
@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "pinball/sim/game_state.h"
-#include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/world.h"
 
 namespace pinball::sim {
 
@@ -28,24 +28,22 @@ struct BallResult {
   bool left_table = false;   ///< lost by leaving the table's bounds rather than by a drain
 };
 
-/// Starts the next ball: a new game if the last one is over, then a launch.
-void begin_ball(const Board& board, GameState& state, double pull);
+/// Starts the next ball: a new game if the last one is over, then the world's launch.
+void begin_ball(World& world, GameState& state, double pull);
 
 /// True when a ball in play has rolled back to the launcher and stopped there.
-bool resting_in_launcher(const Board& board, const GameState& state);
+bool resting_in_launcher(const table::Board& board, const GameState& state);
 
 /// Ends a ball that ran past its time limit: counted as lost.
-void cut_ball(const Board& board, GameState& state);
+void cut_ball(const table::Board& board, GameState& state);
 
-/// Plays one ball on any stepper with step(state), dt_s() and board() (the
-/// thesis or the event stepper). `policy(state)` sets flipper commands before
+/// Plays one ball in `world`. `policy(state)` sets flipper commands before
 /// each step; `observer(state, events)` sees the state after each step.
-template <class Stepper, class Policy, class Observer>
-BallResult play_ball(const Stepper& stepper, GameState& state, const BallLimits& limits, Policy&& policy,
-                     Observer&& observer) {
-  const Board& board = stepper.board();
+template <class Policy, class Observer>
+BallResult play_ball(World& world, GameState& state, const BallLimits& limits, Policy&& policy, Observer&& observer) {
+  const table::Board& board = world.board();
   const double pull = limits.pull >= 0.0 ? limits.pull : board.launcher.pull;
-  begin_ball(board, state, pull);
+  begin_ball(world, state, pull);
   BallResult result;
   result.launches = 1;
   const double score_before = state.score;
@@ -54,7 +52,7 @@ BallResult play_ball(const Stepper& stepper, GameState& state, const BallLimits&
   observer(static_cast<const GameState&>(state), StepEvents{StepEvents::kLaunch});
   while (true) {
     policy(state);
-    const StepEvents events = stepper.step(state);
+    const StepEvents events = world.step(state);
     ++result.steps;
     observer(static_cast<const GameState&>(state), events);
     if (events.has(StepEvents::kBallLost)) {
@@ -62,13 +60,13 @@ BallResult play_ball(const Stepper& stepper, GameState& state, const BallLimits&
       break;
     }
     // Half a step of slack: time is a sum of steps and may fall just short.
-    if (state.time_s - t0 >= limits.max_ball_time_s - 0.5 * stepper.dt_s()) {
+    if (state.time_s - t0 >= limits.max_ball_time_s - 0.5 * world.dt_s()) {
       result.cut = true;
       cut_ball(board, state);
       break;
     }
     if (resting_in_launcher(board, state)) {
-      launch_ball(board, state, pull);
+      world.launch(state, pull);
       ++result.launches;
       observer(static_cast<const GameState&>(state), StepEvents{StepEvents::kLaunch});
     }

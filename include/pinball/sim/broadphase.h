@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::sim {
 
@@ -20,7 +20,7 @@ class UniformGrid {
 
   /// Builds the grid. reach_m: the largest distance from a ball centre in a
   /// cell to a shape it may touch before the next query; cell_m: cell edge.
-  UniformGrid(std::span<const Shape> shapes, double reach_m, double cell_m);
+  UniformGrid(std::span<const table::Shape> shapes, double reach_m, double cell_m);
 
   /// Indices of every shape within reach of `p` (ascending). Empty far from
   /// all shapes, including outside the grid.

@@ -4,7 +4,7 @@
 // integrate, never in what a collision does.
 
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::sim {
 
@@ -19,7 +19,7 @@ struct Contact {
 /// (thesis eq. 3.3–3.4: the ball's nearest point B − r·n meets the segment).
 /// Finds a contact with t in [0, t_max]; a ball already overlapping the front
 /// face while approaching it collides at t = 0; a ball behind passes through.
-bool line_time_of_impact(const Shape& line, const Vec2& p, const Vec2& v, double r, double t_max, Contact& out);
+bool line_time_of_impact(const table::Shape& line, const Vec2& p, const Vec2& v, double r, double t_max, Contact& out);
 
 /// Same against a circle of radius `radius_m` (0 = point) centred at c
 /// (thesis eq. 3.5). A tangent graze is no contact; an overlapping ball that
@@ -28,7 +28,7 @@ bool circle_time_of_impact(const Vec2& c, double radius_m, const Vec2& p, const 
                            Contact& out);
 
 /// Dispatches on the shape's kind.
-bool shape_time_of_impact(const Shape& shape, const Vec2& p, const Vec2& v, double r, double t_max, Contact& out);
+bool shape_time_of_impact(const table::Shape& shape, const Vec2& p, const Vec2& v, double r, double t_max, Contact& out);
 
 /// Reflection with reflectivity rho (thesis 3.3.2): mirror v about the surface,
 /// then scale the normal component: v − (1 + ρ)(v·n)n.
@@ -36,16 +36,16 @@ inline Vec2 reflect(const Vec2& v, const Vec2& n, double rho) { return v - (1.0 
 
 /// The flipper as a two-sided segment at theta_rad: which face the ball at p
 /// is in front of, as a line shape from pivot to tip with that face's normal.
-Shape flipper_face(const Flipper& f, double theta_rad, const Vec2& p);
+table::Shape flipper_face(const table::Flipper& f, double theta_rad, const Vec2& p);
 
 /// Velocity (m/s) of the flipper's material point at `q` when it turns at omega_rad_s.
-Vec2 flipper_point_velocity(const Flipper& f, double theta_rad, double omega_rad_s, const Vec2& q);
+Vec2 flipper_point_velocity(const table::Flipper& f, double theta_rad, double omega_rad_s, const Vec2& q);
 
 /// Ball velocity after touching a flipper at point q with contact normal n
 /// (thesis 3.3.2, "Collision with a Flipper"): reflect with the flipper's ρ if
 /// the ball moves into the face, then add E = μ·(v_q·n)·n when the face at q
 /// moves toward the ball with speed v_q·n = l_moment·θ̇.
-Vec2 flipper_response(const Flipper& f, double theta_rad, double omega_rad_s, const Vec2& q, const Vec2& n,
+Vec2 flipper_response(const table::Flipper& f, double theta_rad, double omega_rad_s, const Vec2& q, const Vec2& n,
                       const Vec2& v);
 
 }  // namespace pinball::sim

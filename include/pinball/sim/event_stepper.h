@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/broadphase.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -49,7 +49,7 @@ class EventStepper {
  public:
   /// Builds the grids. Throws std::invalid_argument if dt or a tolerance is not
   /// positive and finite.
-  explicit EventStepper(const Board& board, EventStepperOptions options = {});
+  explicit EventStepper(const table::Board& board, EventStepperOptions options = {});
 
   /// Advances state.time_s by dt_s exactly: flippers move toward the commanded
   /// stop, the ball flies, slides and collides, sensors fire. Events in the
@@ -59,14 +59,14 @@ class EventStepper {
   /// The step horizon (s).
   double dt_s() const { return options_.dt_s; }
   /// The board it steps.
-  const Board& board() const { return board_; }
+  const table::Board& board() const { return board_; }
   /// The settings in force.
   const EventStepperOptions& options() const { return options_; }
 
  private:
   struct Run;  // one step's working state (event_stepper.cpp)
 
-  const Board& board_;
+  const table::Board& board_;
   EventStepperOptions options_;
   UniformGrid obstacle_grid_;
   UniformGrid sensor_grid_;
@@ -78,7 +78,7 @@ class EventStepper {
   bool has_contact_score_ = false;
   std::vector<std::int32_t> all_obstacles_;  // 0..n-1 for use_grid = false
   std::vector<std::int32_t> all_sensors_;
-  std::vector<Shape> sensor_shapes_;
+  std::vector<table::Shape> sensor_shapes_;
 };
 
 }  // namespace pinball::sim

@@ -8,7 +8,7 @@
 
 #include "pinball/core/geometry.h"
 #include "pinball/core/rng.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::sim {
 
@@ -53,14 +53,14 @@ struct GameState {
 
 /// A fresh game: flippers down, all obstacles at their initial visibility, the
 /// ball waiting in the launcher, balls_left = board.balls_per_game.
-GameState make_game_state(const Board& board, std::uint64_t seed);
+GameState make_game_state(const table::Board& board, std::uint64_t seed);
 
 /// Resets score, balls, visibility and flippers for a new game on the same
 /// state object (keeps the random stream going; allocates nothing).
-void reset_game(const Board& board, GameState& state);
+void reset_game(const table::Board& board, GameState& state);
 
 /// Places the ball in the launcher and launches it with pull fraction `pull`
 /// (thesis 3.3.1): v = (0, pull·(1 − R)·speed_max), R ~ U[0, noise_max].
-void launch_ball(const Board& board, GameState& state, double pull);
+void launch_ball(const table::Board& board, GameState& state, double pull);
 
 }  // namespace pinball::sim

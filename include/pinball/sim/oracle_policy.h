@@ -5,7 +5,7 @@
 // sees true state (thesis 4.1) and will replace this with the tracker's
 // projection.
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 
 namespace pinball::sim {
@@ -13,6 +13,6 @@ namespace pinball::sim {
 /// Energises the flipper nearest the ball while the ball is within
 /// `reach_factor` ball radii of that flipper's down-position segment and
 /// falling; releases every other flipper.
-void oracle_spastic_policy(const Board& board, GameState& state, double reach_factor = 2.5);
+void oracle_spastic_policy(const table::Board& board, GameState& state, double reach_factor = 2.5);
 
 }  // namespace pinball::sim

@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 
 namespace pinball::sim {
@@ -20,14 +20,14 @@ struct RenderOptions {
 };
 
 /// Image size (width, height in px) that render_board produces for `board`.
-cv::Size render_size(const Board& board, const RenderOptions& options);
+cv::Size render_size(const table::Board& board, const RenderOptions& options);
 
 /// Board point (m) to image pixel (u right, v down) under `options`.
-cv::Point2d board_to_pixel(const Board& board, const RenderOptions& options, const Vec2& p_board);
+cv::Point2d board_to_pixel(const table::Board& board, const RenderOptions& options, const Vec2& p_board);
 
 /// Draws the board; with a state also draws flippers at their angles, hidden
 /// flags greyed out, the ball and the HUD. Returns an 8-bit BGR image.
-cv::Mat render_board(const Board& board, const GameState* state, const RenderOptions& options);
+cv::Mat render_board(const table::Board& board, const GameState* state, const RenderOptions& options);
 
 /// Writes an image as PNG. Throws std::runtime_error naming the path on failure.
 void write_png(const cv::Mat& image, const std::string& path);

@@ -8,9 +8,10 @@
 #include <span>
 #include <vector>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/broadphase.h"
 #include "pinball/sim/game_state.h"
+#include "pinball/sim/step_events.h"
 
 namespace pinball::sim {
 
@@ -22,35 +23,13 @@ struct ThesisStepperOptions {
   double contact_tolerance_m = 5e-4;  ///< ball within this of a surface counts as touching (contact score, sensors)
 };
 
-/// What happened during one step (bit flags plus the first index of each kind).
-struct StepEvents {
-  enum Flag : std::uint32_t {
-    kHitObstacle = 1u << 0,     ///< reflected off a static obstacle
-    kHitFlipper = 1u << 1,      ///< reflected off a flipper during the ball update
-    kFlipperPush = 1u << 2,     ///< a moving flipper swept into the ball and pushed it
-    kFlipperStall = 1u << 3,    ///< a flipper stopped because the ball is jammed against a wall
-    kSensor = 1u << 4,          ///< the ball entered a sensor or hole
-    kBallLost = 1u << 5,        ///< the ball was eaten (or left the table)
-    kBankComplete = 1u << 6,    ///< the last flag of a bank fell
-    kLeftTable = 1u << 7,       ///< the ball left the table's bounds (also sets kBallLost)
-    kLaunch = 1u << 8,          ///< the ball was launched (set by the ball runner, not by a step)
-  };
-  std::uint32_t flags = 0;       ///< Flag bits
-  std::int32_t obstacle = -1;    ///< obstacle hit (kHitObstacle)
-  std::int32_t flipper = -1;     ///< flipper hit or pushing (kHitFlipper, kFlipperPush, kFlipperStall)
-  std::int32_t sensor = -1;      ///< first sensor entered (kSensor)
-  double score_gained = 0.0;     ///< points scored this step
-
-  bool has(Flag f) const { return (flags & f) != 0; }
-};
-
 /// Advances a GameState by fixed steps over a Board it borrows. Owns the
 /// broadphase built for its time step. step() allocates nothing.
 class ThesisStepper {
  public:
   /// Builds the grids. Throws std::invalid_argument if dt is not positive or
   /// violates the flipper condition l·sin(θ̇₀·dt/2) < r (thesis 3.3.3).
-  explicit ThesisStepper(const Board& board, ThesisStepperOptions options = {});
+  explicit ThesisStepper(const table::Board& board, ThesisStepperOptions options = {});
 
   /// One step of dt: flippers, then the ball, then sensors and contact scores.
   StepEvents step(GameState& state) const;
@@ -58,7 +37,7 @@ class ThesisStepper {
   /// The time step (s).
   double dt_s() const { return options_.dt_s; }
   /// The board it steps.
-  const Board& board() const { return board_; }
+  const table::Board& board() const { return board_; }
   /// The settings in force.
   const ThesisStepperOptions& options() const { return options_; }
   /// Obstacles the ball at p may touch within one step (the linear list when the grid is off).
@@ -75,7 +54,7 @@ class ThesisStepper {
   void lose_ball(GameState& state, StepEvents& events) const;
   void raise_flags(GameState& state) const;
 
-  const Board& board_;
+  const table::Board& board_;
   ThesisStepperOptions options_;
   double reach_m_ = 0.0;  // farthest a shape can be and still matter this step
   bool has_contact_score_ = false;
@@ -83,7 +62,7 @@ class ThesisStepper {
   UniformGrid sensor_grid_;
   std::vector<std::int32_t> all_obstacles_;  // 0..n-1, for the linear scan
   std::vector<std::int32_t> all_sensors_;
-  std::vector<Shape> sensor_shapes_;
+  std::vector<table::Shape> sensor_shapes_;
 };
 
 }  // namespace pinball::sim

@@ -6,7 +6,7 @@
 #include <array>
 
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::track {
 
@@ -33,7 +33,7 @@ FlipperGeometry make_flipper_geometry(const FlipperLine& left, const FlipperLine
 
 /// The geometry of a board's flippers at θ_min. Throws std::invalid_argument
 /// unless the board has exactly one left and one right flipper.
-FlipperGeometry flipper_geometry_from_board(const sim::Board& board);
+FlipperGeometry flipper_geometry_from_board(const table::Board& board);
 
 /// True when p lies above both flipper lines (inside the 'V' or above it).
 bool above_flippers(const FlipperGeometry& geometry, const Vec2& p);

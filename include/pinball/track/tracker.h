@@ -30,7 +30,7 @@ struct TrackerConfig {
 
 /// Defaults for a board and a camera: g from the board, d and ε from the
 /// flipper length, σ from the camera, the critical area 0.35 m above the pivots.
-TrackerConfig default_tracker_config(const sim::Board& board, const CameraModelConfig& camera);
+TrackerConfig default_tracker_config(const table::Board& board, const CameraModelConfig& camera);
 
 /// Everything one update produced.
 struct TrackerOutput {

@@ -10,7 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "pinball/core/geometry.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 namespace pinball::vision {
 
@@ -38,7 +38,7 @@ class CameraHomography {
   static CameraHomography from_points(const std::array<Vec2, 4>& p_board, const std::array<cv::Point2d, 4>& uv_px);
 
   /// The simulator's default camera over `board` for an image of `image_size`.
-  static CameraHomography default_view(const sim::Board& board, cv::Size image_size, const CameraView& view = {});
+  static CameraHomography default_view(const table::Board& board, cv::Size image_size, const CameraView& view = {});
 
   /// Board point (m) to image point (px).
   cv::Point2d image_from_board(const Vec2& p_board) const;

@@ -17,7 +17,7 @@
 
 #include "pinball/core/geometry.h"
 #include "pinball/core/rng.h"
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/vision/camera_homography.h"
 #include "pinball/vision/frame_source.h"
@@ -95,7 +95,7 @@ struct FrameTruth {
 class SimCameraSource final : public FrameSource {
  public:
   /// Renders the static scene. Throws std::invalid_argument naming a bad setting.
-  SimCameraSource(const sim::Board& board, const SimCameraConfig& config);
+  SimCameraSource(const table::Board& board, const SimCameraConfig& config);
 
   /// Feeds the simulator's state after a step (call every step, time increasing).
   void observe(const sim::GameState& state);
@@ -169,7 +169,7 @@ class SimCameraSource final : public FrameSource {
   void draw_ball(std::span<const Vec2> path_board, int path_total, cv::Mat& image);
   bool sample_at(double t_s, Vec2& p, bool& in_play) const;
 
-  const sim::Board& board_;
+  const table::Board& board_;
   SimCameraConfig config_;
   CameraHomography homography_;
   Rng rng_;

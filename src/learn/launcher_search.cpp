@@ -1,17 +1,17 @@
-#include "pinball/control/launcher_controller.h"
+#include "pinball/learn/launcher_search.h"
 
 #include <stdexcept>
 
 #include "pinball/control/simulated_player.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/model_world.h"
 
-namespace pinball::control {
+namespace pinball::learn {
 
 namespace {
 
 // Never flips; remembers whether the tracker ever saw a hittable state.
-class HittableWatcher final : public FlipperController {
+class HittableWatcher final : public control::FlipperController {
  public:
   void update(const track::TrackerOutput& out, double, std::array<bool, 2>&) override {
     if (out.projection.valid && out.projection.hittable) hittable = true;
@@ -22,11 +22,13 @@ class HittableWatcher final : public FlipperController {
 
 }  // namespace
 
-LauncherSearchResult search_launcher(const sim::Board& board, const LauncherSearchConfig& config) {
+LauncherSearchResult search_launcher(const table::Board& board, const LauncherSearchConfig& config,
+                                     const sim::World* world) {
   if (config.pulls < 1 || config.launches_per_pull < 1 || !(config.time_limit_s > 0.0)) {
     throw std::invalid_argument("launcher search: pulls and launches must be >= 1 and the time limit > 0");
   }
-  const sim::ThesisStepper stepper(board);
+  const std::unique_ptr<sim::World> world_prototype = world != nullptr ? world->fork() : sim::make_model_world(board);
+  sim::check_same_flippers(world_prototype->board(), board);
   LauncherSearchResult result;
   result.best_successes = -1;
   for (int i = 1; i <= config.pulls; ++i) {
@@ -34,14 +36,15 @@ LauncherSearchResult search_launcher(const sim::Board& board, const LauncherSear
     int successes = 0;
     for (int l = 0; l < config.launches_per_pull; ++l) {
       const std::uint64_t seed = config.seed * 1000003ull + static_cast<std::uint64_t>(i * 1000 + l);
-      sim::GameState state = sim::make_game_state(board, seed);
+      const std::unique_ptr<sim::World> ball_world = world_prototype->fork();
+      sim::GameState state = sim::make_game_state(ball_world->board(), seed);
       HittableWatcher watcher;
-      SimulatedPlayer player(board, config.camera, watcher, seed ^ 0x9E3779B97F4A7C15ull);
+      control::SimulatedPlayer player(board, config.camera, watcher, seed ^ 0x9E3779B97F4A7C15ull);
       sim::BallLimits limits;
       limits.max_ball_time_s = config.time_limit_s;
       limits.pull = pull;
       sim::play_ball(
-          stepper, state, limits, [&](sim::GameState& s) { player.act(s); },
+          *ball_world, state, limits, [&](sim::GameState& s) { player.act(s); },
           [&](const sim::GameState&, const sim::StepEvents&) {});
       successes += watcher.hittable ? 1 : 0;
     }
@@ -55,4 +58,4 @@ LauncherSearchResult search_launcher(const sim::Board& board, const LauncherSear
   return result;
 }
 
-}  // namespace pinball::control
+}  // namespace pinball::learn

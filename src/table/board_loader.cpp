@@ -1,4 +1,4 @@
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 // The loader in three layers: a tokenizer that turns text into statements, a
 // Reader that reads one statement's fields and phrases every error, and one
@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-namespace pinball::sim {
+namespace pinball::table {
 
 namespace {
 
@@ -613,4 +613,4 @@ Board load_board(const std::string& path) {
   return parse_board(text.str(), path);
 }
 
-}  // namespace pinball::sim
+}  // namespace pinball::table

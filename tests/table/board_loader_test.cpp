@@ -1,4 +1,4 @@
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <numbers>
 #include <string>
 
-namespace pinball::sim {
+namespace pinball::table {
 namespace {
 
 // Seven lines of required statements in SI; the body of each test starts at line 8.
@@ -527,4 +527,4 @@ TEST(BoardScenes, Flipper) {
 }
 
 }  // namespace
-}  // namespace pinball::sim
+}  // namespace pinball::table

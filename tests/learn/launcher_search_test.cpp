@@ -1,14 +1,14 @@
-#include "pinball/control/launcher_controller.h"
+#include "pinball/learn/launcher_search.h"
 
 #include <gtest/gtest.h>
 
-#include "pinball/sim/board_loader.h"
+#include "pinball/table/board_loader.h"
 
-namespace pinball::control {
+namespace pinball::learn {
 namespace {
 
-TEST(LauncherController, FindsAPullThatReachesAHittableState) {
-  const sim::Board board = sim::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+TEST(LauncherSearch, FindsAPullThatReachesAHittableState) {
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   LauncherSearchConfig c;
   c.pulls = 5;  // a quick version of the thesis's 20 x 10
   c.launches_per_pull = 3;
@@ -24,4 +24,4 @@ TEST(LauncherController, FindsAPullThatReachesAHittableState) {
 }
 
 }  // namespace
-}  // namespace pinball::control
+}  // namespace pinball::learn

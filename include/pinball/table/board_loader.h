@@ -6,9 +6,9 @@
 #include <string>
 #include <string_view>
 
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
-namespace pinball::sim {
+namespace pinball::table {
 
 /// Bad board input. what() is "file:line: message" (line omitted when the
 /// problem is the file as a whole, e.g. a missing required line).
@@ -30,4 +30,4 @@ Board load_board(const std::string& path);
 /// Parses board text; `source_name` is used in error messages and Board::source.
 Board parse_board(std::string_view text, const std::string& source_name);
 
-}  // namespace pinball::sim
+}  // namespace pinball::table

@@ -1,4 +1,4 @@
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 #include <gtest/gtest.h>
 
@@ -7,13 +7,13 @@
 #include <stdexcept>
 #include <string>
 
-#include "test_boards.h"
+#include "sim/test_boards.h"
 
-namespace pinball::sim {
+namespace pinball::table {
 namespace {
 
-using testing::add_flipper;
-using testing::empty_board;
+using sim::testing::add_flipper;
+using sim::testing::empty_board;
 
 TEST(FlipperGeometry, DirectionAtZeroAndUpNormal) {
   Board b = empty_board();
@@ -86,4 +86,4 @@ TEST(CheckFlipperTimeStep, ThrowsAboveTheLimitNamingTheFlipper) {
 }
 
 }  // namespace
-}  // namespace pinball::sim
+}  // namespace pinball::table

@@ -11,7 +11,7 @@
 
 #include "pinball/core/geometry.h"
 
-namespace pinball::sim {
+namespace pinball::table {
 
 /// Primitive shape of an obstacle or sensor (thesis 3.2.3).
 enum class ShapeKind : std::uint8_t {
@@ -151,4 +151,4 @@ double max_stable_dt_s(const Board& board);
 /// l·sin(θ̇₀·dt/2) < r for any flipper.
 void check_flipper_time_step(const Board& board, double dt_s);
 
-}  // namespace pinball::sim
+}  // namespace pinball::table

@@ -1,11 +1,11 @@
-#include "pinball/sim/board.h"
+#include "pinball/table/board.h"
 
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 
-namespace pinball::sim {
+namespace pinball::table {
 
 Shape make_line_shape(const Vec2& p0, const Vec2& p1) {
   Shape s;
@@ -71,4 +71,4 @@ void check_flipper_time_step(const Board& board, double dt_s) {
   }
 }
 
-}  // namespace pinball::sim
+}  // namespace pinball::table

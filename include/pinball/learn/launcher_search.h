@@ -6,10 +6,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "pinball/sim/board.h"
+#include "pinball/sim/world.h"
+#include "pinball/table/board.h"
 #include "pinball/track/camera_model.h"
 
-namespace pinball::control {
+namespace pinball::learn {
 
 /// Settings of the search.
 struct LauncherSearchConfig {
@@ -28,7 +29,9 @@ struct LauncherSearchResult {
   std::vector<int> successes;     ///< successes per value
 };
 
-/// Runs the search on the thesis stepper with the board's time step.
-LauncherSearchResult search_launcher(const sim::Board& board, const LauncherSearchConfig& config = {});
+/// Runs the search with the tracker believing `board`, in forks of `world`
+/// (null: the model of `board` on the thesis stepper at the board's time step).
+LauncherSearchResult search_launcher(const table::Board& board, const LauncherSearchConfig& config = {},
+                                     const sim::World* world = nullptr);
 
-}  // namespace pinball::control
+}  // namespace pinball::learn
