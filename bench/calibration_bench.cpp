@@ -9,7 +9,7 @@
 #include "pinball/calibration/camera_calibration.h"
 #include "pinball/calibration/flipper_calibration.h"
 #include "pinball/calibration/gravity_calibration.h"
-#include "pinball/calibration/sim_lab.h"
+#include "pinball/simlab/sim_lab.h"
 #include "pinball/track/tracker.h"
 #include "pinball/track/trajectory_fit.h"
 #include "tracker_bench.h"
@@ -105,9 +105,9 @@ CalibrationReport run_calibration_bench(const table::Board& board, const Calibra
   CalibrationReport r;
   r.board = board.source;
   r.options = options;
-  calibration::SimLabOptions lab_options;
+  simlab::SimLabOptions lab_options;
   lab_options.seed = options.seed;
-  calibration::SimLab lab(board, lab_options);
+  simlab::SimLab lab(board, lab_options);
   const table::Board& truth = lab.truth();
   r.true_g_mps2 = truth.gravity_mps2;
 

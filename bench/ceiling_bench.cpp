@@ -13,7 +13,7 @@
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 
 namespace pinball::bench {
 
@@ -48,11 +48,11 @@ CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper&
     ball.decisions = player.decisions();
     ball.branch_steps = player.branch_steps();
   } else if (kind == CeilingPlayerKind::kSpastic) {
-    learn::DelayLine delay(board.flippers.size(), options.actuation_delay_s);
+    simlab::DelayLine delay(board.flippers.size(), options.actuation_delay_s);
     r = sim::play_ball(
         world, state, limits,
         [&](sim::GameState& s) {
-          sim::oracle_spastic_policy(world.board(), s, options.spastic_reach_factor);
+          simlab::oracle_spastic_policy(world.board(), s, options.spastic_reach_factor);
           delay.apply(s);
         },
         observer);
@@ -100,7 +100,7 @@ CeilingPlayerReport run_player(const sim::World& world, const sim::ThesisStepper
   const auto start = std::chrono::steady_clock::now();
   learn::parallel_for(n, options.threads, [&](std::size_t i) {
     const std::unique_ptr<sim::World> ball_world = world.fork();
-    balls[i] = play_ceiling_bench_ball(*ball_world, model, options, kind, learn::ball_seed(options.seed, i));
+    balls[i] = play_ceiling_bench_ball(*ball_world, model, options, kind, ball_seed(options.seed, i));
     const int d = ++done;
     if (progress && (d % every == 0 || d == options.balls)) {
       const std::lock_guard<std::mutex> lock(progress_mutex);

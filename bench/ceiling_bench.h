@@ -18,10 +18,10 @@
 // again; otherwise it does nothing this frame and plans again at the next.
 // Ties go to the earlier candidate, so "don't fire" wins when nothing is
 // better. Commands pass through the evaluator's 4 ms actuation delay
-// (learn::DelayLine), in the branches as in the real play.
+// (simlab::DelayLine), in the branches as in the real play.
 //
-// Baselines on the same ball seeds (learn::ball_seed(seed, i)): the spastic
-// flipper on the true state (sim::oracle_spastic_policy, every step, same
+// Baselines on the same ball seeds (ball_seed(seed, i)): the spastic
+// flipper on the true state (simlab::oracle_spastic_policy, every step, same
 // actuation delay), and no flipping. Balls are cut at 60 s as in the evaluator.
 
 #include <cstdint>
@@ -46,7 +46,7 @@ namespace pinball::bench {
 /// What to measure.
 struct CeilingBenchOptions {
   int balls = 200;                  ///< balls per player (same seeds for all three)
-  std::uint64_t seed = 1;           ///< run seed: ball i plays learn::ball_seed(seed, i)
+  std::uint64_t seed = 1;           ///< run seed: ball i plays ball_seed(seed, i)
   int threads = 2;                  ///< worker threads; results do not depend on it
   double max_ball_time_s = 60.0;    ///< a ball alive after this is cut (a possible cycle)
   double actuation_delay_s = 0.004; ///< command to flipper motion, as in the evaluator

@@ -5,7 +5,7 @@
 #include <thread>
 #include <vector>
 
-#include "pinball/daemon/clock.h"
+#include "pinball/core/clock.h"
 #include "pinball/daemon/doorbell.h"
 
 namespace pinball::bench {
@@ -24,8 +24,8 @@ DaemonLatencyRun run_once(const DaemonLatencyOptions& o, bool realtime, const da
   std::thread stopper;
   if (realtime) {
     stopper = std::thread([&] {
-      const double end = daemon::steady_now_s() + o.realtime_s;
-      while (!done.load() && daemon::steady_now_s() < end) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      const double end = steady_now_s() + o.realtime_s;
+      while (!done.load() && steady_now_s() < end) std::this_thread::sleep_for(std::chrono::milliseconds(10));
       d.request_stop();
     });
   }
@@ -52,13 +52,13 @@ void doorbell_baseline(int samples, double& p50_us, double& p99_us) {
   std::thread waiter([&] {
     for (int i = 0; i < samples; ++i) {
       ping.wait(1.0);
-      lat.push_back((daemon::steady_now_s() - rung_at.load()) * 1e6);
+      lat.push_back((steady_now_s() - rung_at.load()) * 1e6);
       pong.ring();
     }
   });
   for (int i = 0; i < samples; ++i) {
     std::this_thread::sleep_for(std::chrono::microseconds(200));  // let the waiter fall asleep, as between frames
-    rung_at = daemon::steady_now_s();
+    rung_at = steady_now_s();
     ping.ring();
     pong.wait(1.0);
   }

@@ -12,13 +12,13 @@
 
 #include "pinball/core/rng.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 #include "pinball/sim/model_world.h"
 
 namespace pinball::bench {
 
-vision::SimCameraConfig DetectorBenchOptions::default_camera() {
-  vision::SimCameraConfig c;
+simlab::SimCameraConfig DetectorBenchOptions::default_camera() {
+  simlab::SimCameraConfig c;
   c.glare.enabled = true;
   c.glare.toggle_probability = 0.01;
   return c;
@@ -60,7 +60,7 @@ double quantile(std::vector<double> v, double q) {
 }
 
 // Learns the detector's background from ball-free frames with the lamps still and the glare off.
-void learn_background(vision::SimCameraSource& camera, vision::BallDetector& detector, int frames, double& t_s) {
+void learn_background(simlab::SimCameraSource& camera, vision::BallDetector& detector, int frames, double& t_s) {
   camera.set_lamps_blinking(false);
   camera.set_glare(false);
   vision::Frame frame;
@@ -77,7 +77,7 @@ void learn_background(vision::SimCameraSource& camera, vision::BallDetector& det
 // Plays the board with the oracle spastic player and hands every delivered
 // frame (with the camera's truth) to `on_frame` until it returns false.
 template <class OnFrame>
-void play_frames(const table::Board& board, std::uint64_t seed, vision::SimCameraSource& camera, OnFrame&& on_frame) {
+void play_frames(const table::Board& board, std::uint64_t seed, simlab::SimCameraSource& camera, OnFrame&& on_frame) {
   const std::unique_ptr<sim::World> world = sim::make_model_world(board);
   sim::GameState state = sim::make_game_state(board, seed);
   sim::BallLimits limits;
@@ -87,7 +87,7 @@ void play_frames(const table::Board& board, std::uint64_t seed, vision::SimCamer
   double last_t = -1.0;
   for (int ball = 0; more && ball < 1000; ++ball) {
     sim::play_ball(
-        *world, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+        *world, state, limits, [&](sim::GameState& s) { simlab::oracle_spastic_policy(board, s); },
         [&](const sim::GameState& s, const sim::StepEvents&) {
           if (!more) return;
           if (s.time_s < last_t) camera.reset(s.time_s);
@@ -98,15 +98,15 @@ void play_frames(const table::Board& board, std::uint64_t seed, vision::SimCamer
   }
 }
 
-vision::SimCameraConfig sized(const vision::SimCameraConfig& c, cv::Size size) {
-  vision::SimCameraConfig out = c;
+simlab::SimCameraConfig sized(const simlab::SimCameraConfig& c, cv::Size size) {
+  simlab::SimCameraConfig out = c;
   out.width_px = size.width;
   out.height_px = size.height;
   return out;
 }
 
 void measure_accuracy(const table::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
-  vision::SimCameraSource camera(board, o.camera);
+  simlab::SimCameraSource camera(board, o.camera);
   vision::BallDetector detector(camera.homography(), camera.frame_size(), o.detector);
   detector.set_occluder_mask(camera.occluder_mask());
   double t_s = -1000.0;
@@ -114,7 +114,7 @@ void measure_accuracy(const table::Board& board, const DetectorBenchOptions& o, 
   AccuracyFigures& a = r.accuracy;
   std::vector<double> err_px, err_mm, naive_px, blur_px, radius_px;
   cv::Mat naive_binary;
-  play_frames(board, o.seed, camera, [&](const vision::Frame& frame, const vision::FrameTruth& truth) {
+  play_frames(board, o.seed, camera, [&](const vision::Frame& frame, const simlab::FrameTruth& truth) {
     ++a.frames;
     const vision::Detection d = detector.detect(frame);
     const double e_px = d.found ? cv::norm(d.uv_px - truth.uv_px_mid) : 0.0;
@@ -160,9 +160,9 @@ void measure_accuracy(const table::Board& board, const DetectorBenchOptions& o, 
 }
 
 void measure_ball_free(const table::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
-  vision::SimCameraConfig c = o.camera;
+  simlab::SimCameraConfig c = o.camera;
   c.seed = o.camera.seed + 1000;
-  vision::SimCameraSource camera(board, c);
+  simlab::SimCameraSource camera(board, c);
   vision::BallDetector detector(camera.homography(), camera.frame_size(), o.detector);
   detector.set_occluder_mask(camera.occluder_mask());
   double t_s = 0.0;
@@ -182,10 +182,10 @@ void measure_ball_free(const table::Board& board, const DetectorBenchOptions& o,
 
 void measure_occlusion(const table::Board& board, const DetectorBenchOptions& o, DetectorReport& r) {
   if (o.camera.plastics.empty()) return;
-  vision::SimCameraConfig c = o.camera;
+  simlab::SimCameraConfig c = o.camera;
   c.seed = o.camera.seed + 2000;
   c.glare.enabled = false;
-  vision::SimCameraSource camera(board, c);
+  simlab::SimCameraSource camera(board, c);
   vision::BallDetector detector(camera.homography(), camera.frame_size(), o.detector);
   detector.set_occluder_mask(camera.occluder_mask());
   double t_s = 0.0;
@@ -197,7 +197,7 @@ void measure_occlusion(const table::Board& board, const DetectorBenchOptions& o,
   int attempts = 0;
   while (r.occlusion.frames < static_cast<std::size_t>(o.occlusion_frames) && attempts < 50 * o.occlusion_frames) {
     ++attempts;
-    const vision::SimPlastic& plastic = c.plastics[rng.next_u64() % c.plastics.size()];
+    const simlab::SimPlastic& plastic = c.plastics[rng.next_u64() % c.plastics.size()];
     Vec2 lo = plastic.polygon_board.front();
     Vec2 hi = lo;
     for (const Vec2& p : plastic.polygon_board) {
@@ -230,11 +230,11 @@ void measure_occlusion(const table::Board& board, const DetectorBenchOptions& o,
 void measure_timing(const table::Board& board, const DetectorBenchOptions& o, cv::Size size, DetectorReport& r) {
   DetectorTiming timing;
   timing.size = size;
-  vision::SimCameraSource camera(board, sized(o.camera, size));
+  simlab::SimCameraSource camera(board, sized(o.camera, size));
   std::vector<cv::Mat> frames;
   std::vector<double> times;
   std::size_t with_ball = 0;
-  play_frames(board, o.seed + 7, camera, [&](const vision::Frame& frame, const vision::FrameTruth& truth) {
+  play_frames(board, o.seed + 7, camera, [&](const vision::Frame& frame, const simlab::FrameTruth& truth) {
     frames.push_back(frame.gray.clone());
     times.push_back(frame.t_s);
     if (truth.ball_present) ++with_ball;

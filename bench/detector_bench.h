@@ -1,6 +1,6 @@
 #pragma once
 // `pinball bench detector`: the camera path measured against the simulator's
-// truth. The simulated camera (vision::SimCameraSource) renders the thesis
+// truth. The simulated camera (simlab::SimCameraSource) renders the thesis
 // table while the oracle spastic player plays it; the BallDetector finds the
 // ball in every frame and its centre is compared with the true ball centre at
 // mid-exposure. Measured in the same run:
@@ -22,7 +22,7 @@
 
 #include "pinball/table/board.h"
 #include "pinball/vision/ball_detector.h"
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 
 namespace pinball::bench {
 
@@ -44,11 +44,11 @@ struct DetectorBenchOptions {
   int background_frames = 32;               ///< ball-free frames averaged into the background
   double wrong_px = 1.0;                    ///< a detection further than this from the truth is wrong (px)
   double naive_threshold = 170.0;           ///< baseline: gray level the naive centroid thresholds at
-  vision::SimCameraConfig camera = default_camera();  ///< the simulated camera (size is per measurement)
+  simlab::SimCameraConfig camera = default_camera();  ///< the simulated camera (size is per measurement)
   vision::BallDetectorConfig detector;      ///< the detector under test
 
   /// The bench's camera: the default simulated camera with a flickering glare patch.
-  static vision::SimCameraConfig default_camera();
+  static simlab::SimCameraConfig default_camera();
 };
 
 /// A short run for tests: few frames of each kind, 640x480 timing only.

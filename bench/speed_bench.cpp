@@ -6,7 +6,7 @@
 
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
 
@@ -54,7 +54,7 @@ Timed run_once(sim::World& world, const sim::ThesisStepper& stepper, std::uint64
   const auto start = std::chrono::steady_clock::now();
   while (state.steps < steps) {
     sim::play_ball(world, state, limits,
-                   [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+                   [&](sim::GameState& s) { simlab::oracle_spastic_policy(board, s); },
                    [&](const sim::GameState&, const sim::StepEvents&) {});
   }
   const auto stop = std::chrono::steady_clock::now();
@@ -62,7 +62,7 @@ Timed run_once(sim::World& world, const sim::ThesisStepper& stepper, std::uint64
   sim::GameState replay = sim::make_game_state(board, seed);
   while (replay.steps < std::min<std::uint64_t>(steps, 200'000)) {
     sim::play_ball(world, replay, limits,
-                   [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+                   [&](sim::GameState& s) { simlab::oracle_spastic_policy(board, s); },
                    [&](const sim::GameState& s, const sim::StepEvents& e) {
                      if (e.has(sim::StepEvents::kLaunch)) return;  // not a step
                      candidates += stepper.obstacle_candidates(s.ball.position_m).size();
@@ -122,7 +122,7 @@ EventSpeedRun measure_event(const std::string& name, const table::Board& board, 
     sim::GameState state = sim::make_game_state(board, options.seed);
     const auto start = std::chrono::steady_clock::now();
     while (state.steps < options.steps) {
-      sim::play_ball(*world, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+      sim::play_ball(*world, state, limits, [&](sim::GameState& s) { simlab::oracle_spastic_policy(board, s); },
                      [&](const sim::GameState&, const sim::StepEvents&) {});
     }
     times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());

@@ -10,7 +10,7 @@
 
 #include "pinball/core/rng.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/track/flipper_geometry.h"
@@ -390,7 +390,7 @@ std::vector<TrackerApproach> collect_tracker_approaches(const table::Board& boar
     }
   };
   while (approaches.size() < wanted && state.time_s < options.max_simulated_s) {
-    sim::play_ball(*world, state, limits, [&](sim::GameState& s) { sim::oracle_spastic_policy(board, s); },
+    sim::play_ball(*world, state, limits, [&](sim::GameState& s) { simlab::oracle_spastic_policy(board, s); },
                    observer);
   }
   c.simulated_s = state.time_s;

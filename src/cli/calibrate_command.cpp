@@ -15,7 +15,7 @@
 #include "pinball/calibration/camera_calibration.h"
 #include "pinball/calibration/flipper_calibration.h"
 #include "pinball/calibration/gravity_calibration.h"
-#include "pinball/calibration/sim_lab.h"
+#include "pinball/simlab/sim_lab.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/track/observation_io.h"
@@ -87,7 +87,7 @@ struct Context {
   const CalibrateArgs& a;
   std::ostream& err;
   table::Board board;
-  std::unique_ptr<calibration::SimLab> lab;
+  std::unique_ptr<simlab::SimLab> lab;
   calibration::Calibration cal;
   nlohmann::json report;
 };
@@ -265,9 +265,9 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
   if (board_path.empty()) throw std::runtime_error("calibrate: give --board BOARD (or --sim BOARD)");
   Context c{a, err, table::load_board(board_path), nullptr, {}, {}};
   if (!a.sim_board.empty()) {
-    calibration::SimLabOptions o;
+    simlab::SimLabOptions o;
     o.seed = a.seed;
-    c.lab = std::make_unique<calibration::SimLab>(c.board, o);
+    c.lab = std::make_unique<simlab::SimLab>(c.board, o);
   }
   // --out updates an existing file: the other sections stay.
   if (!a.out.empty() && std::filesystem::exists(a.out)) c.cal = calibration::read_calibration(a.out);

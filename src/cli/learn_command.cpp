@@ -106,14 +106,14 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
   if (spec != nullptr) {
     std::vector<learn::BallTask> tasks;
     for (int i = 0; i < balls; ++i) {
-      tasks.push_back({spec, learn::ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, static_cast<std::uint64_t>(i))});
+      tasks.push_back({spec, ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, static_cast<std::uint64_t>(i))});
     }
     out = learn::play_balls(ev, tasks, a.threads);
   } else {  // a controller that is no action function (a baseline, the imitation table): one ball per task
     out.resize(static_cast<std::size_t>(balls));
     learn::parallel_for(static_cast<std::size_t>(balls), a.threads, [&](std::size_t i) {
       const std::unique_ptr<control::FlipperController> c = make_controller();
-      out[i] = ev.play_with(*c, a.pull, learn::ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i));
+      out[i] = ev.play_with(*c, a.pull, ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i));
     });
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

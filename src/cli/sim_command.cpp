@@ -16,13 +16,13 @@
 #include "pinball/core/running_stats.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board_loader.h"
-#include "pinball/control/can_flipper_drive.h"
+#include "pinball/simlab/can_flipper_drive.h"
 #include "pinball/control/controller_file.h"
-#include "pinball/control/simulated_player.h"
+#include "pinball/simlab/simulated_player.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/video_recorder.h"
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 #include "trace_writer.h"
 #include "world_options.h"
 
@@ -73,15 +73,15 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   std::unique_ptr<sim::VideoRecorder> video;
   sim::RenderOptions render_options;
   double next_frame_s = 0.0;
-  std::unique_ptr<vision::SimCameraSource> camera;  // --video-camera: the camera's own frames
+  std::unique_ptr<simlab::SimCameraSource> camera;  // --video-camera: the camera's own frames
   vision::Frame camera_frame;
   cv::Mat camera_bgr;
   if (!a.video.empty() && a.video_camera) {
-    vision::SimCameraConfig cc;
+    simlab::SimCameraConfig cc;
     cc.fps = a.video_fps;
     cc.exposure_s = std::min(cc.exposure_s, 1.0 / a.video_fps);
     cc.seed = a.seed;
-    camera = std::make_unique<vision::SimCameraSource>(world_board, cc);
+    camera = std::make_unique<simlab::SimCameraSource>(world_board, cc);
     video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, camera->frame_size());
   } else if (!a.video.empty()) {
     video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(world_board, render_options));
@@ -94,7 +94,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   }
   if (policy == "controller" && a.controller.empty()) throw std::invalid_argument("sim: --policy controller needs --controller FILE");
   std::unique_ptr<control::FlipperController> learned;
-  std::optional<control::SimulatedPlayer> learned_player;
+  std::optional<simlab::SimulatedPlayer> learned_player;
   double pull = -1.0;
   if (policy == "controller") {
     const control::ControllerSpec spec = control::load_controller(a.controller);
@@ -102,13 +102,13 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     learned_player.emplace(board, a.camera, *learned, a.seed ^ 0x5DEECE66Dull);
     pull = spec.launcher_pull;
   }
-  std::optional<control::SimulatedSpasticPlayer> spastic;
+  std::optional<simlab::SimulatedSpasticPlayer> spastic;
   if (policy == "spastic") {
     control::SpasticConfig spastic_config;
     spastic_config.reach_m = a.reach_m;
     spastic.emplace(board, a.camera, spastic_config, a.seed ^ 0x5DEECE66Dull);
   }
-  std::optional<control::CanFlipperDrive> can_drive;
+  std::optional<simlab::CanFlipperDrive> can_drive;
   if (a.actuation == "can") can_drive.emplace(world_board, a.actuation_delay_s);
   sim::BallLimits limits;
   limits.max_ball_time_s = a.max_ball_time_s;

@@ -16,7 +16,7 @@
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/core/running_stats.h"
-#include "pinball/daemon/clock.h"
+#include "pinball/core/clock.h"
 #include "pinball/daemon/doorbell.h"
 #include "pinball/daemon/hot_path.h"
 #include "pinball/daemon/pipeline.h"
@@ -28,7 +28,7 @@
 #include "pinball/table/board_loader.h"
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/vision/capture_source.h"
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 
 namespace pinball::daemon {
 
@@ -79,7 +79,7 @@ struct Daemon::Impl {
   std::unique_ptr<firmware::DriverBus> bus;
   // Frames.
   simlab::OwnedWorld world_model;                      // sim: the table that is played (sim.world_board)
-  std::unique_ptr<SimWorld> world;                     // sim: that table, its camera and its driver board
+  std::unique_ptr<simlab::SimWorld> world;                     // sim: that table, its camera and its driver board
   std::unique_ptr<vision::CaptureSource> capture;      // lab: v4l2 / file
   std::unique_ptr<vision::CameraHomography> homography;
   std::unique_ptr<vision::BallDetector> detector;
@@ -198,12 +198,12 @@ void Daemon::Impl::build() {
 
   cv::Size frame_size(config.camera.width_px, config.camera.height_px);
   if (sim_mode) {
-    vision::SimCameraConfig cc;
+    simlab::SimCameraConfig cc;
     cc.width_px = config.camera.width_px;
     cc.height_px = config.camera.height_px;
     cc.fps = config.camera.fps;
     cc.seed = config.sim.seed;
-    SimWorldOptions wo;
+    simlab::SimWorldOptions wo;
     wo.balls = config.sim.balls;
     wo.seed = config.sim.seed;
     wo.actuation_delay_s = config.sim.actuation_delay_s;
@@ -213,7 +213,7 @@ void Daemon::Impl::build() {
     ws.board_path = config.sim.world_board;
     ws.stepper = config.sim.stepper;
     world_model = simlab::make_world(ws, board);
-    world = std::make_unique<SimWorld>(*world_model, *board_link, cc, wo);
+    world = std::make_unique<simlab::SimWorld>(*world_model, *board_link, cc, wo);
     // A calibration file (e.g. from `pinball calibrate camera --sim`) stands in
     // for the simulated camera's true homography, as it would in the lab.
     homography = std::make_unique<vision::CameraHomography>(setup.homography ? *setup.homography
@@ -280,7 +280,7 @@ void Daemon::Impl::sim_thread() {
   enter_thread(kSimThread);
   std::uint64_t pushed = 0;
   std::uint64_t seq = 0;
-  auto on_event = [&](const GameEvent& e) {
+  auto on_event = [&](const simlab::GameEvent& e) {
     pinball_lcm::lcmt_pinball_game_event m{};
     m.utime = to_utime(e.t_s);
     m.seq = static_cast<std::int64_t>(seq++);
@@ -540,7 +540,7 @@ DaemonReport Daemon::Impl::report() const {
     r.results = world->results();
     r.board = world->driver_board().counters();
     RunningStats score, time;
-    for (const SimBallResult& b : r.results) {
+    for (const simlab::SimBallResult& b : r.results) {
       score.add(b.score);
       time.add(b.duration_s);
       r.cut_balls += b.cut ? 1 : 0;
@@ -675,7 +675,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["mean_ball_time_s"] = r.mean_ball_time_s;
   j["cut_balls"] = r.cut_balls;
   nlohmann::json scores = nlohmann::json::array();
-  for (const SimBallResult& b : r.results) scores.push_back(b.score);
+  for (const simlab::SimBallResult& b : r.results) scores.push_back(b.score);
   j["ball_scores"] = scores;
   nlohmann::json lat = nlohmann::json::object();
   for (int s = 0; s < kStageCount; ++s) {

@@ -2,7 +2,7 @@
 
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/core/utime.h"
-#include "pinball/daemon/clock.h"
+#include "pinball/core/clock.h"
 
 namespace pinball::daemon {
 

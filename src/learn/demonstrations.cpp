@@ -6,7 +6,7 @@
 #include <mutex>
 #include <stdexcept>
 
-#include "pinball/control/simulated_player.h"
+#include "pinball/simlab/simulated_player.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/sim/ball_runner.h"
@@ -95,7 +95,7 @@ class Tee final : public control::FlipperController {
 };
 
 // Board flipper index -> tracker flipper index.
-std::array<int, 2> tracker_index_of(const control::SimulatedPlayer& watcher) {
+std::array<int, 2> tracker_index_of(const simlab::SimulatedPlayer& watcher) {
   std::array<int, 2> index{};
   index[static_cast<std::size_t>(watcher.board_index(track::kRightFlipper))] = track::kRightFlipper;
   index[static_cast<std::size_t>(watcher.board_index(track::kLeftFlipper))] = track::kLeftFlipper;
@@ -130,10 +130,10 @@ DemonstrationBall record_correction(sim::World& world, const sim::ThesisStepper&
   ShotRecorder recorder(ball.shots);
   control::ImitationController learner(learner_table);
   Tee tee(learner, recorder);
-  control::SimulatedPlayer watcher(board, config.camera, tee, camera_seed(seed));
+  simlab::SimulatedPlayer watcher(board, config.camera, tee, camera_seed(seed));
   LookaheadPlanner teacher(model, config.teacher);
   const double frame_s = model.dt_s() * config.teacher.frame_steps;
-  DelayLine delay(board.flippers.size(), config.actuation_delay_s);
+  simlab::DelayLine delay(board.flippers.size(), config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
   sim::GameState state = sim::make_game_state(world.board(), seed);
   bool held = false;  // a learner's flipper was commanded up before this step
@@ -180,7 +180,7 @@ DemonstrationBall record_demonstration(sim::World& world, const sim::ThesisStepp
   DemonstrationBall ball;
   ShotRecorder recorder(ball.shots);
   // The same camera and tracker seeds as the evaluator's, so the examples see what a controller would.
-  control::SimulatedPlayer watcher(board, config.camera, recorder, camera_seed(seed));
+  simlab::SimulatedPlayer watcher(board, config.camera, recorder, camera_seed(seed));
   LookaheadPlayer teacher(model, config.teacher, config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
   sim::GameState state = sim::make_game_state(world.board(), seed);

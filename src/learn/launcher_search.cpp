@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "pinball/control/simulated_player.h"
+#include "pinball/simlab/simulated_player.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
 
@@ -39,7 +39,7 @@ LauncherSearchResult search_launcher(const table::Board& board, const LauncherSe
       const std::unique_ptr<sim::World> ball_world = world_prototype->fork();
       sim::GameState state = sim::make_game_state(ball_world->board(), seed);
       HittableWatcher watcher;
-      control::SimulatedPlayer player(board, config.camera, watcher, seed ^ 0x9E3779B97F4A7C15ull);
+      simlab::SimulatedPlayer player(board, config.camera, watcher, seed ^ 0x9E3779B97F4A7C15ull);
       sim::BallLimits limits;
       limits.max_ball_time_s = config.time_limit_s;
       limits.pull = pull;

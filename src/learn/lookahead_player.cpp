@@ -58,7 +58,7 @@ int LookaheadPlanner::decision_flipper(const sim::GameState& state) const {
 }
 
 const std::vector<LookaheadCandidate>& LookaheadPlanner::evaluate(const sim::GameState& state,
-                                                              const DelayLine& delay, int flipper) {
+                                                              const simlab::DelayLine& delay, int flipper) {
   if (flipper < 0 || static_cast<std::size_t>(flipper) >= state.flippers.size()) {
     throw std::invalid_argument("ceiling planner: no flipper " + std::to_string(flipper));
   }

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/calibration/sim_lab.h"
+#include "pinball/simlab/sim_lab.h"
 #include "pinball/table/board_loader.h"
 
 namespace pinball::calibration {
@@ -10,7 +10,7 @@ namespace {
 
 TEST(CalibrationFigure, DrawsEachKind) {
   const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  SimLab lab(board);
+  simlab::SimLab lab(board);
   const cv::Mat image = lab.camera_image();
   const HomographyFit fit = calibrate_camera(image, default_marker_layout(board));
   const cv::Mat cam = draw_camera_figure(image, fit);

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pinball/calibration/sim_lab.h"
+#include "pinball/simlab/sim_lab.h"
 #include "pinball/table/board_loader.h"
 
 namespace pinball::calibration {
@@ -114,9 +114,9 @@ TEST(FlipperCalibration, SweepTrackWithBladeLinesTakesThePivotFromTheLines) {
 
 TEST(FlipperCalibration, SweepVideoOfTheSimulatedLab) {
   const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  SimLabOptions o;
+  simlab::SimLabOptions o;
   o.sweeps = 1;
-  const SimLab lab(board, o);
+  const simlab::SimLab lab(board, o);
   SweepTrack track;
   const FlipperCalibration c =
       calibrate_flipper_sweep([&] { return lab.sweep_video(0); }, lab.true_homography(), board.flippers[0], {}, &track);
@@ -134,8 +134,8 @@ TEST(FlipperCalibration, SweepVideoOfTheSimulatedLab) {
 
 TEST(FlipperCalibration, StillFlipperIsRefused) {
   const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  const SimLab lab(board);
-  const cv::Mat frame = SimLab(board).flipper_markers_image(false);
+  const simlab::SimLab lab(board);
+  const cv::Mat frame = simlab::SimLab(board).flipper_markers_image(false);
   TipTracker t(frame.size(), lab.true_homography());
   for (int k = 0; k < 20; ++k) t.learn(frame);
   for (int k = 0; k < 20; ++k) t.measure(frame, k / 200.0);

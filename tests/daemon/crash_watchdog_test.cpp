@@ -12,7 +12,7 @@
 #include <chrono>
 #include <thread>
 
-#include "pinball/daemon/clock.h"
+#include "pinball/core/clock.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/stream_transport.h"
 #include "pinball/firmware/virtual_driver_board.h"

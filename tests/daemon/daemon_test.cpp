@@ -97,7 +97,7 @@ TEST(Daemon, FullPathScoresLikeTheFastLearningLoop) {
   const DaemonReport r = d.run();
   ASSERT_EQ(r.balls, kBalls);
   RunningStats daemon_scores;
-  for (const SimBallResult& b : r.results) daemon_scores.add(b.score);
+  for (const simlab::SimBallResult& b : r.results) daemon_scores.add(b.score);
 
   const table::Board board = table::load_board(kSource + "/boards/mit1993.board");
   const control::ControllerSpec spec = control::load_controller(kSource + "/controllers/best.json");
@@ -107,7 +107,7 @@ TEST(Daemon, FullPathScoresLikeTheFastLearningLoop) {
   const learn::PinballEvaluator evaluator(board, ec);
   RunningStats fast_scores;
   for (int i = 0; i < kBalls; ++i) {
-    fast_scores.add(evaluator.play(spec, learn::ball_seed(kSeed, static_cast<std::uint64_t>(i))).score);
+    fast_scores.add(evaluator.play(spec, ball_seed(kSeed, static_cast<std::uint64_t>(i))).score);
   }
   const double se = std::sqrt(daemon_scores.variance() / kBalls + fast_scores.variance() / kBalls);
   std::printf("daemon %.0f +- %.0f, fast loop %.0f +- %.0f (1 se)\n", daemon_scores.mean(),

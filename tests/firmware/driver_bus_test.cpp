@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "board_harness.h"
-#include "pinball/firmware/faulty_link.h"
+#include "pinball/simlab/faulty_link.h"
 
 namespace pinball::firmware {
 namespace {
@@ -106,13 +106,13 @@ TEST_F(DriverBusTest, BusOffIsRecoveredWithANewSession) {
 }
 
 TEST_F(DriverBusTest, WorksThroughALossyLink) {
-  FaultyLinkOptions o;
+  simlab::FaultyLinkOptions o;
   o.drop_p = 0.05;
   o.duplicate_p = 0.05;
   o.delay_p = 0.05;
   o.corrupt_p = 0.05;
   o.seed = 3;
-  FaultyLink lossy(*host_, o);
+  simlab::FaultyLink lossy(*host_, o);
   DriverBus bus(lossy, bus_options());
   run(bus, 0.2);
   ASSERT_EQ(bus.state(), BusState::kRunning);

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "board_harness.h"
-#include "pinball/firmware/faulty_link.h"
+#include "pinball/simlab/faulty_link.h"
 
 namespace pinball::firmware {
 namespace {
@@ -197,10 +197,10 @@ TEST_F(VirtualDriverBoardTest, DuplicatedAndReorderedFramesAreHarmless) {
 
 TEST_F(VirtualDriverBoardTest, CorruptedFramesAreCountedAndIgnored) {
   open_session();
-  FaultyLinkOptions o;
+  simlab::FaultyLinkOptions o;
   o.corrupt_p = 1.0;
   o.seed = 7;
-  FaultyLink noisy(*host_, o);
+  simlab::FaultyLink noisy(*host_, o);
   for (int i = 0; i < 200; ++i) {
     ASSERT_EQ(noisy.send(encode(0, Fire{static_cast<std::uint8_t>(i % 2), FireMode::kPulseHold, 0, ++seq_})), TxStatus::kOk);
     board_.service(*link_, t_);
@@ -294,13 +294,13 @@ TEST(VirtualDriverBoardOptions, RejectsBadSettings) {
 TEST_F(VirtualDriverBoardTest, RandomCommandsOverAFaultyLinkNeverBreakTheCaps) {
   const DriverConfig c{25, 30, 30, 300, 5};
   open_session(c, 2, 100);
-  FaultyLinkOptions o;
+  simlab::FaultyLinkOptions o;
   o.drop_p = 0.1;
   o.delay_p = 0.1;
   o.duplicate_p = 0.1;
   o.corrupt_p = 0.1;
   o.seed = 99;
-  FaultyLink link(*host_, o);
+  simlab::FaultyLink link(*host_, o);
   Rng rng(5);
   for (int step = 0; step < 4000; ++step) {
     t_ += 0.001;

@@ -5,6 +5,7 @@
 #include "pinball/control/spastic_controller.h"
 #include "pinball/table/board_loader.h"
 #include "common/thesis_board.h"
+#include "pinball/sim/model_world.h"
 
 namespace pinball::learn {
 namespace {
@@ -29,6 +30,46 @@ TEST(Evaluator, SameSeedSameBall) {
   EXPECT_EQ(a.duration_s, b.duration_s);
   EXPECT_EQ(a.flips, b.flips);
   EXPECT_EQ(a.opportunities.size(), b.opportunities.size());
+}
+
+TEST(Evaluator, ItsDefaultWorldIsTheBeliefsModelOnTheThesisStepper) {
+  const PinballEvaluator implicit(thesis_board(), EvaluatorConfig{});
+  const PinballEvaluator explicit_world(thesis_board(), EvaluatorConfig{}, sim::make_model_world(thesis_board()));
+  const control::ControllerSpec s = spastic_like(implicit);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    EXPECT_EQ(implicit.play(s, seed).score, explicit_world.play(s, seed).score);
+  }
+  EXPECT_EQ(implicit.world().name(), "thesis");
+}
+
+TEST(Evaluator, AWorldSwappedUnderItPlaysThatWorldWithTheSameBelief) {
+  // The world is the same board with weaker gravity; the tracker is not told.
+  table::Board weak = thesis_board();
+  weak.gravity_mps2 *= 0.9;
+  const PinballEvaluator model(thesis_board(), EvaluatorConfig{});
+  const PinballEvaluator swapped(thesis_board(), EvaluatorConfig{}, sim::make_model_world(weak));
+  sim::ModelWorldOptions event;
+  event.stepper = sim::StepperKind::kEvent;
+  const PinballEvaluator other_stepper(thesis_board(), EvaluatorConfig{}, sim::make_model_world(thesis_board(), event));
+  EXPECT_EQ(&swapped.board(), &thesis_board());
+  EXPECT_EQ(swapped.world().board().gravity_mps2, weak.gravity_mps2);
+  const control::ControllerSpec s = spastic_like(model);
+  int differ = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const BallOutcome a = model.play(s, seed);
+    const BallOutcome b = swapped.play(s, seed);
+    const BallOutcome c = other_stepper.play(s, seed);
+    differ += (a.score != b.score) + (a.score != c.score);
+    EXPECT_EQ(b.score, swapped.play(s, seed).score);  // still deterministic
+  }
+  EXPECT_GT(differ, 6);  // of 12 comparisons: the world, not the belief, decides the play
+}
+
+TEST(Evaluator, AWorldWithOtherFlippersIsRefused) {
+  table::Board one = thesis_board();
+  one.flippers.pop_back();
+  EXPECT_THROW(PinballEvaluator(thesis_board(), EvaluatorConfig{}, sim::make_model_world(one)), std::invalid_argument);
+  EXPECT_THROW(PinballEvaluator(thesis_board(), EvaluatorConfig{}, nullptr), std::invalid_argument);
 }
 
 TEST(Evaluator, OpportunitiesCarryScoreAndTheLossPenalty) {

@@ -35,7 +35,7 @@ TEST(LookaheadPlanner, CandidatesAreDontFireThenEveryFireFrameAndHold) {
   LookaheadPlanner planner(stepper, short_planner());
   const sim::GameState s = ball_on_left_flipper(thesis_board());
   ASSERT_EQ(planner.decision_flipper(s), 0);
-  const DelayLine delay(s.flippers.size(), 0.004);
+  const simlab::DelayLine delay(s.flippers.size(), 0.004);
   const auto& c = planner.evaluate(s, delay, 0);
   ASSERT_EQ(c.size(), 1u + 4u * 2u);
   EXPECT_EQ(c[0].fire_frame, -1);
@@ -55,7 +55,7 @@ TEST(LookaheadPlanner, UnflippedBallOnTheFlipperDrainsAndTheBestPlanSavesIt) {
   LookaheadPlanner planner(stepper, short_planner());
   const sim::GameState s = ball_on_left_flipper(thesis_board());
   const std::uint64_t before = sim::hash_state(s);
-  const DelayLine delay(s.flippers.size(), 0.004);
+  const simlab::DelayLine delay(s.flippers.size(), 0.004);
   const auto& c = planner.evaluate(s, delay, 0);
   EXPECT_EQ(sim::hash_state(s), before) << "evaluate() must play on copies";
   EXPECT_TRUE(c[0].lost) << "a ball left on the resting flipper rolls off into the drain";

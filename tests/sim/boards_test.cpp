@@ -10,7 +10,7 @@
 #include "pinball/sim/model_world.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board_loader.h"
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/thesis_stepper.h"
 
@@ -83,7 +83,7 @@ TEST(Boards, TheSpasticFlipperOutscoresDoingNothing) {
     RunningStats score;
     for (int ball = 0; ball < 40; ++ball) {
       const BallResult r = play_ball(
-          *world, s, limits, [&](GameState& st) { if (spastic) oracle_spastic_policy(b, st); },
+          *world, s, limits, [&](GameState& st) { if (spastic) simlab::oracle_spastic_policy(b, st); },
           [](const GameState&, const StepEvents&) {});
       score.add(r.score);
     }

@@ -6,7 +6,7 @@
 #include "pinball/sim/model_world.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board_loader.h"
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "common/thesis_board.h"
@@ -23,7 +23,7 @@ std::uint64_t hash_game(World& world, GameState& state, double seconds) {
   std::uint64_t h = hash_state(state);
   while (state.time_s < seconds) {
     if (!state.ball_in_play) begin_ball(world, state, board.launcher.pull);
-    oracle_spastic_policy(board, state);
+    simlab::oracle_spastic_policy(board, state);
     world.step(state);
     h = hash_combine_state(h, state);
   }

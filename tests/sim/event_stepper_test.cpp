@@ -13,7 +13,7 @@
 
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board_loader.h"
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "test_boards.h"
@@ -395,7 +395,7 @@ TEST(EventStepper, PlaysBallsOnMit1993WithoutPenetration) {
   limits.max_ball_time_s = 60.0;
   double worst = 0.0;
   for (int ball = 0; ball < 4; ++ball) {
-    play_ball(*world, s, limits, [&](GameState& st) { oracle_spastic_policy(b, st); },
+    play_ball(*world, s, limits, [&](GameState& st) { simlab::oracle_spastic_policy(b, st); },
               [&](const GameState& st, const StepEvents&) {
                 ASSERT_TRUE(finite(st.ball.position_m) && finite(st.ball.velocity_mps));
                 if (st.ball_in_play) worst = std::max(worst, max_penetration_m(b, st));

@@ -8,7 +8,7 @@
 #include "pinball/core/rng.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 #include "common/thesis_board.h"
 
 namespace pinball::vision {
@@ -20,7 +20,7 @@ using pinball::testing::thesis_board;
 // ball-free frames (lamps still, glare off). Lamps stay as learned unless a
 // test lets them blink.
 struct Scene {
-  explicit Scene(SimCameraConfig c = {}, BallDetectorConfig d = {})
+  explicit Scene(simlab::SimCameraConfig c = {}, BallDetectorConfig d = {})
       : camera(thesis_board(), c), detector(camera.homography(), camera.frame_size(), d) {
     detector.set_occluder_mask(camera.occluder_mask());
     camera.set_lamps_blinking(false);
@@ -45,7 +45,7 @@ struct Scene {
 
   double error_px(const Detection& d) const { return cv::norm(d.uv_px - camera.truth().uv_px_mid); }
 
-  SimCameraSource camera;
+  simlab::SimCameraSource camera;
   BallDetector detector;
   Frame frame;
   double t_s = 0.0;
@@ -127,7 +127,7 @@ TEST(BallDetector, BallNearTheTableEdgeIsFoundAccurately) {
 }
 
 TEST(BallDetector, NeedsALearnedBackgroundAndRefusesBadFrames) {
-  SimCameraSource camera(thesis_board(), SimCameraConfig{});
+  simlab::SimCameraSource camera(thesis_board(), simlab::SimCameraConfig{});
   BallDetector detector(camera.homography(), camera.frame_size());
   camera.set_lamps_blinking(false);
   Frame frame;
@@ -152,7 +152,7 @@ TEST(BallDetector, NeedsALearnedBackgroundAndRefusesBadFrames) {
 }
 
 TEST(BallDetector, BlinkingLampsAreNeverTakenForTheBall) {
-  SimCameraConfig c;
+  simlab::SimCameraConfig c;
   c.lamp_toggle_probability = 0.2;
   Scene s(c);
   s.camera.set_lamps_blinking(true);
@@ -169,7 +169,7 @@ TEST(BallDetector, BlinkingLampsAreNeverTakenForTheBall) {
 }
 
 TEST(BallDetector, GlareIsRejectedAndTheBallElsewhereStillFound) {
-  SimCameraConfig c;
+  simlab::SimCameraConfig c;
   c.glare.enabled = true;
   Scene s(c);
   s.camera.set_glare(true);
@@ -192,7 +192,7 @@ TEST(BallDetector, GlareIsRejectedAndTheBallElsewhereStillFound) {
 
 TEST(BallDetector, OccludedBallGivesNoObservationNeverAWrongOne) {
   Scene s;
-  const SimPlastic& plastic = s.camera.config().plastics.at(0);
+  const simlab::SimPlastic& plastic = s.camera.config().plastics.at(0);
   Vec2 centre = Vec2::Zero();
   for (const Vec2& q : plastic.polygon_board) centre += q;
   centre /= static_cast<double>(plastic.polygon_board.size());

@@ -12,7 +12,7 @@
 
 #include "pinball/table/board_loader.h"
 #include "pinball/vision/ball_detector.h"
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 
 namespace pinball::vision {
 namespace {
@@ -76,9 +76,9 @@ TEST(CaptureSource, ReadsARealCameraWhenThereIsOne) {
 
 TEST(CaptureSource, VideoFileGivesTheSameDetectionsAsTheFramesItCameFrom) {
   const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
-  SimCameraConfig c;
+  simlab::SimCameraConfig c;
   c.lamp_toggle_probability = 0.0;
-  SimCameraSource camera(board, c);
+  simlab::SimCameraSource camera(board, c);
   const fs::path path = temp_path("ball.avi");
   // 40 frames: 8 without the ball (the background), then the ball crossing the table.
   std::vector<cv::Mat> originals;

@@ -29,4 +29,8 @@ class Rng {
   std::uint64_t s_[4];
 };
 
+/// Mixes a run seed and a ball index into a ball seed (splitmix64): ball i of
+/// a run plays ball_seed(seed, i) wherever it is played (any thread, world or command).
+std::uint64_t ball_seed(std::uint64_t run_seed, std::uint64_t index);
+
 }  // namespace pinball

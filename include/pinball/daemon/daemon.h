@@ -22,7 +22,7 @@
 #include "pinball/bus/lcm_bus.h"
 #include "pinball/daemon/daemon_config.h"
 #include "pinball/daemon/latency_histogram.h"
-#include "pinball/daemon/sim_world.h"
+#include "pinball/simlab/sim_world.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/virtual_driver_board.h"
 
@@ -53,7 +53,7 @@ struct DaemonReport {
   double score_ci95 = 0.0;                   ///< half-width of its 95 % interval (sim)
   double mean_ball_time_s = 0.0;             ///< mean simulated ball time (s)
   int cut_balls = 0;                         ///< balls cut at the time limit (cycles)
-  std::vector<SimBallResult> results;        ///< per ball (sim)
+  std::vector<simlab::SimBallResult> results;        ///< per ball (sim)
   std::array<LatencySummary, kStageCount> latency{};  ///< per stage
   std::uint64_t frames = 0;                  ///< frames processed by the camera thread
   std::uint64_t frames_dropped = 0;          ///< frames lost before the camera thread

@@ -10,9 +10,10 @@
 #include <vector>
 
 #include "pinball/control/controller_file.h"
+#include "pinball/core/rng.h"
 #include "pinball/control/flipper_controller.h"
-#include "pinball/control/simulated_player.h"
-#include "pinball/learn/delay_line.h"
+#include "pinball/simlab/simulated_player.h"
+#include "pinball/simlab/delay_line.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board.h"
 #include "pinball/sim/world.h"
@@ -59,9 +60,6 @@ struct EvaluatorConfig {
   bool rolling_minicontrollers = false;///< prototype(): separate rolling minicontrollers (7.1)
 };
 
-/// Mixes a run seed and a ball index into a ball seed (splitmix64).
-std::uint64_t ball_seed(std::uint64_t run_seed, std::uint64_t index);
-
 /// The camera model's noise seed for a ball: every player that watches ball
 /// `ball_seed` through the camera sees the same noise.
 inline std::uint64_t camera_seed(std::uint64_t ball_seed) { return ball_seed ^ 0x5DEECE66Dull; }
@@ -75,8 +73,8 @@ sim::BallResult play_through_tracker(sim::World& world, const table::Board& beli
                                      const track::CameraModelConfig& camera, const track::TrackerConfig& tracker,
                                      control::FlipperController& controller, double actuation_delay_s,
                                      const sim::BallLimits& limits, std::uint64_t ball_seed, Observer&& observer) {
-  control::SimulatedPlayer player(belief, camera, tracker, controller, camera_seed(ball_seed));
-  DelayLine delay(world.board().flippers.size(), actuation_delay_s);
+  simlab::SimulatedPlayer player(belief, camera, tracker, controller, camera_seed(ball_seed));
+  simlab::DelayLine delay(world.board().flippers.size(), actuation_delay_s);
   return sim::play_ball(
       world, state, limits,
       [&](sim::GameState& s) {

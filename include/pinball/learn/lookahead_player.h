@@ -17,7 +17,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pinball/learn/delay_line.h"
+#include "pinball/simlab/delay_line.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
 
@@ -57,7 +57,7 @@ class LookaheadPlanner {
 
   /// Evaluates "don't fire" (index 0) and every fire plan for `flipper` from
   /// `state` (commands all off from now, `delay` as it stands). Leaves state and delay untouched.
-  const std::vector<LookaheadCandidate>& evaluate(const sim::GameState& state, const DelayLine& delay,
+  const std::vector<LookaheadCandidate>& evaluate(const sim::GameState& state, const simlab::DelayLine& delay,
                                                 int flipper);
   /// Index of the best candidate of the last evaluate(): the first of the highest value.
   std::size_t best() const;
@@ -74,9 +74,9 @@ class LookaheadPlanner {
   LookaheadConfig config_;
   std::vector<LookaheadCandidate> candidates_;
   sim::GameState scratch_;
-  DelayLine scratch_delay_;
+  simlab::DelayLine scratch_delay_;
   const sim::GameState* origin_ = nullptr;
-  const DelayLine* origin_delay_ = nullptr;
+  const simlab::DelayLine* origin_delay_ = nullptr;
   std::uint64_t branch_steps_ = 0;
 };
 
@@ -103,7 +103,7 @@ class LookaheadPlayer {
   void decide(const sim::GameState& s);
 
   LookaheadPlanner planner_;
-  DelayLine delay_;
+  simlab::DelayLine delay_;
   std::vector<bool> command_;
   std::uint64_t step_ = 0;
   int held_ = -1;

@@ -15,7 +15,7 @@
 #include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 
-namespace pinball::control {
+namespace pinball::simlab {
 
 /// Flipper i of the board is driver i of one virtual driver board.
 class CanFlipperDrive {
@@ -47,4 +47,4 @@ class CanFlipperDrive {
   std::vector<double> theta_max_;   // up stop per flipper, for the end-of-stroke switches
 };
 
-}  // namespace pinball::control
+}  // namespace pinball::simlab

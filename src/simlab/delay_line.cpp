@@ -1,6 +1,6 @@
-#include "pinball/learn/delay_line.h"
+#include "pinball/simlab/delay_line.h"
 
-namespace pinball::learn {
+namespace pinball::simlab {
 
 DelayLine::DelayLine(std::size_t flippers, double delay_s) : last_(flippers, false) {
   actuation_.reserve(flippers);
@@ -20,4 +20,4 @@ void DelayLine::apply(sim::GameState& s) {
   }
 }
 
-}  // namespace pinball::learn
+}  // namespace pinball::simlab

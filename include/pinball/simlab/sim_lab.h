@@ -18,14 +18,14 @@
 #include "pinball/table/board.h"
 #include "pinball/track/camera_model.h"
 #include "pinball/vision/frame_source.h"
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 
-namespace pinball::calibration {
+namespace pinball::simlab {
 
 /// How the simulated lab differs from the board and how it is recorded.
 struct SimLabOptions {
   std::uint64_t seed = 1;                     ///< camera art and noise, roll places and observation noise
-  vision::SimCameraConfig camera;             ///< the camera (its seed is replaced by `seed`)
+  simlab::SimCameraConfig camera;             ///< the camera (its seed is replaced by `seed`)
   Vec2 pivot_offset_m{0.003, -0.002};         ///< the machine's pivots sit this far from the board file's (m)
   double length_offset_m = 0.002;             ///< its flippers are this much longer (m)
   double theta_offset_rad = 0.012;            ///< both stops this much higher (rad)
@@ -75,14 +75,14 @@ class SimLab {
 
   /// `count` rolls from rest at random free places on the table, observed
   /// through the camera model; `stream` picks an independent set.
-  std::vector<GravityRoll> rolls(int count, std::uint64_t stream = 0) const;
+  std::vector<calibration::GravityRoll> rolls(int count, std::uint64_t stream = 0) const;
 
  private:
   table::Board nominal_;
   table::Board truth_;
   SimLabOptions options_;
-  std::unique_ptr<vision::SimCameraSource> camera_;
+  std::unique_ptr<simlab::SimCameraSource> camera_;
   vision::Frame frame_;
 };
 
-}  // namespace pinball::calibration
+}  // namespace pinball::simlab

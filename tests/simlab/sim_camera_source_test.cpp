@@ -1,4 +1,4 @@
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -9,7 +9,7 @@
 #include "pinball/table/board_loader.h"
 #include "common/thesis_board.h"
 
-namespace pinball::vision {
+namespace pinball::simlab {
 namespace {
 
 using pinball::testing::thesis_board;
@@ -20,7 +20,7 @@ TEST(SimCameraSource, SameSeedSameBitsOtherSeedOtherNoise) {
   SimCameraSource b(thesis_board(), c);
   c.seed = 2;
   SimCameraSource other(thesis_board(), c);
-  Frame fa, fb, fo;
+  vision::Frame fa, fb, fo;
   const std::vector<Vec2> path{Vec2{0.2, 0.4}, Vec2{0.21, 0.41}};
   for (int i = 0; i < 5; ++i) {
     a.render(path, i * 0.005, fa);
@@ -38,7 +38,7 @@ TEST(SimCameraSource, DeliversFramesAtItsRateStampedAtMidExposure) {
   c.fps = 200.0;
   c.exposure_s = 0.002;
   SimCameraSource camera(thesis_board(), c);
-  Frame frame;
+  vision::Frame frame;
   EXPECT_FALSE(camera.read(frame));  // nothing observed yet
   std::vector<double> stamps;
   for (int step = 1; step <= 200; ++step) {  // 0.1 s at 0.5 ms
@@ -62,7 +62,7 @@ TEST(SimCameraSource, MotionBlurSpreadsTheBallAlongItsPath) {
   c.noise_sigma = 0.0;
   c.lamp_toggle_probability = 0.0;
   SimCameraSource camera(thesis_board(), c);
-  Frame still, moving, empty;
+  vision::Frame still, moving, empty;
   camera.render({}, 0.0, empty);
   const Vec2 p{0.25, 0.3};
   const Vec2 v{0.0, 5.0};  // 5 m/s up the table: 10 mm in 2 ms
@@ -72,7 +72,7 @@ TEST(SimCameraSource, MotionBlurSpreadsTheBallAlongItsPath) {
   camera.render(path, 0.0, moving);
   const double blur = camera.truth().blur_px;
   EXPECT_NEAR(blur, 0.0098 * camera.homography().px_per_m_at(p), 0.5);
-  auto extent_u = [&](const Frame& f) {
+  auto extent_u = [&](const vision::Frame& f) {
     cv::Mat diff;
     cv::absdiff(f.gray, empty.gray, diff);
     cv::threshold(diff, diff, 3, 255, cv::THRESH_BINARY);
@@ -92,7 +92,7 @@ TEST(SimCameraSource, PlasticHidesTheBallAndTheTruthSaysSo) {
   Vec2 centre = Vec2::Zero();
   for (const Vec2& q : c.plastics[0].polygon_board) centre += q;
   centre /= static_cast<double>(c.plastics[0].polygon_board.size());
-  Frame under, empty;
+  vision::Frame under, empty;
   camera.set_lamps_blinking(false);
   camera.render({}, 0.0, empty);
   camera.render({&centre, 1}, 0.0, under);
@@ -115,4 +115,4 @@ TEST(SimCameraSource, RejectsBadSettings) {
 }
 
 }  // namespace
-}  // namespace pinball::vision
+}  // namespace pinball::simlab

@@ -1,10 +1,10 @@
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 
 #include <gtest/gtest.h>
 
-#include "test_boards.h"
+#include "sim/test_boards.h"
 
-namespace pinball::sim {
+namespace pinball::simlab {
 namespace {
 
 using namespace pinball::sim::testing;
@@ -18,7 +18,7 @@ table::Board two_flippers() {
 
 TEST(OracleSpasticPolicy, FlipsOnlyTheNearerFlipperForAFallingBallInReach) {
   const table::Board b = two_flippers();
-  GameState s = state_with_ball(b, {0.21, 0.16}, {0.0, -1.0});  // just above the left flipper
+  sim::GameState s = state_with_ball(b, {0.21, 0.16}, {0.0, -1.0});  // just above the left flipper
   oracle_spastic_policy(b, s);
   EXPECT_TRUE(s.flippers[0].energized);
   EXPECT_FALSE(s.flippers[1].energized);
@@ -31,7 +31,7 @@ TEST(OracleSpasticPolicy, FlipsOnlyTheNearerFlipperForAFallingBallInReach) {
 
 TEST(OracleSpasticPolicy, ReleasesForBallsOutOfReachRisingOrCradled) {
   const table::Board b = two_flippers();
-  GameState s = state_with_ball(b, {0.20, 0.60}, {0.0, -1.0});  // far above
+  sim::GameState s = state_with_ball(b, {0.20, 0.60}, {0.0, -1.0});  // far above
   for (auto& f : s.flippers) f.energized = true;
   oracle_spastic_policy(b, s);
   EXPECT_FALSE(s.flippers[0].energized);
@@ -53,4 +53,4 @@ TEST(OracleSpasticPolicy, ReleasesForBallsOutOfReachRisingOrCradled) {
 }
 
 }  // namespace
-}  // namespace pinball::sim
+}  // namespace pinball::simlab

@@ -1,11 +1,11 @@
-#include "pinball/firmware/faulty_link.h"
+#include "pinball/simlab/faulty_link.h"
 
 #include <stdexcept>
 #include <string>
 
-namespace pinball::firmware {
+namespace pinball::simlab {
 
-FaultyLink::FaultyLink(CanTransport& inner, FaultyLinkOptions options)
+FaultyLink::FaultyLink(firmware::CanTransport& inner, FaultyLinkOptions options)
     : inner_(inner), options_(options), rng_(options.seed) {
   for (double p : {options.drop_p, options.delay_p, options.duplicate_p, options.corrupt_p}) {
     if (!(p >= 0.0 && p <= 1.0)) throw std::invalid_argument("FaultyLink: probability " + std::to_string(p) + " outside [0, 1]");
@@ -15,7 +15,7 @@ FaultyLink::FaultyLink(CanTransport& inner, FaultyLinkOptions options)
   }
 }
 
-void FaultyLink::corrupt(CanFrame& frame) {
+void FaultyLink::corrupt(firmware::CanFrame& frame) {
   ++faults_.corrupted;
   // One bit flip, as a noisy wire would do: mostly data, sometimes the length.
   if (frame.len == 0 || rng_.uniform01() < 0.1) {
@@ -28,7 +28,7 @@ void FaultyLink::corrupt(CanFrame& frame) {
 }
 
 template <typename Emit>
-void FaultyLink::process(const CanFrame& frame, bool outgoing, Emit&& emit) {
+void FaultyLink::process(const firmware::CanFrame& frame, bool outgoing, Emit&& emit) {
   ++faults_.frames;
   // Draw every decision up front so the stream does not depend on outcomes.
   const bool drop = rng_.uniform01() < options_.drop_p;
@@ -36,7 +36,7 @@ void FaultyLink::process(const CanFrame& frame, bool outgoing, Emit&& emit) {
   const bool dup = rng_.uniform01() < options_.duplicate_p;
   const bool bad = rng_.uniform01() < options_.corrupt_p;
   const int wait = 1 + static_cast<int>(rng_.next_u64() % static_cast<std::uint64_t>(options_.max_delay_frames));
-  CanFrame f = frame;
+  firmware::CanFrame f = frame;
   if (!drop && bad) corrupt(f);
   if (drop) {
     ++faults_.dropped;
@@ -62,29 +62,29 @@ void FaultyLink::process(const CanFrame& frame, bool outgoing, Emit&& emit) {
   }
 }
 
-TxStatus FaultyLink::send(const CanFrame& frame) {
+firmware::TxStatus FaultyLink::send(const firmware::CanFrame& frame) {
   if (!options_.on_send) return inner_.send(frame);
-  TxStatus status = TxStatus::kOk;
-  process(frame, true, [&](const CanFrame& f) {
-    const TxStatus s = inner_.send(f);
-    if (s != TxStatus::kOk) status = s;
+  firmware::TxStatus status = firmware::TxStatus::kOk;
+  process(frame, true, [&](const firmware::CanFrame& f) {
+    const firmware::TxStatus s = inner_.send(f);
+    if (s != firmware::TxStatus::kOk) status = s;
   });
   return status;
 }
 
-RxStatus FaultyLink::receive(CanFrame& frame, int timeout_ms) {
+firmware::RxStatus FaultyLink::receive(firmware::CanFrame& frame, int timeout_ms) {
   for (int first = 1;; first = 0) {
     if (rx_count_ > 0) {
       frame = rx_ready_[static_cast<std::size_t>(rx_head_)];
       rx_head_ = (rx_head_ + 1) % static_cast<int>(rx_ready_.size());
       --rx_count_;
-      return RxStatus::kFrame;
+      return firmware::RxStatus::kFrame;
     }
-    CanFrame in;
-    const RxStatus s = inner_.receive(in, first ? timeout_ms : 0);
-    if (s != RxStatus::kFrame) return s;
-    if (!options_.on_receive || in.error) return frame = in, RxStatus::kFrame;
-    process(in, false, [&](const CanFrame& f) {
+    firmware::CanFrame in;
+    const firmware::RxStatus s = inner_.receive(in, first ? timeout_ms : 0);
+    if (s != firmware::RxStatus::kFrame) return s;
+    if (!options_.on_receive || in.error) return frame = in, firmware::RxStatus::kFrame;
+    process(in, false, [&](const firmware::CanFrame& f) {
       if (rx_count_ >= static_cast<int>(rx_ready_.size())) return;  // cannot happen: bounded by kMaxHeld + 2
       rx_ready_[static_cast<std::size_t>((rx_head_ + rx_count_) % static_cast<int>(rx_ready_.size()))] = f;
       ++rx_count_;
@@ -105,4 +105,4 @@ void FaultyLink::flush_delayed() {
   held_count_ = 0;
 }
 
-}  // namespace pinball::firmware
+}  // namespace pinball::simlab

@@ -9,7 +9,7 @@
 #include "pinball/core/rng.h"
 #include "pinball/firmware/can_transport.h"
 
-namespace pinball::firmware {
+namespace pinball::simlab {
 
 /// Fault probabilities (each drawn independently per frame) and where they apply.
 struct FaultyLinkOptions {
@@ -33,17 +33,17 @@ struct FaultyLinkCounters {
 };
 
 /// Fault injection on a link; owns nothing, borrows the inner transport.
-class FaultyLink final : public CanTransport {
+class FaultyLink final : public firmware::CanTransport {
  public:
   /// Wraps `inner`; throws std::invalid_argument for a probability outside [0, 1]
   /// or max_delay_frames outside 1..kMaxHeld.
-  FaultyLink(CanTransport& inner, FaultyLinkOptions options);
+  FaultyLink(firmware::CanTransport& inner, FaultyLinkOptions options);
 
-  TxStatus send(const CanFrame& frame) override;
-  RxStatus receive(CanFrame& frame, int timeout_ms) override;
+  firmware::TxStatus send(const firmware::CanFrame& frame) override;
+  firmware::RxStatus receive(firmware::CanFrame& frame, int timeout_ms) override;
   int poll_fd() const override { return inner_.poll_fd(); }
   bool reopen() override { return inner_.reopen(); }
-  TransportCounters counters() const override { return inner_.counters(); }
+  firmware::TransportCounters counters() const override { return inner_.counters(); }
 
   /// Releases every held-back frame now (in the direction it was going).
   void flush_delayed();
@@ -55,24 +55,24 @@ class FaultyLink final : public CanTransport {
 
  private:
   struct Held {
-    CanFrame frame;
+    firmware::CanFrame frame;
     int countdown = 0;
     bool outgoing = true;
   };
   // Applies the faults to one frame; emits what survives through `emit`.
   template <typename Emit>
-  void process(const CanFrame& frame, bool outgoing, Emit&& emit);
-  void corrupt(CanFrame& frame);
+  void process(const firmware::CanFrame& frame, bool outgoing, Emit&& emit);
+  void corrupt(firmware::CanFrame& frame);
 
-  CanTransport& inner_;
+  firmware::CanTransport& inner_;
   FaultyLinkOptions options_;
   Rng rng_;
   FaultyLinkCounters faults_;
   std::array<Held, kMaxHeld> held_{};
   int held_count_ = 0;
-  std::array<CanFrame, 2 * kMaxHeld + 4> rx_ready_{};
+  std::array<firmware::CanFrame, 2 * kMaxHeld + 4> rx_ready_{};
   int rx_head_ = 0;
   int rx_count_ = 0;
 };
 
-}  // namespace pinball::firmware
+}  // namespace pinball::simlab

@@ -1,8 +1,8 @@
-#include "pinball/control/can_flipper_drive.h"
+#include "pinball/simlab/can_flipper_drive.h"
 
 #include <stdexcept>
 
-namespace pinball::control {
+namespace pinball::simlab {
 
 CanFlipperDrive::CanFlipperDrive(const table::Board& board, double actuation_delay_s) {
   const int n = static_cast<int>(board.flippers.size());
@@ -44,4 +44,4 @@ void CanFlipperDrive::apply(sim::GameState& state) {
   }
 }
 
-}  // namespace pinball::control
+}  // namespace pinball::simlab

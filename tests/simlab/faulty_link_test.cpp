@@ -1,4 +1,4 @@
-#include "pinball/firmware/faulty_link.h"
+#include "pinball/simlab/faulty_link.h"
 
 #include <gtest/gtest.h>
 
@@ -7,19 +7,19 @@
 #include "pinball/firmware/codec.h"
 #include "pinball/firmware/stream_transport.h"
 
-namespace pinball::firmware {
+namespace pinball::simlab {
 namespace {
 
 std::vector<std::uint16_t> pass(FaultyLinkOptions o, int n, FaultyLinkCounters* counters = nullptr) {
-  auto [a, b] = StreamTransport::make_pair();
+  auto [a, b] = firmware::StreamTransport::make_pair();
   FaultyLink link(*a, o);
   std::vector<std::uint16_t> seen;
   for (int i = 1; i <= n; ++i) {
-    EXPECT_EQ(link.send(encode(0, Heartbeat{kProtocolVersion, static_cast<std::uint16_t>(i)})), TxStatus::kOk);
-    CanFrame f;
-    while (b->receive(f, 0) == RxStatus::kFrame) {
-      const DecodeResult r = decode(f);
-      seen.push_back(r.ok() ? std::get<Heartbeat>(r.message.payload).seq : 0);  // 0: corrupted
+    EXPECT_EQ(link.send(firmware::encode(0, firmware::Heartbeat{firmware::kProtocolVersion, static_cast<std::uint16_t>(i)})), firmware::TxStatus::kOk);
+    firmware::CanFrame f;
+    while (b->receive(f, 0) == firmware::RxStatus::kFrame) {
+      const firmware::DecodeResult r = firmware::decode(f);
+      seen.push_back(r.ok() ? std::get<firmware::Heartbeat>(r.message.payload).seq : 0);  // 0: corrupted
     }
   }
   if (counters != nullptr) *counters = link.fault_counters();
@@ -72,21 +72,21 @@ TEST(FaultyLink, EachFaultDoesWhatItSays) {
 }
 
 TEST(FaultyLink, AppliesToReceivedFramesToo) {
-  auto [a, b] = StreamTransport::make_pair();
+  auto [a, b] = firmware::StreamTransport::make_pair();
   FaultyLinkOptions o;
   o.on_send = false;
   o.on_receive = true;
   o.duplicate_p = 1.0;
   FaultyLink link(*b, o);
-  ASSERT_EQ(a->send(encode(0, ReleaseAll{1})), TxStatus::kOk);
-  CanFrame f;
-  EXPECT_EQ(link.receive(f, 10), RxStatus::kFrame);
-  EXPECT_EQ(link.receive(f, 0), RxStatus::kFrame);
-  EXPECT_EQ(link.receive(f, 0), RxStatus::kTimeout);
+  ASSERT_EQ(a->send(firmware::encode(0, firmware::ReleaseAll{1})), firmware::TxStatus::kOk);
+  firmware::CanFrame f;
+  EXPECT_EQ(link.receive(f, 10), firmware::RxStatus::kFrame);
+  EXPECT_EQ(link.receive(f, 0), firmware::RxStatus::kFrame);
+  EXPECT_EQ(link.receive(f, 0), firmware::RxStatus::kTimeout);
 }
 
 TEST(FaultyLink, RejectsBadProbabilities) {
-  auto [a, b] = StreamTransport::make_pair();
+  auto [a, b] = firmware::StreamTransport::make_pair();
   FaultyLinkOptions o;
   o.drop_p = 1.5;
   EXPECT_THROW(FaultyLink(*a, o), std::invalid_argument);
@@ -96,4 +96,4 @@ TEST(FaultyLink, RejectsBadProbabilities) {
 }
 
 }  // namespace
-}  // namespace pinball::firmware
+}  // namespace pinball::simlab

@@ -1,13 +1,13 @@
-#include "pinball/control/simulated_player.h"
+#include "pinball/simlab/simulated_player.h"
 
-namespace pinball::control {
+namespace pinball::simlab {
 
 SimulatedPlayer::SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera,
-                                 FlipperController& controller, std::uint64_t seed)
+                                 control::FlipperController& controller, std::uint64_t seed)
     : SimulatedPlayer(board, camera, track::default_tracker_config(board, camera), controller, seed) {}
 
 SimulatedPlayer::SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera,
-                                 const track::TrackerConfig& tracker, FlipperController& controller,
+                                 const track::TrackerConfig& tracker, control::FlipperController& controller,
                                  std::uint64_t seed)
     : board_(board),
       camera_(camera, seed),
@@ -42,4 +42,4 @@ void SimulatedPlayer::act(sim::GameState& state) {
   for (int f = 0; f < 2; ++f) state.flippers[board_index_[f]].energized = energized_[f];
 }
 
-}  // namespace pinball::control
+}  // namespace pinball::simlab

@@ -10,7 +10,7 @@
 #include "pinball/firmware/flipper_actuation.h"
 #include "pinball/sim/game_state.h"
 
-namespace pinball::learn {
+namespace pinball::simlab {
 
 /// Delays each flipper's command by a fixed time. Copyable, so a lookahead can
 /// clone it together with the GameState (copy-assigning into an object made for
@@ -29,4 +29,4 @@ class DelayLine {
   std::vector<bool> last_;  // command last passed on, per flipper
 };
 
-}  // namespace pinball::learn
+}  // namespace pinball::simlab

@@ -17,9 +17,9 @@
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/world.h"
 #include "pinball/track/observation.h"
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 
-namespace pinball::daemon {
+namespace pinball::simlab {
 
 /// Settings of the simulated world.
 struct SimWorldOptions {
@@ -55,7 +55,7 @@ class SimWorld {
   /// Plays a fork of `world` (whose board must outlive this) and borrows the
   /// board's end of the CAN link. Throws std::invalid_argument for a board
   /// without two flippers or bad options.
-  SimWorld(const sim::World& world, firmware::CanTransport& board_link, const vision::SimCameraConfig& camera,
+  SimWorld(const sim::World& world, firmware::CanTransport& board_link, const simlab::SimCameraConfig& camera,
            const SimWorldOptions& options);
 
   /// Ball-free frames for the detector's background (lamps still, glare off).
@@ -82,7 +82,7 @@ class SimWorld {
   /// Simulated time now (s).
   double time_s() const { return state_.time_s; }
   /// The camera.
-  vision::SimCameraSource& camera() { return camera_; }
+  simlab::SimCameraSource& camera() { return camera_; }
   /// Steady clock at which each driver's coil last switched on (the latency table's last stage).
   double coil_on_wall_s(int driver) const { return coil_on_wall_s_[static_cast<std::size_t>(driver)]; }
   /// Coil-on events since construction (to find new ones).
@@ -108,7 +108,7 @@ class SimWorld {
   firmware::CanTransport& link_;
   SimWorldOptions options_;
   sim::GameState state_;
-  vision::SimCameraSource camera_;
+  simlab::SimCameraSource camera_;
   firmware::VirtualDriverBoard driver_board_;
   std::vector<std::unique_ptr<firmware::FlipperActuation>> actuation_;
   CoilWatch coil_watch_{*this};
@@ -140,4 +140,4 @@ bool SimWorld::next_frame(vision::Frame& frame, track::ContactSensors& contacts,
   }
 }
 
-}  // namespace pinball::daemon
+}  // namespace pinball::simlab

@@ -1,10 +1,10 @@
-#include "pinball/sim/oracle_policy.h"
+#include "pinball/simlab/oracle_policy.h"
 
 #include <limits>
 
-namespace pinball::sim {
+namespace pinball::simlab {
 
-void oracle_spastic_policy(const table::Board& board, GameState& state, double reach_factor) {
+void oracle_spastic_policy(const table::Board& board, sim::GameState& state, double reach_factor) {
   int nearest = -1;
   double nearest_d = std::numeric_limits<double>::infinity();
   if (state.ball_in_play) {
@@ -27,4 +27,4 @@ void oracle_spastic_policy(const table::Board& board, GameState& state, double r
   }
 }
 
-}  // namespace pinball::sim
+}  // namespace pinball::simlab

@@ -14,7 +14,7 @@
 #include "pinball/track/camera_model.h"
 #include "pinball/track/tracker.h"
 
-namespace pinball::control {
+namespace pinball::simlab {
 
 /// Any FlipperController behind a simulated camera and the tracker.
 class SimulatedPlayer {
@@ -23,10 +23,10 @@ class SimulatedPlayer {
   /// std::invalid_argument for a board without a left and a right flipper or
   /// a bad camera setting. `tracker` overrides the tracker settings derived
   /// from the board and camera (e.g. a miscalibrated g).
-  SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera, FlipperController& controller,
+  SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera, control::FlipperController& controller,
                   std::uint64_t seed);
   SimulatedPlayer(const table::Board& board, const track::CameraModelConfig& camera, const track::TrackerConfig& tracker,
-                  FlipperController& controller, std::uint64_t seed);
+                  control::FlipperController& controller, std::uint64_t seed);
 
   /// One simulation step: expose the camera, feed delivered observations to
   /// the tracker and the controller, and set the flipper commands in `state`.
@@ -43,7 +43,7 @@ class SimulatedPlayer {
   const table::Board& board_;
   track::CameraModel camera_;
   track::Tracker tracker_;
-  FlipperController& controller_;
+  control::FlipperController& controller_;
   std::array<int, 2> board_index_{};  // tracker flipper -> board flipper
   std::array<bool, 2> energized_{};
   bool ball_was_in_play_ = false;
@@ -57,7 +57,7 @@ class SimulatedSpasticPlayer {
   /// Throws std::invalid_argument for a board without a left and a right
   /// flipper or a bad camera setting.
   SimulatedSpasticPlayer(const table::Board& board, const track::CameraModelConfig& camera,
-                         const SpasticConfig& spastic, std::uint64_t seed)
+                         const control::SpasticConfig& spastic, std::uint64_t seed)
       : spastic_(spastic), player_(board, camera, spastic_, seed) {}
 
   SimulatedSpasticPlayer(const SimulatedSpasticPlayer&) = delete;
@@ -71,8 +71,8 @@ class SimulatedSpasticPlayer {
   std::uint64_t observations() const { return player_.observations(); }
 
  private:
-  SpasticController spastic_;
+  control::SpasticController spastic_;
   SimulatedPlayer player_;
 };
 
-}  // namespace pinball::control
+}  // namespace pinball::simlab

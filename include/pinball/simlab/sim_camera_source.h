@@ -22,7 +22,7 @@
 #include "pinball/vision/camera_homography.h"
 #include "pinball/vision/frame_source.h"
 
-namespace pinball::vision {
+namespace pinball::simlab {
 
 /// A piece of plastic above the playfield that hides the ball beneath it.
 struct SimPlastic {
@@ -47,7 +47,7 @@ struct SimCameraConfig {
   double fps = 200.0;               ///< frames per second
   double exposure_s = 0.002;        ///< shutter open time (s): motion blur spans the ball's travel over it
   double first_exposure_s = 0.0;    ///< simulated time the first exposure starts (s)
-  CameraView view;                  ///< where the camera sits (perspective)
+  vision::CameraView view;                  ///< where the camera sits (perspective)
   int supersample = 2;              ///< the static scene is drawn at this multiple of the image scale, then warped
   double floor_gain = 0.6;          ///< playfield drawing brightness: gray = gain · drawing + offset
   double floor_offset = 20.0;       ///< see floor_gain (gray levels)
@@ -92,7 +92,7 @@ struct FrameTruth {
 };
 
 /// The simulated camera.
-class SimCameraSource final : public FrameSource {
+class SimCameraSource final : public vision::FrameSource {
  public:
   /// Renders the static scene. Throws std::invalid_argument naming a bad setting.
   SimCameraSource(const table::Board& board, const SimCameraConfig& config);
@@ -105,12 +105,12 @@ class SimCameraSource final : public FrameSource {
   /// Next frame whose exposure has ended by the latest observed time; false
   /// when none is due. Frames whose exposure is no longer in the history are
   /// skipped and counted as dropped.
-  bool read(Frame& out) override;
+  bool read(vision::Frame& out) override;
 
   /// Renders one frame directly: the ball at `path_board` positions spread
   /// evenly over the exposure (empty: no ball), stamped t_mid_s. Advances the
   /// lamps, glare and noise like read(). For tests and benchmarks.
-  void render(std::span<const Vec2> path_board, double t_mid_s, Frame& out);
+  void render(std::span<const Vec2> path_board, double t_mid_s, vision::Frame& out);
 
   /// Truth of the last frame delivered by read() or render().
   const FrameTruth& truth() const { return truth_; }
@@ -129,7 +129,7 @@ class SimCameraSource final : public FrameSource {
   void set_lamps_blinking(bool blinking) { lamps_blinking_ = blinking; }
 
   /// The camera's homography (board -> image).
-  const CameraHomography& homography() const { return homography_; }
+  const vision::CameraHomography& homography() const { return homography_; }
   /// 255 where a plastic hides the playfield (the detector's occluder mask).
   const cv::Mat& occluder_mask() const { return occluder_mask_; }
   /// The static scene without lamps, glare, ball or noise (8-bit).
@@ -139,7 +139,7 @@ class SimCameraSource final : public FrameSource {
 
   cv::Size frame_size() const override { return {config_.width_px, config_.height_px}; }
   double fps() const override { return config_.fps; }
-  FrameSourceCounters counters() const override { return counters_; }
+  vision::FrameSourceCounters counters() const override { return counters_; }
   std::string describe() const override;
 
  private:
@@ -165,13 +165,13 @@ class SimCameraSource final : public FrameSource {
   void build_glare();
   void build_noise();
   void advance_effects();
-  void compose(std::span<const Vec2> path_board, int path_total, double t_mid_s, Frame& out);
+  void compose(std::span<const Vec2> path_board, int path_total, double t_mid_s, vision::Frame& out);
   void draw_ball(std::span<const Vec2> path_board, int path_total, cv::Mat& image);
   bool sample_at(double t_s, Vec2& p, bool& in_play) const;
 
   const table::Board& board_;
   SimCameraConfig config_;
-  CameraHomography homography_;
+  vision::CameraHomography homography_;
   Rng rng_;
   std::vector<double> flipper_theta_;  // latest angle per board flipper (sized once)
   cv::Mat floor_;          // CV_8U static scene: drawing, clutter, unlit lamps
@@ -197,7 +197,7 @@ class SimCameraSource final : public FrameSource {
   std::uint64_t sequence_ = 0;
   std::array<Vec2, kMaxPath> path_{};
   FrameTruth truth_;
-  FrameSourceCounters counters_;
+  vision::FrameSourceCounters counters_;
 };
 
-}  // namespace pinball::vision
+}  // namespace pinball::simlab

@@ -1,4 +1,4 @@
-#include "pinball/calibration/sim_lab.h"
+#include "pinball/simlab/sim_lab.h"
 
 #include <cmath>
 #include <numbers>
@@ -11,11 +11,11 @@
 #include "pinball/sim/penetration.h"
 #include "pinball/sim/model_world.h"
 
-namespace pinball::calibration {
+namespace pinball::simlab {
 namespace {
 
-vision::SimCameraConfig camera_config(const SimLabOptions& o) {
-  vision::SimCameraConfig c = o.camera;
+simlab::SimCameraConfig camera_config(const SimLabOptions& o) {
+  simlab::SimCameraConfig c = o.camera;
   c.seed = o.seed;
   return c;
 }
@@ -49,7 +49,7 @@ class SweepSource final : public vision::FrameSource {
  private:
   const SimLab& lab_;
   std::size_t index_;
-  vision::SimCameraSource camera_;
+  simlab::SimCameraSource camera_;
   std::vector<double> theta_;
   std::uint64_t frames_ = 0;
   std::uint64_t next_ = 0;
@@ -65,7 +65,7 @@ SimLab::SimLab(const table::Board& nominal, const SimLabOptions& options)
     f.theta_min_rad += options.theta_offset_rad;
     f.theta_max_rad += options.theta_offset_rad;
   }
-  camera_ = std::make_unique<vision::SimCameraSource>(truth_, camera_config(options));
+  camera_ = std::make_unique<simlab::SimCameraSource>(truth_, camera_config(options));
   camera_->set_lamps_blinking(false);
 }
 
@@ -80,7 +80,7 @@ cv::Mat SimLab::marker_image(std::span<const Vec2> markers, bool flippers_up) {
 }
 
 cv::Mat SimLab::camera_image() {
-  const std::vector<Vec2> layout = default_marker_layout(nominal_);
+  const std::vector<Vec2> layout = calibration::default_marker_layout(nominal_);
   return marker_image(layout, false);
 }
 
@@ -121,14 +121,14 @@ std::unique_ptr<vision::FrameSource> SimLab::sweep_video(std::size_t index) cons
   return std::make_unique<SweepSource>(*this, index);
 }
 
-std::vector<GravityRoll> SimLab::rolls(int count, std::uint64_t stream) const {
+std::vector<calibration::GravityRoll> SimLab::rolls(int count, std::uint64_t stream) const {
   Rng rng(options_.seed * 0x9E3779B97F4A7C15ull + stream + 1);
   const std::unique_ptr<sim::World> world = sim::make_model_world(truth_);
   const double r = truth_.ball.radius_m;
   constexpr std::uint32_t kContact = sim::StepEvents::kHitObstacle | sim::StepEvents::kHitFlipper |
                                      sim::StepEvents::kFlipperPush | sim::StepEvents::kSensor |
                                      sim::StepEvents::kBallLost;
-  std::vector<GravityRoll> out;
+  std::vector<calibration::GravityRoll> out;
   for (int attempt = 0; static_cast<int>(out.size()) < count; ++attempt) {
     if (attempt > 200 * std::max(count, 1)) throw std::runtime_error("sim lab: no free place to roll a ball from");
     const Vec2 p0{rng.uniform(0.15, 0.85) * truth_.width_m, rng.uniform(0.45, 0.92) * truth_.height_m};
@@ -141,7 +141,7 @@ std::vector<GravityRoll> SimLab::rolls(int count, std::uint64_t stream) const {
     state.ball.velocity_mps = Vec2::Zero();
     state.ball_in_play = true;
     track::CameraModel camera(options_.roll_camera, rng.next_u64());
-    GravityRoll roll;
+    calibration::GravityRoll roll;
     std::ostringstream name;
     name << "sim roll " << out.size() << " from (" << p0.x() << ", " << p0.y() << ")";
     roll.source = name.str();
@@ -171,4 +171,4 @@ std::vector<GravityRoll> SimLab::rolls(int count, std::uint64_t stream) const {
   return out;
 }
 
-}  // namespace pinball::calibration
+}  // namespace pinball::simlab

@@ -8,11 +8,11 @@
 #include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 
-namespace pinball::sim {
+namespace pinball::simlab {
 
 /// Energises the flipper nearest the ball while the ball is within
 /// `reach_factor` ball radii of that flipper's down-position segment and
 /// falling; releases every other flipper.
-void oracle_spastic_policy(const table::Board& board, GameState& state, double reach_factor = 2.5);
+void oracle_spastic_policy(const table::Board& board, sim::GameState& state, double reach_factor = 2.5);
 
-}  // namespace pinball::sim
+}  // namespace pinball::simlab

@@ -1,12 +1,12 @@
-#include "pinball/daemon/sim_world.h"
+#include "pinball/simlab/sim_world.h"
 
 #include <stdexcept>
 
-#include "pinball/daemon/clock.h"
+#include "pinball/core/clock.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/sim/ball_runner.h"
 
-namespace pinball::daemon {
+namespace pinball::simlab {
 namespace {
 
 firmware::VirtualDriverBoardOptions board_options(const table::Board& board) {
@@ -29,7 +29,7 @@ void SimWorld::CoilWatch::on_coil_change(int driver, const firmware::CoilOutput&
   }
 }
 
-SimWorld::SimWorld(const sim::World& world, firmware::CanTransport& board_link, const vision::SimCameraConfig& camera,
+SimWorld::SimWorld(const sim::World& world, firmware::CanTransport& board_link, const simlab::SimCameraConfig& camera,
                    const SimWorldOptions& options)
     : world_(world.fork()),
       board_(world_->board()),
@@ -64,7 +64,7 @@ void SimWorld::render_background(vision::Frame& frame, double t_s) {
 
 void SimWorld::start_ball() {
   // The same launch noise per ball index as the fast learning loop's evaluator.
-  state_.rng = Rng(learn::ball_seed(options_.seed, static_cast<std::uint64_t>(ball_)));
+  state_.rng = Rng(ball_seed(options_.seed, static_cast<std::uint64_t>(ball_)));
   sim::begin_ball(*world_, state_, pull_);
   ball_active_ = true;
   ball_t0_s_ = state_.time_s;
@@ -132,4 +132,4 @@ bool SimWorld::step(GameEvent* events, int& n) {
   return true;
 }
 
-}  // namespace pinball::daemon
+}  // namespace pinball::simlab

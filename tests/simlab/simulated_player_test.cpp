@@ -1,4 +1,4 @@
-#include "pinball/control/simulated_player.h"
+#include "pinball/simlab/simulated_player.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include "pinball/sim/thesis_stepper.h"
 #include "common/thesis_board.h"
 
-namespace pinball::control {
+namespace pinball::simlab {
 namespace {
 
 constexpr int kBalls = 20;
@@ -38,7 +38,7 @@ Totals play_tracked(const track::CameraModelConfig& camera) {
   Totals t;
   for (int seed = 1; seed <= kBalls; ++seed) {
     sim::GameState s = sim::make_game_state(thesis_board(), static_cast<std::uint64_t>(seed));
-    SimulatedSpasticPlayer player(thesis_board(), camera, SpasticConfig{}, static_cast<std::uint64_t>(seed));
+    SimulatedSpasticPlayer player(thesis_board(), camera, control::SpasticConfig{}, static_cast<std::uint64_t>(seed));
     const sim::BallResult r = sim::play_ball(
         *world, s, limits(), [&](sim::GameState& st) { player.act(st); },
         [](const sim::GameState&, const sim::StepEvents&) {});
@@ -97,8 +97,8 @@ TEST(SimulatedSpasticPlayer, SeesTheBallOnlyThroughTheCamera) {
   camera.latency_s = 0.010;
   for (int seed = 1; seed <= 3; ++seed) {
     sim::GameState s = sim::make_game_state(thesis_board(), static_cast<std::uint64_t>(seed));
-    SimulatedSpasticPlayer truth(thesis_board(), camera, SpasticConfig{}, 7);
-    SimulatedSpasticPlayer blind(thesis_board(), camera, SpasticConfig{}, 7);
+    SimulatedSpasticPlayer truth(thesis_board(), camera, control::SpasticConfig{}, 7);
+    SimulatedSpasticPlayer blind(thesis_board(), camera, control::SpasticConfig{}, 7);
     long steps = 0;
     long disagreements = 0;
     long energized_steps = 0;
@@ -129,7 +129,7 @@ TEST(SimulatedSpasticPlayer, SeesTheBallOnlyThroughTheCamera) {
 TEST(SimulatedSpasticPlayer, BallOutOfPlayReleasesTheFlippersAndSeesNothing) {
   const table::Board& b = thesis_board();
   sim::GameState s = sim::make_game_state(b, 1);
-  SimulatedSpasticPlayer player(b, track::CameraModelConfig{}, SpasticConfig{}, 1);
+  SimulatedSpasticPlayer player(b, track::CameraModelConfig{}, control::SpasticConfig{}, 1);
   ASSERT_FALSE(s.ball_in_play);
   for (auto& f : s.flippers) f.energized = true;
   for (int i = 0; i < 100; ++i) {
@@ -143,11 +143,11 @@ TEST(SimulatedSpasticPlayer, BallOutOfPlayReleasesTheFlippersAndSeesNothing) {
 TEST(SimulatedSpasticPlayer, BadSettingsThrow) {
   track::CameraModelConfig bad;
   bad.fps = 0.0;
-  EXPECT_THROW(SimulatedSpasticPlayer(thesis_board(), bad, SpasticConfig{}, 1), std::invalid_argument);
+  EXPECT_THROW(SimulatedSpasticPlayer(thesis_board(), bad, control::SpasticConfig{}, 1), std::invalid_argument);
   table::Board one = thesis_board();
   one.flippers.pop_back();
-  EXPECT_THROW(SimulatedSpasticPlayer(one, track::CameraModelConfig{}, SpasticConfig{}, 1), std::invalid_argument);
+  EXPECT_THROW(SimulatedSpasticPlayer(one, track::CameraModelConfig{}, control::SpasticConfig{}, 1), std::invalid_argument);
 }
 
 }  // namespace
-}  // namespace pinball::control
+}  // namespace pinball::simlab

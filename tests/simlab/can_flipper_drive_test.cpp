@@ -1,4 +1,4 @@
-#include "pinball/control/can_flipper_drive.h"
+#include "pinball/simlab/can_flipper_drive.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include "pinball/sim/thesis_stepper.h"
 #include "common/thesis_board.h"
 
-namespace pinball::control {
+namespace pinball::simlab {
 namespace {
 
 using pinball::testing::thesis_board;
@@ -58,4 +58,4 @@ TEST(CanFlipperDrive, RefusesBoardsItCannotDrive) {
 }
 
 }  // namespace
-}  // namespace pinball::control
+}  // namespace pinball::simlab

@@ -1,4 +1,4 @@
-#include "pinball/vision/sim_camera_source.h"
+#include "pinball/simlab/sim_camera_source.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 #include "pinball/sim/renderer.h"
 
-namespace pinball::vision {
+namespace pinball::simlab {
 namespace {
 
 void require(bool ok, const std::string& what) {
@@ -73,7 +73,7 @@ std::vector<SimPlastic> SimCameraConfig::default_plastics() {
 SimCameraSource::SimCameraSource(const table::Board& board, const SimCameraConfig& config)
     : board_(board),
       config_(config),
-      homography_(CameraHomography::default_view(board, cv::Size(std::max(config.width_px, 1),
+      homography_(vision::CameraHomography::default_view(board, cv::Size(std::max(config.width_px, 1),
                                                                  std::max(config.height_px, 1)),
                                                  config.view)),
       rng_(config.seed) {
@@ -367,7 +367,7 @@ bool SimCameraSource::sample_at(double t_s, Vec2& p, bool& in_play) const {
   return true;
 }
 
-bool SimCameraSource::read(Frame& out) {
+bool SimCameraSource::read(vision::Frame& out) {
   if (history_size_ == 0) return false;
   const double newest = history_[(history_head_ + history_size_ - 1) % kHistory].t_s;
   const double oldest = history_[history_head_].t_s;
@@ -408,7 +408,7 @@ bool SimCameraSource::read(Frame& out) {
   }
 }
 
-void SimCameraSource::render(std::span<const Vec2> path_board, double t_mid_s, Frame& out) {
+void SimCameraSource::render(std::span<const Vec2> path_board, double t_mid_s, vision::Frame& out) {
   const std::size_t n = std::min(path_board.size(), kMaxPath);
   compose(path_board.first(n), static_cast<int>(n), t_mid_s, out);
   if (n > 0) {
@@ -444,7 +444,7 @@ void SimCameraSource::advance_effects() {
   }
 }
 
-void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, double t_mid_s, Frame& out) {
+void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, double t_mid_s, vision::Frame& out) {
   advance_effects();
   floor_.copyTo(out.gray);  // reuses out.gray's buffer when it already has this size
   cv::Mat& image = out.gray;
@@ -543,4 +543,4 @@ void SimCameraSource::draw_ball(std::span<const Vec2> path_board, int path_total
   truth_.occluded_fraction = covered > 0.0 ? hidden / covered : 0.0;
 }
 
-}  // namespace pinball::vision
+}  // namespace pinball::simlab

@@ -1,0 +1,65 @@
+#include "pinball/simlab/world_factory.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include "common/thesis_board.h"
+#include "pinball/table/board_loader.h"
+
+namespace pinball::simlab {
+namespace {
+
+using pinball::testing::thesis_board;
+
+// A board file written for the test: the thesis table with one line replaced.
+std::string variant_board(const std::string& name, const std::string& from, const std::string& to) {
+  std::ifstream in(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(WorldFactory, TheWorldDefaultsToTheBelief) {
+  const OwnedWorld w = make_world(WorldSpec{}, thesis_board());
+  EXPECT_EQ(w.board->source, thesis_board().source);
+  EXPECT_EQ(w.board->gravity_mps2, thesis_board().gravity_mps2);
+  EXPECT_EQ(&w->board(), w.board.get());
+  EXPECT_EQ(w->name(), "thesis");
+  EXPECT_EQ(w->dt_s(), thesis_board().dt_s);
+}
+
+TEST(WorldFactory, TheWorldMayBeAnotherBoardOnAnotherStepper) {
+  const std::string path = variant_board("world_factory_g.board", "gravity 1110", "gravity 1000");
+  WorldSpec spec;
+  spec.board_path = path;
+  spec.stepper = sim::StepperKind::kEvent;
+  spec.dt_s = 0.001;
+  const OwnedWorld w = make_world(spec, thesis_board());
+  EXPECT_DOUBLE_EQ(w.board->gravity_mps2, 1.0);
+  EXPECT_DOUBLE_EQ(thesis_board().gravity_mps2, 1.11);  // the belief is untouched
+  EXPECT_EQ(w->name(), "event");
+  EXPECT_EQ(w->dt_s(), 0.001);
+  std::remove(path.c_str());
+}
+
+TEST(WorldFactory, AWorldWithOtherFlippersIsRefused) {
+  const std::string path = variant_board("world_factory_flip.board", "flipper left", "flipper right");
+  WorldSpec spec;
+  spec.board_path = path;
+  EXPECT_THROW(make_world(spec, thesis_board()), std::invalid_argument);
+  spec.board_path = "/nonexistent/world.board";
+  EXPECT_THROW(make_world(spec, thesis_board()), table::BoardError);
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace pinball::simlab
