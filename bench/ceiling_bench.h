@@ -34,6 +34,7 @@
 
 #include "pinball/core/running_stats.h"
 #include "pinball/control/controller_file.h"
+#include "pinball/firmware/flipper_actuation.h"
 #include "pinball/learn/lookahead_player.h"
 #include "pinball/track/camera_model.h"
 #include "pinball/table/board.h"
@@ -49,7 +50,7 @@ struct CeilingBenchOptions {
   std::uint64_t seed = 1;           ///< run seed: ball i plays ball_seed(seed, i)
   int threads = 2;                  ///< worker threads; results do not depend on it
   double max_ball_time_s = 60.0;    ///< a ball alive after this is cut (a possible cycle)
-  double actuation_delay_s = 0.004; ///< command to flipper motion, as in the evaluator
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s; ///< command to flipper motion, as in the evaluator
   double pull = -1.0;               ///< launcher pull; negative: the board's
   double spastic_reach_factor = 2.5;///< the spastic baseline's reach (ball radii)
   double left_outlane_x_m = 0.045;  ///< a drain with x below this went down the left outlane

@@ -10,6 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pinball/firmware/flipper_actuation.h"
 #include "pinball/simlab/world_factory.h"
 #include "pinball/track/camera_model.h"
 
@@ -31,7 +32,7 @@ struct SimArgs {
   track::CameraModelConfig camera;  ///< the camera the spastic player sees through
   double reach_m = 0.02;         ///< spastic: flip when the projected impact is this close (m)
   std::string actuation = "direct";  ///< direct | can: flipper commands through the CAN path
-  double actuation_delay_s = 0.004;  ///< can: solenoid rise before the flipper moves (s)
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< can: solenoid rise before the flipper moves (s)
   bool json = false;             ///< one JSON object on stdout
 };
 CLI::App* add_sim_command(CLI::App& app, SimArgs& args);
@@ -103,7 +104,7 @@ struct LearnArgs {
   int rounds = 4;                       ///< imitate: rounds (1: the teacher's balls only; more: DAgger)
   double max_ball_time_s = 60.0;        ///< a ball alive after this is cut: a cycle
   double loss_penalty = 500.0;          ///< reward of an opportunity that lost the ball
-  double actuation_delay_s = 0.004;     ///< command to flipper motion (s)
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;     ///< command to flipper motion (s)
   double gravity_scale = 1.0;           ///< tracker's g / board's g
   track::CameraModelConfig camera;      ///< the camera the tracker sees through
   simlab::WorldSpec world;              ///< the world (default: the model of `board` on the thesis stepper)

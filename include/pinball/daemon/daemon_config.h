@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "pinball/firmware/flipper_actuation.h"
 #include "pinball/sim/world.h"
 
 #include "pinball/firmware/messages.h"
@@ -63,7 +64,7 @@ struct SimSettings {
   int balls = 10;                              ///< balls to play
   std::uint64_t seed = 1;                      ///< launch noise seed (ball i uses ball_seed(seed, i))
   bool realtime = false;                       ///< pace to the wall clock (default: lockstep, as fast as possible)
-  double actuation_delay_s = 0.004;            ///< coil on -> flipper moves (s)
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;            ///< coil on -> flipper moves (s)
   double max_ball_time_s = 60.0;               ///< a ball alive this long is cut (s)
 };
 

@@ -10,6 +10,11 @@
 
 namespace pinball::firmware {
 
+/// Command to flipper motion of a flipper solenoid (s): current rise and
+/// plunger travel. The one default of every place that models it (the fast
+/// loop, the daemon's simulation, `pinball sim`, the teacher, the benches).
+inline constexpr double kDefaultActuationDelay_s = 0.004;
+
 /// Follows one driver's coil and answers "is the flipper energised at t?".
 class FlipperActuation final : public CoilListener {
  public:

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "pinball/control/imitation_controller.h"
+#include "pinball/firmware/flipper_actuation.h"
 #include "pinball/learn/lookahead_player.h"
 #include "pinball/learn/search.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -27,7 +28,7 @@ namespace pinball::learn {
 struct DemonstrationConfig {
   LookaheadConfig teacher;           ///< the teacher's planner
   track::CameraModelConfig camera;   ///< the camera the tracker sees through
-  double actuation_delay_s = 0.004;  ///< command to flipper motion (s), as in the evaluator
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< command to flipper motion (s), as in the evaluator
   double max_ball_time_s = 60.0;     ///< a teacher's ball alive after this is cut
   double pull = -1.0;                ///< launcher pull; negative: the board's
 };

@@ -12,6 +12,7 @@
 #include "pinball/control/controller_file.h"
 #include "pinball/core/rng.h"
 #include "pinball/control/flipper_controller.h"
+#include "pinball/firmware/flipper_actuation.h"
 #include "pinball/simlab/simulated_player.h"
 #include "pinball/simlab/delay_line.h"
 #include "pinball/sim/ball_runner.h"
@@ -50,7 +51,7 @@ class BallObjective {
 /// Settings of the pinball evaluator.
 struct EvaluatorConfig {
   track::CameraModelConfig camera;     ///< the camera the tracker sees through
-  double actuation_delay_s = 0.004;    ///< command to flipper motion (s): the solenoid's rise
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;    ///< command to flipper motion (s): the solenoid's rise
   double max_ball_time_s = 60.0;       ///< a ball alive after this is cut and reported as a cycle
   double loss_penalty = 500.0;         ///< reward of an opportunity that ended with the ball lost (6.3.1)
   double gravity_scale = 1.0;          ///< tracker's g / board's g (1: calibrated)

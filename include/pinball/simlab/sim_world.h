@@ -25,7 +25,7 @@ namespace pinball::simlab {
 struct SimWorldOptions {
   int balls = 10;                     ///< balls to play
   std::uint64_t seed = 1;             ///< ball i launches with noise from ball_seed(seed, i)
-  double actuation_delay_s = 0.004;   ///< coil on -> flipper moves (s)
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;   ///< coil on -> flipper moves (s)
   double max_ball_time_s = 60.0;      ///< a ball alive this long is cut (a cycle)
   double launcher_pull = -1.0;        ///< pull fraction; negative: the board's
   int background_frames = 30;         ///< ball-free frames rendered first for the detector's background
