@@ -32,7 +32,7 @@ struct SimArgs {
   track::CameraModelConfig camera;  ///< the camera the spastic player sees through
   double reach_m = 0.02;         ///< spastic: flip when the projected impact is this close (m)
   std::string actuation = "direct";  ///< direct | can: flipper commands through the CAN path
-  double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< can: solenoid rise before the flipper moves (s)
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< solenoid rise before the flipper moves (s)
   bool json = false;             ///< one JSON object on stdout
 };
 CLI::App* add_sim_command(CLI::App& app, SimArgs& args);

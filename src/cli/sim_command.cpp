@@ -17,6 +17,7 @@
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/simlab/can_flipper_drive.h"
+#include "pinball/simlab/delay_line.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/simlab/simulated_player.h"
 #include "pinball/sim/renderer.h"
@@ -42,10 +43,12 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
       ->check(CLI::Range(0.0, 1.0));
   add_camera_model_options(*cmd, a.camera);
   cmd->add_option("--actuation", a.actuation,
-                  "how commands reach the flippers: direct, or can (DriverBus, CAN frames, the virtual "
-                  "driver board and the solenoid delay)")
+                  "how commands reach the flippers: direct (the solenoid delay applied to the table), or can "
+                  "(DriverBus, CAN frames, the virtual driver board and the solenoid delay)")
       ->check(CLI::IsMember({"direct", "can"}));
-  cmd->add_option("--actuation-delay", a.actuation_delay_s, "can: solenoid rise before the flipper moves (s)")
+  cmd->add_option("--actuation-delay", a.actuation_delay_s,
+                  "solenoid rise before the flipper moves (s), for either actuation: the evaluator's and pinballd's "
+                  "default")
       ->check(CLI::Range(0.0, 0.1));
   cmd->add_option("--balls", a.balls, "balls to play")->check(CLI::Range(1, 100'000'000));
   cmd->add_option("--seed", a.seed, "random seed (launch noise); same seed, same results");
@@ -109,7 +112,14 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     spastic.emplace(board, a.camera, spastic_config, a.seed ^ 0x5DEECE66Dull);
   }
   std::optional<simlab::CanFlipperDrive> can_drive;
-  if (a.actuation == "can") can_drive.emplace(world_board, a.actuation_delay_s);
+  // One actuation model everywhere: commands reach the flippers actuation_delay_s later, through the
+  // CAN path or straight (the fast loop's solenoid delay), as in the evaluator and pinballd.
+  std::optional<simlab::DelayLine> direct_drive;
+  if (a.actuation == "can") {
+    can_drive.emplace(world_board, a.actuation_delay_s);
+  } else {
+    direct_drive.emplace(world_board.flippers.size(), a.actuation_delay_s);
+  }
   sim::BallLimits limits;
   limits.max_ball_time_s = a.max_ball_time_s;
   limits.pull = pull;
@@ -131,6 +141,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
           if (spastic) spastic->act(s);
           if (learned_player) learned_player->act(s);
           if (can_drive) can_drive->apply(s);
+          if (direct_drive) direct_drive->apply(s);
         },
         [&](const sim::GameState& s, const sim::StepEvents& e) {
           if (trace) trace->write(world_board, s, e);
@@ -188,6 +199,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
           {"drop_probability", a.camera.drop_probability}}},
         {"flips", flips},
         {"actuation", a.actuation},
+        {"actuation_delay_s", a.actuation_delay_s},
         {"mean_score_per_ball", score.mean()},
         {"score_ci95_half_width", score.ci95_half_width()},
         {"score_stddev", score.stddev()},
