@@ -5,6 +5,7 @@
 #include <ostream>
 #include <stdexcept>
 
+#include "camera_options.h"
 #include "commands.h"
 #include "world_options.h"
 #include "pinball/table/board_loader.h"
@@ -50,6 +51,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--csv", a.csv, "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here");
   cmd->add_option("--png", a.png, "precision: write the log-log plot of error against run time here");
   add_world_options(*cmd, a.world);
+  add_camera_model_options(*cmd, a.camera);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -169,6 +171,7 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
   options.seed = a.seed;
   options.threads = a.threads;
   options.max_ball_time_s = a.max_ball_time_s;
+  options.camera = a.camera;
   std::optional<control::ControllerSpec> controller;
   if (!a.controller.empty()) {
     controller = control::load_controller(a.controller);

@@ -77,6 +77,7 @@ struct BenchArgs {
   std::string csv;                                   ///< precision: CSV file to write, or empty
   std::string png;                                   ///< precision: log-log plot to write, or empty
   simlab::WorldSpec world;                           ///< ceiling: the world (default: the model of `board`)
+  track::CameraModelConfig camera;                   ///< ceiling: the tracker-side players' camera
   bool json = false;                                 ///< one JSON object on stdout
 };
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& args);

@@ -104,6 +104,7 @@ TEST(Daemon, FullPathScoresLikeTheFastLearningLoop) {
   learn::EvaluatorConfig ec;
   ec.actuation_delay_s = 0.004;
   ec.max_ball_time_s = 60.0;
+  ec.camera.latency_s = 0.0;  // the daemon's simulated camera hands each frame over at once
   const learn::PinballEvaluator evaluator(board, ec);
   RunningStats fast_scores;
   for (int i = 0; i < kBalls; ++i) {

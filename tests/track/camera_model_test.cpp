@@ -12,6 +12,14 @@ namespace {
 
 constexpr double kStep_s = 0.0005;  // the thesis stepper's time step
 
+// A camera that delivers each frame at its exposure: the tests of rate, pixel
+// grid, noise and drops look at what is delivered, not when (latency has its own test).
+CameraModelConfig delivered_at_once() {
+  CameraModelConfig c;
+  c.latency_s = 0.0;
+  return c;
+}
+
 // Steps a camera for `duration_s` at kStep_s, time summed the way the stepper
 // sums it, delivering after every exposure. Returns the delivered frames.
 std::vector<Observation> run_camera(CameraModel& camera, double duration_s, const Vec2& p_true,
@@ -29,7 +37,7 @@ std::vector<Observation> run_camera(CameraModel& camera, double duration_s, cons
 
 TEST(CameraModel, FramesAtTheConfiguredRate) {
   for (const double fps : {200.0, 300.0, 1000.0}) {
-    CameraModelConfig c;
+    CameraModelConfig c = delivered_at_once();
     c.fps = fps;
     CameraModel camera(c, 1);
     const std::vector<Observation> obs = run_camera(camera, 1.0, {0.2, 0.3});
@@ -55,7 +63,7 @@ TEST(CameraModel, FrameCountDoesNotDriftOverALongRun) {
 }
 
 TEST(CameraModel, NoiselessObservationsLieOnThePixelGridWithinHalfAPixel) {
-  CameraModelConfig c;
+  CameraModelConfig c = delivered_at_once();
   c.noise_px = 0.0;
   c.m_per_px = 0.002;
   CameraModel camera(c, 3);
@@ -88,7 +96,7 @@ TEST(CameraModel, NoiselessObservationsLieOnThePixelGridWithinHalfAPixel) {
 
 TEST(CameraModel, NoiseStatisticsMatchObservationSigma) {
   for (const double noise_px : {0.3, 1.0}) {
-    CameraModelConfig c;
+    CameraModelConfig c = delivered_at_once();
     c.noise_px = noise_px;
     c.m_per_px = 0.002;
     c.fps = 2000.0;  // a frame every step
@@ -148,7 +156,7 @@ TEST(CameraModel, LatencyDelaysDeliveryAndKeepsTheExposureTime) {
 }
 
 TEST(CameraModel, DropsFramesWithTheConfiguredProbability) {
-  CameraModelConfig c;
+  CameraModelConfig c = delivered_at_once();
   c.drop_probability = 0.2;
   c.fps = 2000.0;
   CameraModel camera(c, 6);
