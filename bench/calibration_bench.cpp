@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "pinball/core/statistics.h"
 #include "pinball/calibration/camera_calibration.h"
 #include "pinball/calibration/flipper_calibration.h"
 #include "pinball/calibration/gravity_calibration.h"
@@ -19,13 +20,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kDeg = 180.0 / std::numbers::pi;
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
 
 FlipperErrors errors_of(const calibration::FlipperCalibration& c, const table::Flipper& truth) {
   FlipperErrors e;

@@ -5,6 +5,7 @@
 #include <thread>
 #include <vector>
 
+#include "pinball/core/statistics.h"
 #include "pinball/core/clock.h"
 #include "pinball/daemon/doorbell.h"
 
@@ -63,9 +64,8 @@ void doorbell_baseline(int samples, double& p50_us, double& p99_us) {
     pong.wait(1.0);
   }
   waiter.join();
-  std::sort(lat.begin(), lat.end());
-  p50_us = lat[lat.size() / 2];
-  p99_us = lat[std::min(lat.size() - 1, lat.size() * 99 / 100)];
+  p50_us = quantile(lat, 0.5);
+  p99_us = quantile(lat, 0.99);
 }
 
 nlohmann::json run_json(const DaemonLatencyRun& r) {

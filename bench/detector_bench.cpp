@@ -10,6 +10,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/core/statistics.h"
 #include "pinball/core/rng.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/simlab/oracle_policy.h"
@@ -45,18 +46,10 @@ ErrorSummary summarise(std::vector<double> v) {
   ErrorSummary s;
   s.count = v.size();
   if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))]; };
-  s.median = at(0.5);
-  s.p99 = at(0.99);
-  s.max = v.back();
+  s.median = quantile(v, 0.5);
+  s.p99 = quantile(v, 0.99);
+  s.max = *std::max_element(v.begin(), v.end());
   return s;
-}
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
 }
 
 // Learns the detector's background from ball-free frames with the lamps still and the glare off.

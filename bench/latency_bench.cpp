@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "pinball/core/statistics.h"
 #include "pinball/firmware/codec.h"
 #include "pinball/firmware/coil_safety_monitor.h"
 #include "pinball/firmware/driver_bus.h"
@@ -22,13 +23,6 @@ using Clock = std::chrono::steady_clock;
 namespace fw = pinball::firmware;
 
 double now_s() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  return v[std::min(i, v.size() - 1)];
-}
 
 // Board side: serve frames until `done` or the deadline (s).
 template <typename Done>
@@ -86,8 +80,8 @@ LatencyReport run_latency_bench(const LatencyBenchOptions& options,
     bus.stop();
     monitor.finish(now_s());
     r.samples = options.samples;
-    r.fire_to_coil_p50_us = percentile(lat_us, 0.50);
-    r.fire_to_coil_p99_us = percentile(lat_us, 0.99);
+    r.fire_to_coil_p50_us = quantile(lat_us, 0.50);
+    r.fire_to_coil_p99_us = quantile(lat_us, 0.99);
     r.fire_to_coil_max_us = *std::max_element(lat_us.begin(), lat_us.end());
     r.coil_violations = static_cast<std::uint64_t>(monitor.violations());
     say("fire -> coil: p50 " + std::to_string(r.fire_to_coil_p50_us) + " us, p99 " +
@@ -115,8 +109,8 @@ LatencyReport run_latency_bench(const LatencyBenchOptions& options,
       }
       raw_us.push_back((now_s() - t0) * 1e6);
     }
-    r.raw_p50_us = percentile(raw_us, 0.50);
-    r.raw_p99_us = percentile(raw_us, 0.99);
+    r.raw_p50_us = quantile(raw_us, 0.50);
+    r.raw_p99_us = quantile(raw_us, 0.99);
     r.stack_overhead_ratio = r.raw_p50_us > 0.0 ? r.fire_to_coil_p50_us / r.raw_p50_us : 0.0;
     say("raw socketpair frame: p50 " + std::to_string(r.raw_p50_us) + " us");
   }

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pinball/core/statistics.h"
 #include "pinball/core/rng.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/simlab/oracle_policy.h"
@@ -101,20 +102,6 @@ struct ErrorSamples {
     dtheta_deg.insert(dtheta_deg.end(), o.dtheta_deg.begin(), o.dtheta_deg.end());
   }
 };
-
-double quantile(std::vector<float> v, double q) {
-  if (v.empty()) return 0.0;
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
 
 ErrorStats stats_of(const std::vector<float>& v) {
   ErrorStats s;

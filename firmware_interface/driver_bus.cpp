@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pinball/core/check.h"
+#include "pinball/core/clock.h"
 #include "pinball/firmware/frame_log.h"
 
 namespace pinball::firmware {
@@ -19,13 +21,6 @@ namespace {
 constexpr int kCounterCount = sizeof(DriverBusCounters) / sizeof(std::uint64_t);
 static_assert(sizeof(DriverBusCounters) == kCounterCount * sizeof(std::uint64_t), "DriverBusCounters: uint64 fields only");
 
-double steady_s() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("DriverBusOptions: " + what);
-}
 }  // namespace
 
 struct DriverBus::AtomicCounters {
@@ -49,20 +44,20 @@ DriverBusCounters DriverBus::counters() const {
 
 DriverBus::DriverBus(CanTransport& transport, DriverBusOptions options)
     : transport_(transport), options_(options), counters_(std::make_unique<AtomicCounters>()) {
-  require(options.board_id < kMaxBoards, "board_id must be 0..15");
-  require(options.driver_count >= 1 && options.driver_count <= kMaxDrivers, "driver_count must be 1..8");
+  check_input(options.board_id < kMaxBoards, "DriverBusOptions", "board_id must be 0..15");
+  check_input(options.driver_count >= 1 && options.driver_count <= kMaxDrivers, "DriverBusOptions", "driver_count must be 1..8");
   for (int d = 0; d < options.driver_count; ++d) {
     const char* why = validate(options.drivers[static_cast<std::size_t>(d)]);
-    require(why == nullptr, "drivers[" + std::to_string(d) + "]: " + (why ? why : ""));
+    check_input(why == nullptr, "DriverBusOptions", "drivers[" + std::to_string(d) + "]: " + (why ? why : ""));
   }
-  require(std::isfinite(options.heartbeat_period_s) && options.heartbeat_period_s > 0.0, "heartbeat_period_s must be > 0");
+  check_input(std::isfinite(options.heartbeat_period_s) && options.heartbeat_period_s > 0.0, "DriverBusOptions", "heartbeat_period_s must be > 0");
   const double wd_ms = options.watchdog_timeout_s * 1e3;
-  require(wd_ms >= kMinWatchdogMs && wd_ms <= kMaxWatchdogMs, "watchdog_timeout_s must be 0.01..1 s");
-  require(options.watchdog_timeout_s >= 3.0 * options.heartbeat_period_s,
+  check_input(wd_ms >= kMinWatchdogMs && wd_ms <= kMaxWatchdogMs, "DriverBusOptions", "watchdog_timeout_s must be 0.01..1 s");
+  check_input(options.watchdog_timeout_s >= 3.0 * options.heartbeat_period_s, "DriverBusOptions",
           "watchdog_timeout_s must be at least 3 heartbeat periods (one lost heartbeat must not trip it)");
-  require(options.reply_timeout_s > 0.0, "reply_timeout_s must be > 0");
-  require(options.status_timeout_s > 0.0, "status_timeout_s must be > 0");
-  require(options.bus_off_holdoff_s >= 0.0, "bus_off_holdoff_s must be >= 0");
+  check_input(options.reply_timeout_s > 0.0, "DriverBusOptions", "reply_timeout_s must be > 0");
+  check_input(options.status_timeout_s > 0.0, "DriverBusOptions", "status_timeout_s must be > 0");
+  check_input(options.bus_off_holdoff_s >= 0.0, "DriverBusOptions", "bus_off_holdoff_s must be >= 0");
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
 }
 
@@ -85,7 +80,7 @@ void DriverBus::stop() {
   thread_.join();
   if (!hang_.load()) {
     const std::lock_guard<std::mutex> lock(io_mutex_);
-    make_safe(steady_s());
+    make_safe(steady_now_s());
     set_state(BusState::kStopped);
   }
 }
@@ -355,7 +350,7 @@ void DriverBus::send_commands(double now_s) {
 
 void DriverBus::run() {
   while (running_.load(std::memory_order_acquire)) {
-    const double now = steady_s();
+    const double now = steady_now_s();
     poll_once(now);
     double wait_s = 0.005;
     if (state() == BusState::kConfiguring || state() == BusState::kRunning) {

@@ -1,5 +1,7 @@
 #include "pinball/core/running_stats.h"
 
+#include "pinball/core/statistics.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -39,7 +41,7 @@ double RunningStats::stddev() const { return std::sqrt(variance()); }
 
 double RunningStats::ci95_half_width() const {
   if (n_ < 2) return 0.0;
-  return 1.959963984540054 * stddev() / std::sqrt(static_cast<double>(n_));
+  return student_t95(n_ - 1) * stddev() / std::sqrt(static_cast<double>(n_));
 }
 
 }  // namespace pinball

@@ -547,7 +547,7 @@ DaemonReport Daemon::Impl::report() const {
     }
     r.balls = static_cast<int>(r.results.size());
     r.mean_score = score.mean();
-    r.score_ci95 = r.balls > 1 ? 1.96 * std::sqrt(score.variance() / r.balls) : 0.0;
+    r.score_ci95 = score.ci95_half_width();
     r.mean_ball_time_s = time.mean();
   }
   return r;

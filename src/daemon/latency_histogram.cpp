@@ -1,5 +1,7 @@
 #include "pinball/daemon/latency_histogram.h"
 
+#include "pinball/core/statistics.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -40,13 +42,14 @@ LatencySummary LatencyHistogram::summary() const {
   s.count = total;
   s.max_us = max_us_.load(std::memory_order_relaxed);
   if (total == 0) return s;
-  // The rank-based quantile: the smallest bin whose cumulative count reaches q·n.
+  // The project's quantile rule (core/statistics.h): the smallest bin whose
+  // cumulative count reaches the nearest rank.
   auto quantile = [&](double q) {
-    const auto rank = static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(total)));
+    const std::uint64_t rank = quantile_rank(q, static_cast<std::size_t>(total));
     std::uint64_t seen = 0;
     for (int i = 0; i < kBins; ++i) {
       seen += copy[static_cast<std::size_t>(i)];
-      if (seen >= std::max<std::uint64_t>(rank, 1)) return std::min(latency_bin_upper_us(i), s.max_us);
+      if (seen >= rank) return std::min(latency_bin_upper_us(i), s.max_us);
     }
     return s.max_us;
   };

@@ -8,14 +8,11 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/core/check.h"
 #include "pinball/sim/renderer.h"
 
 namespace pinball::simlab {
 namespace {
-
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("sim camera: " + what);
-}
 
 // The renderer's playfield colour (BGR) as gray, to tell the table's art from its obstacles.
 std::uint8_t playfield_gray() {
@@ -78,36 +75,36 @@ SimCameraSource::SimCameraSource(const table::Board& board, const SimCameraConfi
                                                  config.view)),
       rng_(config.seed) {
   const SimCameraConfig& c = config_;
-  require(c.width_px >= 32 && c.height_px >= 32 && c.width_px <= 8192 && c.height_px <= 8192,
+  check_input(c.width_px >= 32 && c.height_px >= 32 && c.width_px <= 8192 && c.height_px <= 8192, "sim camera",
           "width_px and height_px must be in [32, 8192]");
-  require(std::isfinite(c.fps) && c.fps > 0.0, "fps must be > 0");
-  require(std::isfinite(c.exposure_s) && c.exposure_s >= 0.0 && c.exposure_s <= 1.0 / c.fps,
+  check_input(std::isfinite(c.fps) && c.fps > 0.0, "sim camera", "fps must be > 0");
+  check_input(std::isfinite(c.exposure_s) && c.exposure_s >= 0.0 && c.exposure_s <= 1.0 / c.fps, "sim camera",
           "exposure_s must be in [0, 1/fps]");
-  require(std::isfinite(c.first_exposure_s), "first_exposure_s must be finite");
-  require(c.supersample >= 1 && c.supersample <= 4, "supersample must be in [1, 4]");
-  require(std::isfinite(c.floor_gain) && c.floor_gain >= 0.0 && std::isfinite(c.floor_offset),
+  check_input(std::isfinite(c.first_exposure_s), "sim camera", "first_exposure_s must be finite");
+  check_input(c.supersample >= 1 && c.supersample <= 4, "sim camera", "supersample must be in [1, 4]");
+  check_input(std::isfinite(c.floor_gain) && c.floor_gain >= 0.0 && std::isfinite(c.floor_offset), "sim camera",
           "floor_gain must be >= 0 and floor_offset finite");
-  require(c.clutter_shapes >= 0 && std::isfinite(c.clutter_contrast), "clutter_shapes must be >= 0");
-  require(c.ball_gray >= 0.0 && c.ball_gray <= 255.0 && c.highlight_gray >= 0.0 && c.highlight_gray <= 255.0,
+  check_input(c.clutter_shapes >= 0 && std::isfinite(c.clutter_contrast), "sim camera", "clutter_shapes must be >= 0");
+  check_input(c.ball_gray >= 0.0 && c.ball_gray <= 255.0 && c.highlight_gray >= 0.0 && c.highlight_gray <= 255.0, "sim camera",
           "ball_gray and highlight_gray must be in [0, 255]");
-  require(c.ball_limb_darkening >= 0.0 && c.ball_limb_darkening <= 1.0, "ball_limb_darkening must be in [0, 1]");
-  require(std::isfinite(c.highlight_sigma) && c.highlight_sigma > 0.0, "highlight_sigma must be > 0");
-  require(c.lamps >= 0 && c.lamp_delta_gray >= 0.0 && c.lamp_delta_gray <= 255.0, "lamps must be >= 0, lamp_delta_gray in [0, 255]");
-  require(c.lamp_toggle_probability >= 0.0 && c.lamp_toggle_probability <= 1.0,
+  check_input(c.ball_limb_darkening >= 0.0 && c.ball_limb_darkening <= 1.0, "sim camera", "ball_limb_darkening must be in [0, 1]");
+  check_input(std::isfinite(c.highlight_sigma) && c.highlight_sigma > 0.0, "sim camera", "highlight_sigma must be > 0");
+  check_input(c.lamps >= 0 && c.lamp_delta_gray >= 0.0 && c.lamp_delta_gray <= 255.0, "sim camera", "lamps must be >= 0, lamp_delta_gray in [0, 255]");
+  check_input(c.lamp_toggle_probability >= 0.0 && c.lamp_toggle_probability <= 1.0, "sim camera",
           "lamp_toggle_probability must be in [0, 1]");
-  require(c.glare.toggle_probability >= 0.0 && c.glare.toggle_probability <= 1.0 && c.glare.sigma_m > 0.0 &&
-              c.glare.peak_gray >= 0.0 && c.glare.peak_gray <= 255.0,
+  check_input(c.glare.toggle_probability >= 0.0 && c.glare.toggle_probability <= 1.0 && c.glare.sigma_m > 0.0 &&
+              c.glare.peak_gray >= 0.0 && c.glare.peak_gray <= 255.0, "sim camera",
           "glare needs sigma_m > 0, peak_gray in [0, 255], toggle_probability in [0, 1]");
-  require(std::isfinite(c.noise_sigma) && c.noise_sigma >= 0.0 && c.noise_sigma <= 40.0,
+  check_input(std::isfinite(c.noise_sigma) && c.noise_sigma >= 0.0 && c.noise_sigma <= 40.0, "sim camera",
           "noise_sigma must be in [0, 40]");
   for (const SimPlastic& p : c.plastics) {
-    require(p.polygon_board.size() >= 3 && p.opacity >= 0.0 && p.opacity <= 1.0 && p.gray >= 0.0 && p.gray <= 255.0,
+    check_input(p.polygon_board.size() >= 3 && p.opacity >= 0.0 && p.opacity <= 1.0 && p.gray >= 0.0 && p.gray <= 255.0, "sim camera",
             "a plastic needs >= 3 vertices, opacity in [0, 1] and gray in [0, 255]");
   }
-  require(c.flipper_gray >= 0.0 && c.flipper_gray <= 255.0 && c.flipper_width_m > 0.0,
+  check_input(c.flipper_gray >= 0.0 && c.flipper_gray <= 255.0 && c.flipper_width_m > 0.0, "sim camera",
           "flipper_gray must be in [0, 255] and flipper_width_m > 0");
-  require(c.marker_radius_m > 0.0 && c.marker_ring_m >= c.marker_radius_m && c.marker_gray >= 0.0 &&
-              c.marker_gray <= 255.0 && c.marker_ring_gray >= 0.0 && c.marker_ring_gray <= 255.0,
+  check_input(c.marker_radius_m > 0.0 && c.marker_ring_m >= c.marker_radius_m && c.marker_gray >= 0.0 &&
+              c.marker_gray <= 255.0 && c.marker_ring_gray >= 0.0 && c.marker_ring_gray <= 255.0, "sim camera",
           "markers need 0 < marker_radius_m <= marker_ring_m and grays in [0, 255]");
   for (const table::Flipper& f : board.flippers) flipper_theta_.push_back(f.theta_min_rad);
   period_s_ = 1.0 / c.fps;

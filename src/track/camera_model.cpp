@@ -4,14 +4,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "pinball/core/check.h"
+
 namespace pinball::track {
-namespace {
-
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("camera model: " + what);
-}
-
-}  // namespace
 
 double observation_sigma_m(const CameraModelConfig& c) {
   const double quantisation = c.m_per_px * c.m_per_px / 12.0;
@@ -20,11 +15,11 @@ double observation_sigma_m(const CameraModelConfig& c) {
 }
 
 CameraModel::CameraModel(const CameraModelConfig& config, std::uint64_t seed) : config_(config), rng_(seed) {
-  require(std::isfinite(config.fps) && config.fps > 0.0, "fps must be > 0");
-  require(std::isfinite(config.m_per_px) && config.m_per_px > 0.0, "m_per_px must be > 0");
-  require(std::isfinite(config.noise_px) && config.noise_px >= 0.0, "noise_px must be >= 0");
-  require(std::isfinite(config.latency_s) && config.latency_s >= 0.0, "latency_s must be >= 0");
-  require(config.drop_probability >= 0.0 && config.drop_probability < 1.0, "drop_probability must be in [0, 1)");
+  check_input(std::isfinite(config.fps) && config.fps > 0.0, "camera model", "fps must be > 0");
+  check_input(std::isfinite(config.m_per_px) && config.m_per_px > 0.0, "camera model", "m_per_px must be > 0");
+  check_input(std::isfinite(config.noise_px) && config.noise_px >= 0.0, "camera model", "noise_px must be >= 0");
+  check_input(std::isfinite(config.latency_s) && config.latency_s >= 0.0, "camera model", "latency_s must be >= 0");
+  check_input(config.drop_probability >= 0.0 && config.drop_probability < 1.0, "camera model", "drop_probability must be in [0, 1)");
   period_s_ = 1.0 / config.fps;
 }
 

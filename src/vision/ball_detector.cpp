@@ -9,12 +9,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/core/check.h"
+
 namespace pinball::vision {
 namespace {
-
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("ball detector: " + what);
-}
 
 // Second moments of a uniform stadium of radius 1 and length k (k = L / r), per unit area.
 double stadium_major(double k) {
@@ -68,28 +66,28 @@ const char* to_string(DetectionMiss miss) {
 BallDetector::BallDetector(const CameraHomography& homography, cv::Size frame_size, const BallDetectorConfig& config)
     : homography_(homography), size_(frame_size), config_(config), background_(frame_size) {
   const BallDetectorConfig& c = config_;
-  require(std::isfinite(c.ball_radius_m) && c.ball_radius_m > 0.0, "ball_radius_m must be > 0");
-  require(c.threshold >= 1 && c.threshold <= 254, "threshold must be in [1, 254]");
-  require(c.min_area_ratio > 0.0 && c.min_area_ratio < 1.0 && c.max_area_ratio > 1.0,
+  check_input(std::isfinite(c.ball_radius_m) && c.ball_radius_m > 0.0, "ball detector", "ball_radius_m must be > 0");
+  check_input(c.threshold >= 1 && c.threshold <= 254, "ball detector", "threshold must be in [1, 254]");
+  check_input(c.min_area_ratio > 0.0 && c.min_area_ratio < 1.0 && c.max_area_ratio > 1.0, "ball detector",
           "area ratios need 0 < min_area_ratio < 1 < max_area_ratio");
-  require(c.max_elongation > 1.0, "max_elongation must be > 1");
-  require(c.max_model_error > 0.0 && c.radius_tolerance > 0.0 && c.radius_tolerance < 1.0,
+  check_input(c.max_elongation > 1.0, "ball detector", "max_elongation must be > 1");
+  check_input(c.max_model_error > 0.0 && c.radius_tolerance > 0.0 && c.radius_tolerance < 1.0, "ball detector",
           "max_model_error must be > 0 and radius_tolerance in (0, 1)");
-  require(c.min_fill > 0.0 && c.min_fill <= 1.0, "min_fill must be in (0, 1]");
-  require(c.weight_floor_fraction >= 0.0 && c.weight_floor_fraction < 1.0, "weight_floor_fraction must be in [0, 1)");
-  require(c.weight_saturation > 0.0 && c.weight_saturation <= 1.0, "weight_saturation must be in (0, 1]");
-  require(c.roi_radius_factor >= 1.5, "roi_radius_factor must be >= 1.5");
-  require(c.occluder_margin_px >= 0 && c.edge_margin_px >= 0, "margins must be >= 0");
-  require(c.background_rate >= 0.0 && c.background_rate <= 1.0 && c.background_every >= 1,
+  check_input(c.min_fill > 0.0 && c.min_fill <= 1.0, "ball detector", "min_fill must be in (0, 1]");
+  check_input(c.weight_floor_fraction >= 0.0 && c.weight_floor_fraction < 1.0, "ball detector", "weight_floor_fraction must be in [0, 1)");
+  check_input(c.weight_saturation > 0.0 && c.weight_saturation <= 1.0, "ball detector", "weight_saturation must be in (0, 1]");
+  check_input(c.roi_radius_factor >= 1.5, "ball detector", "roi_radius_factor must be >= 1.5");
+  check_input(c.occluder_margin_px >= 0 && c.edge_margin_px >= 0, "ball detector", "margins must be >= 0");
+  check_input(c.background_rate >= 0.0 && c.background_rate <= 1.0 && c.background_every >= 1, "ball detector",
           "background_rate must be in [0, 1] and background_every >= 1");
   diff_ = cv::Mat::zeros(size_, CV_8U);
   binary_ = cv::Mat::zeros(size_, CV_8U);
   stack_.resize(static_cast<std::size_t>(size_.width) * static_cast<std::size_t>(size_.height));
   halo_ = cv::Mat::zeros(size_, CV_8U);
-  require(std::isfinite(c.separation_radius_fraction) && c.separation_radius_fraction >= 0.0 &&
-              c.separation_radius_fraction < 1.0,
+  check_input(std::isfinite(c.separation_radius_fraction) && c.separation_radius_fraction >= 0.0 &&
+              c.separation_radius_fraction < 1.0, "ball detector",
           "separation_radius_fraction must be in [0, 1)");
-  require(c.max_separated_elongation >= 1.0, "max_separated_elongation must be >= 1");
+  check_input(c.max_separated_elongation >= 1.0, "ball detector", "max_separated_elongation must be >= 1");
   split_label_ = cv::Mat::zeros(size_, CV_8U);
   split_core_ = cv::Mat::zeros(size_, CV_8U);
   split_run_ = cv::Mat::zeros(size_, CV_16S);
@@ -100,7 +98,7 @@ void BallDetector::set_occluder_mask(const cv::Mat& mask) {
     occluder_.release();
     return;
   }
-  require(mask.type() == CV_8UC1 && mask.size() == size_, "the occluder mask must be 8-bit gray of the frame size");
+  check_input(mask.type() == CV_8UC1 && mask.size() == size_, "ball detector", "the occluder mask must be 8-bit gray of the frame size");
   cv::Mat nonzero;
   cv::threshold(mask, nonzero, 0, 255, cv::THRESH_BINARY);
   const int m = config_.occluder_margin_px;
