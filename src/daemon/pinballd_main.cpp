@@ -67,11 +67,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   if (threads) {
-    for (const ThreadSpec& t : kThreadTable) {
-      const std::string policy = t.fifo_priority > 0 ? "FIFO " + std::to_string(t.fifo_priority)
-                                                     : "OTHER nice " + std::to_string(t.nice);
-      std::printf("%-14s %-14s %-6s %-48s %s\n", t.name, policy.c_str(), t.chain ? "chain" : "", t.period, t.job);
-    }
+    std::fputs(thread_table_markdown().c_str(), stdout);
     return 0;
   }
   install(SIGINT, on_stop_signal);

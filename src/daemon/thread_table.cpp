@@ -16,6 +16,15 @@
 
 namespace pinball::daemon {
 
+std::string thread_table_markdown() {
+  std::string out = "| thread | SCHED_FIFO | nice | CPU | runs | does |\n|---|---|---|---|---|---|\n";
+  for (const ThreadSpec& t : kThreadTable) {
+    out += std::string("| ") + t.name + " | " + (t.fifo_priority > 0 ? std::to_string(t.fifo_priority) : "-") +
+           " | " + std::to_string(t.nice) + " | " + t.cpu + " | " + t.period + " | " + t.job + " |\n";
+  }
+  return out;
+}
+
 bool configure_current_thread(ThreadId id, bool realtime, std::string& why, int priority) {
   const ThreadSpec& spec = kThreadTable[static_cast<std::size_t>(id)];
   pthread_setname_np(pthread_self(), spec.name);

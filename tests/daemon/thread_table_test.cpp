@@ -6,6 +6,8 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "pinball/daemon/daemon_config.h"
@@ -22,6 +24,20 @@ std::vector<int> allowed_cpus() {
     if (CPU_ISSET(c, &set)) cpus.push_back(c);
   }
   return cpus;
+}
+
+TEST(ThreadTable, DocsShowWhatPinballdPrints) {
+  std::ifstream in(PINBALL_SOURCE_DIR "/docs/daemon.md");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string doc = text.str();
+  const std::string begin = "<!-- pinballd --threads -->\n";
+  const std::size_t from = doc.find(begin);
+  const std::size_t to = doc.find("<!-- end pinballd --threads -->");
+  ASSERT_NE(from, std::string::npos);
+  ASSERT_NE(to, std::string::npos);
+  EXPECT_EQ(doc.substr(from + begin.size(), to - from - begin.size()), thread_table_markdown())
+      << "paste the output of `pinballd --threads` into docs/daemon.md";
 }
 
 TEST(ThreadTable, TheChainIsCameraControllerAndDriver) {

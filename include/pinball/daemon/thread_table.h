@@ -22,6 +22,7 @@ struct ThreadSpec {
   int fifo_priority;     ///< SCHED_FIFO priority when real-time scheduling is on (0: stays SCHED_OTHER)
   int nice;              ///< niceness while SCHED_OTHER (always applied: raising it needs no privilege)
   bool chain;            ///< on the frame -> CAN chain: shares the chain's CPU (threads.chain_cpu)
+  const char* cpu;       ///< where it runs, in words (the simulator joins the chain in lockstep)
   const char* period;    ///< how it runs
   const char* job;       ///< what it does
 };
@@ -31,16 +32,20 @@ enum ThreadId : int { kDriverThread = 0, kControllerThread, kCameraThread, kSimT
 
 /// The table (README and `pinballd --threads` print it).
 inline constexpr std::array<ThreadSpec, kThreadCount> kThreadTable{{
-    {"pb-driver", 90, 0, true, "1 ms, or at once when a command is queued",
+    {"pb-driver", 90, 0, true, "chain", "1 ms, or at once when a command is queued",
      "DriverBus: send commands, heartbeat, read Status and Faults, bus-off recovery"},
-    {"pb-controller", 85, 0, true, "per projection; stall check every frame period",
-     "action function + actuator controller -> DriverBus fire/release; fail-safe releases"},
-    {"pb-camera", 80, 0, true, "per frame (5 ms at 200 fps)", "grab -> detect -> track -> project"},
-    {"pb-sim", 70, 0, false, "per simulator step (sim mode only)",
-     "simulated table, rendered camera frames, the virtual driver board on the far end of CAN"},
-    {"pb-lcm", 0, 10, false, "1 ms idle poll; stats once a second",
+    {"pb-controller", 85, 0, true, "chain", "per projection; stall check every frame period",
+     "action function + actuator controller -> DriverBus fire/release, writes the CAN frame itself; fail-safe "
+     "releases"},
+    {"pb-camera", 80, 0, true, "chain", "per frame (5 ms at 200 fps)", "grab -> detect -> track -> project"},
+    {"pb-sim", 70, 0, false, "chain in lockstep, else others", "per simulator step (sim mode only)",
+     "the simulated table (a world), its rendered camera frames, the virtual driver board on the far end of CAN"},
+    {"pb-lcm", 0, 10, false, "others", "1 ms idle poll; stats once a second",
      "encode and publish LCM messages, receive observations, count malformed ones"},
 }};
+
+/// The table as Markdown (`pinballd --threads`; docs/daemon.md holds this very text).
+std::string thread_table_markdown();
 
 /// Names the calling thread, sets its niceness from the table and, when
 /// `realtime`, gives it SCHED_FIFO at `priority` (the table's when negative;
