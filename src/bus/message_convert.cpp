@@ -75,6 +75,56 @@ pinball_lcm::lcmt_pinball_driver_status to_lcm_driver_status(std::int64_t utime,
   return m;
 }
 
+pinball_lcm::lcmt_pinball_flipper_command to_lcm_flipper_command(std::int64_t utime, std::int64_t seq,
+                                                                  std::int64_t projection_seq, int flipper,
+                                                                  bool energize, std::int8_t cause) {
+  pinball_lcm::lcmt_pinball_flipper_command m{};
+  m.utime = utime;
+  m.seq = seq;
+  m.projection_seq = projection_seq;
+  m.flipper = static_cast<std::int8_t>(flipper);
+  m.energize = energize;
+  m.cause = cause;
+  return m;
+}
+
+pinball_lcm::lcmt_pinball_game_event to_lcm_game_event(std::int64_t utime, std::int64_t seq, std::int8_t kind,
+                                                        int ball, double points, double ball_time_s) {
+  pinball_lcm::lcmt_pinball_game_event m{};
+  m.utime = utime;
+  m.seq = seq;
+  m.kind = kind;
+  m.ball = ball;
+  m.points = points;
+  m.ball_time_s = ball_time_s;
+  return m;
+}
+
+pinball_lcm::lcmt_pinball_daemon_stats to_lcm_daemon_stats(std::int64_t utime, std::int64_t seq,
+                                                            std::span<const StageLatency> stages,
+                                                            const DaemonStatsCounts& counts) {
+  pinball_lcm::lcmt_pinball_daemon_stats m;
+  m.utime = utime;
+  m.seq = seq;
+  m.num_stages = static_cast<std::int32_t>(stages.size());
+  for (const StageLatency& s : stages) {
+    m.stage.emplace_back(s.name);
+    m.count.push_back(static_cast<std::int64_t>(s.count));
+    m.p50_us.push_back(s.p50_us);
+    m.p99_us.push_back(s.p99_us);
+    m.max_us.push_back(s.max_us);
+  }
+  m.frames = static_cast<std::int64_t>(counts.frames);
+  m.frames_dropped = static_cast<std::int64_t>(counts.frames_dropped);
+  m.detections = static_cast<std::int64_t>(counts.detections);
+  m.projections = static_cast<std::int64_t>(counts.projections);
+  m.commands = static_cast<std::int64_t>(counts.commands);
+  m.camera_stalls = static_cast<std::int64_t>(counts.camera_stalls);
+  m.malformed_messages = static_cast<std::int64_t>(counts.malformed_messages);
+  m.ring_overflows = static_cast<std::int64_t>(counts.ring_overflows);
+  return m;
+}
+
 bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& found, track::Observation& out,
                           track::ContactSensors& contacts) {
   if (m.utime < 0 || m.seq < 0) return false;
@@ -90,7 +140,9 @@ bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& 
 }
 
 bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m) {
-  return m.utime >= 0 && m.flipper >= -1 && m.flipper <= 1 && m.cause >= 0 && m.cause <= 5;
+  using M = pinball_lcm::lcmt_pinball_flipper_command;
+  return m.utime >= 0 && m.flipper >= -1 && m.flipper <= 1 && m.cause >= M::CAUSE_PROJECTION &&
+         m.cause <= M::CAUSE_BUS_FAULT;
 }
 
 }  // namespace pinball::bus

@@ -41,6 +41,20 @@ const char* stage_name(int stage) {
 
 namespace {
 
+// The messages carry the codes of the enums as constants: one spelling, checked here.
+using FlipperCommandMessage = pinball_lcm::lcmt_pinball_flipper_command;
+static_assert(static_cast<int>(CommandCause::kProjection) == FlipperCommandMessage::CAUSE_PROJECTION);
+static_assert(static_cast<int>(CommandCause::kLaunch) == FlipperCommandMessage::CAUSE_LAUNCH);
+static_assert(static_cast<int>(CommandCause::kBallLost) == FlipperCommandMessage::CAUSE_BALL_LOST);
+static_assert(static_cast<int>(CommandCause::kCameraStall) == FlipperCommandMessage::CAUSE_CAMERA_STALL);
+static_assert(static_cast<int>(CommandCause::kShutdown) == FlipperCommandMessage::CAUSE_SHUTDOWN);
+static_assert(static_cast<int>(CommandCause::kBusFault) == FlipperCommandMessage::CAUSE_BUS_FAULT);
+using GameEventMessage = pinball_lcm::lcmt_pinball_game_event;
+static_assert(simlab::GameEvent::kLaunch == GameEventMessage::KIND_LAUNCH);
+static_assert(simlab::GameEvent::kBallLost == GameEventMessage::KIND_BALL_LOST);
+static_assert(simlab::GameEvent::kScore == GameEventMessage::KIND_SCORE);
+static_assert(simlab::GameEvent::kBallCut == GameEventMessage::KIND_BALL_CUT);
+
 // A frame and what was read with it, handed from the frame producer to the camera thread.
 struct FrameSlot {
   vision::Frame frame;
@@ -281,14 +295,8 @@ void Daemon::Impl::sim_thread() {
   std::uint64_t pushed = 0;
   std::uint64_t seq = 0;
   auto on_event = [&](const simlab::GameEvent& e) {
-    pinball_lcm::lcmt_pinball_game_event m{};
-    m.utime = to_utime(e.t_s);
-    m.seq = static_cast<std::int64_t>(seq++);
-    m.kind = e.kind;
-    m.ball = e.ball;
-    m.points = e.points;
-    m.ball_time_s = e.ball_time_s;
-    lcm->try_publish(m);
+    lcm->try_publish(bus::to_lcm_game_event(to_utime(e.t_s), static_cast<std::int64_t>(seq++), e.kind, e.ball,
+                                            e.points, e.ball_time_s));
   };
   wall_offset_s = steady_now_s() - world->time_s();
   while (!stop.load(std::memory_order_acquire)) {
@@ -400,14 +408,8 @@ void Daemon::Impl::publish_commands(const ControllerStage::Commands& cmds, int n
   for (int i = 0; i < n; ++i) {
     const CommandRecord& c = cmds[static_cast<std::size_t>(i)];
     if (!commands.try_push(c)) ring_overflows.fetch_add(1, std::memory_order_relaxed);
-    pinball_lcm::lcmt_pinball_flipper_command m{};
-    m.utime = to_utime(c.t_s);
-    m.seq = static_cast<std::int64_t>(c.seq);
-    m.projection_seq = c.projection_seq;
-    m.flipper = static_cast<std::int8_t>(c.flipper);
-    m.energize = c.energize;
-    m.cause = static_cast<std::int8_t>(c.cause);
-    lcm->try_publish(m);
+    lcm->try_publish(bus::to_lcm_flipper_command(to_utime(c.t_s), static_cast<std::int64_t>(c.seq), c.projection_seq,
+                                                 c.flipper, c.energize, static_cast<std::int8_t>(c.cause)));
   }
 }
 
@@ -555,26 +557,22 @@ DaemonReport Daemon::Impl::report() const {
 
 void Daemon::Impl::publish_stats(lcm::LCM& l) {
   const DaemonReport r = report();
-  pinball_lcm::lcmt_pinball_daemon_stats m;
-  m.utime = to_utime(steady_now_s());
-  m.seq = stats_seq++;
-  m.num_stages = kStageCount;
+  std::array<bus::StageLatency, kStageCount> stages;
   for (int s = 0; s < kStageCount; ++s) {
     const LatencySummary& x = r.latency[static_cast<std::size_t>(s)];
-    m.stage.push_back(stage_name(s));
-    m.count.push_back(static_cast<std::int64_t>(x.count));
-    m.p50_us.push_back(x.p50_us);
-    m.p99_us.push_back(x.p99_us);
-    m.max_us.push_back(x.max_us);
+    stages[static_cast<std::size_t>(s)] = {stage_name(s), x.count, x.p50_us, x.p99_us, x.max_us};
   }
-  m.frames = static_cast<std::int64_t>(r.frames);
-  m.frames_dropped = static_cast<std::int64_t>(r.frames_dropped);
-  m.detections = static_cast<std::int64_t>(r.detections);
-  m.projections = static_cast<std::int64_t>(r.projections);
-  m.commands = static_cast<std::int64_t>(r.commands);
-  m.camera_stalls = static_cast<std::int64_t>(r.camera_stalls);
-  m.malformed_messages = static_cast<std::int64_t>(r.lcm.malformed);
-  m.ring_overflows = static_cast<std::int64_t>(r.ring_overflows + r.lcm.overflows);
+  bus::DaemonStatsCounts counts;
+  counts.frames = r.frames;
+  counts.frames_dropped = r.frames_dropped;
+  counts.detections = r.detections;
+  counts.projections = r.projections;
+  counts.commands = r.commands;
+  counts.camera_stalls = r.camera_stalls;
+  counts.malformed_messages = r.lcm.malformed;
+  counts.ring_overflows = r.ring_overflows + r.lcm.overflows;
+  const pinball_lcm::lcmt_pinball_daemon_stats m =
+      bus::to_lcm_daemon_stats(to_utime(steady_now_s()), stats_seq++, stages, counts);
   l.publish(bus::kStatsChannel, &m);
 }
 

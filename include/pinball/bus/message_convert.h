@@ -5,9 +5,12 @@
 // an out-of-range code; such a message is malformed).
 
 #include <cstdint>
+#include <span>
 
+#include "pinball_lcm/lcmt_pinball_daemon_stats.hpp"
 #include "pinball_lcm/lcmt_pinball_driver_status.hpp"
 #include "pinball_lcm/lcmt_pinball_flipper_command.hpp"
+#include "pinball_lcm/lcmt_pinball_game_event.hpp"
 #include "pinball_lcm/lcmt_pinball_observation.hpp"
 #include "pinball_lcm/lcmt_pinball_projection.hpp"
 #include "pinball/firmware/driver_bus.h"
@@ -32,6 +35,35 @@ pinball_lcm::lcmt_pinball_driver_status to_lcm_driver_status(std::int64_t utime,
                                                               firmware::BusState state,
                                                               const firmware::BoardView& board,
                                                               const firmware::DriverBusCounters& counters);
+
+/// A flipper command message; `cause` is one of the message's CAUSE_ codes.
+pinball_lcm::lcmt_pinball_flipper_command to_lcm_flipper_command(std::int64_t utime, std::int64_t seq,
+                                                                  std::int64_t projection_seq, int flipper,
+                                                                  bool energize, std::int8_t cause);
+
+/// A game event message; `kind` is one of the message's KIND_ codes.
+pinball_lcm::lcmt_pinball_game_event to_lcm_game_event(std::int64_t utime, std::int64_t seq, std::int8_t kind,
+                                                        int ball, double points, double ball_time_s);
+
+/// One stage of the latency table, as PINBALL_STATS carries it.
+struct StageLatency {
+  const char* name = "";  ///< e.g. "capture->detection"
+  std::uint64_t count = 0;
+  double p50_us = 0.0;
+  double p99_us = 0.0;
+  double max_us = 0.0;
+};
+
+/// The counters PINBALL_STATS carries beside the latencies.
+struct DaemonStatsCounts {
+  std::uint64_t frames = 0, frames_dropped = 0, detections = 0, projections = 0, commands = 0, camera_stalls = 0,
+                malformed_messages = 0, ring_overflows = 0;
+};
+
+/// A daemon statistics message.
+pinball_lcm::lcmt_pinball_daemon_stats to_lcm_daemon_stats(std::int64_t utime, std::int64_t seq,
+                                                            std::span<const StageLatency> stages,
+                                                            const DaemonStatsCounts& counts);
 
 /// The observation inside a message; false when the message is malformed
 /// (non-finite or out-of-range fields, a found ball without a position).
