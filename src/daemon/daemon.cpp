@@ -18,7 +18,6 @@
 #include "pinball/core/running_stats.h"
 #include "pinball/core/clock.h"
 #include "pinball/daemon/doorbell.h"
-#include "pinball/daemon/hot_path.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/daemon/thread_table.h"
 #include "pinball/firmware/frame_log.h"
@@ -29,6 +28,12 @@
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/vision/capture_source.h"
 #include "pinball/simlab/sim_camera_source.h"
+
+#include "camera_worker.h"
+#include "controller_worker.h"
+#include "driver_worker.h"
+#include "handoffs.h"
+#include "sim_worker.h"
 
 namespace pinball::daemon {
 
@@ -54,16 +59,6 @@ static_assert(simlab::GameEvent::kLaunch == GameEventMessage::KIND_LAUNCH);
 static_assert(simlab::GameEvent::kBallLost == GameEventMessage::KIND_BALL_LOST);
 static_assert(simlab::GameEvent::kScore == GameEventMessage::KIND_SCORE);
 static_assert(simlab::GameEvent::kBallCut == GameEventMessage::KIND_BALL_CUT);
-
-// A frame and what was read with it, handed from the frame producer to the camera thread.
-struct FrameSlot {
-  vision::Frame frame;
-  track::ContactSensors contacts;
-  double capture_wall_s = 0.0;
-};
-
-constexpr std::size_t kFrameQueue = 4;              // frames waiting for the camera thread
-constexpr std::size_t kFramePool = kFrameQueue + 2; // + one being processed + one being written
 
 firmware::DriverBusOptions bus_options(const DaemonConfig& c, int drivers) {
   firmware::DriverBusOptions o;
@@ -104,39 +99,20 @@ struct Daemon::Impl {
   // LCM.
   std::unique_ptr<bus::LcmBus> lcm;
   bus::ObservationRing lcm_observations;
-  // Hand-offs.
-  std::array<FrameSlot, kFramePool> pool;
-  SpscRing<int, kFrameQueue> frames;
-  SpscRing<ProjectionRecord, 64> records;
-  SpscRing<CommandRecord, 64> commands;
-  Doorbell camera_bell, controller_bell, driver_bell, sim_bell, main_bell;
-  std::atomic<bool> stop{false};
+  // What the threads share (handoffs.h), the pipeline's clock, and one worker per thread.
+  Handoffs h;
+  std::unique_ptr<PipelineClock> clock;
+  std::unique_ptr<SimWorker> sim_worker;
+  std::unique_ptr<CameraWorker> camera_worker;
+  std::unique_ptr<ControllerWorker> controller_worker;
+  std::unique_ptr<DriverWorker> driver_worker;
   std::atomic<bool> stats_requested{false};
-  std::atomic<bool> producer_done{false};
-  std::atomic<bool> camera_done{false};
-  std::atomic<bool> controller_done{false};
-  std::atomic<std::uint64_t> frames_pushed{0};
-  std::atomic<std::uint64_t> records_done{0};   // records the controller finished
-  std::atomic<std::uint64_t> driver_done{0};    // records whose commands the driver sent
-  std::atomic<double> virtual_now_s{0.0};       // lockstep: exposure time of the latest record
-  std::atomic<std::uint64_t> frames_dropped{0};
-  std::atomic<std::uint64_t> ring_overflows{0};
-  std::atomic<double> sim_time_s{0.0};
-  std::array<std::atomic<double>, firmware::kMaxDrivers> can_written_wall_s{};
-  double wall_offset_s = 0.0;                   // sim realtime: wall = sim + offset
-  std::array<LatencyHistogram, kStageCount> latency;
   mutable std::mutex warnings_mutex;
   std::vector<std::string> warnings;
   double start_wall_s = 0.0;
   bool coils_off_at_exit = true;
-  std::uint64_t last_coil_on_count = 0;
   std::int64_t stats_seq = 0;  // PINBALL_STATS sequence (the LCM thread only)
 
-  double pipeline_now_s() const {
-    if (!sim_mode) return steady_now_s();
-    if (lockstep) return virtual_now_s.load(std::memory_order_acquire);
-    return steady_now_s() - wall_offset_s;
-  }
 
   // Names the calling thread and applies its scheduling and CPUs; a refusal becomes a warning.
   void enter_thread(ThreadId id) {
@@ -156,12 +132,7 @@ struct Daemon::Impl {
   void build();
   void learn_background();
   void warm_up_bus();
-  void sim_thread();
-  void camera_thread();
-  void controller_thread();
-  void driver_thread();
-  void send_now(ControllerStage::Commands& cmds, int n, double now_s);
-  void publish_commands(const ControllerStage::Commands& cmds, int n);
+  void make_workers();
   void publish_stats(lcm::LCM& lcm);
   void shutdown();
   DaemonReport report() const;
@@ -255,7 +226,8 @@ void Daemon::Impl::build() {
 
   lcm = std::make_unique<bus::LcmBus>(config.lcm_url);
   if (config.camera.source == "lcm") lcm->subscribe_observations(lcm_observations);
-  for (auto& slot : pool) slot.frame.gray.create(frame_size, CV_8UC1);
+  clock = std::make_unique<PipelineClock>(h, sim_mode, lockstep);
+  for (auto& slot : h.pool) slot.frame.gray.create(frame_size, CV_8UC1);
 }
 
 void Daemon::Impl::learn_background() {
@@ -290,215 +262,23 @@ void Daemon::Impl::warm_up_bus() {
   throw std::runtime_error("can: the driver board did not answer within 2 s (" + config.can.interface + ")");
 }
 
-void Daemon::Impl::sim_thread() {
-  enter_thread(kSimThread);
-  std::uint64_t pushed = 0;
-  std::uint64_t seq = 0;
-  auto on_event = [&](const simlab::GameEvent& e) {
-    lcm->try_publish(bus::to_lcm_game_event(to_utime(e.t_s), static_cast<std::int64_t>(seq++), e.kind, e.ball,
-                                            e.points, e.ball_time_s));
-  };
-  wall_offset_s = steady_now_s() - world->time_s();
-  while (!stop.load(std::memory_order_acquire)) {
-    FrameSlot& slot = pool[pushed % kFramePool];
-    if (!world->next_frame(slot.frame, slot.contacts, on_event)) break;
-    sim_time_s.store(world->time_s(), std::memory_order_relaxed);
-    // Coil-on stamps of the virtual board close the latency chain.
-    if (world->coil_on_count() != last_coil_on_count) {
-      last_coil_on_count = world->coil_on_count();
-      for (int d = 0; d < static_cast<int>(board.flippers.size()); ++d) {
-        const double written = can_written_wall_s[static_cast<std::size_t>(d)].exchange(0.0);
-        if (written > 0.0) latency[kCanToCoil].record((world->coil_on_wall_s(d) - written) * 1e6);
-      }
-    }
-    if (!lockstep) {
-      // Pace to the wall clock.
-      const double wait_s = slot.frame.t_s + wall_offset_s - steady_now_s();
-      if (wait_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
-    }
-    slot.capture_wall_s = steady_now_s();
-    if (!frames.try_push(static_cast<int>(pushed % kFramePool))) {
-      frames_dropped.fetch_add(1, std::memory_order_relaxed);  // the camera thread is behind: this frame is lost
-      continue;
-    }
-    ++pushed;
-    frames_pushed.store(pushed, std::memory_order_release);
-    camera_bell.ring();
-    if (lockstep) {
-      while (driver_done.load(std::memory_order_acquire) < pushed && !stop.load(std::memory_order_acquire)) {
-        sim_bell.wait(0.1);
-      }
-    }
-  }
-  producer_done.store(true, std::memory_order_release);
-  camera_bell.ring();
-}
-
-void Daemon::Impl::camera_thread() {
-  enter_thread(kCameraThread);
-  ProjectionRecord record;
-  FrameSlot lab_slot;
-  const bool from_lcm = config.camera.source == "lcm";
-  while (!stop.load(std::memory_order_acquire)) {
-    const FrameSlot* slot = nullptr;
-    pinball_lcm::lcmt_pinball_observation incoming;
-    int index = -1;
-    if (world) {
-      if (!frames.try_pop(index)) {
-        if (producer_done.load(std::memory_order_acquire) && frames.empty()) break;
-        camera_bell.wait(0.05);
-        continue;
-      }
-      slot = &pool[static_cast<std::size_t>(index)];
-    } else if (from_lcm) {
-      if (!lcm_observations.try_pop(incoming)) {
-        std::this_thread::sleep_for(std::chrono::microseconds(200));
-        continue;
-      }
-    } else {
-      if (!capture->read(lab_slot.frame)) {  // the camera's own blocking grab
-        if (!vision::is_device_source(config.camera.device)) break;  // end of the video file
-        continue;
-      }
-      lab_slot.capture_wall_s = steady_now_s();
-      slot = &lab_slot;
-    }
-    {
-      HotPathScope hot;
-      if (slot != nullptr) {
-        camera_stage->process(slot->frame, slot->contacts, slot->capture_wall_s, record);
-      } else {
-        bool found = false;
-        track::Observation o;
-        track::ContactSensors c;
-        bus::from_lcm_observation(incoming, found, o, c);
-        const double now = steady_now_s();
-        camera_stage->track(found, o, o.t_s, c, now, record);
-        record.detected_wall_s = now;
-      }
-      record.projected_wall_s = steady_now_s();
-      if (slot != nullptr) {
-        latency[kCaptureToDetection].record((record.detected_wall_s - record.capture_wall_s) * 1e6);
-      }
-      latency[kDetectionToProjection].record((record.projected_wall_s - record.detected_wall_s) * 1e6);
-      if (!records.try_push(record)) ring_overflows.fetch_add(1, std::memory_order_relaxed);
-      controller_bell.ring();
-      const std::int64_t utime = to_utime(record.t_s);
-      if (!from_lcm) {
-        lcm->try_publish(bus::to_lcm_observation(utime, static_cast<std::int64_t>(record.frame_seq), record.found,
-                                                 record.observation, record.u_px, record.v_px, record.contacts));
-      }
-      lcm->try_publish(bus::to_lcm_projection(utime, static_cast<std::int64_t>(record.seq),
-                                              static_cast<std::int64_t>(record.frame_seq), record.output));
-    }
-  }
-  camera_done.store(true, std::memory_order_release);
-  controller_bell.ring();
-}
-
-// Writes the commands' CAN frames on the controller thread, saving the wake-up
-// of the driver thread; when the driver thread is busy sending, it takes them.
-void Daemon::Impl::send_now(ControllerStage::Commands& cmds, int n, double now_s) {
-  if (n == 0 || !bus->send_queued(now_s)) return;
-  const double written = steady_now_s();
-  for (int i = 0; i < n; ++i) cmds[static_cast<std::size_t>(i)].written_wall_s = written;
-}
-
-void Daemon::Impl::publish_commands(const ControllerStage::Commands& cmds, int n) {
-  for (int i = 0; i < n; ++i) {
-    const CommandRecord& c = cmds[static_cast<std::size_t>(i)];
-    if (!commands.try_push(c)) ring_overflows.fetch_add(1, std::memory_order_relaxed);
-    lcm->try_publish(bus::to_lcm_flipper_command(to_utime(c.t_s), static_cast<std::int64_t>(c.seq), c.projection_seq,
-                                                 c.flipper, c.energize, static_cast<std::int8_t>(c.cause)));
-  }
-}
-
-void Daemon::Impl::controller_thread() {
-  enter_thread(kControllerThread);
-  ProjectionRecord record;
-  ControllerStage::Commands cmds;
-  const double frame_period_s = 1.0 / config.camera.fps;
-  while (!stop.load(std::memory_order_acquire)) {
-    if (records.try_pop(record)) {
-      HotPathScope hot;
-      if (lockstep) virtual_now_s.store(record.t_s, std::memory_order_release);
-      const double now = lockstep ? record.t_s : pipeline_now_s();
-      const int n = controller_stage->on_record(record, now, steady_now_s(), cmds);
-      send_now(cmds, n, now);
-      latency[kProjectionToDecision].record((steady_now_s() - record.projected_wall_s) * 1e6);
-      publish_commands(cmds, n);
-      records_done.fetch_add(1, std::memory_order_acq_rel);
-      driver_bell.ring();
-      continue;
-    }
-    if (camera_done.load(std::memory_order_acquire) && records.empty()) break;
-    controller_bell.wait(frame_period_s);
-    if (!lockstep) {
-      HotPathScope hot;
-      const double now = pipeline_now_s();
-      const int n = controller_stage->on_idle(now, steady_now_s(), cmds);
-      send_now(cmds, n, now);
-      if (n > 0) {
-        publish_commands(cmds, n);
-        driver_bell.ring();
-      }
-    }
-  }
-  controller_done.store(true, std::memory_order_release);
-  driver_bell.ring();
-}
-
-void Daemon::Impl::driver_thread() {
-  enter_thread(kDriverThread);
-  CommandRecord c;
-  double next_status_s = 0.0;
-  std::uint64_t status_seq = 0;
-  while (!stop.load(std::memory_order_acquire)) {
-    std::uint64_t done = 0;
-    if (lockstep) {
-      done = records_done.load(std::memory_order_acquire);
-      if (done == driver_done.load(std::memory_order_relaxed)) {
-        if (controller_done.load(std::memory_order_acquire)) break;
-        driver_bell.wait(0.05);
-        continue;
-      }
-    } else {
-      driver_bell.wait(0.001);
-      if (controller_done.load(std::memory_order_acquire) && commands.empty()) break;
-    }
-    const double now = pipeline_now_s();
-    bus->poll_once(now);
-    const double polled = steady_now_s();
-    while (commands.try_pop(c)) {
-      const double written = c.written_wall_s > 0.0 ? c.written_wall_s : polled;  // > 0: sent by the controller thread
-      latency[kCommandToCan].record((written - c.command_wall_s) * 1e6);
-      if (c.capture_wall_s > 0.0) latency[kFrameToCan].record((written - c.capture_wall_s) * 1e6);
-      if (c.energize && c.flipper >= 0) {
-        can_written_wall_s[static_cast<std::size_t>(driver_of_flipper[static_cast<std::size_t>(c.flipper)])].store(
-            written);
-      }
-    }
-    if (now >= next_status_s) {
-      next_status_s = now + 0.1;
-      lcm->try_publish(bus::to_lcm_driver_status(to_utime(now), static_cast<std::int64_t>(status_seq++),
-                                                 bus->state(), bus->board(), bus->counters()));
-    }
-    if (lockstep) {
-      driver_done.store(done, std::memory_order_release);
-      sim_bell.ring();
-    }
-  }
-  if (lockstep) {
-    driver_done.store(~std::uint64_t{0}, std::memory_order_release);
-    sim_bell.ring();
-  }
+// One worker per thread, each borrowing only what its thread uses.
+void Daemon::Impl::make_workers() {
+  const CameraInput input = world ? CameraInput::kSimulator
+                                  : config.camera.source == "lcm" ? CameraInput::kLcm : CameraInput::kCapture;
+  if (world) sim_worker = std::make_unique<SimWorker>(h, *world, *lcm, lockstep, static_cast<int>(board.flippers.size()));
+  camera_worker = std::make_unique<CameraWorker>(h, *camera_stage, *lcm, input, capture.get(),
+                                                 vision::is_device_source(config.camera.device), lcm_observations);
+  controller_worker =
+      std::make_unique<ControllerWorker>(h, *controller_stage, *bus, *lcm, *clock, 1.0 / config.camera.fps);
+  driver_worker = std::make_unique<DriverWorker>(h, *bus, *lcm, *clock, driver_of_flipper);
 }
 
 void Daemon::Impl::shutdown() {
   // Every coil off first, then no more heartbeats: the board's watchdog
   // stays as the second line of defence.
   ControllerStage::Commands cmds;
-  controller_stage->release_all(CommandCause::kShutdown, pipeline_now_s(), steady_now_s(), cmds);
+  controller_stage->release_all(CommandCause::kShutdown, clock->now_s(), steady_now_s(), cmds);
   if (world) {
     const double t = world->time_s();
     bus->poll_once(t);
@@ -513,7 +293,7 @@ DaemonReport Daemon::Impl::report() const {
   DaemonReport r;
   r.mode = config.mode;
   r.lockstep = lockstep;
-  for (int s = 0; s < kStageCount; ++s) r.latency[static_cast<std::size_t>(s)] = latency[static_cast<std::size_t>(s)].summary();
+  for (int s = 0; s < kStageCount; ++s) r.latency[static_cast<std::size_t>(s)] = h.latency[static_cast<std::size_t>(s)].summary();
   const CameraStageCounters& cc = camera_stage->counters();
   const ControllerStageCounters& kc = controller_stage->counters();
   r.frames = cc.frames;
@@ -524,12 +304,12 @@ DaemonReport Daemon::Impl::report() const {
   r.ball_lost_releases = kc.ball_lost;
   r.bus_fault_releases = kc.bus_faults;
   r.fires_deferred = kc.deferred;
-  r.frames_dropped = frames_dropped.load() + (capture ? capture->counters().dropped : 0);
-  r.ring_overflows = ring_overflows.load();
+  r.frames_dropped = h.frames_dropped.load() + (capture ? capture->counters().dropped : 0);
+  r.ring_overflows = h.ring_overflows.load();
   r.lcm = lcm->counters();
   r.driver = bus->counters();
   r.wall_s = steady_now_s() - start_wall_s;
-  r.sim_s = sim_time_s.load();
+  r.sim_s = h.sim_time_s.load();
   {
     const std::lock_guard<std::mutex> lock(warnings_mutex);
     r.warnings = warnings;
@@ -627,17 +407,32 @@ DaemonReport Daemon::run() {
   d.learn_background();
   d.warm_up_bus();
   d.lcm->start([&d](lcm::LCM& l) { d.publish_stats(l); }, 1.0, [&d] { d.enter_thread(kLcmThread); });
-  std::thread driver([&d] { d.driver_thread(); });
-  std::thread controller([&d] { d.controller_thread(); });
-  std::thread camera([&d] { d.camera_thread(); });
+  d.make_workers();
+  std::thread driver([&d] {
+    d.enter_thread(kDriverThread);
+    d.driver_worker->run();
+  });
+  std::thread controller([&d] {
+    d.enter_thread(kControllerThread);
+    d.controller_worker->run();
+  });
+  std::thread camera([&d] {
+    d.enter_thread(kCameraThread);
+    d.camera_worker->run();
+  });
   std::thread world;
-  if (d.world) world = std::thread([&d] { d.sim_thread(); });
-  while (!d.stop.load(std::memory_order_acquire) && !d.controller_done.load(std::memory_order_acquire)) {
-    d.main_bell.wait(0.1);
+  if (d.sim_worker) {
+    world = std::thread([&d] {
+      d.enter_thread(kSimThread);
+      d.sim_worker->run();
+    });
+  }
+  while (!d.h.stop.load(std::memory_order_acquire) && !d.h.controller_done.load(std::memory_order_acquire)) {
+    d.h.main_bell.wait(0.1);
     if (d.stats_requested.exchange(false)) std::fputs(report_to_text(d.report()).c_str(), stderr);
   }
-  d.stop.store(true, std::memory_order_release);
-  for (Doorbell* b : {&d.camera_bell, &d.controller_bell, &d.driver_bell, &d.sim_bell}) b->ring();
+  d.h.stop.store(true, std::memory_order_release);
+  for (Doorbell* b : {&d.h.camera_bell, &d.h.controller_bell, &d.h.driver_bell, &d.h.sim_bell}) b->ring();
   if (world.joinable()) world.join();
   camera.join();
   controller.join();
@@ -649,13 +444,13 @@ DaemonReport Daemon::run() {
 }
 
 void Daemon::request_stop() {
-  impl_->stop.store(true, std::memory_order_release);
-  impl_->main_bell.ring();
+  impl_->h.stop.store(true, std::memory_order_release);
+  impl_->h.main_bell.ring();
 }
 
 void Daemon::request_stats() {
   impl_->stats_requested.store(true, std::memory_order_release);
-  impl_->main_bell.ring();
+  impl_->h.main_bell.ring();
 }
 
 DaemonReport Daemon::snapshot() const { return impl_->report(); }
