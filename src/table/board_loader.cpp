@@ -2,8 +2,8 @@
 
 // The loader in three layers: a tokenizer that turns text into statements, a
 // Reader that reads one statement's fields and phrases every error, and one
-// Loader method per statement kind. Whole-file checks run last, so a Board is
-// returned only when the entire file is valid (docs/board-format.md).
+// function per statement kind over a LoadState. Whole-file checks run last, so a
+// Board is returned only when the entire file is valid (docs/board-format.md).
 
 #include <algorithm>
 #include <cerrno>
@@ -198,402 +198,401 @@ class Reader {
   std::vector<Attribute> attributes_;
 };
 
-class Loader {
- public:
-  Loader(std::string_view text, const std::string& file) : text_(text), file_(file) { board_.source = file; }
+/// What the statements of one file build up: the board so far and the settings
+/// that later statements and the whole-file checks read.
+struct LoadState {
+  explicit LoadState(const std::string& file_name) : file(file_name) { board.source = file_name; }
 
-  Board run() {
-    for (const Statement& st : tokenize(text_)) statement(st);
-    check_whole_file();
-    return std::move(board_);
-  }
-
- private:
-  using Handler = void (Loader::*)(const Reader&);
-  struct Kind {
-    std::string_view keyword;
-    Handler handler;
-    bool singleton;      // at most once
-    bool dimensioned;    // uses a length or an angle: units/angles must come first
-    std::string_view attributes;
-  };
-
-  static constexpr std::string_view kRequired[] = {"pinball-board", "size",  "ball",    "gravity",
-                                                   "dt",            "balls", "launcher"};
-
-  static const Kind* find_kind(std::string_view keyword) {
-    static constexpr std::string_view kObstacleTwoSided = "rho score kick contact eat hidden bank name two-sided";
-    static const Kind kKinds[] = {
-        {"pinball-board", &Loader::header, true, false, ""},
-        {"units", &Loader::units, true, false, ""},
-        {"angles", &Loader::angles, true, false, ""},
-        {"size", &Loader::size, true, true, ""},
-        {"ball", &Loader::ball, true, true, ""},
-        {"gravity", &Loader::gravity, true, true, ""},
-        {"dt", &Loader::dt, true, false, ""},
-        {"balls", &Loader::balls, true, false, ""},
-        {"launcher", &Loader::launcher, true, true, "pull noise"},
-        {"defaults", &Loader::defaults, false, false, "rho"},
-        {"bank", &Loader::bank, false, false, "bonus"},
-        {"line", &Loader::line, false, true, kObstacleAttributes},
-        {"wall", &Loader::wall, false, true, kObstacleAttributes},
-        {"point", &Loader::point, false, true, kObstacleAttributes},
-        {"circle", &Loader::circle, false, true, kObstacleAttributes},
-        {"polyline", &Loader::polyline, false, true, kObstacleTwoSided},
-        {"polygon", &Loader::polygon, false, true, kObstacleAttributes},
-        {"flipper", &Loader::flipper, false, true, "rho mu name"},
-        {"sensor", &Loader::sensor, false, true, "score eat name"},
-        {"hole", &Loader::hole, false, true, "score eat kickout name"},
-    };
-    for (const Kind& k : kKinds) {
-      if (k.keyword == keyword) return &k;
-    }
-    return nullptr;
-  }
-
-  void statement(const Statement& st) {
-    const std::string keyword(st.tokens[0]);
-    const Kind* kind = find_kind(keyword);
-    if (kind == nullptr) throw BoardError(file_, st.line, "unknown keyword '" + keyword + "'");
-    if (seen_.empty() && keyword != "pinball-board") {
-      throw BoardError(file_, st.line, "expected 'pinball-board 1' as the first statement, got '" + keyword + "'");
-    }
-    if (kind->singleton) {
-      const auto [it, inserted] = seen_.emplace(keyword, st.line);
-      if (!inserted) {
-        throw BoardError(file_, st.line,
-                         "duplicate '" + keyword + "' statement (first at line " + std::to_string(it->second) + ")");
-      }
-    }
-    if (kind->dimensioned && first_dimensioned_line_ == 0) first_dimensioned_line_ = st.line;
-    const Reader r(st, file_, kind->attributes);
-    (this->*kind->handler)(r);
-  }
-
-  // ---- header and constants ----
-
-  void header(const Reader& r) {
-    const double version = r.numbers(0, {"VERSION"})[0];
-    if (version != 1.0) r.fail("unsupported format version " + fmt(version) + " (this loader reads version 1)");
-  }
-
-  /// units/angles: a single word, before any length or angle.
-  std::string_view unit_word(const Reader& r, std::string_view a, std::string_view b) {
-    std::string choices = "'";  // built piecewise: GCC 12 warns falsely on "literal" + std::string
-    choices.append(a).append("' or '").append(b).append("'");
-    if (r.arg_count() != 1) r.fail("expected one word, " + choices + ", got " + std::to_string(r.arg_count()));
-    if (r.arg(0) != a && r.arg(0) != b) r.fail("expected " + choices + ", got '" + std::string(r.arg(0)) + "'");
-    if (first_dimensioned_line_ != 0) {
-      r.fail("must come before the first statement that uses a length or angle (line " +
-             std::to_string(first_dimensioned_line_) + ")");
-    }
-    return r.arg(0);
-  }
-  void units(const Reader& r) { length_scale_ = unit_word(r, "m", "mm") == "mm" ? 1e-3 : 1.0; }
-  void angles(const Reader& r) { angle_scale_ = unit_word(r, "rad", "deg") == "deg" ? std::numbers::pi / 180.0 : 1.0; }
-
-  void size(const Reader& r) {
-    const auto v = r.numbers(0, {"W", "H"});
-    r.require(v[0] > 0, "field W (width)", "> 0", v[0]);
-    r.require(v[1] > 0, "field H (height)", "> 0", v[1]);
-    board_.width_m = v[0] * length_scale_;
-    board_.height_m = v[1] * length_scale_;
-  }
-
-  void ball(const Reader& r) {
-    const auto v = r.numbers(0, {"R", "SPEED_MAX"});
-    r.require(v[0] > 0, "field R (radius)", "> 0", v[0]);
-    r.require(v[1] > 0, "field SPEED_MAX", "> 0", v[1]);
-    board_.ball.radius_m = v[0] * length_scale_;
-    board_.ball.speed_max_mps = v[1] * length_scale_;
-  }
-
-  void gravity(const Reader& r) {
-    const double g = r.numbers(0, {"G"})[0];
-    r.require(g >= 0, "field G", ">= 0", g);
-    board_.gravity_mps2 = g * length_scale_;
-  }
-
-  void dt(const Reader& r) {
-    const double dt = r.numbers(0, {"DT"})[0];
-    r.require(dt > 0, "field DT (seconds)", "> 0", dt);
-    board_.dt_s = dt;
-  }
-
-  void balls(const Reader& r) {
-    const double n = r.numbers(0, {"N"})[0];
-    r.require(n >= 1 && n == std::floor(n), "field N (balls per game)", "an integer >= 1", n);
-    r.require(n <= 1e6, "field N (balls per game)", "at most 1000000", n);
-    board_.balls_per_game = static_cast<int>(n);
-  }
-
-  void launcher(const Reader& r) {
-    const auto v = r.numbers(0, {"X", "Y"});
-    Launcher& l = board_.launcher;
-    l.position = Vec2{v[0], v[1]} * length_scale_;
-    l.pull = r.attribute("pull", 1.0);
-    r.require(l.pull > 0 && l.pull <= 1, "attribute pull", "in (0, 1]", l.pull);
-    l.noise_max = r.attribute("noise", 0.03);
-    r.require(l.noise_max >= 0 && l.noise_max <= 0.5, "attribute noise", "in [0, 0.5]", l.noise_max);
-  }
-
-  void defaults(const Reader& r) {
-    if (r.arg_count() != 0) r.fail("takes only attributes (rho=R), got '" + std::string(r.arg(0)) + "'");
-    default_rho_ = r.attribute("rho", default_rho_);
-    r.require(default_rho_ >= 0, "attribute rho", ">= 0", default_rho_);
-  }
-
-  void bank(const Reader& r) {
-    if (r.arg_count() != 1) r.fail("expected one NAME, got " + std::to_string(r.arg_count()));
-    const std::string name(r.arg(0));
-    if (bank_index(name) >= 0) r.fail("bank '" + name + "' is declared twice");
-    if (!r.flag("bonus")) r.fail("needs bonus=POINTS");
-    board_.banks.push_back(Bank{name, r.attribute("bonus", 0.0), {}});
-    bank_lines_.push_back(r.line());
-  }
-
-  // ---- obstacles ----
-
-  int bank_index(std::string_view name) const {
-    for (std::size_t k = 0; k < board_.banks.size(); ++k) {
-      if (board_.banks[k].name == name) return static_cast<int>(k);
-    }
-    return -1;
-  }
-
-  /// The attributes every shape of one obstacle statement shares.
-  Obstacle obstacle_attributes(const Reader& r) const {
-    Obstacle o;
-    o.rho = r.attribute("rho", default_rho_);
-    r.require(o.rho >= 0, "attribute rho", ">= 0", o.rho);
-    o.action.score = r.attribute("score", 0.0);
-    const double kick = r.attribute("kick", 0.0);
-    r.require(kick >= 0, "attribute kick", ">= 0", kick);
-    o.action.kick_mps = kick * length_scale_;
-    o.action.contact_score_per_s = r.attribute("contact", 0.0);
-    o.action.eats_ball = r.flag("eat");
-    o.visible = !r.flag("hidden");
-    if (r.flag("bank")) {
-      const std::string_view bank = r.text("bank");
-      o.bank = bank_index(bank);
-      if (o.bank < 0) r.fail("attribute bank names an undeclared bank '" + std::string(bank) + "'");
-    }
-    o.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
-    o.source_line = r.line();
-    return o;
-  }
-
-  static std::string default_name(const Reader& r) {
-    return std::string(r.keyword()) + "@" + std::to_string(r.line());
-  }
-
-  void add(const Shape& shape, const Obstacle& o) {
-    if (o.bank >= 0) {
-      board_.banks[static_cast<std::size_t>(o.bank)].members.push_back(static_cast<int>(board_.obstacles.size()));
-    }
-    board_.shapes.push_back(shape);
-    board_.obstacles.push_back(o);
-  }
-
-  /// Two points, in file units, checked to differ; returned in metres.
-  std::pair<Vec2, Vec2> segment(const Reader& r, std::size_t first) const {
-    const auto v = r.numbers(first, {"X1", "Y1", "X2", "Y2"});
-    if (v[0] == v[2] && v[1] == v[3]) r.fail("zero-length segment");
-    return {Vec2{v[0], v[1]} * length_scale_, Vec2{v[2], v[3]} * length_scale_};
-  }
-
-  void line(const Reader& r) {
-    const auto [p0, p1] = segment(r, 0);
-    add(make_line_shape(p0, p1), obstacle_attributes(r));
-  }
-
-  void wall(const Reader& r) {
-    const auto [p0, p1] = segment(r, 0);
-    const Obstacle o = obstacle_attributes(r);
-    add(make_line_shape(p0, p1), o);
-    add(make_line_shape(p1, p0), o);
-    add(make_circle_shape(p0, 0.0), o);
-    add(make_circle_shape(p1, 0.0), o);
-  }
-
-  void point(const Reader& r) {
-    const auto v = r.numbers(0, {"X", "Y"});
-    add(make_circle_shape(Vec2{v[0], v[1]} * length_scale_, 0.0), obstacle_attributes(r));
-  }
-
-  void circle(const Reader& r) {
-    const auto v = r.numbers(0, {"X", "Y", "R"});
-    r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
-    add(make_circle_shape(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_), obstacle_attributes(r));
-  }
-
-  /// Vertices in file units, checked for zero-length edges (closed: also last -> first).
-  std::vector<Vec2> path(const Reader& r, std::size_t min_count, bool closed) const {
-    const std::vector<Vec2> v = r.vertices(0, min_count);
-    const std::size_t edges = closed ? v.size() : v.size() - 1;
-    for (std::size_t i = 0; i < edges; ++i) {
-      const std::size_t j = (i + 1) % v.size();
-      if (v[i] == v[j]) {
-        r.fail("zero-length segment (vertices " + std::to_string(i + 1) + " and " + std::to_string(j + 1) + ")");
-      }
-    }
-    return v;
-  }
-
-  void polyline(const Reader& r) {
-    const std::vector<Vec2> v = path(r, 2, false);
-    const Obstacle o = obstacle_attributes(r);
-    const bool two_sided = r.flag("two-sided");
-    for (std::size_t i = 0; i + 1 < v.size(); ++i) {
-      add(make_line_shape(v[i] * length_scale_, v[i + 1] * length_scale_), o);
-      if (two_sided) add(make_line_shape(v[i + 1] * length_scale_, v[i] * length_scale_), o);
-    }
-    for (const Vec2& p : v) add(make_circle_shape(p * length_scale_, 0.0), o);
-  }
-
-  void polygon(const Reader& r) {
-    std::vector<Vec2> v = path(r, 3, true);
-    double twice_area = 0.0;
-    for (std::size_t i = 0; i < v.size(); ++i) twice_area += cross(v[i], v[(i + 1) % v.size()]);
-    if (twice_area == 0.0) r.fail("the vertices enclose no area");
-    // Clockwise traversal puts each edge's left normal outside.
-    if (twice_area > 0.0) std::reverse(v.begin(), v.end());
-    const Obstacle o = obstacle_attributes(r);
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      add(make_line_shape(v[i] * length_scale_, v[(i + 1) % v.size()] * length_scale_), o);
-    }
-    for (const Vec2& p : v) add(make_circle_shape(p * length_scale_, 0.0), o);
-  }
-
-  // ---- flippers and sensors ----
-
-  void flipper(const Reader& r) {
-    Flipper f;
-    const std::string_view side = r.arg_count() > 0 ? r.arg(0) : std::string_view{};
-    if (side != "left" && side != "right") {
-      r.fail("field SIDE must be 'left' or 'right', got '" + std::string(side) + "'");
-    }
-    f.side = side == "left" ? Side::kLeft : Side::kRight;
-    const auto v = r.numbers(1, {"PX", "PY", "LENGTH", "THETA_MIN", "THETA_MAX", "OMEGA"});
-    r.require(v[2] > 0, "field LENGTH", "> 0", v[2]);
-    if (!(v[3] < v[4])) r.fail("field THETA_MIN (" + fmt(v[3]) + ") must be less than THETA_MAX (" + fmt(v[4]) + ")");
-    r.require(v[5] > 0, "field OMEGA", "> 0", v[5]);
-    f.pivot = Vec2{v[0], v[1]} * length_scale_;
-    f.length_m = v[2] * length_scale_;
-    f.theta_min_rad = v[3] * angle_scale_;
-    f.theta_max_rad = v[4] * angle_scale_;
-    f.omega_rad_s = v[5] * angle_scale_;
-    f.rho = r.attribute("rho", default_rho_);
-    r.require(f.rho >= 0, "attribute rho", ">= 0", f.rho);
-    f.mu = r.attribute("mu", 1.0);
-    r.require(f.mu >= 0, "attribute mu", ">= 0", f.mu);
-    f.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
-    f.source_line = r.line();
-    board_.flippers.push_back(f);
-  }
-
-  void sensor(const Reader& r) {
-    Sensor s;
-    const std::string_view shape = r.arg_count() > 0 ? r.arg(0) : std::string_view{};
-    if (shape == "line") {
-      const auto [p0, p1] = segment(r, 1);
-      s.shape = make_line_shape(p0, p1);
-    } else if (shape == "circle") {
-      const auto v = r.numbers(1, {"X", "Y", "R"});
-      r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
-      s.shape = make_circle_shape(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_);
-    } else {
-      r.fail("field SHAPE must be 'line' or 'circle', got '" + std::string(shape) + "'");
-    }
-    s.kind = SensorKind::kProximity;
-    finish_sensor(r, s);
-  }
-
-  void hole(const Reader& r) {
-    Sensor s;
-    const auto v = r.numbers(0, {"X", "Y", "R"});
-    r.require(v[2] > 0, "field R (radius)", "> 0", v[2]);
-    s.kind = SensorKind::kHole;
-    s.shape = make_circle_shape(Vec2{v[0], v[1]} * length_scale_, v[2] * length_scale_);
-    const bool eat = r.flag("eat");
-    if (eat == r.flag("kickout")) r.fail("needs exactly one of 'eat' or 'kickout=VX,VY'");
-    if (!eat) {
-      const std::string_view k = r.text("kickout");
-      const std::size_t comma = k.find(',');
-      if (comma == std::string_view::npos) r.fail("attribute kickout must be VX,VY, got '" + std::string(k) + "'");
-      s.has_kickout = true;
-      s.kickout_mps = Vec2{r.number(k.substr(0, comma), "attribute kickout VX"),
-                           r.number(k.substr(comma + 1), "attribute kickout VY")} *
-                      length_scale_;
-    }
-    finish_sensor(r, s);
-  }
-
-  void finish_sensor(const Reader& r, Sensor& s) {
-    s.action.score = r.attribute("score", 0.0);
-    s.action.eats_ball = r.flag("eat");
-    s.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
-    s.source_line = r.line();
-    board_.sensors.push_back(s);
-  }
-
-  // ---- whole file ----
-
-  void check_whole_file() {
-    for (const std::string_view required : kRequired) {
-      if (!seen_.contains(std::string(required))) {
-        throw BoardError(file_, 0, "missing required '" + std::string(required) + "' statement");
-      }
-    }
-    for (std::size_t k = 0; k < board_.banks.size(); ++k) {
-      if (board_.banks[k].members.empty()) {
-        throw BoardError(file_, bank_lines_[k],
-                         "bank: bank '" + board_.banks[k].name + "' has no members (no obstacle says bank=" +
-                             board_.banks[k].name + ")");
-      }
-    }
-    for (const Flipper& f : board_.flippers) {
-      Board one;
-      one.ball = board_.ball;
-      one.flippers.push_back(f);
-      try {
-        check_flipper_time_step(one, board_.dt_s);
-      } catch (const std::invalid_argument& e) {
-        throw BoardError(file_, f.source_line, std::string("flipper: ") + e.what());
-      }
-    }
-    check_launcher_clear();
-  }
-
-  void check_launcher_clear() const {
-    const Vec2 p = board_.launcher.position;
-    const double r = board_.ball.radius_m;
-    const int line = seen_.at("launcher");
-    const auto overlap = [&](const std::string& what, double d) {
-      throw BoardError(file_, line,
-                       "launcher: ball at the launch position overlaps " + what + " (distance " + fmt(d) +
-                           " m, ball radius " + fmt(r) + " m)");
-    };
-    for (std::size_t i = 0; i < board_.shapes.size(); ++i) {
-      const double d = distance_to_shape(board_.shapes[i], p);
-      if (d < r) overlap("'" + board_.obstacles[i].name + "'", d);
-    }
-    for (const Flipper& f : board_.flippers) {
-      const double d = distance_point_segment(p, f.pivot, flipper_tip(f, f.theta_min_rad));
-      if (d < r) overlap("flipper '" + f.name + "' in its down position", d);
-    }
-  }
-
-  std::string_view text_;
-  const std::string& file_;
-  Board board_;
-  double length_scale_ = 1.0;       // file length unit -> m
-  double angle_scale_ = 1.0;        // file angle unit -> rad
-  double default_rho_ = 1.0;        // `defaults rho=`
-  int first_dimensioned_line_ = 0;  // first statement using a length or angle
-  std::map<std::string, int> seen_; // singleton keyword -> its line
-  std::vector<int> bank_lines_;     // same index as board_.banks
+  const std::string& file;          // source name for errors
+  Board board;                      // built up statement by statement
+  double length_scale = 1.0;        // file length unit -> m
+  double angle_scale = 1.0;         // file angle unit -> rad
+  double default_rho = 1.0;         // `defaults rho=`
+  int first_dimensioned_line = 0;   // first statement using a length or angle
+  std::map<std::string, int> seen;  // singleton keyword -> its line
+  std::vector<int> bank_lines;      // same index as board.banks
 };
+
+// ---- header and constants ----
+
+void header(LoadState&, const Reader& r) {
+  const double version = r.numbers(0, {"VERSION"})[0];
+  if (version != 1.0) r.fail("unsupported format version " + fmt(version) + " (this loader reads version 1)");
+}
+
+/// units/angles: a single word, before any length or angle.
+std::string_view unit_word(const LoadState& state, const Reader& r, std::string_view a, std::string_view b) {
+  std::string choices = "'";  // built piecewise: GCC 12 warns falsely on "literal" + std::string
+  choices.append(a).append("' or '").append(b).append("'");
+  if (r.arg_count() != 1) r.fail("expected one word, " + choices + ", got " + std::to_string(r.arg_count()));
+  if (r.arg(0) != a && r.arg(0) != b) r.fail("expected " + choices + ", got '" + std::string(r.arg(0)) + "'");
+  if (state.first_dimensioned_line != 0) {
+    r.fail("must come before the first statement that uses a length or angle (line " +
+           std::to_string(state.first_dimensioned_line) + ")");
+  }
+  return r.arg(0);
+}
+void units(LoadState& state, const Reader& r) {
+  state.length_scale = unit_word(state, r, "m", "mm") == "mm" ? 1e-3 : 1.0;
+}
+void angles(LoadState& state, const Reader& r) {
+  state.angle_scale = unit_word(state, r, "rad", "deg") == "deg" ? std::numbers::pi / 180.0 : 1.0;
+}
+
+void size(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"W", "H"});
+  r.require(v[0] > 0, "field W (width)", "> 0", v[0]);
+  r.require(v[1] > 0, "field H (height)", "> 0", v[1]);
+  state.board.width_m = v[0] * state.length_scale;
+  state.board.height_m = v[1] * state.length_scale;
+}
+
+void ball(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"R", "SPEED_MAX"});
+  r.require(v[0] > 0, "field R (radius)", "> 0", v[0]);
+  r.require(v[1] > 0, "field SPEED_MAX", "> 0", v[1]);
+  state.board.ball.radius_m = v[0] * state.length_scale;
+  state.board.ball.speed_max_mps = v[1] * state.length_scale;
+}
+
+void gravity(LoadState& state, const Reader& r) {
+  const double g = r.numbers(0, {"G"})[0];
+  r.require(g >= 0, "field G", ">= 0", g);
+  state.board.gravity_mps2 = g * state.length_scale;
+}
+
+void dt(LoadState& state, const Reader& r) {
+  const double dt = r.numbers(0, {"DT"})[0];
+  r.require(dt > 0, "field DT (seconds)", "> 0", dt);
+  state.board.dt_s = dt;
+}
+
+void balls(LoadState& state, const Reader& r) {
+  const double n = r.numbers(0, {"N"})[0];
+  r.require(n >= 1 && n == std::floor(n), "field N (balls per game)", "an integer >= 1", n);
+  r.require(n <= 1e6, "field N (balls per game)", "at most 1000000", n);
+  state.board.balls_per_game = static_cast<int>(n);
+}
+
+void launcher(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"X", "Y"});
+  Launcher& l = state.board.launcher;
+  l.position = Vec2{v[0], v[1]} * state.length_scale;
+  l.pull = r.attribute("pull", 1.0);
+  r.require(l.pull > 0 && l.pull <= 1, "attribute pull", "in (0, 1]", l.pull);
+  l.noise_max = r.attribute("noise", 0.03);
+  r.require(l.noise_max >= 0 && l.noise_max <= 0.5, "attribute noise", "in [0, 0.5]", l.noise_max);
+}
+
+void defaults(LoadState& state, const Reader& r) {
+  if (r.arg_count() != 0) r.fail("takes only attributes (rho=R), got '" + std::string(r.arg(0)) + "'");
+  state.default_rho = r.attribute("rho", state.default_rho);
+  r.require(state.default_rho >= 0, "attribute rho", ">= 0", state.default_rho);
+}
+
+int bank_index(const Board& board, std::string_view name) {
+  for (std::size_t k = 0; k < board.banks.size(); ++k) {
+    if (board.banks[k].name == name) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+void bank(LoadState& state, const Reader& r) {
+  if (r.arg_count() != 1) r.fail("expected one NAME, got " + std::to_string(r.arg_count()));
+  const std::string name(r.arg(0));
+  if (bank_index(state.board, name) >= 0) r.fail("bank '" + name + "' is declared twice");
+  if (!r.flag("bonus")) r.fail("needs bonus=POINTS");
+  state.board.banks.push_back(Bank{name, r.attribute("bonus", 0.0), {}});
+  state.bank_lines.push_back(r.line());
+}
+
+// ---- obstacles ----
+
+std::string default_name(const Reader& r) { return std::string(r.keyword()) + "@" + std::to_string(r.line()); }
+
+/// The attributes every shape of one obstacle statement shares.
+Obstacle obstacle_attributes(const LoadState& state, const Reader& r) {
+  Obstacle o;
+  o.rho = r.attribute("rho", state.default_rho);
+  r.require(o.rho >= 0, "attribute rho", ">= 0", o.rho);
+  o.action.score = r.attribute("score", 0.0);
+  const double kick = r.attribute("kick", 0.0);
+  r.require(kick >= 0, "attribute kick", ">= 0", kick);
+  o.action.kick_mps = kick * state.length_scale;
+  o.action.contact_score_per_s = r.attribute("contact", 0.0);
+  o.action.eats_ball = r.flag("eat");
+  o.visible = !r.flag("hidden");
+  if (r.flag("bank")) {
+    const std::string_view bank = r.text("bank");
+    o.bank = bank_index(state.board, bank);
+    if (o.bank < 0) r.fail("attribute bank names an undeclared bank '" + std::string(bank) + "'");
+  }
+  o.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  o.source_line = r.line();
+  return o;
+}
+
+void add(Board& board, const Shape& shape, const Obstacle& o) {
+  if (o.bank >= 0) {
+    board.banks[static_cast<std::size_t>(o.bank)].members.push_back(static_cast<int>(board.obstacles.size()));
+  }
+  board.shapes.push_back(shape);
+  board.obstacles.push_back(o);
+}
+
+/// Two points, in file units, checked to differ; returned in metres.
+std::pair<Vec2, Vec2> segment(const LoadState& state, const Reader& r, std::size_t first) {
+  const auto v = r.numbers(first, {"X1", "Y1", "X2", "Y2"});
+  if (v[0] == v[2] && v[1] == v[3]) r.fail("zero-length segment");
+  return {Vec2{v[0], v[1]} * state.length_scale, Vec2{v[2], v[3]} * state.length_scale};
+}
+
+void line(LoadState& state, const Reader& r) {
+  const auto [p0, p1] = segment(state, r, 0);
+  add(state.board, make_line_shape(p0, p1), obstacle_attributes(state, r));
+}
+
+void wall(LoadState& state, const Reader& r) {
+  const auto [p0, p1] = segment(state, r, 0);
+  const Obstacle o = obstacle_attributes(state, r);
+  add(state.board, make_line_shape(p0, p1), o);
+  add(state.board, make_line_shape(p1, p0), o);
+  add(state.board, make_circle_shape(p0, 0.0), o);
+  add(state.board, make_circle_shape(p1, 0.0), o);
+}
+
+void point(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"X", "Y"});
+  add(state.board, make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, 0.0), obstacle_attributes(state, r));
+}
+
+void circle(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"X", "Y", "R"});
+  r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
+  add(state.board, make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale),
+      obstacle_attributes(state, r));
+}
+
+/// Vertices in file units, checked for zero-length edges (closed: also last -> first).
+std::vector<Vec2> path(const Reader& r, std::size_t min_count, bool closed) {
+  const std::vector<Vec2> v = r.vertices(0, min_count);
+  const std::size_t edges = closed ? v.size() : v.size() - 1;
+  for (std::size_t i = 0; i < edges; ++i) {
+    const std::size_t j = (i + 1) % v.size();
+    if (v[i] == v[j]) {
+      r.fail("zero-length segment (vertices " + std::to_string(i + 1) + " and " + std::to_string(j + 1) + ")");
+    }
+  }
+  return v;
+}
+
+void polyline(LoadState& state, const Reader& r) {
+  const std::vector<Vec2> v = path(r, 2, false);
+  const Obstacle o = obstacle_attributes(state, r);
+  const bool two_sided = r.flag("two-sided");
+  for (std::size_t i = 0; i + 1 < v.size(); ++i) {
+    add(state.board, make_line_shape(v[i] * state.length_scale, v[i + 1] * state.length_scale), o);
+    if (two_sided) add(state.board, make_line_shape(v[i + 1] * state.length_scale, v[i] * state.length_scale), o);
+  }
+  for (const Vec2& p : v) add(state.board, make_circle_shape(p * state.length_scale, 0.0), o);
+}
+
+void polygon(LoadState& state, const Reader& r) {
+  std::vector<Vec2> v = path(r, 3, true);
+  double twice_area = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i) twice_area += cross(v[i], v[(i + 1) % v.size()]);
+  if (twice_area == 0.0) r.fail("the vertices enclose no area");
+  // Clockwise traversal puts each edge's left normal outside.
+  if (twice_area > 0.0) std::reverse(v.begin(), v.end());
+  const Obstacle o = obstacle_attributes(state, r);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    add(state.board, make_line_shape(v[i] * state.length_scale, v[(i + 1) % v.size()] * state.length_scale), o);
+  }
+  for (const Vec2& p : v) add(state.board, make_circle_shape(p * state.length_scale, 0.0), o);
+}
+
+// ---- flippers and sensors ----
+
+void flipper(LoadState& state, const Reader& r) {
+  Flipper f;
+  const std::string_view side = r.arg_count() > 0 ? r.arg(0) : std::string_view{};
+  if (side != "left" && side != "right") {
+    r.fail("field SIDE must be 'left' or 'right', got '" + std::string(side) + "'");
+  }
+  f.side = side == "left" ? Side::kLeft : Side::kRight;
+  const auto v = r.numbers(1, {"PX", "PY", "LENGTH", "THETA_MIN", "THETA_MAX", "OMEGA"});
+  r.require(v[2] > 0, "field LENGTH", "> 0", v[2]);
+  if (!(v[3] < v[4])) r.fail("field THETA_MIN (" + fmt(v[3]) + ") must be less than THETA_MAX (" + fmt(v[4]) + ")");
+  r.require(v[5] > 0, "field OMEGA", "> 0", v[5]);
+  f.pivot = Vec2{v[0], v[1]} * state.length_scale;
+  f.length_m = v[2] * state.length_scale;
+  f.theta_min_rad = v[3] * state.angle_scale;
+  f.theta_max_rad = v[4] * state.angle_scale;
+  f.omega_rad_s = v[5] * state.angle_scale;
+  f.rho = r.attribute("rho", state.default_rho);
+  r.require(f.rho >= 0, "attribute rho", ">= 0", f.rho);
+  f.mu = r.attribute("mu", 1.0);
+  r.require(f.mu >= 0, "attribute mu", ">= 0", f.mu);
+  f.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  f.source_line = r.line();
+  state.board.flippers.push_back(f);
+}
+
+void finish_sensor(LoadState& state, const Reader& r, Sensor& s) {
+  s.action.score = r.attribute("score", 0.0);
+  s.action.eats_ball = r.flag("eat");
+  s.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  s.source_line = r.line();
+  state.board.sensors.push_back(s);
+}
+
+void sensor(LoadState& state, const Reader& r) {
+  Sensor s;
+  const std::string_view shape = r.arg_count() > 0 ? r.arg(0) : std::string_view{};
+  if (shape == "line") {
+    const auto [p0, p1] = segment(state, r, 1);
+    s.shape = make_line_shape(p0, p1);
+  } else if (shape == "circle") {
+    const auto v = r.numbers(1, {"X", "Y", "R"});
+    r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
+    s.shape = make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale);
+  } else {
+    r.fail("field SHAPE must be 'line' or 'circle', got '" + std::string(shape) + "'");
+  }
+  s.kind = SensorKind::kProximity;
+  finish_sensor(state, r, s);
+}
+
+void hole(LoadState& state, const Reader& r) {
+  Sensor s;
+  const auto v = r.numbers(0, {"X", "Y", "R"});
+  r.require(v[2] > 0, "field R (radius)", "> 0", v[2]);
+  s.kind = SensorKind::kHole;
+  s.shape = make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale);
+  const bool eat = r.flag("eat");
+  if (eat == r.flag("kickout")) r.fail("needs exactly one of 'eat' or 'kickout=VX,VY'");
+  if (!eat) {
+    const std::string_view k = r.text("kickout");
+    const std::size_t comma = k.find(',');
+    if (comma == std::string_view::npos) r.fail("attribute kickout must be VX,VY, got '" + std::string(k) + "'");
+    s.has_kickout = true;
+    s.kickout_mps = Vec2{r.number(k.substr(0, comma), "attribute kickout VX"),
+                         r.number(k.substr(comma + 1), "attribute kickout VY")} *
+                    state.length_scale;
+  }
+  finish_sensor(state, r, s);
+}
+
+/// One statement kind: how the driver treats it, and the function that reads it.
+struct Kind {
+  std::string_view keyword;
+  void (*handler)(LoadState&, const Reader&);
+  bool singleton;      // at most once
+  bool dimensioned;    // uses a length or an angle: units/angles must come first
+  std::string_view attributes;
+};
+
+const Kind* find_kind(std::string_view keyword) {
+  static constexpr std::string_view kObstacleTwoSided = "rho score kick contact eat hidden bank name two-sided";
+  static const Kind kKinds[] = {
+      {"pinball-board", &header, true, false, ""},
+      {"units", &units, true, false, ""},
+      {"angles", &angles, true, false, ""},
+      {"size", &size, true, true, ""},
+      {"ball", &ball, true, true, ""},
+      {"gravity", &gravity, true, true, ""},
+      {"dt", &dt, true, false, ""},
+      {"balls", &balls, true, false, ""},
+      {"launcher", &launcher, true, true, "pull noise"},
+      {"defaults", &defaults, false, false, "rho"},
+      {"bank", &bank, false, false, "bonus"},
+      {"line", &line, false, true, kObstacleAttributes},
+      {"wall", &wall, false, true, kObstacleAttributes},
+      {"point", &point, false, true, kObstacleAttributes},
+      {"circle", &circle, false, true, kObstacleAttributes},
+      {"polyline", &polyline, false, true, kObstacleTwoSided},
+      {"polygon", &polygon, false, true, kObstacleAttributes},
+      {"flipper", &flipper, false, true, "rho mu name"},
+      {"sensor", &sensor, false, true, "score eat name"},
+      {"hole", &hole, false, true, "score eat kickout name"},
+  };
+  for (const Kind& k : kKinds) {
+    if (k.keyword == keyword) return &k;
+  }
+  return nullptr;
+}
+
+// ---- whole file ----
+
+constexpr std::string_view kRequired[] = {"pinball-board", "size", "ball", "gravity", "dt", "balls", "launcher"};
+
+void check_launcher_clear(const LoadState& state) {
+  const Board& board = state.board;
+  const Vec2 p = board.launcher.position;
+  const double r = board.ball.radius_m;
+  const int line = state.seen.at("launcher");
+  const auto overlap = [&](const std::string& what, double d) {
+    throw BoardError(state.file, line,
+                     "launcher: ball at the launch position overlaps " + what + " (distance " + fmt(d) +
+                         " m, ball radius " + fmt(r) + " m)");
+  };
+  for (std::size_t i = 0; i < board.shapes.size(); ++i) {
+    const double d = distance_to_shape(board.shapes[i], p);
+    if (d < r) overlap("'" + board.obstacles[i].name + "'", d);
+  }
+  for (const Flipper& f : board.flippers) {
+    const double d = distance_point_segment(p, f.pivot, flipper_tip(f, f.theta_min_rad));
+    if (d < r) overlap("flipper '" + f.name + "' in its down position", d);
+  }
+}
+
+void check_whole_file(const LoadState& state) {
+  const Board& board = state.board;
+  for (const std::string_view required : kRequired) {
+    if (!state.seen.contains(std::string(required))) {
+      throw BoardError(state.file, 0, "missing required '" + std::string(required) + "' statement");
+    }
+  }
+  for (std::size_t k = 0; k < board.banks.size(); ++k) {
+    if (board.banks[k].members.empty()) {
+      throw BoardError(state.file, state.bank_lines[k],
+                       "bank: bank '" + board.banks[k].name + "' has no members (no obstacle says bank=" +
+                           board.banks[k].name + ")");
+    }
+  }
+  for (const Flipper& f : board.flippers) {
+    Board one;
+    one.ball = board.ball;
+    one.flippers.push_back(f);
+    try {
+      check_flipper_time_step(one, board.dt_s);
+    } catch (const std::invalid_argument& e) {
+      throw BoardError(state.file, f.source_line, std::string("flipper: ") + e.what());
+    }
+  }
+  check_launcher_clear(state);
+}
+
+// ---- the driver ----
+
+void statement(LoadState& state, const Statement& st) {
+  const std::string keyword(st.tokens[0]);
+  const Kind* kind = find_kind(keyword);
+  if (kind == nullptr) throw BoardError(state.file, st.line, "unknown keyword '" + keyword + "'");
+  if (state.seen.empty() && keyword != "pinball-board") {
+    throw BoardError(state.file, st.line, "expected 'pinball-board 1' as the first statement, got '" + keyword + "'");
+  }
+  if (kind->singleton) {
+    const auto [it, inserted] = state.seen.emplace(keyword, st.line);
+    if (!inserted) {
+      throw BoardError(state.file, st.line,
+                       "duplicate '" + keyword + "' statement (first at line " + std::to_string(it->second) + ")");
+    }
+  }
+  if (kind->dimensioned && state.first_dimensioned_line == 0) state.first_dimensioned_line = st.line;
+  const Reader r(st, state.file, kind->attributes);
+  kind->handler(state, r);
+}
 
 }  // namespace
 
@@ -601,7 +600,10 @@ BoardError::BoardError(std::string file, int line, const std::string& message)
     : std::runtime_error(what_text(file, line, message)), file_(std::move(file)), line_(line) {}
 
 Board parse_board(std::string_view text, const std::string& source_name) {
-  return Loader(text, source_name).run();
+  LoadState state(source_name);
+  for (const Statement& st : tokenize(text)) statement(state, st);
+  check_whole_file(state);
+  return std::move(state.board);
 }
 
 Board load_board(const std::string& path) {
