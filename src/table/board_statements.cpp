@@ -1,0 +1,319 @@
+#include "board_loader_internal.h"
+
+// One function per statement kind of docs/board-format.md, and the table that
+// tells the driver which one reads a keyword.
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <utility>
+
+namespace pinball::table::loader {
+
+namespace {
+
+constexpr std::string_view kObstacleAttributes = "rho score kick contact eat hidden bank name";
+
+// ---- header and constants ----
+
+void header(LoadState&, const Reader& r) {
+  const double version = r.numbers(0, {"VERSION"})[0];
+  if (version != 1.0) r.fail("unsupported format version " + fmt(version) + " (this loader reads version 1)");
+}
+
+/// units/angles: a single word, before any length or angle.
+std::string_view unit_word(const LoadState& state, const Reader& r, std::string_view a, std::string_view b) {
+  std::string choices = "'";  // built piecewise: GCC 12 warns falsely on "literal" + std::string
+  choices.append(a).append("' or '").append(b).append("'");
+  if (r.arg_count() != 1) r.fail("expected one word, " + choices + ", got " + std::to_string(r.arg_count()));
+  if (r.arg(0) != a && r.arg(0) != b) r.fail("expected " + choices + ", got '" + std::string(r.arg(0)) + "'");
+  if (state.first_dimensioned_line != 0) {
+    r.fail("must come before the first statement that uses a length or angle (line " +
+           std::to_string(state.first_dimensioned_line) + ")");
+  }
+  return r.arg(0);
+}
+void units(LoadState& state, const Reader& r) {
+  state.length_scale = unit_word(state, r, "m", "mm") == "mm" ? 1e-3 : 1.0;
+}
+void angles(LoadState& state, const Reader& r) {
+  state.angle_scale = unit_word(state, r, "rad", "deg") == "deg" ? std::numbers::pi / 180.0 : 1.0;
+}
+
+void size(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"W", "H"});
+  r.require(v[0] > 0, "field W (width)", "> 0", v[0]);
+  r.require(v[1] > 0, "field H (height)", "> 0", v[1]);
+  state.board.width_m = v[0] * state.length_scale;
+  state.board.height_m = v[1] * state.length_scale;
+}
+
+void ball(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"R", "SPEED_MAX"});
+  r.require(v[0] > 0, "field R (radius)", "> 0", v[0]);
+  r.require(v[1] > 0, "field SPEED_MAX", "> 0", v[1]);
+  state.board.ball.radius_m = v[0] * state.length_scale;
+  state.board.ball.speed_max_mps = v[1] * state.length_scale;
+}
+
+void gravity(LoadState& state, const Reader& r) {
+  const double g = r.numbers(0, {"G"})[0];
+  r.require(g >= 0, "field G", ">= 0", g);
+  state.board.gravity_mps2 = g * state.length_scale;
+}
+
+void dt(LoadState& state, const Reader& r) {
+  const double dt = r.numbers(0, {"DT"})[0];
+  r.require(dt > 0, "field DT (seconds)", "> 0", dt);
+  state.board.dt_s = dt;
+}
+
+void balls(LoadState& state, const Reader& r) {
+  const double n = r.numbers(0, {"N"})[0];
+  r.require(n >= 1 && n == std::floor(n), "field N (balls per game)", "an integer >= 1", n);
+  r.require(n <= 1e6, "field N (balls per game)", "at most 1000000", n);
+  state.board.balls_per_game = static_cast<int>(n);
+}
+
+void launcher(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"X", "Y"});
+  Launcher& l = state.board.launcher;
+  l.position = Vec2{v[0], v[1]} * state.length_scale;
+  l.pull = r.attribute("pull", 1.0);
+  r.require(l.pull > 0 && l.pull <= 1, "attribute pull", "in (0, 1]", l.pull);
+  l.noise_max = r.attribute("noise", 0.03);
+  r.require(l.noise_max >= 0 && l.noise_max <= 0.5, "attribute noise", "in [0, 0.5]", l.noise_max);
+}
+
+void defaults(LoadState& state, const Reader& r) {
+  if (r.arg_count() != 0) r.fail("takes only attributes (rho=R), got '" + std::string(r.arg(0)) + "'");
+  state.default_rho = r.attribute("rho", state.default_rho);
+  r.require(state.default_rho >= 0, "attribute rho", ">= 0", state.default_rho);
+}
+
+int bank_index(const Board& board, std::string_view name) {
+  for (std::size_t k = 0; k < board.banks.size(); ++k) {
+    if (board.banks[k].name == name) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+void bank(LoadState& state, const Reader& r) {
+  if (r.arg_count() != 1) r.fail("expected one NAME, got " + std::to_string(r.arg_count()));
+  const std::string name(r.arg(0));
+  if (bank_index(state.board, name) >= 0) r.fail("bank '" + name + "' is declared twice");
+  if (!r.flag("bonus")) r.fail("needs bonus=POINTS");
+  state.board.banks.push_back(Bank{name, r.attribute("bonus", 0.0), {}});
+  state.bank_lines.push_back(r.line());
+}
+
+// ---- obstacles ----
+
+std::string default_name(const Reader& r) { return std::string(r.keyword()) + "@" + std::to_string(r.line()); }
+
+/// The attributes every shape of one obstacle statement shares.
+Obstacle obstacle_attributes(const LoadState& state, const Reader& r) {
+  Obstacle o;
+  o.rho = r.attribute("rho", state.default_rho);
+  r.require(o.rho >= 0, "attribute rho", ">= 0", o.rho);
+  o.action.score = r.attribute("score", 0.0);
+  const double kick = r.attribute("kick", 0.0);
+  r.require(kick >= 0, "attribute kick", ">= 0", kick);
+  o.action.kick_mps = kick * state.length_scale;
+  o.action.contact_score_per_s = r.attribute("contact", 0.0);
+  o.action.eats_ball = r.flag("eat");
+  o.visible = !r.flag("hidden");
+  if (r.flag("bank")) {
+    const std::string_view bank = r.text("bank");
+    o.bank = bank_index(state.board, bank);
+    if (o.bank < 0) r.fail("attribute bank names an undeclared bank '" + std::string(bank) + "'");
+  }
+  o.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  o.source_line = r.line();
+  return o;
+}
+
+void add(Board& board, const Shape& shape, const Obstacle& o) {
+  if (o.bank >= 0) {
+    board.banks[static_cast<std::size_t>(o.bank)].members.push_back(static_cast<int>(board.obstacles.size()));
+  }
+  board.shapes.push_back(shape);
+  board.obstacles.push_back(o);
+}
+
+/// Two points, in file units, checked to differ; returned in metres.
+std::pair<Vec2, Vec2> segment(const LoadState& state, const Reader& r, std::size_t first) {
+  const auto v = r.numbers(first, {"X1", "Y1", "X2", "Y2"});
+  if (v[0] == v[2] && v[1] == v[3]) r.fail("zero-length segment");
+  return {Vec2{v[0], v[1]} * state.length_scale, Vec2{v[2], v[3]} * state.length_scale};
+}
+
+void line(LoadState& state, const Reader& r) {
+  const auto [p0, p1] = segment(state, r, 0);
+  add(state.board, make_line_shape(p0, p1), obstacle_attributes(state, r));
+}
+
+void wall(LoadState& state, const Reader& r) {
+  const auto [p0, p1] = segment(state, r, 0);
+  const Obstacle o = obstacle_attributes(state, r);
+  add(state.board, make_line_shape(p0, p1), o);
+  add(state.board, make_line_shape(p1, p0), o);
+  add(state.board, make_circle_shape(p0, 0.0), o);
+  add(state.board, make_circle_shape(p1, 0.0), o);
+}
+
+void point(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"X", "Y"});
+  add(state.board, make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, 0.0), obstacle_attributes(state, r));
+}
+
+void circle(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"X", "Y", "R"});
+  r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
+  add(state.board, make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale),
+      obstacle_attributes(state, r));
+}
+
+/// Vertices in file units, checked for zero-length edges (closed: also last -> first).
+std::vector<Vec2> path(const Reader& r, std::size_t min_count, bool closed) {
+  const std::vector<Vec2> v = r.vertices(0, min_count);
+  const std::size_t edges = closed ? v.size() : v.size() - 1;
+  for (std::size_t i = 0; i < edges; ++i) {
+    const std::size_t j = (i + 1) % v.size();
+    if (v[i] == v[j]) {
+      r.fail("zero-length segment (vertices " + std::to_string(i + 1) + " and " + std::to_string(j + 1) + ")");
+    }
+  }
+  return v;
+}
+
+void polyline(LoadState& state, const Reader& r) {
+  const std::vector<Vec2> v = path(r, 2, false);
+  const Obstacle o = obstacle_attributes(state, r);
+  const bool two_sided = r.flag("two-sided");
+  for (std::size_t i = 0; i + 1 < v.size(); ++i) {
+    add(state.board, make_line_shape(v[i] * state.length_scale, v[i + 1] * state.length_scale), o);
+    if (two_sided) add(state.board, make_line_shape(v[i + 1] * state.length_scale, v[i] * state.length_scale), o);
+  }
+  for (const Vec2& p : v) add(state.board, make_circle_shape(p * state.length_scale, 0.0), o);
+}
+
+void polygon(LoadState& state, const Reader& r) {
+  std::vector<Vec2> v = path(r, 3, true);
+  double twice_area = 0.0;
+  for (std::size_t i = 0; i < v.size(); ++i) twice_area += cross(v[i], v[(i + 1) % v.size()]);
+  if (twice_area == 0.0) r.fail("the vertices enclose no area");
+  // Clockwise traversal puts each edge's left normal outside.
+  if (twice_area > 0.0) std::reverse(v.begin(), v.end());
+  const Obstacle o = obstacle_attributes(state, r);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    add(state.board, make_line_shape(v[i] * state.length_scale, v[(i + 1) % v.size()] * state.length_scale), o);
+  }
+  for (const Vec2& p : v) add(state.board, make_circle_shape(p * state.length_scale, 0.0), o);
+}
+
+// ---- flippers and sensors ----
+
+void flipper(LoadState& state, const Reader& r) {
+  Flipper f;
+  const std::string_view side = r.arg_count() > 0 ? r.arg(0) : std::string_view{};
+  if (side != "left" && side != "right") {
+    r.fail("field SIDE must be 'left' or 'right', got '" + std::string(side) + "'");
+  }
+  f.side = side == "left" ? Side::kLeft : Side::kRight;
+  const auto v = r.numbers(1, {"PX", "PY", "LENGTH", "THETA_MIN", "THETA_MAX", "OMEGA"});
+  r.require(v[2] > 0, "field LENGTH", "> 0", v[2]);
+  if (!(v[3] < v[4])) r.fail("field THETA_MIN (" + fmt(v[3]) + ") must be less than THETA_MAX (" + fmt(v[4]) + ")");
+  r.require(v[5] > 0, "field OMEGA", "> 0", v[5]);
+  f.pivot = Vec2{v[0], v[1]} * state.length_scale;
+  f.length_m = v[2] * state.length_scale;
+  f.theta_min_rad = v[3] * state.angle_scale;
+  f.theta_max_rad = v[4] * state.angle_scale;
+  f.omega_rad_s = v[5] * state.angle_scale;
+  f.rho = r.attribute("rho", state.default_rho);
+  r.require(f.rho >= 0, "attribute rho", ">= 0", f.rho);
+  f.mu = r.attribute("mu", 1.0);
+  r.require(f.mu >= 0, "attribute mu", ">= 0", f.mu);
+  f.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  f.source_line = r.line();
+  state.board.flippers.push_back(f);
+}
+
+void finish_sensor(LoadState& state, const Reader& r, Sensor& s) {
+  s.action.score = r.attribute("score", 0.0);
+  s.action.eats_ball = r.flag("eat");
+  s.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  s.source_line = r.line();
+  state.board.sensors.push_back(s);
+}
+
+void sensor(LoadState& state, const Reader& r) {
+  Sensor s;
+  const std::string_view shape = r.arg_count() > 0 ? r.arg(0) : std::string_view{};
+  if (shape == "line") {
+    const auto [p0, p1] = segment(state, r, 1);
+    s.shape = make_line_shape(p0, p1);
+  } else if (shape == "circle") {
+    const auto v = r.numbers(1, {"X", "Y", "R"});
+    r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
+    s.shape = make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale);
+  } else {
+    r.fail("field SHAPE must be 'line' or 'circle', got '" + std::string(shape) + "'");
+  }
+  s.kind = SensorKind::kProximity;
+  finish_sensor(state, r, s);
+}
+
+void hole(LoadState& state, const Reader& r) {
+  Sensor s;
+  const auto v = r.numbers(0, {"X", "Y", "R"});
+  r.require(v[2] > 0, "field R (radius)", "> 0", v[2]);
+  s.kind = SensorKind::kHole;
+  s.shape = make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale);
+  const bool eat = r.flag("eat");
+  if (eat == r.flag("kickout")) r.fail("needs exactly one of 'eat' or 'kickout=VX,VY'");
+  if (!eat) {
+    const std::string_view k = r.text("kickout");
+    const std::size_t comma = k.find(',');
+    if (comma == std::string_view::npos) r.fail("attribute kickout must be VX,VY, got '" + std::string(k) + "'");
+    s.has_kickout = true;
+    s.kickout_mps = Vec2{r.number(k.substr(0, comma), "attribute kickout VX"),
+                         r.number(k.substr(comma + 1), "attribute kickout VY")} *
+                    state.length_scale;
+  }
+  finish_sensor(state, r, s);
+}
+
+}  // namespace
+
+const StatementKind* find_kind(std::string_view keyword) {
+  static constexpr std::string_view kObstacleTwoSided = "rho score kick contact eat hidden bank name two-sided";
+  static const StatementKind kKinds[] = {
+      {"pinball-board", &header, true, false, ""},
+      {"units", &units, true, false, ""},
+      {"angles", &angles, true, false, ""},
+      {"size", &size, true, true, ""},
+      {"ball", &ball, true, true, ""},
+      {"gravity", &gravity, true, true, ""},
+      {"dt", &dt, true, false, ""},
+      {"balls", &balls, true, false, ""},
+      {"launcher", &launcher, true, true, "pull noise"},
+      {"defaults", &defaults, false, false, "rho"},
+      {"bank", &bank, false, false, "bonus"},
+      {"line", &line, false, true, kObstacleAttributes},
+      {"wall", &wall, false, true, kObstacleAttributes},
+      {"point", &point, false, true, kObstacleAttributes},
+      {"circle", &circle, false, true, kObstacleAttributes},
+      {"polyline", &polyline, false, true, kObstacleTwoSided},
+      {"polygon", &polygon, false, true, kObstacleAttributes},
+      {"flipper", &flipper, false, true, "rho mu name"},
+      {"sensor", &sensor, false, true, "score eat name"},
+      {"hole", &hole, false, true, "score eat kickout name"},
+  };
+  for (const StatementKind& k : kKinds) {
+    if (k.keyword == keyword) return &k;
+  }
+  return nullptr;
+}
+
+}  // namespace pinball::table::loader
