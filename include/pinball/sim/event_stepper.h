@@ -64,8 +64,6 @@ class EventStepper {
   const EventStepperOptions& options() const { return options_; }
 
  private:
-  struct Run;  // one step's working state (event_stepper.cpp)
-
   const table::Board& board_;
   EventStepperOptions options_;
   UniformGrid obstacle_grid_;
