@@ -27,6 +27,64 @@ int count_lines(const std::string& s) {
   return n;
 }
 
+// The thesis table with one line replaced, written into the test's directory.
+fs::path variant_board(const fs::path& dir, const std::string& from, const std::string& to) {
+  std::string text = slurp(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+  const fs::path path = dir / "world.board";
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST_F(Cli, SimPlaysTheWorldBoardWhileTheTrackerBelievesTheBoard) {
+  const fs::path world = variant_board(dir_, "gravity 1110", "gravity 1000");
+  const CommandResult model = run("sim boards/mit1993.board --policy spastic --balls 6 --seed 3 --json");
+  const CommandResult other = run("sim boards/mit1993.board --policy spastic --balls 6 --seed 3 --json --world-board " +
+                                  world.string());
+  const CommandResult event = run("sim boards/mit1993.board --policy spastic --balls 6 --seed 3 --json --stepper event");
+  ASSERT_EQ(model.exit_code, 0) << model.err;
+  ASSERT_EQ(other.exit_code, 0) << other.err;
+  ASSERT_EQ(event.exit_code, 0) << event.err;
+  const auto m = nlohmann::json::parse(model.out), o = nlohmann::json::parse(other.out),
+             e = nlohmann::json::parse(event.out);
+  EXPECT_EQ(m.at("world_board"), "boards/mit1993.board");
+  EXPECT_EQ(o.at("world_board"), world.string());
+  EXPECT_EQ(o.at("board"), "boards/mit1993.board");
+  EXPECT_EQ(e.at("stepper"), "event");
+  EXPECT_NE(m.at("state_hash"), o.at("state_hash"));
+  EXPECT_NE(m.at("state_hash"), e.at("state_hash"));
+}
+
+TEST_F(Cli, LearnAndBenchCeilingTakeTheWorldApartFromTheBelief) {
+  const fs::path world = variant_board(dir_, "gravity 1110", "gravity 1000");
+  const std::string eval = "learn boards/mit1993.board --method spastic --eval-balls 8 --seed 5 --threads 1 --json";
+  const CommandResult model = run(eval);
+  const CommandResult other = run(eval + " --world-board " + world.string());
+  ASSERT_EQ(model.exit_code, 0) << model.err;
+  ASSERT_EQ(other.exit_code, 0) << other.err;
+  const auto m = nlohmann::json::parse(model.out), o = nlohmann::json::parse(other.out);
+  EXPECT_EQ(o.at("world_board"), world.string());
+  EXPECT_EQ(o.at("stepper"), "thesis");
+  EXPECT_NE(m.at("evaluation").at("mean_score_per_ball"), o.at("evaluation").at("mean_score_per_ball"));
+  const CommandResult ceiling =
+      run("bench ceiling --balls 2 --max-ball-time 3 --threads 1 --json --stepper event --world-board " + world.string());
+  ASSERT_EQ(ceiling.exit_code, 0) << ceiling.err;
+  const auto c = nlohmann::json::parse(ceiling.out);
+  EXPECT_EQ(c.at("world"), "event");
+  EXPECT_EQ(c.at("world_board"), world.string());
+}
+
+TEST_F(Cli, AWorldWithOtherFlippersIsRefusedNamingBothBoards) {
+  const fs::path world = variant_board(dir_, "flipper left ", "flipper right ");
+  const CommandResult r = run("sim boards/mit1993.board --balls 1 --world-board " + world.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("world.board"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("mit1993.board"), std::string::npos) << r.err;
+  EXPECT_EQ(run("sim boards/mit1993.board --balls 1 --stepper euler").exit_code, 2);
+}
+
 TEST_F(Cli, SimPlaysTheEventStepper) {
   const CommandResult r = run("sim boards/mit1993.board --stepper event --policy spastic --balls 5 --seed 3 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -11,6 +11,9 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <thread>
 
@@ -58,6 +61,43 @@ TEST(Daemon, LockstepRunsAreDeterminedByTheSeed) {
   EXPECT_EQ(a.frames_dropped, 0u);
   EXPECT_EQ(a.ring_overflows, 0u);
   EXPECT_EQ(a.board.watchdog_trips, 0u);
+}
+
+// The simulated table may be another board (or stepper) than the one the
+// tracker and the controller believe: the world is configured apart.
+TEST(Daemon, TheWorldIsConfiguredApartFromTheBelief) {
+  std::ifstream in(kSource + "/boards/mit1993.board");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("gravity 1110"), 12, "gravity 1000");
+  const std::string world_board =
+      (std::filesystem::temp_directory_path() / ("pinballd_world_" + std::to_string(getpid()) + ".board")).string();
+  std::ofstream(world_board) << text;
+  DaemonReport model, other, event;
+  {
+    Daemon d(sim_config(2, 5));
+    model = d.run();
+  }
+  {
+    DaemonConfig c = sim_config(2, 5);
+    c.sim.world_board = world_board;
+    Daemon d(c);
+    other = d.run();
+  }
+  {
+    DaemonConfig c = sim_config(2, 5);
+    c.sim.stepper = sim::StepperKind::kEvent;
+    Daemon d(c);
+    event = d.run();
+  }
+  std::filesystem::remove(world_board);
+  EXPECT_EQ(model.world, "thesis");
+  EXPECT_EQ(model.world_board, kSource + "/boards/mit1993.board");
+  EXPECT_EQ(other.world_board, world_board);
+  EXPECT_EQ(event.world, "event");
+  ASSERT_EQ(other.balls, 2);
+  EXPECT_NE(model.results[0].duration_s, other.results[0].duration_s);
+  EXPECT_NE(model.results[0].duration_s, event.results[0].duration_s);
+  EXPECT_EQ(report_to_json(other).at("world").at("board"), world_board);
 }
 
 // Where the threads run and who writes the CAN frame change the timing, never the game.
