@@ -32,17 +32,7 @@ namespace {
 
 // Distance from the ball to the nearest flipper's rest segment, and which flipper.
 std::pair<int, double> nearest_flipper(const table::Board& board, const sim::GameState& state) {
-  int nearest = -1;
-  double nearest_d = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    const table::Flipper& f = board.flippers[i];
-    const double d = distance_point_segment(state.ball.position_m, f.pivot, table::flipper_tip(f, f.theta_min_rad));
-    if (d < nearest_d) {
-      nearest_d = d;
-      nearest = static_cast<int>(i);
-    }
-  }
-  return {nearest, nearest_d};
+  return table::nearest_flipper_at_rest(board, state.ball.position_m);
 }
 
 }  // namespace

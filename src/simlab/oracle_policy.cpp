@@ -1,22 +1,14 @@
 #include "pinball/simlab/oracle_policy.h"
 
 #include <limits>
+#include <tuple>
 
 namespace pinball::simlab {
 
 void oracle_spastic_policy(const table::Board& board, sim::GameState& state, double reach_factor) {
   int nearest = -1;
   double nearest_d = std::numeric_limits<double>::infinity();
-  if (state.ball_in_play) {
-    for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-      const table::Flipper& f = board.flippers[i];
-      const double d = distance_point_segment(state.ball.position_m, f.pivot, table::flipper_tip(f, f.theta_min_rad));
-      if (d < nearest_d) {
-        nearest_d = d;
-        nearest = static_cast<int>(i);
-      }
-    }
-  }
+  if (state.ball_in_play) std::tie(nearest, nearest_d) = table::nearest_flipper_at_rest(board, state.ball.position_m);
   // Falling balls only: a ball cradled on a raised flipper is let go, so it
   // rolls down and is flipped again instead of resting there forever.
   constexpr double kFallingSpeed_mps = 0.05;

@@ -47,6 +47,20 @@ Vec2 flipper_tip(const Flipper& f, double theta_rad) {
   return f.pivot + f.length_m * flipper_direction(f, theta_rad);
 }
 
+std::pair<int, double> nearest_flipper_at_rest(const Board& board, const Vec2& p) {
+  int nearest = -1;
+  double nearest_d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+    const Flipper& f = board.flippers[i];
+    const double d = distance_point_segment(p, f.pivot, flipper_tip(f, f.theta_min_rad));
+    if (d < nearest_d) {
+      nearest_d = d;
+      nearest = static_cast<int>(i);
+    }
+  }
+  return {nearest, nearest_d};
+}
+
 double max_stable_dt_s(const Board& board) {
   double dt = std::numeric_limits<double>::infinity();
   for (const Flipper& f : board.flippers) {

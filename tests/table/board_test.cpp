@@ -48,6 +48,21 @@ TEST(FlipperGeometry, DirectionAtZeroAndUpNormal) {
               1e-15);
 }
 
+TEST(NearestFlipperAtRest, IsTheClosestRestSegment) {
+  Board b = empty_board();
+  const auto none = nearest_flipper_at_rest(b, {0.2, 0.2});
+  EXPECT_EQ(none.first, -1);
+  EXPECT_EQ(none.second, std::numeric_limits<double>::infinity());
+  add_flipper(b, Side::kLeft, {0.1, 0.2}, 0.076, 0.0, 0.5, 33.0);   // rest segment (0.1..0.176, 0.2)
+  add_flipper(b, Side::kRight, {0.4, 0.2}, 0.076, 0.0, 0.5, 33.0);  // rest segment (0.324..0.4, 0.2)
+  const auto left = nearest_flipper_at_rest(b, {0.15, 0.25});
+  EXPECT_EQ(left.first, 0);
+  EXPECT_NEAR(left.second, 0.05, 1e-12);
+  const auto right = nearest_flipper_at_rest(b, {0.33, 0.1});
+  EXPECT_EQ(right.first, 1);
+  EXPECT_NEAR(right.second, 0.1, 1e-12);
+}
+
 TEST(MaxStableDt, FormulaAndSmallestOverFlippers) {
   Board b = empty_board();
   EXPECT_EQ(max_stable_dt_s(b), std::numeric_limits<double>::infinity());

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pinball/core/geometry.h"
@@ -142,6 +143,10 @@ Vec2 flipper_up_normal(const Flipper& f, double theta_rad);
 
 /// Tip position at theta_rad (m).
 Vec2 flipper_tip(const Flipper& f, double theta_rad);
+
+/// The flipper whose rest segment (pivot to tip at θ_min) is nearest to `p`,
+/// and that distance (m): {-1, inf} on a board without flippers.
+std::pair<int, double> nearest_flipper_at_rest(const Board& board, const Vec2& p);
 
 /// The largest time step for which a flipper moving at its θ̇₀ cannot jump
 /// over the ball: l·sin(θ̇₀·dt/2) < r (thesis 3.3.3). Infinite with no flippers.
