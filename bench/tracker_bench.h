@@ -177,6 +177,14 @@ struct TrackerReport {
 TrackerReport run_tracker_bench(const table::Board& board, const TrackerBenchOptions& options,
                                 const std::function<void(const std::string&)>& progress);
 
+/// Whether two cameras have the same frame rate, resolution and noise (finds the headline setting).
+bool same_camera(const track::CameraModelConfig& a, const track::CameraModelConfig& b);
+
+/// A setting as the progress lines and the text name it: "200 fps, 2 mm/px, 0.3 px, g x1".
+std::string camera_label(const track::CameraModelConfig& c, double g_factor);
+
+// The report (tracker_bench_report.cpp).
+
 /// The report as one JSON object.
 nlohmann::json to_json(const TrackerReport& report);
 
