@@ -15,6 +15,10 @@
 
 namespace pinball::bench {
 
+/// Errors below this (the rounding unit of a coordinate of tens of metres) are
+/// counted as this in ratios and on the plot, whose axes are logarithmic (m).
+inline constexpr double kPrecisionErrorFloor_m = 1e-15;
+
 /// What to measure.
 struct PrecisionBenchOptions {
   std::vector<double> thesis_dt_s;           ///< thesis stepper time steps (s)
@@ -110,6 +114,8 @@ struct LogLogFit {
   double slope = 0.0;      ///< exponent
 };
 LogLogFit loglog_fit(const std::vector<std::pair<double, double>>& xy);
+
+// The report (precision_bench_report.cpp).
 
 /// The report as one JSON object.
 nlohmann::json to_json(const PrecisionReport& report);
