@@ -134,6 +134,8 @@ struct DetectorReport {
 DetectorReport run_detector_bench(const table::Board& board, const DetectorBenchOptions& options,
                                   const std::function<void(const std::string&)>& progress);
 
+// The report (detector_bench_report.cpp).
+
 /// The report as one JSON object.
 nlohmann::json to_json(const DetectorReport& report);
 
