@@ -91,6 +91,8 @@ struct CalibrationReport {
 CalibrationReport run_calibration_bench(const table::Board& board, const CalibrationBenchOptions& options,
                                         const std::function<void(const std::string&)>& progress);
 
+// The report (calibration_bench_report.cpp).
+
 /// The report as one JSON object.
 nlohmann::json to_json(const CalibrationReport& report);
 
