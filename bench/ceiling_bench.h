@@ -128,6 +128,8 @@ CeilingReport run_ceiling_bench(const table::Board& board, const CeilingBenchOpt
                                 const std::function<void(const std::string&)>& progress,
                                 const sim::World* world = nullptr);
 
+// The report (ceiling_bench_report.cpp).
+
 /// The report as one JSON object.
 nlohmann::json to_json(const CeilingReport& report);
 /// The report as text.

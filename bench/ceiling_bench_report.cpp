@@ -1,0 +1,88 @@
+// The ceiling bench's report, JSON and text (the measurement: ceiling_bench.cpp).
+#include "ceiling_bench.h"
+
+#include <sstream>
+#include <vector>
+
+namespace pinball::bench {
+namespace {
+
+nlohmann::json player_json(const CeilingPlayerReport& r) {
+  return {{"mean_score_per_ball", r.score.mean()},
+          {"score_ci95_half_width", r.score.ci95_half_width()},
+          {"score_stddev", r.score.stddev()},
+          {"mean_ball_time_s", r.duration_s.mean()},
+          {"flips_per_ball", r.flips.mean()},
+          {"balls_cut_at_time_limit", r.cut},
+          {"drains_left_outlane", r.drains_left_outlane},
+          {"drains_elsewhere", r.drains_elsewhere},
+          {"drains_left_table", r.left_table},
+          {"decisions_per_ball", r.decisions_per_ball},
+          {"branch_steps_per_ball", r.branch_steps_per_ball},
+          {"wall_s", r.wall_s}};
+}
+
+}  // namespace
+
+nlohmann::json to_json(const CeilingReport& r) {
+  const CeilingBenchOptions& o = r.options;
+  const learn::LookaheadConfig& p = o.planner;
+  nlohmann::json players = {{"ceiling", player_json(r.ceiling)},
+                            {"spastic", player_json(r.spastic)},
+                            {"no_flipping", player_json(r.no_flipping)},
+                            {"tracker_spastic", player_json(r.tracker_spastic)}};
+  if (r.controller) players["controller"] = player_json(*r.controller);
+  return {{"benchmark", "ceiling"},
+          {"board", r.board},
+          {"world_board", r.world_board},
+          {"world", r.world},
+          {"balls", o.balls},
+          {"seed", o.seed},
+          {"threads", o.threads},
+          {"max_ball_time_s", o.max_ball_time_s},
+          {"actuation_delay_s", o.actuation_delay_s},
+          {"pull", o.pull},
+          {"spastic_reach_factor", o.spastic_reach_factor},
+          {"left_outlane_x_m", o.left_outlane_x_m},
+          {"planner",
+           {{"frame_steps", p.frame_steps},
+            {"fire_frames", p.fire_frames},
+            {"hold_frames", p.hold_frames},
+            {"zone_factor", p.zone_factor},
+            {"horizon_s", p.horizon_s},
+            {"drain_penalty", p.drain_penalty}}},
+          {"players", players},
+          {"controller", o.controller_name},
+          {"ceiling_over_spastic", r.ceiling_over_spastic},
+          {"ceiling_over_tracker_spastic", r.ceiling_over_tracker_spastic},
+          {"controller_over_tracker_spastic", r.controller_over_tracker_spastic}};
+}
+
+std::string to_text(const CeilingReport& r) {
+  std::ostringstream out;
+  const CeilingBenchOptions& o = r.options;
+  out << "ceiling reference on " << r.board << " (world: " << r.world_board << " on the " << r.world
+      << " stepper): " << o.balls << " balls per player (seed " << o.seed
+      << "), cut at " << o.max_ball_time_s << " s, actuation delay " << o.actuation_delay_s * 1e3 << " ms\n"
+      << "the ceiling player CHEATS (true state, lookahead with the true simulator): a reference, not a "
+         "controller\n";
+  std::vector<const CeilingPlayerReport*> players = {&r.ceiling, &r.spastic, &r.no_flipping, &r.tracker_spastic};
+  if (r.controller) players.push_back(&*r.controller);
+  for (const CeilingPlayerReport* p : players) {
+    out << "  " << p->name << ": " << p->score.mean() << " +- " << p->score.ci95_half_width()
+        << " per ball (95 %), " << p->duration_s.mean() << " s per ball, " << p->flips.mean()
+        << " flips per ball, " << p->cut << " cut; drains: left outlane " << p->drains_left_outlane << ", elsewhere "
+        << p->drains_elsewhere << "; wall " << p->wall_s << " s\n";
+  }
+  out << "  ceiling planning: " << r.ceiling.decisions_per_ball << " decisions, " << r.ceiling.branch_steps_per_ball
+      << " lookahead steps per ball\n"
+      << "ceiling / spastic: " << r.ceiling_over_spastic << "x; ceiling / spastic through the tracker: "
+      << r.ceiling_over_tracker_spastic << "x\n";
+  if (r.controller) {
+    out << "controller (" << o.controller_name << ") / spastic through the tracker: " << r.controller_over_tracker_spastic
+        << "x\n";
+  }
+  return out.str();
+}
+
+}  // namespace pinball::bench
