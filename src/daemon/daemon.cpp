@@ -32,6 +32,7 @@
 #include "camera_worker.h"
 #include "controller_worker.h"
 #include "driver_worker.h"
+#include "frame_handoff.h"
 #include "handoffs.h"
 #include "sim_worker.h"
 
@@ -103,6 +104,7 @@ struct Daemon::Impl {
   Handoffs h;
   std::unique_ptr<PipelineClock> clock;
   std::unique_ptr<SimWorker> sim_worker;
+  std::unique_ptr<FrameHandoffSource> frame_handoff;  // sim: the camera thread's FrameSource
   std::unique_ptr<CameraWorker> camera_worker;
   std::unique_ptr<ControllerWorker> controller_worker;
   std::unique_ptr<DriverWorker> driver_worker;
@@ -264,11 +266,17 @@ void Daemon::Impl::warm_up_bus() {
 
 // One worker per thread, each borrowing only what its thread uses.
 void Daemon::Impl::make_workers() {
-  const CameraInput input = world ? CameraInput::kSimulator
-                                  : config.camera.source == "lcm" ? CameraInput::kLcm : CameraInput::kCapture;
-  if (world) sim_worker = std::make_unique<SimWorker>(h, *world, *lcm, lockstep, static_cast<int>(board.flippers.size()));
-  camera_worker = std::make_unique<CameraWorker>(h, *camera_stage, *lcm, input, capture.get(),
-                                                 vision::is_device_source(config.camera.device), lcm_observations);
+  const CameraInput input = config.camera.source == "lcm" ? CameraInput::kLcm : CameraInput::kFrames;
+  if (world) {
+    sim_worker = std::make_unique<SimWorker>(h, *world, *lcm, lockstep, static_cast<int>(board.flippers.size()));
+    frame_handoff = std::make_unique<FrameHandoffSource>(
+        h, config.camera.fps, cv::Size(config.camera.width_px, config.camera.height_px));
+  }
+  vision::FrameSource* frames = world ? static_cast<vision::FrameSource*>(frame_handoff.get()) : capture.get();
+  camera_worker = std::make_unique<CameraWorker>(
+      h, *camera_stage, *lcm, input, frames, frame_handoff.get(),
+      !world && vision::is_device_source(config.camera.device), lcm_observations,
+      cv::Size(config.camera.width_px, config.camera.height_px));
   controller_worker =
       std::make_unique<ControllerWorker>(h, *controller_stage, *bus, *lcm, *clock, 1.0 / config.camera.fps);
   driver_worker = std::make_unique<DriverWorker>(h, *bus, *lcm, *clock, driver_of_flipper);
