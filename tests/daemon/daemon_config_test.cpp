@@ -77,6 +77,17 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
   EXPECT_NE(error_of("camera: {fps: [").find("t.yaml:1: not valid YAML"), std::string::npos);
 }
 
+TEST(DaemonConfig, TheWorldIsReadApartFromTheBelief) {
+  const DaemonConfig c =
+      daemon_config_from_yaml("sim: {board: a.board, world_board: b.board, stepper: event}", "t.yaml");
+  EXPECT_EQ(c.sim.board, "a.board");
+  EXPECT_EQ(c.sim.world_board, "b.board");
+  EXPECT_EQ(c.sim.stepper, sim::StepperKind::kEvent);
+  EXPECT_EQ(daemon_config_from_yaml("", "t.yaml").sim.stepper, sim::StepperKind::kThesis);
+  EXPECT_EQ(error_of("sim: {stepper: euler}"),
+            "t.yaml: sim.stepper: unknown stepper 'euler' (expected thesis or event)");
+}
+
 TEST(DaemonConfig, LabModeNeedsItsHardware) {
   EXPECT_EQ(error_of("mode: lab"), "t.yaml: camera.source: cannot be sim in mode lab");
   EXPECT_EQ(error_of("mode: lab\ncamera: {source: v4l2}"), "t.yaml: camera.device: is required in mode lab");
