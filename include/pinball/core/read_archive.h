@@ -1,0 +1,178 @@
+#pragma once
+// The one checked key reader: fills any struct with a Serialize() (see
+// name_value.h) from a YAML or JSON document, naming `file:key.path` in every
+// error and refusing wrong types ("expected an integer"), integers that do
+// not fit the field, non-finite numbers and, unless told otherwise, unknown
+// keys. `Doc` adapts one document type (yaml_read_archive.h,
+// json_read_archive.h); this file knows no parser.
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <set>
+#include <string>
+#include <system_error>
+#include <type_traits>
+#include <utility>
+
+#include "pinball/core/name_value.h"
+
+namespace pinball {
+
+/// What a reader does with keys the file has and the struct lacks, and the reverse.
+struct ReadOptions {
+  bool refuse_unknown_keys = true;  ///< a key the struct lacks is an error: a misspelt key must not silently keep a default
+  bool require_every_key = false;   ///< a key the file lacks is an error; false: the field keeps its default (std::optional may always be absent)
+};
+
+/// How a document's value parsed as an integer.
+enum class IntegerParse { kOk, kNotInteger, kOutOfRange };
+
+/// Parses a whole decimal integer (an optional leading '+').
+template <class I>
+IntegerParse parse_decimal_integer(const std::string& text, I* out) {
+  const char* first = text.data();
+  const char* last = first + text.size();
+  if (first != last && *first == '+') ++first;
+  const auto [end, ec] = std::from_chars(first, last, *out);
+  if (ec == std::errc::result_out_of_range) return IntegerParse::kOutOfRange;
+  return ec == std::errc() && end == last ? IntegerParse::kOk : IntegerParse::kNotInteger;
+}
+
+/// Reads documents of one kind into Serialize() structs. `Doc` gives `Node`
+/// and is_null, is_map, is_list, find, keys, size, at, get_bool, get_int,
+/// get_uint, get_double, get_string.
+template <class Doc>
+class ReadArchive {
+ public:
+  using Node = typename Doc::Node;
+
+  /// `file` names the document in every error.
+  explicit ReadArchive(std::string file, ReadOptions options = {}) : file_(std::move(file)), options_(options) {}
+
+  /// Reads `node` into `out`; `key` is its path in the file ("" at the top).
+  /// Throws KeyError.
+  template <class T>
+  void read(const Node& node, const std::string& key, T* out) {
+    read_value(node, key, out);
+  }
+
+  /// One field of the struct being read (called by Serialize).
+  template <class T>
+  void Visit(const NameValue<T>& field) {
+    frame_->used.insert(field.name);
+    const std::string key = join_key(frame_->path, field.name);
+    const std::optional<Node> child = Doc::find(frame_->node, field.name);
+    if (!child) {
+      if constexpr (archive_detail::kIsOptional<T>) {
+        field.value->reset();
+      } else if (options_.require_every_key) {
+        fail(key, "missing");
+      }
+      return;
+    }
+    read_value(*child, key, field.value);
+  }
+
+  /// Throws KeyError(file, key, message): the one way a reader reports.
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const {
+    throw KeyError(file_, key, message);
+  }
+
+  const std::string& file() const { return file_; }  ///< the document's name
+
+ private:
+  // The mapping a Serialize() is walking and the keys it has used.
+  struct Frame {
+    Node node;
+    std::string path;
+    std::set<std::string> used;
+  };
+
+  template <class T>
+  void read_value(const Node& n, const std::string& key, T* out) {
+    using archive_detail::FixedList;
+    if constexpr (std::is_same_v<T, bool>) {
+      if (!Doc::get_bool(n, out)) fail(key, "expected true or false");
+    } else if constexpr (std::is_integral_v<T>) {
+      read_integer(n, key, out);
+    } else if constexpr (std::is_floating_point_v<T>) {
+      double v = 0.0;
+      if (!Doc::get_double(n, &v) || !std::isfinite(v)) fail(key, "expected a finite number");
+      *out = static_cast<T>(v);
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      if (!Doc::get_string(n, out)) fail(key, "expected text");
+    } else if constexpr (std::is_enum_v<T>) {
+      std::string text;
+      read_value(n, key, &text);
+      try {
+        *out = EnumText<T>::parse(text);
+      } catch (const std::invalid_argument& e) {
+        fail(key, e.what());
+      }
+    } else if constexpr (archive_detail::kIsOptional<T>) {
+      read_value(n, key, &out->emplace());
+    } else if constexpr (archive_detail::kIsVector<T>) {
+      if (!Doc::is_list(n)) fail(key, "expected a list");
+      out->assign(Doc::size(n), typename T::value_type{});
+      for (std::size_t i = 0; i < out->size(); ++i) read_value(Doc::at(n, i), index_key(key, i), &(*out)[i]);
+    } else if constexpr (FixedList<T>) {
+      constexpr std::size_t size = archive_detail::fixed_size<T>();
+      if (!Doc::is_list(n) || Doc::size(n) != size) fail(key, "expected a list of " + std::to_string(size));
+      for (std::size_t i = 0; i < size; ++i) read_value(Doc::at(n, i), index_key(key, i), &(*out)[i]);
+    } else {
+      static_assert(requires(T& t, ReadArchive* a) { t.Serialize(a); }, "a field type the archive cannot read");
+      read_struct(n, key, out);
+    }
+  }
+
+  // Integers go through 64 bits and must fit the field: 300 is refused for a
+  // uint8_t, not wrapped to 44.
+  template <class T>
+  void read_integer(const Node& n, const std::string& key, T* out) {
+    std::int64_t s = 0;
+    std::uint64_t u = 0;
+    IntegerParse r = IntegerParse::kNotInteger;
+    bool fits = false;
+    if constexpr (std::is_signed_v<T>) {
+      r = Doc::get_int(n, &s);
+      fits = r == IntegerParse::kOk && std::in_range<T>(s);
+      if (fits) *out = static_cast<T>(s);
+    } else {
+      r = Doc::get_uint(n, &u);
+      if (r == IntegerParse::kNotInteger && Doc::get_int(n, &s) == IntegerParse::kOk) r = IntegerParse::kOutOfRange;
+      fits = r == IntegerParse::kOk && std::in_range<T>(u);
+      if (fits) *out = static_cast<T>(u);
+    }
+    if (fits) return;
+    if (r == IntegerParse::kNotInteger) fail(key, "expected an integer");
+    fail(key, "expected an integer in [" + std::to_string(std::numeric_limits<T>::min()) + ", " +
+                  std::to_string(std::numeric_limits<T>::max()) + "]");
+  }
+
+  template <class T>
+  void read_struct(const Node& n, const std::string& path, T* out) {
+    if (Doc::is_null(n) && !options_.require_every_key) return;  // an empty section keeps its defaults
+    if (!Doc::is_map(n)) fail(path.empty() ? "(top)" : path, "expected a mapping");
+    Frame frame{n, path, {}};
+    Frame* const outer = std::exchange(frame_, &frame);
+    out->Serialize(this);
+    frame_ = outer;
+    if (!options_.refuse_unknown_keys) return;
+    for (const std::string& k : Doc::keys(n)) {
+      if (!frame.used.count(k)) fail(join_key(path, k), "unknown key");
+    }
+  }
+
+  static std::string index_key(const std::string& key, std::size_t i) {
+    return key + "[" + std::to_string(i) + "]";
+  }
+
+  std::string file_;
+  ReadOptions options_;
+  Frame* frame_ = nullptr;
+};
+
+}  // namespace pinball

@@ -1,0 +1,70 @@
+#pragma once
+// ReadArchive over yaml-cpp: reads a YAML document into a Serialize() struct.
+// Header-only so that pinball_core links Eigen alone; a target that includes
+// it links yaml-cpp.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "pinball/core/read_archive.h"
+
+namespace pinball {
+
+/// yaml-cpp as a ReadArchive document. Scalars are text; numbers and
+/// booleans are parsed from it.
+struct YamlDoc {
+  using Node = YAML::Node;
+  static bool is_null(const Node& n) { return !n || n.IsNull(); }
+  static bool is_map(const Node& n) { return n.IsMap(); }
+  static bool is_list(const Node& n) { return n.IsSequence(); }
+  static std::optional<Node> find(const Node& map, const char* key) {
+    if (!map.IsMap()) return std::nullopt;
+    const Node child = map[key];
+    return child ? std::optional<Node>(child) : std::nullopt;
+  }
+  static std::vector<std::string> keys(const Node& map) {
+    std::vector<std::string> out;
+    for (const auto& kv : map) out.push_back(kv.first.Scalar());
+    return out;
+  }
+  static std::size_t size(const Node& list) { return list.size(); }
+  static Node at(const Node& list, std::size_t i) { return list[i]; }
+  static bool get_bool(const Node& n, bool* out) { return n.IsScalar() && YAML::convert<bool>::decode(n, *out); }
+  static bool get_double(const Node& n, double* out) {
+    return n.IsScalar() && YAML::convert<double>::decode(n, *out);
+  }
+  static bool get_string(const Node& n, std::string* out) {
+    if (!n.IsScalar()) return false;
+    *out = n.Scalar();
+    return true;
+  }
+  static IntegerParse get_int(const Node& n, std::int64_t* out) {
+    return n.IsScalar() ? parse_decimal_integer(n.Scalar(), out) : IntegerParse::kNotInteger;
+  }
+  static IntegerParse get_uint(const Node& n, std::uint64_t* out) {
+    return n.IsScalar() ? parse_decimal_integer(n.Scalar(), out) : IntegerParse::kNotInteger;
+  }
+};
+
+/// Reads YAML into Serialize() structs.
+using YamlReadArchive = ReadArchive<YamlDoc>;
+
+/// YAML that does not parse; key() is the line number ("file:line: message").
+class YamlSyntaxError : public KeyError {
+ public:
+  using KeyError::KeyError;
+};
+
+/// Parses YAML text. Throws YamlSyntaxError.
+inline YAML::Node load_yaml(const std::string& text, const std::string& file) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw YamlSyntaxError(file, std::to_string(e.mark.line + 1), e.msg);
+  }
+}
+
+}  // namespace pinball

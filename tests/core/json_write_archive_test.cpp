@@ -1,0 +1,73 @@
+#include "pinball/core/json_write_archive.h"
+
+#include <gtest/gtest.h>
+
+#include "core/archive_test_types.h"
+#include "pinball/core/json_read_archive.h"
+
+namespace pinball {
+namespace {
+
+using archive_test::Colour;
+using archive_test::Everything;
+using archive_test::Inner;
+using nlohmann::json;
+
+Everything sample() {
+  Everything e;
+  e.flag = true;
+  e.small = 200;
+  e.seed = UINT64_MAX;
+  e.g_mps2 = 1.0 / 3.0;
+  e.colour = Colour::kGreen;
+  e.inners = {Inner{2.0, "a"}};
+  e.maybe = Inner{3.0, "b"};
+  return e;
+}
+
+TEST(JsonWriteArchive, WritesEveryFieldUnderItsName) {
+  const json j = to_json_value(sample());
+  EXPECT_EQ(j, json::parse(R"({
+    "flag": true, "count": 3, "small": 200, "big": -5, "seed": 18446744073709551615,
+    "g_mps2": 0.3333333333333333, "name": "default", "colour": "green", "values": [1.0, 2.0],
+    "triple": [1, 2, 3], "p_m": [0.5, 0.25], "inner": {"x_m": 1.5, "label": "in"},
+    "inners": [{"x_m": 2.0, "label": "a"}], "maybe": {"x_m": 3.0, "label": "b"}})"));
+  EXPECT_TRUE(j["small"].is_number_unsigned());
+  EXPECT_TRUE(j["count"].is_number_integer());
+}
+
+TEST(JsonWriteArchive, AnEmptyOptionalWritesNoKey) {
+  EXPECT_FALSE(to_json_value(Everything{}).contains("maybe"));
+}
+
+TEST(JsonReadArchive, ReadsBackWhatWasWritten) {
+  const json j = to_json_value(sample());
+  Everything e;
+  JsonReadArchive("t.json").read(&j, "", &e);
+  EXPECT_EQ(to_json_value(e), j);
+  EXPECT_EQ(e.g_mps2, 1.0 / 3.0);  // bit for bit
+}
+
+TEST(JsonReadArchive, TypesAreTheDocumentsOwn) {
+  auto error_of = [](const std::string& text) -> std::string {
+    const json j = json::parse(text);
+    Everything e;
+    try {
+      JsonReadArchive("t.json").read(&j, "", &e);
+    } catch (const KeyError& k) {
+      return k.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error_of(R"({"count": "3"})"), "t.json:count: expected an integer");
+  EXPECT_EQ(error_of(R"({"count": 3.5})"), "t.json:count: expected an integer");
+  EXPECT_EQ(error_of(R"({"small": 256})"), "t.json:small: expected an integer in [0, 255]");
+  EXPECT_EQ(error_of(R"({"seed": -1})"), "t.json:seed: expected an integer in [0, 18446744073709551615]");
+  EXPECT_EQ(error_of(R"({"flag": 1})"), "t.json:flag: expected true or false");
+  EXPECT_EQ(error_of(R"({"inner": {"lable": "x"}})"), "t.json:inner.lable: unknown key");
+  EXPECT_EQ(error_of(R"({"g_mps2": null})"), "t.json:g_mps2: expected a finite number");
+  EXPECT_EQ(error_of(R"({"count": 4})"), "");
+}
+
+}  // namespace
+}  // namespace pinball
