@@ -57,16 +57,18 @@ lcm_url: "udpm://239.255.76.67:7667?ttl=0"
 
 TEST(DaemonConfig, ErrorsNameTheKey) {
   EXPECT_EQ(error_of("camera: {fsp: 200}"), "t.yaml: camera.fsp: unknown key");
-  EXPECT_EQ(error_of("sim: {balls: many}"), "t.yaml: sim.balls: has the wrong type");
+  EXPECT_EQ(error_of("sim: {balls: many}"), "t.yaml: sim.balls: expected an integer");
   EXPECT_EQ(error_of("version: 2"), "t.yaml: version: is 2, this build reads 1");
   EXPECT_EQ(error_of("coils: {hold_duty_pct: 150}"), "t.yaml: coils.hold_duty_pct: must be in [0, 100]");
   EXPECT_EQ(error_of("camera: {fps: 0}"), "t.yaml: camera.fps: must be in (0, 10000]");
   EXPECT_EQ(error_of("can: {watchdog_timeout_s: 0.03}"),
             "t.yaml: can.watchdog_timeout_s: must be at least 3 heartbeat periods");
   EXPECT_EQ(error_of("mode: arcade"), "t.yaml: mode: must be sim or lab");
-  EXPECT_EQ(error_of("camera: 5"), "t.yaml: camera: must be a mapping");
+  EXPECT_EQ(error_of("camera: 5"), "t.yaml: camera: expected a mapping");
   EXPECT_EQ(error_of("threads: {priorities: {camera: 120}}"), "t.yaml: threads.priorities.camera: must be in [0, 99]");
   EXPECT_EQ(error_of("threads: {priorities: {gpu: 1}}"), "t.yaml: threads.priorities.gpu: unknown key");
+  EXPECT_EQ(error_of("coils: {pulse_ms: 300}"), "t.yaml: coils.pulse_ms: expected an integer in [0, 255]");
+  EXPECT_EQ(error_of("sim: {stepper: rk4}"), "t.yaml: sim.stepper: unknown stepper 'rk4' (expected thesis or event)");
   EXPECT_EQ(error_of("threads: {chain_cpu: fast}"), "t.yaml: threads.chain_cpu: must be auto, off or a CPU number");
   EXPECT_EQ(error_of("threads: {chain_cpu: -3}"), "t.yaml: threads.chain_cpu: must be auto, off or a CPU number");
   EXPECT_EQ(error_of("threads: {chain_cpu: 1023}")

@@ -3,16 +3,18 @@
 // every key). Without a file the defaults run the embedded simulation of
 // boards/mit1993.board over memq:// with the shipped controller. Loading is
 // all or nothing: a bad file throws ConfigError naming the file and the key.
+// Each struct lists its keys once, in Serialize(); core/yaml_read_archive.h
+// reads them (unknown keys refused, missing keys keep the defaults below).
 
 #include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
 
+#include "pinball/core/name_value.h"
 #include "pinball/firmware/flipper_actuation.h"
-#include "pinball/sim/world.h"
-
 #include "pinball/firmware/messages.h"
+#include "pinball/sim/world.h"
 
 namespace pinball::daemon {
 
@@ -28,6 +30,17 @@ struct CameraSettings {
   double fps = 200.0;             ///< requested frame rate (frames per second)
   double stall_timeout_s = 0.02;  ///< no frame (or no ball while a flipper is up) this long: release all (s)
   int background_frames = 30;     ///< ball-free frames averaged into the detector's background at start
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(source));
+    a->Visit(PINBALL_NVP(device));
+    a->Visit(PINBALL_NVP(width_px));
+    a->Visit(PINBALL_NVP(height_px));
+    a->Visit(PINBALL_NVP(fps));
+    a->Visit(PINBALL_NVP(stall_timeout_s));
+    a->Visit(PINBALL_NVP(background_frames));
+  }
 };
 
 /// The CAN link to the solenoid driver board.
@@ -37,6 +50,28 @@ struct CanSettings {
   double heartbeat_period_s = 0.02;  ///< heartbeat period (s)
   double watchdog_timeout_s = 0.1;   ///< the board switches everything off after this silence (s)
   std::string log;                   ///< candump-format log of every frame (empty: none); in the lab `candump -l` does the same
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(interface));
+    a->Visit(PINBALL_NVP(board_id));
+    a->Visit(PINBALL_NVP(heartbeat_period_s));
+    a->Visit(PINBALL_NVP(watchdog_timeout_s));
+    a->Visit(PINBALL_NVP(log));
+  }
+};
+
+/// The keys of threads.priorities, in ThreadId order.
+inline constexpr std::array<const char*, 5> kPriorityKeys{"driver", "controller", "camera", "sim", "lcm"};
+
+/// Thread priorities as the file spells them: one key per thread.
+struct PriorityKeys {
+  std::array<int, 5>* priorities;  ///< ThreadSettings::priorities
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    for (std::size_t i = 0; i < kPriorityKeys.size(); ++i) a->Visit(make_name_value(kPriorityKeys[i], &(*priorities)[i]));
+  }
 };
 
 /// Real-time scheduling of the daemon's threads (the table is in thread_table.h).
@@ -54,6 +89,16 @@ struct ThreadSettings {
   /// leave it alone). 0 keeps idle cores polling instead of sleeping, so that
   /// waking a thread costs microseconds, not a deep-idle exit (needs root).
   int cpu_dma_latency_us = -1;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(realtime));
+    a->Visit(PINBALL_NVP(enforce));
+    PriorityKeys keys{&priorities};  // the file names each thread
+    a->Visit(make_name_value("priorities", &keys));
+    a->Visit(PINBALL_NVP(chain_cpu));
+    a->Visit(PINBALL_NVP(cpu_dma_latency_us));
+  }
 };
 
 /// The embedded simulation.
@@ -66,6 +111,18 @@ struct SimSettings {
   bool realtime = false;                       ///< pace to the wall clock (default: lockstep, as fast as possible)
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;            ///< coil on -> flipper moves (s)
   double max_ball_time_s = 60.0;               ///< a ball alive this long is cut (s)
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(board));
+    a->Visit(PINBALL_NVP(world_board));
+    a->Visit(PINBALL_NVP(stepper));
+    a->Visit(PINBALL_NVP(balls));
+    a->Visit(PINBALL_NVP(seed));
+    a->Visit(PINBALL_NVP(realtime));
+    a->Visit(PINBALL_NVP(actuation_delay_s));
+    a->Visit(PINBALL_NVP(max_ball_time_s));
+  }
 };
 
 /// Everything pinballd reads.
@@ -81,6 +138,21 @@ struct DaemonConfig {
   std::string controller = "controllers/best.json";  ///< controller file (docs/learning.md)
   std::string lcm_url = "memq://";                   ///< LCM provider URL
   ThreadSettings threads;                            ///< scheduling
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(version));
+    a->Visit(PINBALL_NVP(mode));
+    a->Visit(PINBALL_NVP(sim));
+    a->Visit(PINBALL_NVP(camera));
+    a->Visit(PINBALL_NVP(board));
+    a->Visit(PINBALL_NVP(calibration));
+    a->Visit(PINBALL_NVP(can));
+    a->Visit(PINBALL_NVP(coils));
+    a->Visit(PINBALL_NVP(controller));
+    a->Visit(PINBALL_NVP(lcm_url));
+    a->Visit(PINBALL_NVP(threads));
+  }
 };
 
 /// Bad configuration; what() is "file: key: message".
@@ -97,3 +169,10 @@ DaemonConfig load_daemon_config(const std::string& path);
 void validate_daemon_config(const DaemonConfig& config, const std::string& source_name);
 
 }  // namespace pinball::daemon
+
+/// The stepper as the file spells it: thesis | event.
+template <>
+struct pinball::EnumText<pinball::sim::StepperKind> {
+  static std::string name(sim::StepperKind kind) { return std::string(sim::stepper_kind_name(kind)); }
+  static sim::StepperKind parse(const std::string& text) { return sim::parse_stepper_kind(text); }
+};

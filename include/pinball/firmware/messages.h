@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <variant>
 
+#include "pinball/core/name_value.h"
 #include "pinball/firmware/protocol.h"
 
 namespace pinball::firmware {
@@ -16,6 +17,16 @@ struct DriverConfig {
   std::uint8_t max_pulse_ms = kDefaultMaxPulseMs;     ///< per-driver pulse cap (ms)
   std::uint16_t max_hold_ms = kDefaultMaxHoldMs;      ///< per-driver hold cap (ms)
   std::uint8_t recycle_ms = kDefaultRecycleMs;        ///< off time required before the next Fire (ms)
+
+  /// The fields under their own names (pinballd's `coils` section).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(pulse_ms));
+    a->Visit(PINBALL_NVP(hold_duty_pct));
+    a->Visit(PINBALL_NVP(max_pulse_ms));
+    a->Visit(PINBALL_NVP(max_hold_ms));
+    a->Visit(PINBALL_NVP(recycle_ms));
+  }
 };
 
 /// Start of a session.
