@@ -4,12 +4,12 @@
 #include <cmath>
 #include <ctime>
 #include <fstream>
-#include <initializer_list>
-#include <utility>
 #include <sstream>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
+
+#include "pinball/core/yaml_read_archive.h"
 
 namespace pinball::calibration {
 namespace {
@@ -28,129 +28,34 @@ void emit_vec2(YAML::Emitter& e, const char* key, const Vec2& v, const char* com
   if (comment) e << YAML::Comment(comment);
 }
 
-// Reads keys of one file, naming file:key in every error.
-class Reader {
- public:
-  explicit Reader(std::string name) : name_(std::move(name)) {}
-
-  [[noreturn]] void fail(const std::string& key, const std::string& what) const {
-    throw std::runtime_error(name_ + ":" + key + ": " + what);
-  }
-  YAML::Node need(const YAML::Node& parent, const std::string& path, const char* key) const {
-    if (!parent.IsMap()) fail(path, "expected a mapping");
-    const YAML::Node n = parent[key];
-    if (!n) fail(join(path, key), "missing");
-    return n;
-  }
-  double number(const YAML::Node& parent, const std::string& path, const char* key) const {
-    const YAML::Node n = need(parent, path, key);
-    double v = 0.0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v)) {
-      fail(join(path, key), "expected a finite number");
-    }
-    return v;
-  }
-  // Several finite numbers of one mapping, each into its field, in order (the first missing or bad one is named).
-  void numbers_into(const YAML::Node& parent, const std::string& path,
-                    std::initializer_list<std::pair<const char*, double*>> fields) const {
-    for (const auto& [key, field] : fields) *field = number(parent, path, key);
-  }
-  int integer(const YAML::Node& parent, const std::string& path, const char* key) const {
-    const YAML::Node n = need(parent, path, key);
-    int v = 0;
-    if (!n.IsScalar() || !YAML::convert<int>::decode(n, v)) fail(join(path, key), "expected an integer");
-    return v;
-  }
-  std::string text(const YAML::Node& parent, const std::string& path, const char* key) const {
-    const YAML::Node n = need(parent, path, key);
-    if (!n.IsScalar()) fail(join(path, key), "expected text");
-    return n.Scalar();
-  }
-  std::vector<double> numbers(const YAML::Node& n, const std::string& path, std::size_t size) const {
-    if (!n.IsSequence() || (size > 0 && n.size() != size)) {
-      fail(path, size > 0 ? "expected a list of " + std::to_string(size) + " numbers" : "expected a list of numbers");
-    }
-    std::vector<double> out;
-    for (std::size_t i = 0; i < n.size(); ++i) {
-      double v = 0.0;
-      if (!n[i].IsScalar() || !YAML::convert<double>::decode(n[i], v) || !std::isfinite(v)) {
-        fail(path + "[" + std::to_string(i) + "]", "expected a finite number");
-      }
-      out.push_back(v);
-    }
-    return out;
-  }
-  Vec2 vec2(const YAML::Node& parent, const std::string& path, const char* key) const {
-    const std::vector<double> v = numbers(need(parent, path, key), join(path, key), 2);
-    return {v[0], v[1]};
-  }
-  static std::string join(const std::string& path, const std::string& key) {
-    return path.empty() ? key : path + "." + key;
-  }
-  const std::string& name() const { return name_; }
-
- private:
-  std::string name_;
-};
-
-CameraCalibration read_camera(const Reader& r, const YAML::Node& n) {
-  const std::string p = "camera";
-  CameraCalibration c;
-  c.image_width_px = r.integer(n, p, "image_width_px");
-  c.image_height_px = r.integer(n, p, "image_height_px");
-  const YAML::Node m = r.need(n, p, "image_from_board");
-  if (!m.IsSequence() || m.size() != 3) r.fail(p + ".image_from_board", "expected 3 rows of 3 numbers");
-  for (int i = 0; i < 3; ++i) {
-    const std::vector<double> row = r.numbers(m[i], p + ".image_from_board[" + std::to_string(i) + "]", 3);
-    for (int j = 0; j < 3; ++j) c.image_from_board(i, j) = row[static_cast<std::size_t>(j)];
-  }
-  if (!(std::abs(cv::determinant(c.image_from_board)) > 0.0)) r.fail(p + ".image_from_board", "singular matrix");
-  c.markers_used = r.integer(n, p, "markers_used");
-  c.reprojection_rms_px = r.number(n, p, "reprojection_rms_px");
-  c.reprojection_max_px = r.number(n, p, "reprojection_max_px");
-  if (c.image_width_px <= 0 || c.image_height_px <= 0) r.fail(p + ".image_width_px", "image size must be > 0");
-  return c;
-}
-
-FlipperCalibration read_flipper(const Reader& r, const YAML::Node& n, const std::string& p) {
-  FlipperCalibration f;
-  f.name = r.text(n, p, "name");
-  const std::string side = r.text(n, p, "side");
-  if (side != "left" && side != "right") r.fail(p + ".side", "expected left or right");
-  f.side = side == "left" ? table::Side::kLeft : table::Side::kRight;
-  const std::string method = r.text(n, p, "method");
-  if (method != "markers" && method != "markerless") r.fail(p + ".method", "expected markers or markerless");
-  f.method = method == "markers" ? FlipperMethod::kMarkers : FlipperMethod::kMarkerless;
-  f.pivot_m = r.vec2(n, p, "pivot_m");
-  f.tip_m = r.vec2(n, p, "tip_m");
-  r.numbers_into(n, p, {{"length_m", &f.length_m}, {"theta_min_rad", &f.theta_min_rad},
-                        {"theta_max_rad", &f.theta_max_rad}, {"fit_rms_m", &f.fit_rms_m}});
-  f.points = r.integer(n, p, "points");
+// The checks a type cannot express, after reading.
+void check_flipper(const FlipperCalibration& f, const std::string& p, const YamlReadArchive& r) {
   if (!(f.length_m > 0.0)) r.fail(p + ".length_m", "must be > 0");
   if (!(f.theta_max_rad > f.theta_min_rad)) r.fail(p + ".theta_max_rad", "must be above theta_min_rad");
-  if (n["disagreement"]) {
-    const std::string q = p + ".disagreement";
-    const YAML::Node d = n["disagreement"];
-    FlipperDisagreement g;
-    r.numbers_into(d, q, {{"pivot_m", &g.pivot_m}, {"tip_m", &g.tip_m}, {"length_m", &g.length_m},
-                          {"theta_min_rad", &g.theta_min_rad}, {"theta_max_rad", &g.theta_max_rad}});
-    f.disagreement = g;
-  }
-  return f;
 }
 
-GravityEstimate read_gravity(const Reader& r, const YAML::Node& n) {
-  const std::string p = "gravity";
-  GravityEstimate g;
-  r.numbers_into(n, p, {{"g_mps2", &g.g_mps2}, {"ci_low_mps2", &g.ci_low_mps2}, {"ci_high_mps2", &g.ci_high_mps2},
-                        {"confidence", &g.confidence}});
-  g.rolls_used = r.integer(n, p, "rolls_used");
-  g.rolls_rejected = r.integer(n, p, "rolls_rejected");
-  g.per_roll_mps2 = r.numbers(r.need(n, p, "per_roll_mps2"), p + ".per_roll_mps2", 0);
-  if (!(g.g_mps2 > 0.0)) r.fail(p + ".g_mps2", "must be > 0");
-  if (!(g.ci_low_mps2 <= g.g_mps2 && g.g_mps2 <= g.ci_high_mps2)) r.fail(p + ".ci_low_mps2", "the interval must hold g_mps2");
-  return g;
+void check_calibration(const Calibration& c, const YamlReadArchive& r) {
+  if (c.camera) {
+    const CameraCalibration& k = *c.camera;
+    if (!(std::abs(cv::determinant(k.image_from_board)) > 0.0)) r.fail("camera.image_from_board", "singular matrix");
+    if (k.image_width_px <= 0 || k.image_height_px <= 0) r.fail("camera.image_width_px", "image size must be > 0");
+  }
+  for (std::size_t i = 0; i < c.flippers.size(); ++i) check_flipper(c.flippers[i], "flippers[" + std::to_string(i) + "]", r);
+  if (c.gravity) {
+    const GravityEstimate& g = *c.gravity;
+    if (!(g.g_mps2 > 0.0)) r.fail("gravity.g_mps2", "must be > 0");
+    if (!(g.ci_low_mps2 <= g.g_mps2 && g.g_mps2 <= g.ci_high_mps2)) r.fail("gravity.ci_low_mps2", "the interval must hold g_mps2");
+  }
 }
+
+// The version alone, read first: a file of another version is refused as such.
+struct VersionKey {
+  int version = 0;
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(version));
+  }
+};
 
 }  // namespace
 
@@ -233,31 +138,19 @@ void write_calibration(const Calibration& calibration, const std::string& path) 
 }
 
 Calibration parse_calibration(const std::string& text, const std::string& name) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw std::runtime_error(name + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
-  const Reader r(name);
+  const YAML::Node root = load_yaml(text, name);
+  // Every key is required; sections and `disagreement` are optional.
+  YamlReadArchive r(name, {.refuse_unknown_keys = false, .require_every_key = true});
   if (!root.IsMap()) r.fail("version", "missing (not a calibration file)");
-  Calibration c;
-  c.version = r.integer(root, "", "version");
-  if (c.version != kCalibrationFileVersion) {
-    r.fail("version", std::to_string(c.version) + " is not the supported version " +
+  VersionKey v;
+  r.read(root, "", &v);
+  if (v.version != kCalibrationFileVersion) {
+    r.fail("version", std::to_string(v.version) + " is not the supported version " +
                           std::to_string(kCalibrationFileVersion));
   }
-  c.date = r.text(root, "", "date");
-  c.board = r.text(root, "", "board");
-  if (root["camera"]) c.camera = read_camera(r, root["camera"]);
-  if (root["flippers"]) {
-    const YAML::Node fl = root["flippers"];
-    if (!fl.IsSequence()) r.fail("flippers", "expected a list");
-    for (std::size_t i = 0; i < fl.size(); ++i) {
-      c.flippers.push_back(read_flipper(r, fl[i], "flippers[" + std::to_string(i) + "]"));
-    }
-  }
-  if (root["gravity"]) c.gravity = read_gravity(r, root["gravity"]);
+  Calibration c;
+  r.read(root, "", &c);
+  check_calibration(c, r);
   return c;
 }
 

@@ -4,15 +4,19 @@
 // along the table. Every section is optional in the file (each `pinball
 // calibrate` kind writes its own and keeps the others); what a consumer needs
 // it asks for by name, and a missing or bad key is reported as file:key.
-// Format field by field: docs/calibration.md.
+// Format field by field: docs/calibration.md. Each struct lists its keys once,
+// in Serialize(); core/yaml_read_archive.h reads them, every key required.
 
+#include <array>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "pinball/core/geometry.h"
+#include "pinball/core/name_value.h"
 #include "pinball/table/board.h"
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/track/tracker.h"
@@ -31,6 +35,22 @@ struct CameraCalibration {
   int markers_used = 0;               ///< markers matched and kept by RANSAC
   double reprojection_rms_px = 0.0;   ///< RMS distance between detected and reprojected markers (px)
   double reprojection_max_px = 0.0;   ///< largest such distance (px)
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(image_width_px));
+    a->Visit(PINBALL_NVP(image_height_px));
+    // The matrix as 3 rows of 3 numbers, through a copy (cv::Matx is not a list).
+    std::array<std::array<double, 3>, 3> rows{};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] = image_from_board(i, j);
+    a->Visit(make_name_value("image_from_board", &rows));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) image_from_board(i, j) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+    a->Visit(PINBALL_NVP(markers_used));
+    a->Visit(PINBALL_NVP(reprojection_rms_px));
+    a->Visit(PINBALL_NVP(reprojection_max_px));
+  }
 };
 
 /// How a flipper's geometry was measured.
@@ -46,6 +66,15 @@ struct FlipperDisagreement {
   double length_m = 0.0;       ///< difference of lengths (m)
   double theta_min_rad = 0.0;  ///< difference of down stops (rad)
   double theta_max_rad = 0.0;  ///< difference of up stops (rad)
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(pivot_m));
+    a->Visit(PINBALL_NVP(tip_m));
+    a->Visit(PINBALL_NVP(length_m));
+    a->Visit(PINBALL_NVP(theta_min_rad));
+    a->Visit(PINBALL_NVP(theta_max_rad));
+  }
 };
 
 /// One flipper as measured.
@@ -61,6 +90,21 @@ struct FlipperCalibration {
   double fit_rms_m = 0.0;                  ///< markerless: RMS distance of the tip points to the circle about the pivot (m)
   int points = 0;                          ///< markers or tip points behind the figures
   std::optional<FlipperDisagreement> disagreement;  ///< against the other method, when both were run
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(name));
+    a->Visit(PINBALL_NVP(side));
+    a->Visit(PINBALL_NVP(method));
+    a->Visit(PINBALL_NVP(pivot_m));
+    a->Visit(PINBALL_NVP(tip_m));
+    a->Visit(PINBALL_NVP(length_m));
+    a->Visit(PINBALL_NVP(theta_min_rad));
+    a->Visit(PINBALL_NVP(theta_max_rad));
+    a->Visit(PINBALL_NVP(fit_rms_m));
+    a->Visit(PINBALL_NVP(points));
+    a->Visit(PINBALL_NVP(disagreement));
+  }
 };
 
 /// The gravity section.
@@ -72,6 +116,17 @@ struct GravityEstimate {
   int rolls_used = 0;             ///< rolls in the estimate
   int rolls_rejected = 0;         ///< outlier or unusable rolls left out
   std::vector<double> per_roll_mps2;  ///< every usable roll's acceleration, rejected ones too
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(g_mps2));
+    a->Visit(PINBALL_NVP(ci_low_mps2));
+    a->Visit(PINBALL_NVP(ci_high_mps2));
+    a->Visit(PINBALL_NVP(confidence));
+    a->Visit(PINBALL_NVP(rolls_used));
+    a->Visit(PINBALL_NVP(rolls_rejected));
+    a->Visit(PINBALL_NVP(per_roll_mps2));
+  }
 };
 
 /// A whole calibration file.
@@ -82,6 +137,20 @@ struct Calibration {
   std::optional<CameraCalibration> camera; ///< camera section
   std::vector<FlipperCalibration> flippers;///< flippers section (board order)
   std::optional<GravityEstimate> gravity;  ///< gravity section
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(version));
+    a->Visit(PINBALL_NVP(date));
+    a->Visit(PINBALL_NVP(board));
+    a->Visit(PINBALL_NVP(camera));
+    // The section may be absent (an empty list is not written).
+    std::optional<std::vector<FlipperCalibration>> listed;
+    if (!flippers.empty()) listed = flippers;
+    a->Visit(make_name_value("flippers", &listed));
+    flippers = listed.value_or(std::vector<FlipperCalibration>{});
+    a->Visit(PINBALL_NVP(gravity));
+  }
 };
 
 /// Writes `calibration` as YAML to `path` (the date set to now when empty).
@@ -121,3 +190,25 @@ vision::CameraHomography camera_homography(const Calibration& calibration, const
 void apply_calibration(const Calibration& calibration, const std::string& name, table::Board& board);
 
 }  // namespace pinball::calibration
+
+/// A calibrated flipper's side as the file spells it.
+template <>
+struct pinball::EnumText<pinball::table::Side> {
+  static std::string name(table::Side side) { return side == table::Side::kLeft ? "left" : "right"; }
+  static table::Side parse(const std::string& text) {
+    if (text == "left") return table::Side::kLeft;
+    if (text == "right") return table::Side::kRight;
+    throw std::invalid_argument("expected left or right");
+  }
+};
+
+/// A flipper's method as the file spells it.
+template <>
+struct pinball::EnumText<pinball::calibration::FlipperMethod> {
+  static std::string name(calibration::FlipperMethod method) { return calibration::to_string(method); }
+  static calibration::FlipperMethod parse(const std::string& text) {
+    if (text == "markers") return calibration::FlipperMethod::kMarkers;
+    if (text == "markerless") return calibration::FlipperMethod::kMarkerless;
+    throw std::invalid_argument("expected markers or markerless");
+  }
+};
