@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "pinball/core/name_value.h"
 #include "pinball/core/rng.h"
 #include "pinball/track/projection.h"
 
@@ -31,6 +32,15 @@ struct ActionFunctionConfig {
   bool rolling_minicontrollers = false;
   /// Random gains are uniform in [−gain_range[i], +gain_range[i]] (thesis 6.1.3: symmetric about 0).
   std::array<double, 4> gain_range{0.12, 0.2, 0.08, 0.2};
+
+  /// The keys of a controller file (docs/learning.md).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(angle_borders_rad));
+    a->Visit(PINBALL_NVP(h_borders));
+    a->Visit(PINBALL_NVP(rolling_minicontrollers));
+    a->Visit(PINBALL_NVP(gain_range));
+  }
 };
 
 /// k uniform angle bins over [−π/2, π/2] (the thesis's choice, 6.1.1). Throws for k < 1.

@@ -7,6 +7,7 @@
 
 #include "pinball/control/action_function.h"
 #include "pinball/control/flipper_controller.h"
+#include "pinball/core/name_value.h"
 
 namespace pinball::control {
 
@@ -15,6 +16,12 @@ struct ActuatorConfig {
   /// Release a flipper held this long with no launch seen (a cradled ball), and
   /// allow a new approach; 0 disables (the thesis: launch or loss only).
   double max_hold_s = 1.0;
+
+  /// The keys of a controller file (docs/learning.md).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(max_hold_s));
+  }
 };
 
 /// The action function driving the flippers.

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "pinball/control/flipper_controller.h"
+#include "pinball/core/name_value.h"
 #include "pinball/track/projection.h"
 
 namespace pinball::control {
@@ -46,6 +47,17 @@ struct ImitationConfig {
   /// was nearest its choice, so firing at the first frame with d <= d_critical
   /// would be half a frame late on average. Half a 200 fps frame by default.
   double lead_s = 0.0025;
+
+  /// The keys of a controller file (docs/learning.md).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(neighbours));
+    a->Visit(PINBALL_NVP(angle_scale_rad));
+    a->Visit(PINBALL_NVP(h_scale));
+    a->Visit(PINBALL_NVP(speed_scale_mps));
+    a->Visit(PINBALL_NVP(max_hold_s));
+    a->Visit(PINBALL_NVP(lead_s));
+  }
 };
 
 /// Largest k the controller supports (it keeps the neighbours in a fixed array).
