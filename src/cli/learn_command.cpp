@@ -22,6 +22,7 @@
 #include <functional>
 #include <optional>
 #include "pinball/control/spastic_controller.h"
+#include "pinball/core/json_write_archive.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/learn/cross_entropy.h"
 #include "pinball/learn/evaluator.h"
@@ -89,18 +90,34 @@ struct IdleController final : control::FlipperController {
   void reset(std::array<bool, 2>& e) override { e = {false, false}; }
 };
 
+// One controller on fresh balls: the "evaluation" object of --json, written
+// from Serialize() so that each key is spelled once (scripts read these keys).
 struct Evaluation {
-  RunningStats score;
-  RunningStats duration_s;
-  RunningStats flips;
-  int cut = 0;
-  double balls_per_s = 0.0;
+  std::int64_t balls = 0;              // balls played
+  double mean_score_per_ball = 0.0;
+  double score_ci95_half_width = 0.0;  // of the mean score, 95 %
+  double score_stddev = 0.0;
+  double mean_ball_time_s = 0.0;       // simulated (s)
+  double flips_per_ball = 0.0;
+  int balls_cut_at_time_limit = 0;
+  double balls_per_s = 0.0;            // wall clock
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(balls));
+    a->Visit(PINBALL_NVP(mean_score_per_ball));
+    a->Visit(PINBALL_NVP(score_ci95_half_width));
+    a->Visit(PINBALL_NVP(score_stddev));
+    a->Visit(PINBALL_NVP(mean_ball_time_s));
+    a->Visit(PINBALL_NVP(flips_per_ball));
+    a->Visit(PINBALL_NVP(balls_cut_at_time_limit));
+    a->Visit(PINBALL_NVP(balls_per_s));
+  }
 };
 
 // Plays `balls` fresh balls (seeds apart from any search's) with one controller.
 Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const control::ControllerSpec* spec,
                     const std::function<std::unique_ptr<control::FlipperController>()>& make_controller, int balls) {
-  Evaluation e;
   const auto start = std::chrono::steady_clock::now();
   std::vector<learn::BallOutcome> out;
   if (spec != nullptr) {
@@ -117,25 +134,22 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
     });
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  RunningStats score, duration_s, flips;
+  Evaluation e;
   for (const auto& o : out) {
-    e.score.add(o.score);
-    e.duration_s.add(o.duration_s);
-    e.flips.add(o.flips);
-    e.cut += o.cut ? 1 : 0;
+    score.add(o.score);
+    duration_s.add(o.duration_s);
+    flips.add(o.flips);
+    e.balls_cut_at_time_limit += o.cut ? 1 : 0;
   }
+  e.balls = score.count();
+  e.mean_score_per_ball = score.mean();
+  e.score_ci95_half_width = score.ci95_half_width();
+  e.score_stddev = score.stddev();
+  e.mean_ball_time_s = duration_s.mean();
+  e.flips_per_ball = flips.mean();
   e.balls_per_s = wall > 0.0 ? balls / wall : 0.0;
   return e;
-}
-
-nlohmann::json to_json(const Evaluation& e) {
-  return {{"balls", e.score.count()},
-          {"mean_score_per_ball", e.score.mean()},
-          {"score_ci95_half_width", e.score.ci95_half_width()},
-          {"score_stddev", e.score.stddev()},
-          {"mean_ball_time_s", e.duration_s.mean()},
-          {"flips_per_ball", e.flips.mean()},
-          {"balls_cut_at_time_limit", e.cut},
-          {"balls_per_s", e.balls_per_s}};
 }
 
 }  // namespace
@@ -325,7 +339,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   const int eval_balls = a.eval_balls > 0 ? a.eval_balls : (search ? 0 : 1000);
   if (eval_balls > 0) {
     const Evaluation e = evaluate(objective.ev, a, eval_spec, make_controller, eval_balls);
-    j["evaluation"] = to_json(e);
+    j["evaluation"] = to_json_value(e);
     j["evaluation"]["camera_noise_px"] = a.camera.noise_px;
     j["evaluation"]["actuation_delay_s"] = a.actuation_delay_s;
     j["evaluation"]["gravity_scale"] = a.gravity_scale;
