@@ -40,11 +40,15 @@ void check_calibration(const Calibration& c, const YamlReadArchive& r) {
     if (!(std::abs(cv::determinant(k.image_from_board)) > 0.0)) r.fail("camera.image_from_board", "singular matrix");
     if (k.image_width_px <= 0 || k.image_height_px <= 0) r.fail("camera.image_width_px", "image size must be > 0");
   }
-  for (std::size_t i = 0; i < c.flippers.size(); ++i) check_flipper(c.flippers[i], "flippers[" + std::to_string(i) + "]", r);
+  for (std::size_t i = 0; i < c.flippers.size(); ++i) {
+    check_flipper(c.flippers[i], "flippers[" + std::to_string(i) + "]", r);
+  }
   if (c.gravity) {
     const GravityEstimate& g = *c.gravity;
     if (!(g.g_mps2 > 0.0)) r.fail("gravity.g_mps2", "must be > 0");
-    if (!(g.ci_low_mps2 <= g.g_mps2 && g.g_mps2 <= g.ci_high_mps2)) r.fail("gravity.ci_low_mps2", "the interval must hold g_mps2");
+    if (!(g.ci_low_mps2 <= g.g_mps2 && g.g_mps2 <= g.ci_high_mps2)) {
+      r.fail("gravity.ci_low_mps2", "the interval must hold g_mps2");
+    }
   }
 }
 

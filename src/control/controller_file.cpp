@@ -56,7 +56,9 @@ json shot_table_json(const ShotTable& t) {
 }
 
 ShotTable shot_table_from_json(const json& j, JsonReadArchive& r) {
-  for (const char* key : {"neighbours", "angle_scale_rad", "h_scale", "speed_scale_mps"}) need(r, j, "imitation", key);
+  for (const char* key : {"neighbours", "angle_scale_rad", "h_scale", "speed_scale_mps"}) {
+    need(r, j, "imitation", key);
+  }
   ImitationConfig c;
   r.read(&j, "imitation", &c);
   // The shots are rows of numbers, not keyed structs: read as lists, then checked here.

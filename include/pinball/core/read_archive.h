@@ -23,8 +23,11 @@ namespace pinball {
 
 /// What a reader does with keys the file has and the struct lacks, and the reverse.
 struct ReadOptions {
-  bool refuse_unknown_keys = true;  ///< a key the struct lacks is an error: a misspelt key must not silently keep a default
-  bool require_every_key = false;   ///< a key the file lacks is an error; false: the field keeps its default (std::optional may always be absent)
+  /// A key the struct lacks is an error: a misspelt key must not silently keep a default.
+  bool refuse_unknown_keys = true;
+  /// A key the file lacks is an error; false: the field keeps its default.
+  /// A std::optional field may always be absent.
+  bool require_every_key = false;
 };
 
 /// How a document's value parsed as an integer.

@@ -70,7 +70,9 @@ struct PriorityKeys {
 
   template <class Archive>
   void Serialize(Archive* a) {
-    for (std::size_t i = 0; i < kPriorityKeys.size(); ++i) a->Visit(make_name_value(kPriorityKeys[i], &(*priorities)[i]));
+    for (std::size_t i = 0; i < kPriorityKeys.size(); ++i) {
+      a->Visit(make_name_value(kPriorityKeys[i], &(*priorities)[i]));
+    }
   }
 };
 
