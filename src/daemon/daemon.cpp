@@ -112,7 +112,8 @@ struct Daemon::Impl {
   mutable std::mutex warnings_mutex;
   std::vector<std::string> warnings;
   double start_wall_s = 0.0;
-  bool coils_off_at_exit = true;
+  std::atomic<bool> coils_off_at_exit{true};  // written by shutdown() while the LCM thread may report
+  std::atomic<bool> threads_joined{false};    // every thread is done: the simulator's own state may be read
   std::int64_t stats_seq = 0;  // PINBALL_STATS sequence (the LCM thread only)
 
 
@@ -291,7 +292,7 @@ void Daemon::Impl::shutdown() {
     const double t = world->time_s();
     bus->poll_once(t);
     world->idle(0.001);  // the board reads the ReleaseAll
-    coils_off_at_exit = world->all_coils_off();
+    coils_off_at_exit.store(world->all_coils_off(), std::memory_order_release);
   } else {
     bus->poll_once(steady_now_s());
   }
@@ -322,13 +323,14 @@ DaemonReport Daemon::Impl::report() const {
     const std::lock_guard<std::mutex> lock(warnings_mutex);
     r.warnings = warnings;
   }
-  r.coils_off_at_exit = coils_off_at_exit;
+  r.coils_off_at_exit = coils_off_at_exit.load(std::memory_order_acquire);
   r.cpus = cpus.describe;
   if (world) {
     r.world_board = world_model->board().source;
     r.world = std::string(world_model->name());
     r.results = world->results();
-    r.board = world->driver_board().counters();
+    // The virtual board belongs to the simulator thread: its counters are read once that thread is done.
+    if (threads_joined.load(std::memory_order_acquire)) r.board = world->driver_board().counters();
     RunningStats score, time;
     for (const simlab::SimBallResult& b : r.results) {
       score.add(b.score);
@@ -447,6 +449,7 @@ DaemonReport Daemon::run() {
   driver.join();
   d.shutdown();
   d.lcm->stop();
+  d.threads_joined.store(true, std::memory_order_release);  // nothing else runs: the board may be read
   if (d.frame_log) d.frame_log->flush();
   return d.report();
 }

@@ -31,15 +31,15 @@ void CameraStage::track(bool found, const track::Observation& observation, doubl
   out.contacts = contacts;
   out.capture_wall_s = capture_wall_s;
   out.found = found;
-  ++counters_.frames;
+  frames_.add();
   if (found) {
-    ++counters_.detections;
+    detections_.add();
     out.observation = observation;
     out.observation.t_s = t_s;
     last_seen_t_s_ = t_s;
     tracking_ = true;
     out.output = tracker_.update(out.observation, contacts);
-    if (out.output.projection.valid) ++counters_.projections;
+    if (out.output.projection.valid) projections_.add();
     return;
   }
   out.output = track::TrackerOutput{};
@@ -47,7 +47,7 @@ void CameraStage::track(bool found, const track::Observation& observation, doubl
     // Out of sight for too long (drained, or hidden): the next sighting is a new trajectory.
     tracker_.reset();
     tracking_ = false;
-    ++counters_.track_resets;
+    track_resets_.add();
     out.output.launch.lost = true;
   }
 }
@@ -57,7 +57,7 @@ ControllerStage::ControllerStage(control::FlipperController& controller, firmwar
     : controller_(controller), bus_(bus), options_(options) {}
 
 int ControllerStage::on_record(const ProjectionRecord& record, double now_s, double now_wall_s, Commands& out) {
-  ++counters_.projections;
+  projections_.add();
   started_ = true;
   // A session that dropped, or restarted since the last record, has lost our commands.
   const bool running = bus_.state() == firmware::BusState::kRunning;
@@ -66,7 +66,7 @@ int ControllerStage::on_record(const ProjectionRecord& record, double now_s, dou
   bus_was_running_ = running;
   sessions_seen_ = sessions;
   if (dropped) {
-    ++counters_.bus_faults;
+    bus_faults_.add();
     if (energized_[0] || energized_[1]) {
       controller_.reset(wanted_);
       return release_all(CommandCause::kBusFault, now_s, now_wall_s, out);
@@ -85,7 +85,7 @@ int ControllerStage::on_record(const ProjectionRecord& record, double now_s, dou
   } else if ((wanted_[0] || wanted_[1]) && record.t_s - last_seen_t_s_ > options_.stall_timeout_s) {
     // A flipper is up and the ball has not been seen for the timeout: let go.
     controller_.reset(wanted_);
-    ++counters_.ball_lost;
+    ball_lost_.add();
     cause = CommandCause::kBallLost;
   }
   return apply(wanted_, cause, static_cast<std::int64_t>(record.seq), now_s, record.capture_wall_s, now_wall_s, out);
@@ -94,7 +94,7 @@ int ControllerStage::on_record(const ProjectionRecord& record, double now_s, dou
 int ControllerStage::on_idle(double now_s, double now_wall_s, Commands& out) {
   if (!started_ || now_s - last_record_t_s_ <= options_.stall_timeout_s) return 0;
   if (!energized_[0] && !energized_[1]) return 0;
-  ++counters_.camera_stalls;
+  camera_stalls_.add();
   controller_.reset(wanted_);
   return release_all(CommandCause::kCameraStall, now_s, now_wall_s, out);
 }
@@ -109,7 +109,7 @@ int ControllerStage::release_all(CommandCause cause, double now_s, double now_wa
   CommandRecord& c = out[static_cast<std::size_t>(n++)];
   c = CommandRecord{seq_++, -1, -1, false, cause, now_s, 0.0, now_wall_s};
   energized_ = {false, false};
-  counters_.commands += 1;
+  commands_.add();
   return n;
 }
 
@@ -122,19 +122,19 @@ int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, 
     // The board measures the recycle time on its own clock; a millisecond of
     // margin covers the hand-off to the driver thread.
     if (on && now_s - released_at_s_[static_cast<std::size_t>(f)] < options_.recycle_s + 1e-3) {
-      ++counters_.deferred;  // the next record fires it, once the coil may be fired again
+      deferred_.add();  // the next record fires it, once the coil may be fired again
       continue;
     }
     const int driver = options_.driver_of_flipper[static_cast<std::size_t>(f)];
     const bool accepted = on ? bus_.fire(driver) : bus_.release(driver);
     if (!accepted) {
-      ++counters_.refused;
+      refused_.add();
       if (on) continue;     // a refused fire is tried again on the next record
       bus_.release_all();   // a release must not be lost: this one cannot be refused
     }
     energized_[static_cast<std::size_t>(f)] = on;
     if (!on) released_at_s_[static_cast<std::size_t>(f)] = now_s;
-    ++counters_.commands;
+    commands_.add();
     out[static_cast<std::size_t>(n++)] =
         CommandRecord{seq_++, projection_seq, f, on, on ? CommandCause::kProjection : cause, now_s, capture_wall_s,
                       now_wall_s};

@@ -50,7 +50,7 @@ SimWorld::SimWorld(const sim::World& world, firmware::CanTransport& board_link, 
   }
   if (!left || !right) throw std::invalid_argument("sim: the board needs a left and a right flipper");
   driver_board_.add_listener(&coil_watch_);
-  results_.reserve(static_cast<std::size_t>(options.balls));
+  results_.resize(static_cast<std::size_t>(options.balls));
   pull_ = options.launcher_pull >= 0.0 ? options.launcher_pull : board.launcher.pull;
 }
 
@@ -122,7 +122,8 @@ bool SimWorld::step(GameEvent* events, int& n) {
     r.duration_s = ball_time;
     r.flips = static_cast<int>(state_.flips - ball_flips0_);
     r.cut = cut;
-    results_.push_back(r);
+    results_[finished_.load(std::memory_order_relaxed)] = r;
+    finished_.fetch_add(1, std::memory_order_release);
     events[n++] = GameEvent{cut ? GameEvent::kBallCut : GameEvent::kBallLost, ball_, state_.time_s, r.score, ball_time};
     ++ball_;
     ball_active_ = false;

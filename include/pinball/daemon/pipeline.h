@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "pinball/control/flipper_controller.h"
+#include "pinball/core/single_writer_counter.h"
 #include "pinball/daemon/daemon_config.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/table/board.h"
@@ -85,8 +86,10 @@ class CameraStage {
   /// false is a frame without the ball at `t_s`.
   void track(bool found, const track::Observation& observation, double t_s, const track::ContactSensors& contacts,
              double capture_wall_s, ProjectionRecord& out);
-  /// Counters so far.
-  const CameraStageCounters& counters() const { return counters_; }
+  /// Counters so far (from any thread).
+  CameraStageCounters counters() const {
+    return {frames_.load(), detections_.load(), projections_.load(), track_resets_.load()};
+  }
 
  private:
   vision::BallDetector* detector_;
@@ -95,7 +98,7 @@ class CameraStage {
   double last_seen_t_s_ = -1e300;
   bool tracking_ = false;
   std::uint64_t seq_ = 0;
-  CameraStageCounters counters_;
+  SingleWriterCounter frames_, detections_, projections_, track_resets_;  // CameraStageCounters, live
 };
 
 /// Settings of the controller stage.
@@ -145,8 +148,11 @@ class ControllerStage {
   int release_all(CommandCause cause, double now_s, double now_wall_s, Commands& out);
   /// Commands in force (true: energised), per tracker flipper.
   const std::array<bool, 2>& energized() const { return energized_; }
-  /// Counters so far.
-  const ControllerStageCounters& counters() const { return counters_; }
+  /// Counters so far (from any thread: the LCM thread reports them while the stage runs).
+  ControllerStageCounters counters() const {
+    return {projections_.load(), commands_.load(), refused_.load(), camera_stalls_.load(),
+            ball_lost_.load(),   bus_faults_.load(), deferred_.load()};
+  }
   /// The settings.
   const ControllerStageOptions& options() const { return options_; }
 
@@ -165,7 +171,8 @@ class ControllerStage {
   bool bus_was_running_ = false;
   std::uint64_t sessions_seen_ = 0;
   std::uint64_t seq_ = 0;
-  ControllerStageCounters counters_;
+  SingleWriterCounter projections_, commands_, refused_, camera_stalls_, ball_lost_, bus_faults_,
+      deferred_;  // ControllerStageCounters, live
 };
 
 /// What the tracker and the detector believe about the table: the board's

@@ -6,6 +6,7 @@
 // only through frames and CAN frames, exactly as it sees the lab machine.
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -77,8 +78,12 @@ class SimWorld {
   const firmware::VirtualDriverBoard& driver_board() const { return driver_board_; }
   /// Board flipper index of tracker flipper f.
   int board_flipper(int f) const { return board_flipper_[static_cast<std::size_t>(f)]; }
-  /// Balls finished so far, in order.
-  const std::vector<SimBallResult>& results() const { return results_; }
+  /// Balls finished so far, in order: a copy, safe to take from any thread
+  /// while the simulator thread plays (the daemon's statistics do).
+  std::vector<SimBallResult> results() const {
+    const std::size_t n = finished_.load(std::memory_order_acquire);
+    return {results_.begin(), results_.begin() + static_cast<std::ptrdiff_t>(n)};
+  }
   /// Simulated time now (s).
   double time_s() const { return state_.time_s; }
   /// The camera.
@@ -115,7 +120,8 @@ class SimWorld {
   std::array<int, 2> board_flipper_{};
   std::array<double, firmware::kMaxDrivers> coil_on_wall_s_{};
   std::uint64_t coil_on_count_ = 0;
-  std::vector<SimBallResult> results_;
+  std::vector<SimBallResult> results_;   // one slot per ball, sized at construction
+  std::atomic<std::size_t> finished_{0};  // slots written; released after each write
   int ball_ = 0;
   bool ball_active_ = false;
   double ball_t0_s_ = 0.0;
