@@ -287,7 +287,7 @@ void Daemon::Impl::shutdown() {
   // Every coil off first, then no more heartbeats: the board's watchdog
   // stays as the second line of defence.
   ControllerStage::Commands cmds;
-  controller_stage->release_all(CommandCause::kShutdown, clock->now_s(), steady_now_s(), cmds);
+  const int n = controller_stage->release_all(CommandCause::kShutdown, clock->now_s(), steady_now_s(), cmds);
   if (world) {
     const double t = world->time_s();
     bus->poll_once(t);
@@ -296,6 +296,9 @@ void Daemon::Impl::shutdown() {
   } else {
     bus->poll_once(steady_now_s());
   }
+  // Then report it: PINBALL_FLIPPER_CMD promises the shutdown's release (cause "shutdown")
+  // like every other command; the LCM thread still runs and publishes it before it stops.
+  if (controller_worker) controller_worker->publish(cmds, n);
 }
 
 DaemonReport Daemon::Impl::report() const {

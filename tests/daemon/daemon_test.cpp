@@ -194,6 +194,24 @@ TEST(Daemon, PublishesStatsAndGameEventsOnLcm) {
   EXPECT_EQ(r.lcm.overflows, 0u);
 }
 
+// Every command the controller gave is on PINBALL_FLIPPER_CMD, the shutdown's
+// release-all included (it used to reach the CAN log but not LCM).
+TEST(Daemon, EveryCommandIsPublishedTheShutdownReleaseLast) {
+  std::atomic<std::uint64_t> published{0};
+  std::atomic<int> last_cause{-1};
+  bus::RawHandler on_command = bus::typed_handler<pinball_lcm::lcmt_pinball_flipper_command>(
+      [&](const pinball_lcm::lcmt_pinball_flipper_command& m) {
+        ++published;
+        last_cause = m.cause;
+      });
+  Daemon d(sim_config(2, 4));
+  bus::subscribe_raw(d.lcm_bus().lcm(), bus::kFlipperCommandChannel, on_command);
+  const DaemonReport r = d.run();
+  EXPECT_GT(r.commands, 1u);
+  EXPECT_EQ(published.load(), r.commands);
+  EXPECT_EQ(last_cause.load(), pinball_lcm::lcmt_pinball_flipper_command::CAUSE_SHUTDOWN);
+}
+
 TEST(Daemon, StopMidBallReleasesEveryCoil) {
   DaemonConfig c = sim_config(1000, 2);
   c.sim.realtime = true;  // the wall clock: stop arrives mid-game
