@@ -2,6 +2,8 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <array>
+#include <fstream>
 #include <stdexcept>
 #include <vector>
 
@@ -31,10 +33,25 @@ bool decided_by_observations(int cause) {
          cause == static_cast<int>(CommandCause::kBallLost);
 }
 
+// An LCM log is a sequence of events, each starting with the sync word
+// 0xEDA1DA01 (big-endian); liblcm reads anything else as an empty log.
+void require_lcm_log(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot read the LCM log");
+  std::array<unsigned char, 4> word{};
+  in.read(reinterpret_cast<char*>(word.data()), static_cast<std::streamsize>(word.size()));
+  if (in.gcount() == 0) throw std::runtime_error(path + ": is empty, not an LCM log");
+  constexpr std::array<unsigned char, 4> kSync{0xED, 0xA1, 0xDA, 0x01};
+  if (in.gcount() < 4 || word != kSync) {
+    throw std::runtime_error(path + ": not an LCM log (it does not start with an LCM event header)");
+  }
+}
+
 }  // namespace
 
 ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
                         const std::function<void(const std::string&)>& progress) {
+  require_lcm_log(log_path);
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
   const table::Board board = table::load_board(config.mode == "sim" ? config.sim.board : config.board);

@@ -9,6 +9,8 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -90,6 +92,22 @@ TEST(Replay, AnAlteredDecisionIsFoundAndBadMessagesAreSkipped) {
   EXPECT_EQ(r.first_mismatch, 1);
   EXPECT_EQ(r.malformed, 1u);
   EXPECT_NE(r.mismatch.find("recorded"), std::string::npos);
+}
+
+TEST(Replay, AFileThatIsNoLcmLogIsRefusedNamingIt) {
+  for (const std::string& path : {std::string(PINBALL_SOURCE_DIR "/README.md"),
+                                  std::string(PINBALL_SOURCE_DIR "/.gitignore")}) {
+    try {
+      replay_log(path, config_for_test());
+      FAIL() << path;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ": not an LCM log"), std::string::npos) << e.what();
+    }
+  }
+  const std::string empty = (std::filesystem::temp_directory_path() / "pinball_replay_empty.lcmlog").string();
+  std::ofstream(empty).close();
+  EXPECT_THROW(replay_log(empty, config_for_test()), std::runtime_error);
+  std::filesystem::remove(empty);
 }
 
 TEST(Replay, MissingLogIsNamed) {
