@@ -7,6 +7,7 @@ namespace pinball::cli {
 
 int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app{"pinball: simulator and tools of the pinball controller (see README.md)", "pinball"};
+  app.set_version_flag("--version", std::string("pinball ") + PINBALL_VERSION);
   app.require_subcommand(1);
   SimArgs sim;
   RenderArgs render;
@@ -29,6 +30,9 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
     return 0;
   } catch (const CLI::CallForAllHelp&) {
     out << app.help("", CLI::AppFormatMode::All);
+    return 0;
+  } catch (const CLI::CallForVersion& e) {
+    out << e.what() << "\n";
     return 0;
   } catch (const CLI::ParseError& e) {
     err << "pinball: " << e.what() << " (try --help)\n";

@@ -39,6 +39,7 @@ void install(int sig, void (*handler)(int)) {
 int main(int argc, char** argv) {
   using namespace pinball::daemon;
   CLI::App app("pinballd: the real-time pinball controller (camera -> tracker -> controller -> CAN)");
+  app.set_version_flag("--version", std::string("pinballd ") + PINBALL_VERSION);
   std::string config_path, sim_board, world_board, stepper, controller, lcm_url, can_log;
   int balls = -1;
   long long seed = -1;

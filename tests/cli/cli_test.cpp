@@ -85,6 +85,12 @@ TEST_F(Cli, AWorldWithOtherFlippersIsRefusedNamingBothBoards) {
   EXPECT_EQ(run("sim boards/mit1993.board --balls 1 --stepper euler").exit_code, 2);
 }
 
+TEST_F(Cli, VersionNamesTheProgramAndItsVersion) {
+  const CommandResult r = run("--version");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("pinball 0.", 0), 0u) << r.out;
+}
+
 TEST_F(Cli, SimPlaysTheEventStepper) {
   const CommandResult r = run("sim boards/mit1993.board --stepper event --policy spastic --balls 5 --seed 3 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;

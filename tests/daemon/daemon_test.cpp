@@ -339,6 +339,12 @@ void write_file(const std::string& path, const std::string& text) {
   std::fclose(f);
 }
 
+TEST(Pinballd, VersionNamesTheProgramAndItsVersion) {
+  std::string text;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --version", text), 0);
+  EXPECT_EQ(text.rfind("pinballd 0.", 0), 0u) << text;
+}
+
 TEST(Pinballd, BadConfigExitsOneNamingTheKey) {
   const std::string path = ::testing::TempDir() + "/bad_pinballd.yaml";
   write_file(path, "camera:\n  fsp: 200\n");
