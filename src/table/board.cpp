@@ -30,6 +30,14 @@ double distance_to_shape(const Shape& shape, const Vec2& p) {
   return (p - shape.p0).norm() - shape.radius_m;
 }
 
+std::string_view side_name(Side side) { return side == Side::kLeft ? "left" : "right"; }
+
+std::optional<Side> parse_side(std::string_view text) {
+  if (text == "left") return Side::kLeft;
+  if (text == "right") return Side::kRight;
+  return std::nullopt;
+}
+
 Vec2 flipper_direction(const Flipper& f, double theta_rad) {
   const double c = std::cos(theta_rad);
   const double s = std::sin(theta_rad);

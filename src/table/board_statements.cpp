@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <utility>
 
 namespace pinball::table::loader {
@@ -217,10 +218,9 @@ void polygon(LoadState& state, const Reader& r) {
 void flipper(LoadState& state, const Reader& r) {
   Flipper f;
   const std::string_view side = r.arg_count() > 0 ? r.arg(0) : std::string_view{};
-  if (side != "left" && side != "right") {
-    r.fail("field SIDE must be 'left' or 'right', got '" + std::string(side) + "'");
-  }
-  f.side = side == "left" ? Side::kLeft : Side::kRight;
+  const std::optional<Side> parsed = parse_side(side);
+  if (!parsed) r.fail("field SIDE must be 'left' or 'right', got '" + std::string(side) + "'");
+  f.side = *parsed;
   const auto v = r.numbers(1, {"PX", "PY", "LENGTH", "THETA_MIN", "THETA_MAX", "OMEGA"});
   r.require(v[2] > 0, "field LENGTH", "> 0", v[2]);
   if (!(v[3] < v[4])) r.fail("field THETA_MIN (" + fmt(v[3]) + ") must be less than THETA_MAX (" + fmt(v[4]) + ")");

@@ -48,6 +48,15 @@ TEST(FlipperGeometry, DirectionAtZeroAndUpNormal) {
               1e-15);
 }
 
+TEST(Side, IsSpelledLeftOrRightBothWays) {
+  EXPECT_EQ(side_name(Side::kLeft), "left");
+  EXPECT_EQ(side_name(Side::kRight), "right");
+  EXPECT_EQ(parse_side("left"), Side::kLeft);
+  EXPECT_EQ(parse_side("right"), Side::kRight);
+  EXPECT_FALSE(parse_side("Left").has_value());
+  EXPECT_FALSE(parse_side("").has_value());
+}
+
 TEST(NearestFlipperAtRest, IsTheClosestRestSegment) {
   Board b = empty_board();
   const auto none = nearest_flipper_at_rest(b, {0.2, 0.2});

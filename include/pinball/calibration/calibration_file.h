@@ -194,10 +194,9 @@ void apply_calibration(const Calibration& calibration, const std::string& name, 
 /// A calibrated flipper's side as the file spells it.
 template <>
 struct pinball::EnumText<pinball::table::Side> {
-  static std::string name(table::Side side) { return side == table::Side::kLeft ? "left" : "right"; }
+  static std::string name(table::Side side) { return std::string(table::side_name(side)); }
   static table::Side parse(const std::string& text) {
-    if (text == "left") return table::Side::kLeft;
-    if (text == "right") return table::Side::kRight;
+    if (const std::optional<table::Side> side = table::parse_side(text)) return *side;
     throw std::invalid_argument("expected left or right");
   }
 };

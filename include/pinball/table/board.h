@@ -6,7 +6,9 @@
 // of the playfield, +x right, +y up the table).
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -133,6 +135,12 @@ Shape make_circle_shape(const Vec2& centre, double radius_m);
 /// Distance from a point p to a shape's surface (lines: to the segment,
 /// either side; circles: to the rim, negative inside).
 double distance_to_shape(const Shape& shape, const Vec2& p);
+
+/// "left" or "right": how board and calibration files spell a side.
+std::string_view side_name(Side side);
+
+/// The side `text` names ("left" or "right"); nullopt for anything else.
+std::optional<Side> parse_side(std::string_view text);
 
 /// Unit vector from pivot to tip at elevation theta_rad.
 Vec2 flipper_direction(const Flipper& f, double theta_rad);
