@@ -140,7 +140,9 @@ TEST(ImitationController, FiresOnceDWithItsLeadReachesDCriticalAndReleasesAfterT
   for (double d = 0.100; d > 0.0; d -= 0.010, t += 0.005) {
     c.update(update_of(hittable_projection(1, -1.0, 0.5, 2.0, d)), t, e);
     if (e[1] && fired_at_d < 0.0) fired_at_d = d;
-    if (fired_at_d > 0.0 && t < 0.02) EXPECT_TRUE(e[1]);
+    if (fired_at_d > 0.0 && t < 0.02) {
+      EXPECT_TRUE(e[1]);
+    }
   }
   EXPECT_NEAR(fired_at_d, 0.050, 1e-9) << "first d <= 55 mm in 10 mm steps from 100 mm";
   EXPECT_EQ(c.fires(), 1);
