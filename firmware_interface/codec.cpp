@@ -209,4 +209,19 @@ const char* to_string(DecodeError e) {
   return "?";
 }
 
+const char* to_string(FaultCode code) {
+  switch (code) {
+    case FaultCode::kWatchdogExpired: return "watchdog expired";
+    case FaultCode::kHoldCapReached: return "hold cap reached";
+    case FaultCode::kPulseClamped: return "pulse clamped";
+    case FaultCode::kBadFrame: return "bad frame";
+    case FaultCode::kVersionMismatch: return "version mismatch";
+    case FaultCode::kNotConfigured: return "not configured";
+    case FaultCode::kNotArmed: return "not armed";
+    case FaultCode::kStale: return "stale command";
+    case FaultCode::kLocked: return "driver locked by its hold cap";
+  }
+  return "?";
+}
+
 }  // namespace pinball::firmware

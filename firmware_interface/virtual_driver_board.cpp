@@ -225,9 +225,10 @@ void VirtualDriverBoard::handle(const Message& m, double now_s) {
 void VirtualDriverBoard::on_hello(const Hello& m, double now_s) {
   ++counters_.hellos;
   all_off(now_s);
+  // A hold-cap lock survives the new session: only Release or ReleaseAll
+  // acknowledge it (rule 6).
   for (Driver& d : drivers_) {
     d.configured = false;
-    d.locked = false;
     d.has_seq = false;
   }
   session_ = true;
@@ -251,8 +252,7 @@ void VirtualDriverBoard::on_configure(const Configure& m, double now_s) {
   Driver& drv = drivers_[m.driver];
   if (drv.out.state != CoilState::kOff) set_output(m.driver, CoilState::kOff, 0.0, now_s);
   drv.config = m.config;
-  drv.configured = true;
-  drv.locked = false;
+  drv.configured = true;  // a hold-cap lock stays: only Release or ReleaseAll clear it (rule 6)
   push_tx(status());
 }
 
@@ -265,6 +265,7 @@ void VirtualDriverBoard::on_fire(const Fire& m, double now_s) {
   Driver& drv = drivers_[m.driver];
   if (drv.has_seq && !seq_newer(m.seq, drv.last_seq)) {
     ++counters_.stale;  // a duplicate or an old frame overtaken by a newer command
+    fault(FaultCode::kStale, m.driver, m.seq, kFaultBitRefused);
     return;
   }
   drv.has_seq = true;
@@ -277,6 +278,7 @@ void VirtualDriverBoard::on_fire(const Fire& m, double now_s) {
   }
   if (drv.locked) {
     ++counters_.refused_locked;
+    fault(FaultCode::kLocked, m.driver, 0, kFaultBitRefused);
     return;
   }
   if (drv.out.state != CoilState::kOff) {
@@ -325,9 +327,16 @@ void VirtualDriverBoard::on_heartbeat(const Heartbeat& m, double now_s) {
 }
 
 void VirtualDriverBoard::note_seq(std::uint16_t seq) {
-  if (!has_seq_ || seq_newer(seq, last_seq_)) {
-    has_seq_ = true;
-    last_seq_ = seq;
+  if (has_seq_ && !seq_newer(seq, last_seq_)) return;
+  has_seq_ = true;
+  last_seq_ = seq;
+  // Rule 9: a driver's reference never trails the session's newest number by
+  // more than kSeqReferenceLag. Without this, 2^15 idle heartbeats (11 min at
+  // 20 ms) would make the driver's next Fire look older than its last one.
+  const auto floor = static_cast<std::uint16_t>(seq - kSeqReferenceLag);
+  for (int d = 0; d < options_.driver_count; ++d) {
+    Driver& drv = drivers_[static_cast<std::size_t>(d)];
+    if (drv.has_seq && seq_newer(floor, drv.last_seq)) drv.last_seq = floor;
   }
 }
 

@@ -137,7 +137,7 @@ TEST(Codec, RejectsEveryMalformedCase) {
   cases.push_back({"Status coil state 3", encode(0, Status{0x0300, 0, 0, 0, 0}), DecodeError::kOutOfRange});
   cases.push_back({"Status reserved bit", encode(0, Status{0, 0, 0, 0x40, 0}), DecodeError::kOutOfRange});
   tamper("Fault code 0", Fault{}, 0, 0, DecodeError::kOutOfRange);
-  tamper("Fault code 8", Fault{}, 0, 8, DecodeError::kOutOfRange);
+  tamper("Fault code 10", Fault{}, 0, 10, DecodeError::kOutOfRange);
   tamper("Fault driver 8", Fault{}, 1, 8, DecodeError::kOutOfRange);
   for (const Case& c : cases) {
     const DecodeResult r = decode(c.frame);

@@ -109,6 +109,76 @@ TEST_F(VirtualDriverBoardTest, HoldIsCappedAndTheDriverStaysLockedUntilRelease) 
   EXPECT_EQ(board_.coil(0).state, CoilState::kPulse);
 }
 
+TEST_F(VirtualDriverBoardTest, OnlyReleaseUnlocksAHoldCappedDriverNotConfigureOrHello) {
+  const DriverConfig c{30, 25, 40, 200, 0};
+  open_session(c, 2, 1000);
+  fire(0);
+  for (int k = 1; k <= 30; ++k) {
+    advance_to(k * 0.01);
+    heartbeat();
+  }
+  ASSERT_EQ(board_.counters().hold_cap_trips, 1u);
+  send(Configure{0, c});  // protocol v1 unlocked here
+  fire(0);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  send(Hello{kProtocolVersion, 1000});  // nor does a new session
+  send(Configure{0, c});
+  heartbeat();
+  fire(0);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  EXPECT_EQ(board_.counters().refused_locked, 2u);
+  EXPECT_EQ(faults(board_messages(), FaultCode::kLocked), 2);  // each refusal is reported
+  release(0);
+  fire(0);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kPulse);
+}
+
+TEST_F(VirtualDriverBoardTest, AStaleFireIsReportedAsAFault) {
+  open_session(DriverConfig{30, 25, 40, 5000, 0});
+  const CanFrame fire_frame = encode(0, Fire{0, FireMode::kPulseHold, 0, ++seq_});
+  send_raw(fire_frame);
+  release(0);
+  advance_to(0.05);
+  send_raw(fire_frame);
+  const std::vector<Message> msgs = board_messages();
+  ASSERT_EQ(faults(msgs, FaultCode::kStale), 1);
+  for (const Message& m : msgs) {
+    if (const auto* f = std::get_if<Fault>(&m.payload); f != nullptr && f->code == FaultCode::kStale) {
+      EXPECT_EQ(f->driver, 0);
+      EXPECT_EQ(f->detail, 2);  // the stale Fire's seq (the first heartbeat was seq 1)
+    }
+  }
+}
+
+// Protocol v1 compared a Fire with the driver's last command only: after 2^15
+// heartbeats (11 minutes at 20 ms) the host's next Fire looked older than it.
+TEST_F(VirtualDriverBoardTest, AFlipperFiresAfterTwoHoursOfIdleHeartbeats) {
+  open_session(DriverConfig{30, 25, 40, 5000, 0}, 2, 100);
+  fire(0);
+  release(0);
+  const int heartbeats = 2 * 3600 * 50;  // 2 h at 20 ms: the 16-bit seq wraps five times
+  for (int k = 1; k <= heartbeats; ++k) {
+    t_ = 0.1 + k * 0.02;
+    heartbeat();
+    if (k % 20 == 0) board_messages();  // keep the socket pair from filling
+    if (k % 36000 == 0) {  // every 12 min, the other flipper too
+      fire(1);
+      EXPECT_EQ(board_.coil(1).state, CoilState::kPulse) << "after " << k << " heartbeats";
+      release(1);
+    }
+  }
+  fire(0);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kPulse);
+  EXPECT_EQ(board_.counters().stale, 0u);
+  // Serial arithmetic still refuses a duplicate of that Fire.
+  const CanFrame dup = encode(0, Fire{0, FireMode::kPulseHold, 0, seq_});
+  release(0);
+  advance_to(t_ + 0.05);
+  send_raw(dup);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  EXPECT_EQ(board_.counters().stale, 1u);
+}
+
 TEST_F(VirtualDriverBoardTest, RecycleTimeIsRespected) {
   const DriverConfig c{10, 0, 40, 100, 50};  // no hold, 50 ms recycle
   open_session(c);

@@ -50,6 +50,8 @@ const char* validate(const DriverConfig& config);
 
 /// Name of a decode error ("wrong length", ...).
 const char* to_string(DecodeError error);
+/// Name of a board fault code ("watchdog expired", ...).
+const char* to_string(FaultCode code);
 
 /// Fixed data length of a message kind, or -1 for an unknown kind.
 int frame_length(std::uint8_t kind);

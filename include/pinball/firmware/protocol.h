@@ -13,7 +13,10 @@
 namespace pinball::firmware {
 
 /// Protocol version; exchanged in Hello/HelloAck and carried by every Heartbeat.
-inline constexpr std::uint8_t kProtocolVersion = 1;
+/// 2: Fault codes 8 (stale) and 9 (locked); a driver's sequence reference
+/// follows the session's newest (rule 9); only Release/ReleaseAll unlock a
+/// hold-capped driver (rule 6).
+inline constexpr std::uint8_t kProtocolVersion = 2;
 
 /// Classic CAN 2.0: at most 8 data bytes.
 inline constexpr int kMaxFrameBytes = 8;
@@ -88,9 +91,11 @@ enum class FaultCode : std::uint8_t {
   kVersionMismatch = 5,  ///< Hello or Heartbeat with another version (detail: that version)
   kNotConfigured = 6,    ///< a command before Hello/Configure (detail: message kind)
   kNotArmed = 7,         ///< Fire while the watchdog is not alive
+  kStale = 8,            ///< a Fire whose seq was not newer than the driver's reference (detail: that seq)
+  kLocked = 9,           ///< a Fire on a driver locked by its hold cap (detail: 0)
 };
 /// Largest valid FaultCode value.
-inline constexpr std::uint8_t kMaxFaultCode = 7;
+inline constexpr std::uint8_t kMaxFaultCode = 9;
 
 /// Bits of Status::faults: what happened since the previous Status.
 enum FaultBits : std::uint8_t {
@@ -209,5 +214,10 @@ inline constexpr std::uint8_t kBoardDriver = 0xFF;
 constexpr bool seq_newer(std::uint16_t a, std::uint16_t b) {
   return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b)) > 0;
 }
+
+/// How far a driver's sequence reference may trail the newest sequence
+/// number of the session (rule 9): half of serial arithmetic's window, so
+/// that heartbeats alone can never make a later command look old.
+inline constexpr std::uint16_t kSeqReferenceLag = 1u << 14;
 
 }  // namespace pinball::firmware
