@@ -14,6 +14,7 @@
 #include "pinball/core/check.h"
 #include "pinball/core/clock.h"
 #include "pinball/firmware/frame_log.h"
+#include "pinball/firmware/liveness.h"
 
 namespace pinball::firmware {
 
@@ -22,6 +23,34 @@ constexpr int kCounterCount = sizeof(DriverBusCounters) / sizeof(std::uint64_t);
 static_assert(sizeof(DriverBusCounters) == kCounterCount * sizeof(std::uint64_t), "DriverBusCounters: uint64 fields only");
 
 }  // namespace
+
+std::string describe(const BusFault& f, const Liveness* liveness) {
+  const std::string driver = f.driver == kBoardDriver ? std::string("the board") : "driver " + std::to_string(f.driver);
+  switch (f.kind) {
+    case BusFaultKind::kBoard: {
+      std::string s = std::string("board fault: ") + to_string(f.code) + " (" + driver + ", detail " +
+                      std::to_string(f.detail) + ")";
+      if (f.code == FaultCode::kWatchdogExpired) s += ": every coil is off";
+      if (f.code == FaultCode::kHoldCapReached || f.code == FaultCode::kLocked) s += ": released to unlock it";
+      return s;
+    }
+    case BusFaultKind::kReleaseEscalated:
+      return driver + " stayed on after its Release: ReleaseAll sent";
+    case BusFaultKind::kLivenessStall: {
+      const std::string who = liveness != nullptr && f.detail < liveness->count()
+                                  ? std::string(liveness->name(f.detail)) + " thread"
+                                  : "watched thread " + std::to_string(f.detail);
+      return "the " + who + " stopped making progress: every coil released, heartbeats withheld";
+    }
+    case BusFaultKind::kStatusTimeout:
+      return "no Status from the board: every coil released, session restarted";
+    case BusFaultKind::kBusOff:
+      return "CAN bus-off: the board's watchdog switches the coils off; reopening";
+    case BusFaultKind::kTxFailure:
+      return "a CAN frame could not be sent: ReleaseAll attempted";
+  }
+  return "?";
+}
 
 struct DriverBus::AtomicCounters {
   std::array<std::atomic<std::uint64_t>, kCounterCount> v{};
@@ -58,6 +87,10 @@ DriverBus::DriverBus(CanTransport& transport, DriverBusOptions options)
   check_input(options.reply_timeout_s > 0.0, "DriverBusOptions", "reply_timeout_s must be > 0");
   check_input(options.status_timeout_s > 0.0, "DriverBusOptions", "status_timeout_s must be > 0");
   check_input(options.bus_off_holdoff_s >= 0.0, "DriverBusOptions", "bus_off_holdoff_s must be >= 0");
+  check_input(std::isfinite(options.release_retry_s) && options.release_retry_s > 0.0, "DriverBusOptions",
+              "release_retry_s must be > 0");
+  check_input(std::isfinite(options.release_deadline_s) && options.release_deadline_s >= options.release_retry_s,
+              "DriverBusOptions", "release_deadline_s must be >= release_retry_s");
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
 }
 
@@ -143,6 +176,23 @@ BoardView DriverBus::board() const {
 }
 
 bool DriverBus::send(const Payload& p, double now_s) {
+  // What the host wants is decided here, whether or not the frame leaves.
+  if (const auto* fire = std::get_if<Fire>(&p)) {
+    Intent& i = intent_[fire->driver];
+    i.on = true;
+    i.seen_on_since_s = -1.0;
+  } else if (const auto* rel = std::get_if<Release>(&p)) {
+    Intent& i = intent_[rel->driver];
+    i.on = false;
+    i.off_seq = rel->seq;
+    i.off_sent_s = now_s;
+  } else if (const auto* all = std::get_if<ReleaseAll>(&p)) {
+    for (Intent& i : intent_) {
+      i.on = false;
+      i.off_seq = all->seq;
+      i.off_sent_s = now_s;
+    }
+  }
   const CanFrame frame = encode(options_.board_id, p);
   const TxStatus s = transport_.send(frame);
   if (options_.log != nullptr) options_.log->record(frame);
@@ -155,11 +205,19 @@ bool DriverBus::send(const Payload& p, double now_s) {
     bump(&DriverBusCounters::bus_off);
     set_state(BusState::kBusOff);
     bus_off_s_ = now_s;
+    note_fault(BusFaultKind::kBusOff, now_s);
     return false;
   }
+  note_fault(BusFaultKind::kTxFailure, now_s, kBoardDriver, static_cast<std::uint16_t>(s));
   // Safe first: whatever failed, try to switch every coil off (once).
   if (!std::holds_alternative<ReleaseAll>(p)) {
-    const CanFrame off = encode(options_.board_id, ReleaseAll{++seq_});
+    const std::uint16_t off_seq = ++seq_;
+    for (Intent& i : intent_) {
+      i.on = false;
+      i.off_seq = off_seq;
+      i.off_sent_s = now_s;
+    }
+    const CanFrame off = encode(options_.board_id, ReleaseAll{off_seq});
     if (transport_.send(off) == TxStatus::kOk) {
       bump(&DriverBusCounters::frames_sent);
     } else {
@@ -176,6 +234,10 @@ void DriverBus::make_safe(double now_s) {
 }
 
 void DriverBus::begin_session(double now_s) {
+  // Off first, whatever the board kept; and only a Release or ReleaseAll
+  // unlocks a hold-capped driver (PROTOCOL.md rule 6), so the new session
+  // starts with none locked.
+  if (state() != BusState::kBusOff) send(ReleaseAll{++seq_}, now_s);
   set_state(BusState::kHandshake);
   status_word_.store(0, std::memory_order_release);
   last_request_s_ = now_s;
@@ -190,7 +252,100 @@ void DriverBus::on_error_frame(const CanFrame& f, double now_s) {
     bump(&DriverBusCounters::bus_off);
     set_state(BusState::kBusOff);
     bus_off_s_ = now_s;
+    note_fault(BusFaultKind::kBusOff, now_s);
   }
+}
+
+void DriverBus::note_fault(BusFaultKind kind, double now_s, std::uint8_t driver, std::uint16_t detail, FaultCode code) {
+  if (!faults_.try_push(BusFault{now_s, kind, code, driver, detail})) bump(&DriverBusCounters::faults_unreported);
+}
+
+void DriverBus::send_release(std::uint8_t driver, double now_s) {
+  if (driver < options_.driver_count) send(Release{driver, ++seq_}, now_s);
+}
+
+// The board's faults change what is true about the coils; act on them.
+void DriverBus::on_board_fault(const Fault& f, double now_s) {
+  bump(&DriverBusCounters::faults);
+  note_fault(BusFaultKind::kBoard, now_s, f.driver, f.detail, f.code);
+  switch (f.code) {
+    case FaultCode::kWatchdogExpired:
+      bump(&DriverBusCounters::watchdog_faults);
+      bump(&DriverBusCounters::coils_dropped);
+      for (Intent& i : intent_) i.on = false;  // the board switched every coil off
+      break;
+    case FaultCode::kHoldCapReached:
+      bump(&DriverBusCounters::hold_cap_faults);
+      bump(&DriverBusCounters::coils_dropped);
+      send_release(f.driver, now_s);  // acknowledges the cap: the driver may fire again
+      break;
+    case FaultCode::kLocked:
+      bump(&DriverBusCounters::locked_faults);
+      bump(&DriverBusCounters::coils_dropped);
+      send_release(f.driver, now_s);
+      break;
+    case FaultCode::kStale:
+      bump(&DriverBusCounters::stale_faults);
+      break;
+    case FaultCode::kNotConfigured:
+    case FaultCode::kNotArmed:
+      bump(&DriverBusCounters::refused_faults);
+      break;
+    default:
+      break;
+  }
+}
+
+// The closed loop: a coil the host wants off and the board reports on gets
+// its Release again once the board has had time to act on the last one (or
+// has accepted a later frame, so the Release was lost), and a ReleaseAll
+// once it has stayed on for release_deadline_s.
+void DriverBus::check_coils(const Status& st, double now_s) {
+  bool escalate = false;
+  for (int d = 0; d < options_.driver_count; ++d) {
+    Intent& i = intent_[static_cast<std::size_t>(d)];
+    const auto state = static_cast<CoilState>((st.coil_states >> (2 * d)) & 0x3u);
+    if (i.on || state == CoilState::kOff) {
+      i.seen_on_since_s = -1.0;
+      continue;
+    }
+    const bool overtaken = !seq_newer(i.off_seq, st.last_seq);  // the board accepted it or something later
+    if (!overtaken && now_s - i.off_sent_s < options_.release_retry_s) continue;  // still on its way
+    if (i.seen_on_since_s < 0.0) i.seen_on_since_s = now_s;
+    if (now_s - i.seen_on_since_s >= options_.release_deadline_s) {
+      escalate = true;
+      note_fault(BusFaultKind::kReleaseEscalated, now_s, static_cast<std::uint8_t>(d));
+      i.seen_on_since_s = now_s;  // the next escalation, if any, one deadline later
+      continue;
+    }
+    bump(&DriverBusCounters::release_retries);
+    send_release(static_cast<std::uint8_t>(d), now_s);
+  }
+  if (escalate) {
+    bump(&DriverBusCounters::release_escalations);
+    bump(&DriverBusCounters::coils_dropped);
+    make_safe(now_s);
+  }
+}
+
+// Heartbeats only while every watched thread makes progress. On the first
+// stall the coils go off at once; the missing heartbeats are the second line.
+bool DriverBus::chain_alive(double now_s) {
+  const Liveness* live = options_.liveness;
+  if (live == nullptr) return true;
+  const int stalled = live->stalled(now_s);
+  if (stalled < 0) {
+    chain_stalled_ = false;
+    return true;
+  }
+  if (!chain_stalled_ && live->started(stalled)) {  // a thread still starting up is not a stall
+    chain_stalled_ = true;
+    bump(&DriverBusCounters::liveness_stalls);
+    bump(&DriverBusCounters::coils_dropped);
+    note_fault(BusFaultKind::kLivenessStall, now_s, kBoardDriver, static_cast<std::uint16_t>(stalled));
+    make_safe(now_s);
+  }
+  return false;
 }
 
 void DriverBus::on_message(const Message& m, double now_s) {
@@ -207,14 +362,17 @@ void DriverBus::on_message(const Message& m, double now_s) {
     for (int d = 0; d < options_.driver_count; ++d) {
       send(Configure{static_cast<std::uint8_t>(d), options_.drivers[static_cast<std::size_t>(d)]}, now_s);
     }
-    last_heartbeat_s_ = now_s;
-    bump(&DriverBusCounters::heartbeats);
-    send(Heartbeat{kProtocolVersion, ++seq_}, now_s);  // arm the watchdog at once
+    if (chain_alive(now_s)) {  // arm the watchdog at once, if the chain runs
+      last_heartbeat_s_ = now_s;
+      bump(&DriverBusCounters::heartbeats);
+      send(Heartbeat{kProtocolVersion, ++seq_}, now_s);
+    }
     return;
   }
   if (const auto* st = std::get_if<Status>(&m.payload)) {
     bump(&DriverBusCounters::statuses);
     last_status_s_ = now_s;
+    check_coils(*st, now_s);
     const std::uint64_t w = (1ull << 63) | st->coil_states | (std::uint64_t{st->end_of_stroke} << 16) |
                             (std::uint64_t{st->configured} << 24) | (std::uint64_t{st->faults} << 32) |
                             (std::uint64_t{st->last_seq} << 40);
@@ -229,11 +387,7 @@ void DriverBus::on_message(const Message& m, double now_s) {
     }
     return;
   }
-  if (const auto* fault = std::get_if<Fault>(&m.payload)) {
-    bump(&DriverBusCounters::faults);
-    if (fault->code == FaultCode::kWatchdogExpired) bump(&DriverBusCounters::watchdog_faults);
-    if (fault->code == FaultCode::kHoldCapReached) bump(&DriverBusCounters::hold_cap_faults);
-  }
+  if (const auto* fault = std::get_if<Fault>(&m.payload)) on_board_fault(*fault, now_s);
 }
 
 void DriverBus::poll_once(double now_s) {
@@ -286,8 +440,9 @@ void DriverBus::poll_once(double now_s) {
     case BusState::kRunning:
       if (now_s - last_status_s_ > options_.status_timeout_s) {
         bump(&DriverBusCounters::status_timeouts);
-        make_safe(now_s);
-        begin_session(now_s);
+        bump(&DriverBusCounters::coils_dropped);
+        note_fault(BusFaultKind::kStatusTimeout, now_s);
+        begin_session(now_s);  // ReleaseAll first
       }
       break;
     case BusState::kBusOff:
@@ -296,8 +451,7 @@ void DriverBus::poll_once(double now_s) {
           bump(&DriverBusCounters::reconnects);
           release_all_pending_.store(false);
           set_state(BusState::kStopped);
-          make_safe(now_s);  // whatever the board kept, off first
-          begin_session(now_s);
+          begin_session(now_s);  // whatever the board kept, off first
         } else {
           bus_off_s_ = now_s;
         }
@@ -308,13 +462,20 @@ void DriverBus::poll_once(double now_s) {
   // 3. Commands.
   send_commands(now_s);
 
-  // 4. The heartbeat.
+  // 4. The heartbeat, while the chain it vouches for makes progress.
+  // Checked on every poll, so that a stall releases the coils at once.
   const BusState s = state();
+  const bool alive = chain_alive(now_s);
   if ((s == BusState::kConfiguring || s == BusState::kRunning) &&
       now_s - last_heartbeat_s_ >= options_.heartbeat_period_s) {
-    last_heartbeat_s_ = now_s;
-    bump(&DriverBusCounters::heartbeats);
-    send(Heartbeat{kProtocolVersion, ++seq_}, now_s);
+    if (alive) {
+      last_heartbeat_s_ = now_s;
+      bump(&DriverBusCounters::heartbeats);
+      send(Heartbeat{kProtocolVersion, ++seq_}, now_s);
+    } else if (now_s - last_withheld_s_ >= options_.heartbeat_period_s) {
+      last_withheld_s_ = now_s;
+      bump(&DriverBusCounters::heartbeats_withheld);
+    }
   }
 }
 
@@ -354,7 +515,8 @@ void DriverBus::run() {
     poll_once(now);
     double wait_s = 0.005;
     if (state() == BusState::kConfiguring || state() == BusState::kRunning) {
-      wait_s = std::clamp(last_heartbeat_s_ + options_.heartbeat_period_s - now, 0.0, wait_s);
+      const double last_slot_s = std::max(last_heartbeat_s_, last_withheld_s_);  // sent or withheld
+      wait_s = std::clamp(last_slot_s + options_.heartbeat_period_s - now, 0.0, wait_s);
     }
     pollfd fds[2] = {{transport_.poll_fd(), POLLIN, 0}, {wake_fd_, POLLIN, 0}};
     const timespec ts{0, static_cast<long>(wait_s * 1e9)};

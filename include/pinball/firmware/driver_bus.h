@@ -10,20 +10,31 @@
 // writes the queue on its own thread unless the bus thread is busy at that
 // moment (a try-lock: it never waits), which saves one thread wake-up
 // between a decision and its CAN frame.
+//
+// The host proves the coils are off rather than hoping so: every Status is
+// compared with what the host commanded, and a coil it wants off but sees on
+// gets its Release again and, past a deadline, a ReleaseAll. The board's
+// faults are acted on (a hold-capped driver is released, which unlocks it)
+// and handed to one reader as BusFault events. With a Liveness, heartbeats
+// flow only while the watched threads make progress: a stalled chain makes
+// the board switch every coil off within its watchdog.
 
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 
+#include "pinball/core/spsc_ring.h"
 #include "pinball/firmware/can_transport.h"
 #include "pinball/firmware/codec.h"
 
 namespace pinball::firmware {
 
 class FrameLog;
+class Liveness;
 
 /// Settings of a DriverBus; checked by the constructor.
 struct DriverBusOptions {
@@ -35,7 +46,14 @@ struct DriverBusOptions {
   double reply_timeout_s = 0.05;                      ///< resend Hello / Configure after this (s)
   double status_timeout_s = 0.25;                     ///< no Status for this long: restart the session (s)
   double bus_off_holdoff_s = 0.1;                     ///< wait after bus-off before reopening (s)
+  /// A Status still showing a coil on this long after its Release was sent
+  /// (or after the board accepted a later frame) gets the Release again (s).
+  double release_retry_s = 0.003;
+  /// A coil still on this long after a Status first showed it on against the
+  /// host's wish gets a ReleaseAll (s).
+  double release_deadline_s = 0.05;
   FrameLog* log = nullptr;                            ///< optional candump log of every frame (borrowed)
+  Liveness* liveness = nullptr;                       ///< heartbeat only while these threads progress (borrowed; null: always)
 };
 
 /// Session state.
@@ -70,7 +88,40 @@ struct DriverBusCounters {
   std::uint64_t bus_off = 0;           ///< bus-off events
   std::uint64_t reconnects = 0;        ///< transport reopened after bus-off
   std::uint64_t status_timeouts = 0;   ///< sessions restarted for lack of Status
+  std::uint64_t release_retries = 0;   ///< Releases sent again because a Status still showed the coil on
+  std::uint64_t release_escalations = 0;  ///< ReleaseAlls because a coil outlived release_deadline_s
+  std::uint64_t stale_faults = 0;      ///< Fires the board refused as not newer (Fault 8)
+  std::uint64_t locked_faults = 0;     ///< Fires the board refused on a hold-capped driver (Fault 9)
+  std::uint64_t refused_faults = 0;    ///< other refused commands (Faults 6 not configured, 7 not armed)
+  std::uint64_t liveness_stalls = 0;   ///< a watched thread stopped progressing: coils released, heartbeats withheld
+  std::uint64_t heartbeats_withheld = 0;  ///< heartbeats not sent while a watched thread was stalled
+  /// The coils went off behind the controller's back (watchdog, hold cap,
+  /// stall, escalation): the commands in force are void.
+  std::uint64_t coils_dropped = 0;
+  std::uint64_t faults_unreported = 0;  ///< BusFault events lost because nobody read them in time
 };
+
+/// What a BusFault event is about.
+enum class BusFaultKind : std::uint8_t {
+  kBoard,             ///< a Fault frame from the board (code, driver, detail)
+  kReleaseEscalated,  ///< a coil stayed on past release_deadline_s: ReleaseAll (driver)
+  kLivenessStall,     ///< a watched thread stopped progressing (detail: its Liveness index)
+  kStatusTimeout,     ///< the board fell silent: coils released, session restarted
+  kBusOff,            ///< the CAN controller went bus-off
+  kTxFailure,         ///< a frame could not be sent: ReleaseAll attempted
+};
+
+/// One fault the bus saw or acted on, for the daemon to report.
+struct BusFault {
+  double t_s = 0.0;                            ///< bus time (s)
+  BusFaultKind kind = BusFaultKind::kBoard;    ///< what
+  FaultCode code = FaultCode::kBadFrame;       ///< the board's code (kBoard only)
+  std::uint8_t driver = kBoardDriver;          ///< driver concerned, kBoardDriver: all / the board
+  std::uint16_t detail = 0;                    ///< code-specific (PROTOCOL.md's Fault detail)
+};
+
+/// One line naming `f` and what the host did about it; `liveness` names stalled threads (may be null).
+std::string describe(const BusFault& f, const Liveness* liveness = nullptr);
 
 /// The board's last Status as the host saw it.
 struct BoardView {
@@ -122,6 +173,8 @@ class DriverBus {
   BoardView board() const;
   /// The options in force.
   const DriverBusOptions& options() const { return options_; }
+  /// Takes the oldest unread fault event; false when none. One reader thread.
+  bool pop_fault(BusFault& out) { return faults_.try_pop(out); }
 
   /// Commands that fit in the queue between two bus iterations.
   static constexpr int kQueueSize = 64;
@@ -133,7 +186,21 @@ class DriverBus {
     std::uint8_t driver;
   };
 
+  // What the host last commanded one driver, for the closed loop on Status.
+  struct Intent {
+    bool on = false;                // Fire sent, no Release since
+    std::uint16_t off_seq = 0;      // seq of the last Release / ReleaseAll covering it
+    double off_sent_s = -1e300;     // when that was sent
+    double seen_on_since_s = -1.0;  // first Status showing it on against our wish (< 0: none)
+  };
+
   bool push(Op op, int flipper);
+  void note_fault(BusFaultKind kind, double now_s, std::uint8_t driver = kBoardDriver, std::uint16_t detail = 0,
+                  FaultCode code = FaultCode::kBadFrame);
+  void on_board_fault(const Fault& f, double now_s);
+  void check_coils(const Status& st, double now_s);
+  void send_release(std::uint8_t driver, double now_s);
+  bool chain_alive(double now_s);
   void run();
   void wake();
   bool send(const Payload& p, double now_s);
@@ -162,10 +229,14 @@ class DriverBus {
   // Bus-thread state.
   std::uint16_t seq_ = 0;
   double last_heartbeat_s_ = -1e300;
+  double last_withheld_s_ = -1e300;
   double last_request_s_ = -1e300;
   double last_status_s_ = 0.0;
   double bus_off_s_ = 0.0;
   std::uint8_t board_drivers_ = 0;
+  std::array<Intent, kMaxDrivers> intent_{};
+  bool chain_stalled_ = false;
+  SpscRing<BusFault, 64> faults_;  // written under io_mutex_, read by one reporter
 
   std::atomic<std::uint64_t> status_word_{0};  // bit 63: valid; then the Status fields
   struct AtomicCounters;
