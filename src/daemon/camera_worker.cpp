@@ -1,5 +1,6 @@
 #include "camera_worker.h"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -9,12 +10,14 @@
 
 namespace pinball::daemon {
 
-CameraWorker::CameraWorker(Handoffs& handoffs, CameraStage& stage, bus::LcmBus& lcm, CameraInput input,
+CameraWorker::CameraWorker(Handoffs& handoffs, CameraStage& stage, bus::LcmBus& lcm, const PipelineClock& clock,
+                           CameraInput input,
                            vision::FrameSource* frames, const FrameHandoffSource* handoff, bool retry_failed_reads,
                            bus::ObservationRing& observations, cv::Size frame_size)
     : h_(handoffs),
       stage_(stage),
       lcm_(lcm),
+      clock_(clock),
       input_(input),
       frames_(frames),
       handoff_(handoff),
@@ -34,8 +37,11 @@ bool CameraWorker::next(bool& ready) {
     return true;
   }
   if (!frames_->read(frame_)) {  // the camera's own blocking grab, or the hand-off's wait
-    return retry_failed_reads_ && !h_.stop.load(std::memory_order_acquire);
+    if (!retry_failed_reads_ || h_.stop.load(std::memory_order_acquire)) return false;
+    back_off_after_failed_read();
+    return true;
   }
+  retry_wait_s_ = 0.0;
   if (handoff_ != nullptr) {
     contacts_ = handoff_->contacts();
     capture_wall_s_ = handoff_->capture_wall_s();
@@ -44,6 +50,16 @@ bool CameraWorker::next(bool& ready) {
   }
   ready = true;
   return true;
+}
+
+// A camera that fails (unplugged, driver error) is retried with a growing
+// wait, 1 ms to 100 ms, and counted: the daemon raises the alarm. No frame
+// means no beat, so the CAN heartbeat stops and the board drops the coils.
+void CameraWorker::back_off_after_failed_read() {
+  h_.camera_read_failures.fetch_add(1, std::memory_order_relaxed);
+  h_.main_bell.ring();
+  retry_wait_s_ = std::clamp(retry_wait_s_ * 2.0, 0.001, 0.1);
+  std::this_thread::sleep_for(std::chrono::duration<double>(retry_wait_s_));
 }
 
 void CameraWorker::process() {
@@ -74,14 +90,19 @@ void CameraWorker::process() {
   }
   lcm_.try_publish(bus::to_lcm_projection(utime, static_cast<std::int64_t>(record_.seq),
                                           static_cast<std::int64_t>(record_.frame_seq), record_.output));
+  // Progress: in lockstep at the frame's own time (the driver polls on that
+  // clock), else now (a lab frame's exposure time lags by the camera's latency).
+  if (h_.liveness != nullptr) h_.liveness->beat(kCameraBeat, clock_.lockstep() ? record_.t_s : clock_.now_s());
 }
 
 void CameraWorker::run() {
   while (!h_.stop.load(std::memory_order_acquire)) {
+    h_.take_injected_fault(kCameraThread);
     bool ready = false;
     if (!next(ready)) break;
     if (ready) process();
   }
+  if (h_.liveness != nullptr) h_.liveness->retire(kCameraBeat);  // done on purpose: not a stall
   h_.camera_done.store(true, std::memory_order_release);
   h_.controller_bell.ring();
 }

@@ -26,7 +26,8 @@ class CameraWorker {
   /// switches), else null; `retry_failed_reads` keeps reading after a failed
   /// grab (a camera) instead of ending (a video file, the simulator).
   /// `observations` is read with kLcm only.
-  CameraWorker(Handoffs& handoffs, CameraStage& stage, bus::LcmBus& lcm, CameraInput input,
+  /// Each processed input is a beat of h.liveness (kCameraBeat) at `clock`'s time.
+  CameraWorker(Handoffs& handoffs, CameraStage& stage, bus::LcmBus& lcm, const PipelineClock& clock, CameraInput input,
                vision::FrameSource* frames, const FrameHandoffSource* handoff, bool retry_failed_reads,
                bus::ObservationRing& observations, cv::Size frame_size);
   /// Until the input ends or the daemon stops.
@@ -36,10 +37,13 @@ class CameraWorker {
   // Waits for the next input; false when it ended. `ready` tells whether one arrived.
   bool next(bool& ready);
   void process();
+  void back_off_after_failed_read();
 
   Handoffs& h_;
   CameraStage& stage_;
   bus::LcmBus& lcm_;
+  const PipelineClock& clock_;
+  double retry_wait_s_ = 0.0;  // grows while a camera keeps failing, so a dead device does not spin
   CameraInput input_;
   vision::FrameSource* frames_;
   const FrameHandoffSource* handoff_;

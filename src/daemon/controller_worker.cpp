@@ -28,10 +28,12 @@ void ControllerWorker::run() {
   ControllerStage::Commands cmds;
   const bool lockstep = clock_.lockstep();
   while (!h_.stop.load(std::memory_order_acquire)) {
+    h_.take_injected_fault(kControllerThread);
     if (h_.records.try_pop(record)) {
       HotPathScope hot;
       if (lockstep) h_.virtual_now_s.store(record.t_s, std::memory_order_release);
       const double now = lockstep ? record.t_s : clock_.now_s();
+      beat(now);
       const int n = stage_.on_record(record, now, steady_now_s(), cmds);
       send_now(cmds, n, now);
       h_.latency[kProjectionToDecision].record((steady_now_s() - record.projected_wall_s) * 1e6);
@@ -45,6 +47,7 @@ void ControllerWorker::run() {
     if (!lockstep) {
       HotPathScope hot;
       const double now = clock_.now_s();
+      beat(now);  // alive between frames too: a missing camera is the camera's beat's business
       const int n = stage_.on_idle(now, steady_now_s(), cmds);
       send_now(cmds, n, now);
       if (n > 0) {
@@ -53,6 +56,7 @@ void ControllerWorker::run() {
       }
     }
   }
+  if (h_.liveness != nullptr) h_.liveness->retire(kControllerBeat);  // done on purpose: not a stall
   h_.controller_done.store(true, std::memory_order_release);
   h_.driver_bell.ring();
 }

@@ -3,7 +3,8 @@
 // thread hands over, the controller stage decides (fire, hold, release) and
 // the thread writes the commands' CAN frames itself when the driver thread is
 // not busy; between projections it runs the stall and ball-lost checks off
-// the real-time clock. Publishes each command on LCM.
+// the real-time clock. Publishes each command on LCM. Every iteration is a
+// beat of the liveness the driver bus's heartbeat depends on.
 
 #include "handoffs.h"
 #include "pinball/bus/lcm_bus.h"
@@ -27,6 +28,10 @@ class ControllerWorker {
  private:
   // Writes the commands' CAN frames on this thread when the driver thread is not sending.
   void send_now(ControllerStage::Commands& cmds, int n, double now_s);
+  // Progress, for the CAN heartbeat (the driver thread watches it; this thread cannot watch itself).
+  void beat(double now_s) {
+    if (h_.liveness != nullptr) h_.liveness->beat(kControllerBeat, now_s);
+  }
 
   Handoffs& h_;
   ControllerStage& stage_;

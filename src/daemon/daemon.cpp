@@ -86,6 +86,7 @@ struct Daemon::Impl {
   std::unique_ptr<firmware::CanTransport> host_link;
   std::unique_ptr<firmware::StreamTransport> board_link;  // sim: the virtual board's end
   std::unique_ptr<firmware::FrameLog> frame_log;  // optional candump log
+  std::unique_ptr<firmware::Liveness> liveness;  // camera and controller progress, behind the heartbeat
   std::unique_ptr<firmware::DriverBus> bus;
   // Frames.
   simlab::OwnedWorld world_model;                      // sim: the table that is played (sim.world_board)
@@ -114,6 +115,11 @@ struct Daemon::Impl {
   double start_wall_s = 0.0;
   std::atomic<bool> coils_off_at_exit{true};  // written by shutdown() while the LCM thread may report
   std::atomic<bool> threads_joined{false};    // every thread is done: the simulator's own state may be read
+  // Faults, read by the main thread alone (DriverBus::pop_fault has one reader).
+  std::vector<std::string> faults;  // guarded by warnings_mutex (the LCM thread's stats read them)
+  std::uint64_t fault_count = 0;
+  std::uint64_t camera_failures_reported = 0;
+  std::vector<std::string> thread_failures;  // guarded by warnings_mutex
   std::int64_t stats_seq = 0;  // PINBALL_STATS sequence (the LCM thread only)
 
 
@@ -139,6 +145,19 @@ struct Daemon::Impl {
   void publish_stats(lcm::LCM& lcm);
   void shutdown();
   DaemonReport report() const;
+  void report_faults();
+  void fail_thread(ThreadId id, const std::string& what);
+  // Runs one thread's body: an exception makes the coils safe first, reports second, stops the run.
+  template <class Body>
+  void guarded(ThreadId id, Body body) {
+    try {
+      body();
+    } catch (const std::exception& e) {
+      fail_thread(id, e.what());
+    } catch (...) {
+      fail_thread(id, "unknown exception");
+    }
+  }
 };
 
 // A relative path that does not exist from the working directory is looked up
@@ -174,6 +193,15 @@ void Daemon::Impl::build() {
     host_link = std::make_unique<firmware::SocketCanTransport>(o);
   }
   firmware::DriverBusOptions bo = bus_options(config, drivers);
+  // The heartbeat vouches for the chain: it flows only while the camera and
+  // the controller threads progress. A beat every frame is expected; three
+  // frame periods (at least one heartbeat period) without one is a stall.
+  liveness = std::make_unique<firmware::Liveness>(std::max(config.can.heartbeat_period_s, 3.0 / config.camera.fps));
+  if (liveness->watch("camera") != kCameraBeat || liveness->watch("controller") != kControllerBeat) {
+    throw std::logic_error("daemon: liveness indices");
+  }
+  h.liveness = liveness.get();
+  bo.liveness = liveness.get();
   if (!config.can.log.empty()) {
     frame_log = std::make_unique<firmware::FrameLog>(config.can.log,
                                                      config.can.interface == "sim" ? "simcan" : config.can.interface);
@@ -238,6 +266,7 @@ void Daemon::Impl::learn_background() {
   vision::Frame f;
   f.gray.create(cv::Size(config.camera.width_px, config.camera.height_px), CV_8UC1);
   for (int i = 0; i < config.camera.background_frames; ++i) {
+    if (h.stop.load(std::memory_order_acquire)) return;  // SIGINT during start-up
     if (world) {
       world->render_background(f, -1.0 - i / config.camera.fps);
     } else if (!capture->read(f)) {
@@ -253,6 +282,7 @@ void Daemon::Impl::warm_up_bus() {
   // on the world's clock in sim mode (the table idles), else on the steady clock.
   const double deadline_s = 2.0;
   for (double t = 0.0; t < deadline_s; t += 0.001) {
+    if (h.stop.load(std::memory_order_acquire)) return;  // SIGINT during start-up
     if (world) {
       world->idle(0.001);
       bus->poll_once(world->time_s());
@@ -275,12 +305,46 @@ void Daemon::Impl::make_workers() {
   }
   vision::FrameSource* frames = world ? static_cast<vision::FrameSource*>(frame_handoff.get()) : capture.get();
   camera_worker = std::make_unique<CameraWorker>(
-      h, *camera_stage, *lcm, input, frames, frame_handoff.get(),
+      h, *camera_stage, *lcm, *clock, input, frames, frame_handoff.get(),
       !world && vision::is_device_source(config.camera.device), lcm_observations,
       cv::Size(config.camera.width_px, config.camera.height_px));
   controller_worker =
       std::make_unique<ControllerWorker>(h, *controller_stage, *bus, *lcm, *clock, 1.0 / config.camera.fps);
   driver_worker = std::make_unique<DriverWorker>(h, *bus, *lcm, *clock, driver_of_flipper);
+}
+
+void Daemon::Impl::fail_thread(ThreadId id, const std::string& what) {
+  // Safe first: ReleaseAll, written now from this thread when the bus is free
+  // (the driver thread sends it otherwise); this thread's beats stop, so the
+  // heartbeat stops too if it was the camera or the controller.
+  bus->release_all();
+  bus->send_queued(clock ? clock->now_s() : steady_now_s());
+  const std::string line = std::string(kThreadTable[static_cast<std::size_t>(id)].name) + ": " + what;
+  {
+    const std::lock_guard<std::mutex> lock(warnings_mutex);
+    thread_failures.push_back(line);
+  }
+  h.stop.store(true, std::memory_order_release);
+  h.main_bell.ring();
+}
+
+// The main thread's watch: every CAN fault on stderr at once, and in the
+// report; a failing camera raises the alarm at 1, 10, 100, ... failed reads.
+void Daemon::Impl::report_faults() {
+  firmware::BusFault f;
+  while (bus->pop_fault(f)) {
+    const std::string line = firmware::describe(f, liveness.get());
+    std::fprintf(stderr, "pinballd: t=%.3f s: %s\n", f.t_s, line.c_str());
+    const std::lock_guard<std::mutex> lock(warnings_mutex);
+    ++fault_count;
+    if (faults.size() < kMaxReportedFaults) faults.push_back(line);
+  }
+  const std::uint64_t failed = h.camera_read_failures.load(std::memory_order_relaxed);
+  if (failed > 0 && failed >= camera_failures_reported * 10) {
+    std::fprintf(stderr, "pinballd: camera: %llu failed reads (%s); retrying with back-off up to 0.1 s\n",
+                 static_cast<unsigned long long>(failed), capture ? capture->describe().c_str() : "?");
+    camera_failures_reported = std::max<std::uint64_t>(failed, 1);
+  }
 }
 
 void Daemon::Impl::shutdown() {
@@ -327,6 +391,13 @@ DaemonReport Daemon::Impl::report() const {
     r.warnings = warnings;
   }
   r.coils_off_at_exit = coils_off_at_exit.load(std::memory_order_acquire);
+  {
+    const std::lock_guard<std::mutex> lock(warnings_mutex);
+    r.faults = faults;
+    r.fault_count = fault_count;
+    r.thread_failures = thread_failures;
+  }
+  r.camera_read_failures = h.camera_read_failures.load(std::memory_order_relaxed);
   r.cpus = cpus.describe;
   if (world) {
     r.world_board = world_model->board().source;
@@ -419,29 +490,43 @@ DaemonReport Daemon::run() {
   }
   d.learn_background();
   d.warm_up_bus();
-  d.lcm->start([&d](lcm::LCM& l) { d.publish_stats(l); }, 1.0, [&d] { d.enter_thread(kLcmThread); });
+  d.lcm->start([&d](lcm::LCM& l) { d.guarded(kLcmThread, [&] { d.publish_stats(l); }); }, 1.0,
+               [&d] { d.enter_thread(kLcmThread); });
   d.make_workers();
+  // The simulated clock's offset before any thread reads it: the driver
+  // thread's first poll must not see the steady clock's epoch (a false
+  // Status timeout); the simulator thread refreshes it when it starts.
+  if (d.world) d.h.wall_offset_s.store(steady_now_s() - d.world->time_s(), std::memory_order_release);
   std::thread driver([&d] {
-    d.enter_thread(kDriverThread);
-    d.driver_worker->run();
+    d.guarded(kDriverThread, [&d] {
+      d.enter_thread(kDriverThread);
+      d.driver_worker->run();
+    });
   });
   std::thread controller([&d] {
-    d.enter_thread(kControllerThread);
-    d.controller_worker->run();
+    d.guarded(kControllerThread, [&d] {
+      d.enter_thread(kControllerThread);
+      d.controller_worker->run();
+    });
   });
   std::thread camera([&d] {
-    d.enter_thread(kCameraThread);
-    d.camera_worker->run();
+    d.guarded(kCameraThread, [&d] {
+      d.enter_thread(kCameraThread);
+      d.camera_worker->run();
+    });
   });
   std::thread world;
   if (d.sim_worker) {
     world = std::thread([&d] {
-      d.enter_thread(kSimThread);
-      d.sim_worker->run();
+      d.guarded(kSimThread, [&d] {
+        d.enter_thread(kSimThread);
+        d.sim_worker->run();
+      });
     });
   }
   while (!d.h.stop.load(std::memory_order_acquire) && !d.h.controller_done.load(std::memory_order_acquire)) {
     d.h.main_bell.wait(0.1);
+    d.report_faults();
     if (d.stats_requested.exchange(false)) std::fputs(report_to_text(d.report()).c_str(), stderr);
   }
   d.h.stop.store(true, std::memory_order_release);
@@ -451,6 +536,7 @@ DaemonReport Daemon::run() {
   controller.join();
   driver.join();
   d.shutdown();
+  d.report_faults();
   d.lcm->stop();
   d.threads_joined.store(true, std::memory_order_release);  // nothing else runs: the board may be read
   if (d.frame_log) d.frame_log->flush();
@@ -470,6 +556,19 @@ void Daemon::request_stats() {
 DaemonReport Daemon::snapshot() const { return impl_->report(); }
 bus::LcmBus& Daemon::lcm_bus() { return *impl_->lcm; }
 firmware::DriverBus& Daemon::driver_bus() { return *impl_->bus; }
+
+void Daemon::emergency_release() {
+  if (!impl_->bus) return;
+  impl_->bus->release_all();
+  impl_->bus->send_queued(steady_now_s());
+}
+
+void Daemon::inject_fault(int thread, double freeze_s, bool fail) {
+  if (thread < 0 || thread >= kThreadCount) throw std::invalid_argument("inject_fault: no thread " + std::to_string(thread));
+  InjectedFault& f = impl_->h.injected[static_cast<std::size_t>(thread)];
+  f.freeze_s.store(freeze_s, std::memory_order_relaxed);
+  f.fail.store(fail, std::memory_order_relaxed);
+}
 
 nlohmann::json report_to_json(const DaemonReport& r) {
   nlohmann::json j;
@@ -506,7 +605,16 @@ nlohmann::json report_to_json(const DaemonReport& r) {
               {"fires", r.driver.fires}, {"releases", r.driver.releases}, {"release_alls", r.driver.release_alls},
               {"bus_off", r.driver.bus_off}, {"reconnects", r.driver.reconnects},
               {"tx_failures", r.driver.tx_failures}, {"rx_bad", r.driver.rx_bad},
-              {"dropped_not_running", r.driver.dropped_not_running}};
+              {"dropped_not_running", r.driver.dropped_not_running},
+              {"release_retries", r.driver.release_retries}, {"release_escalations", r.driver.release_escalations},
+              {"liveness_stalls", r.driver.liveness_stalls}, {"heartbeats_withheld", r.driver.heartbeats_withheld},
+              {"watchdog_faults", r.driver.watchdog_faults}, {"hold_cap_faults", r.driver.hold_cap_faults},
+              {"stale_faults", r.driver.stale_faults}, {"locked_faults", r.driver.locked_faults},
+              {"refused_faults", r.driver.refused_faults}, {"coils_dropped", r.driver.coils_dropped},
+              {"faults", r.driver.faults}};
+  j["faults"] = {{"count", r.fault_count}, {"listed", r.faults}};
+  j["camera_read_failures"] = r.camera_read_failures;
+  j["thread_failures"] = r.thread_failures;
   j["board"] = {{"fires_accepted", r.board.fires_accepted}, {"watchdog_trips", r.board.watchdog_trips},
                 {"bad_frames", r.board.bad_frames}, {"refused_recycle", r.board.refused_recycle}};
   j["coils_off_at_exit"] = r.coils_off_at_exit;
@@ -538,6 +646,16 @@ std::string report_to_text(const DaemonReport& r) {
       << x.p50_us << std::setw(10) << x.p99_us << std::setw(10) << x.max_us << "\n";
   }
   o << "threads: " << r.cpus << "\n";
+  const firmware::DriverBusCounters& k = r.driver;
+  if (r.fault_count + k.release_retries + k.liveness_stalls > 0) {
+    o << "CAN faults " << r.fault_count << "  release retries " << k.release_retries << "  escalations "
+      << k.release_escalations << "  chain stalls " << k.liveness_stalls << "  watchdog " << k.watchdog_faults
+      << "  hold cap " << k.hold_cap_faults << "\n";
+    for (const std::string& f : r.faults) o << "fault: " << f << "\n";
+    if (r.fault_count > r.faults.size()) o << "fault: ... and " << r.fault_count - r.faults.size() << " more\n";
+  }
+  if (r.camera_read_failures > 0) o << "camera: " << r.camera_read_failures << " failed reads\n";
+  for (const std::string& f : r.thread_failures) o << "thread failed: " << f << "\n";
   for (const std::string& w : r.warnings) o << "warning: " << w << "\n";
   return o.str();
 }

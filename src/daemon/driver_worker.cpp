@@ -11,6 +11,7 @@ void DriverWorker::run() {
   std::uint64_t status_seq = 0;
   const bool lockstep = clock_.lockstep();
   while (!h_.stop.load(std::memory_order_acquire)) {
+    h_.take_injected_fault(kDriverThread);
     std::uint64_t done = 0;
     if (lockstep) {
       done = h_.records_done.load(std::memory_order_acquire);

@@ -17,6 +17,8 @@
 #include "pinball/daemon/doorbell.h"
 #include "pinball/daemon/latency_histogram.h"
 #include "pinball/daemon/pipeline.h"
+#include "pinball/daemon/thread_table.h"
+#include "pinball/firmware/liveness.h"
 #include "pinball/firmware/protocol.h"
 #include "pinball/track/observation.h"
 #include "pinball/vision/frame.h"
@@ -32,6 +34,17 @@ struct FrameSlot {
 
 inline constexpr std::size_t kFrameQueue = 4;               ///< frames waiting for the camera thread
 inline constexpr std::size_t kFramePool = kFrameQueue + 2;  ///< + one being processed + one being written
+
+/// A fault a test asks one worker to suffer at the top of its next loop
+/// (Daemon::inject_fault): the fault-injection suite's frozen and failing threads.
+struct InjectedFault {
+  std::atomic<double> freeze_s{0.0};  ///< sleep this long once (s)
+  std::atomic<bool> fail{false};      ///< throw once
+};
+
+/// The chain's threads whose progress the CAN heartbeat vouches for (their
+/// indices in Handoffs::liveness).
+enum ChainBeat : int { kCameraBeat = 0, kControllerBeat = 1 };
 
 /// The shared state of the daemon's threads.
 struct Handoffs {
@@ -54,6 +67,12 @@ struct Handoffs {
   std::atomic<double> wall_offset_s{0.0};        ///< sim in real time: wall = simulated + offset (s)
   std::array<std::atomic<double>, firmware::kMaxDrivers> can_written_wall_s{};  ///< per driver: last Fire written
   std::array<LatencyHistogram, kStageCount> latency;  ///< per stage of the latency table
+  firmware::Liveness* liveness = nullptr;    ///< camera and controller beats, read by the DriverBus (ChainBeat)
+  std::atomic<std::uint64_t> camera_read_failures{0};  ///< failed grabs of a lab camera (each backed off)
+  std::array<InjectedFault, kThreadCount> injected{};  ///< per ThreadId; one relaxed load per loop when unused
+
+  /// Suffers the fault injected for thread `id`, if any: sleeps, or throws std::runtime_error.
+  void take_injected_fault(ThreadId id);
 };
 
 /// The pipeline's clock: the steady clock in the lab; in simulation the

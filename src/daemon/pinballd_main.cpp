@@ -5,6 +5,8 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -23,6 +25,13 @@ extern "C" void on_stop_signal(int) {
   g_stop_pending = 1;
   if (pinball::daemon::Daemon* d = g_daemon.load()) d->request_stop();
 }
+// Last resort: anything that still reaches std::terminate switches the coils off before aborting.
+[[noreturn]] void on_terminate() {
+  if (pinball::daemon::Daemon* d = g_daemon.load()) d->emergency_release();
+  std::fputs("pinballd: terminated by an unhandled error; every coil released\n", stderr);
+  std::abort();
+}
+
 extern "C" void on_stats_signal(int) {
   if (pinball::daemon::Daemon* d = g_daemon.load()) d->request_stats();
 }
@@ -71,6 +80,7 @@ int main(int argc, char** argv) {
     std::fputs(thread_table_markdown().c_str(), stdout);
     return 0;
   }
+  std::set_terminate(on_terminate);
   install(SIGINT, on_stop_signal);
   install(SIGTERM, on_stop_signal);
   install(SIGUSR1, on_stats_signal);
@@ -108,7 +118,8 @@ int main(int argc, char** argv) {
     } else {
       std::cout << report_to_text(report);
     }
-    return 0;
+    for (const std::string& f : report.thread_failures) std::fprintf(stderr, "pinballd: thread failed: %s\n", f.c_str());
+    return report.thread_failures.empty() ? 0 : 1;
   } catch (const ConfigError& e) {
     std::fprintf(stderr, "pinballd: %s\n", e.what());
     return 1;

@@ -59,12 +59,16 @@ ControllerStage::ControllerStage(control::FlipperController& controller, firmwar
 int ControllerStage::on_record(const ProjectionRecord& record, double now_s, double now_wall_s, Commands& out) {
   projections_.add();
   started_ = true;
-  // A session that dropped, or restarted since the last record, has lost our commands.
+  // A session that dropped or restarted since the last record has lost our
+  // commands, and so has a coil the board or the bus switched off on its own
+  // (watchdog, hold cap, a stalled chain, a Release that had to be escalated).
   const bool running = bus_.state() == firmware::BusState::kRunning;
-  const std::uint64_t sessions = bus_.counters().sessions;
-  const bool dropped = (bus_was_running_ && !running) || (sessions_seen_ != 0 && sessions != sessions_seen_);
+  const firmware::DriverBusCounters bc = bus_.counters();
+  const bool dropped = (bus_was_running_ && !running) || (sessions_seen_ != 0 && bc.sessions != sessions_seen_) ||
+                       bc.coils_dropped != coils_dropped_seen_;
   bus_was_running_ = running;
-  sessions_seen_ = sessions;
+  sessions_seen_ = bc.sessions;
+  coils_dropped_seen_ = bc.coils_dropped;
   if (dropped) {
     bus_faults_.add();
     if (energized_[0] || energized_[1]) {

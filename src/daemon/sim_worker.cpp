@@ -17,6 +17,7 @@ void SimWorker::run() {
   };
   h_.wall_offset_s.store(steady_now_s() - world_.time_s(), std::memory_order_release);
   while (!h_.stop.load(std::memory_order_acquire)) {
+    h_.take_injected_fault(kSimThread);
     FrameSlot& slot = h_.pool[pushed % kFramePool];
     if (!world_.next_frame(slot.frame, slot.contacts, on_event)) break;
     h_.sim_time_s.store(world_.time_s(), std::memory_order_relaxed);

@@ -73,7 +73,14 @@ struct DaemonReport {
   std::string cpus;                          ///< where the threads ran (threads.chain_cpu)
   bool coils_off_at_exit = true;             ///< sim: every coil of the virtual board was off after shutdown
   std::vector<std::string> warnings;         ///< e.g. real-time scheduling refused
+  std::vector<std::string> faults;           ///< CAN faults seen and what was done (the first kMaxReportedFaults)
+  std::uint64_t fault_count = 0;             ///< all of them, reported or not
+  std::uint64_t camera_read_failures = 0;    ///< failed grabs of a lab camera
+  std::vector<std::string> thread_failures;  ///< a thread that ended by an exception: "pb-camera: what"
 };
+
+/// Faults listed one by one in a report (the rest are counted).
+inline constexpr std::size_t kMaxReportedFaults = 100;
 
 /// The report as one JSON object (the --json output).
 nlohmann::json report_to_json(const DaemonReport& report);
@@ -103,6 +110,15 @@ class Daemon {
   bus::LcmBus& lcm_bus();
   /// The host side of the CAN link.
   firmware::DriverBus& driver_bus();
+
+  /// Queues a ReleaseAll and writes it from the calling thread if the bus is
+  /// free (never waits): for a process about to die (std::terminate).
+  void emergency_release();
+
+  /// Fault injection (tests/faults): thread `thread` (a ThreadId) sleeps for
+  /// `freeze_s` seconds at the top of its next loop, or throws there when
+  /// `fail`. Any thread may call it while run() runs.
+  void inject_fault(int thread, double freeze_s, bool fail = false);
 
  private:
   struct Impl;

@@ -120,7 +120,7 @@ struct ControllerStageCounters {
   std::uint64_t refused = 0;         ///< commands DriverBus refused (queue full, not running)
   std::uint64_t camera_stalls = 0;   ///< releases because frames stopped
   std::uint64_t ball_lost = 0;       ///< releases because the ball was out of sight
-  std::uint64_t bus_faults = 0;      ///< releases because the CAN session dropped (bus-off, silence)
+  std::uint64_t bus_faults = 0;      ///< releases because the CAN session dropped or the coils were dropped under it
   std::uint64_t deferred = 0;        ///< fires held back until the coil's recycle time had passed
 };
 
@@ -170,6 +170,7 @@ class ControllerStage {
   bool started_ = false;
   bool bus_was_running_ = false;
   std::uint64_t sessions_seen_ = 0;
+  std::uint64_t coils_dropped_seen_ = 0;
   std::uint64_t seq_ = 0;
   SingleWriterCounter projections_, commands_, refused_, camera_stalls_, ball_lost_, bus_faults_,
       deferred_;  // ControllerStageCounters, live

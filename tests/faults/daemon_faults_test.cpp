@@ -1,0 +1,110 @@
+// pinballd's threads frozen and failing, in the embedded simulation: the
+// heartbeat vouches for the chain, and a failing thread makes the coils safe
+// before anything else (ctest -L faults).
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include "pinball/daemon/daemon.h"
+#include "pinball/daemon/thread_table.h"
+
+namespace pinball::daemon {
+namespace {
+
+const std::string kSource = PINBALL_SOURCE_DIR;
+
+DaemonConfig sim_config(int balls, bool realtime) {
+  DaemonConfig c;
+  c.sim.board = kSource + "/boards/mit1993.board";
+  c.controller = kSource + "/controllers/best.json";
+  c.sim.balls = balls;
+  c.sim.seed = 11;
+  c.sim.realtime = realtime;
+  return c;
+}
+
+bool mentions(const std::vector<std::string>& lines, const std::string& what) {
+  for (const std::string& l : lines) {
+    if (l.find(what) != std::string::npos) return true;
+  }
+  return false;
+}
+
+// On the wall clock, a thread of the chain frozen for 0.4 s: its beats stop,
+// the driver thread releases every coil and withholds the heartbeat, and the
+// board's watchdog expires (no heartbeat for longer than 0.1 s). The game goes
+// on afterwards.
+class FrozenChainThread : public ::testing::TestWithParam<int> {};
+
+TEST_P(FrozenChainThread, StopsTheHeartbeatAndTheBoardDropsEveryCoil) {
+  const int thread = GetParam();
+  Daemon d(sim_config(1000, true));
+  std::thread tester([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    d.inject_fault(thread, 0.4);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+    d.request_stop();
+  });
+  const DaemonReport r = d.run();
+  tester.join();
+  EXPECT_GE(r.driver.liveness_stalls, 1u);
+  EXPECT_GE(r.driver.heartbeats_withheld, 3u);
+  EXPECT_GE(r.board.watchdog_trips, 1u);
+  EXPECT_GE(r.driver.watchdog_faults, 1u);  // the board's Fault reached the host
+  const std::string name = thread == kCameraThread ? "camera" : "controller";
+  EXPECT_TRUE(mentions(r.faults, "the " + name + " thread stopped making progress")) << name;
+  EXPECT_TRUE(mentions(r.faults, "watchdog expired"));
+  EXPECT_TRUE(r.coils_off_at_exit);
+  EXPECT_TRUE(r.thread_failures.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(CameraAndController, FrozenChainThread, ::testing::Values(kCameraThread, kControllerThread),
+                         [](const auto& info) { return std::string(info.param == kCameraThread ? "Camera" : "Controller"); });
+
+// The driver thread itself frozen: no heartbeat at all, so the board's watchdog acts.
+TEST(FrozenDriverThread, TheBoardsWatchdogSwitchesEveryCoilOff) {
+  Daemon d(sim_config(1000, true));
+  std::thread tester([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    d.inject_fault(kDriverThread, 0.4);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+    d.request_stop();
+  });
+  const DaemonReport r = d.run();
+  tester.join();
+  EXPECT_GE(r.board.watchdog_trips, 1u);
+  EXPECT_TRUE(r.coils_off_at_exit);
+}
+
+// Any thread that throws: ReleaseAll first, then the failure is reported and
+// the run ends cleanly (before, std::terminate with the coils as they were).
+class FailingThread : public ::testing::TestWithParam<int> {};
+
+TEST_P(FailingThread, MakesTheCoilsSafeReportsAndEndsTheRun) {
+  const int thread = GetParam();
+  Daemon d(sim_config(3, false));
+  std::thread tester([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    d.inject_fault(thread, 0.0, /*fail=*/true);
+  });
+  const DaemonReport r = d.run();
+  tester.join();
+  ASSERT_EQ(r.thread_failures.size(), 1u);
+  const std::string name = kThreadTable[static_cast<std::size_t>(thread)].name;
+  EXPECT_EQ(r.thread_failures[0], name + ": injected failure of " + name);
+  EXPECT_TRUE(r.coils_off_at_exit);
+  EXPECT_GE(r.driver.release_alls, 1u);
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryWorker, FailingThread,
+                         ::testing::Values(kDriverThread, kControllerThread, kCameraThread, kSimThread),
+                         [](const auto& info) {
+                           std::string n = kThreadTable[static_cast<std::size_t>(info.param)].name;
+                           return n.substr(3);  // "pb-driver" -> "driver"
+                         });
+
+}  // namespace
+}  // namespace pinball::daemon
