@@ -18,6 +18,7 @@
 #include "daemon_latency_bench.h"
 #include "latency_bench.h"
 #include "precision_bench.h"
+#include "protocol_bench.h"
 #include "speed_bench.h"
 #include "tracker_bench.h"
 
@@ -25,10 +26,12 @@ namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   CLI::App* cmd =
-      app.add_subcommand("bench", "run a benchmark (speed, tracker, latency, detector, calibration, precision, ceiling)");
-  cmd->add_option("kind", a.which, "which benchmark: speed, tracker, latency, detector, calibration, precision, ceiling")
+      app.add_subcommand("bench",
+                         "run a benchmark (speed, tracker, latency, detector, calibration, precision, ceiling, protocol)");
+  cmd->add_option("kind", a.which,
+                  "which benchmark: speed, tracker, latency, detector, calibration, precision, ceiling, protocol")
       ->required()
-      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration", "precision", "ceiling"}));
+      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration", "precision", "ceiling", "protocol"}));
   cmd->add_option("--board", a.board, "board file")->check(CLI::ExistingFile);
   cmd->add_option("--steps", a.steps, "steps per timed run")->check(CLI::Range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
@@ -48,6 +51,9 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "ceiling: seconds after which a ball still alive is cut")
       ->check(CLI::Range(1.0, 3600.0));
+  cmd->add_option("--frames", a.frames, "protocol: random and mutated frames per seed")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
+  cmd->add_option("--seeds", a.seeds, "protocol: seeds to run, from --seed on")->check(CLI::Range(1, 1000));
   cmd->add_option("--csv", a.csv, "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here");
   cmd->add_option("--png", a.png, "precision: write the log-log plot of error against run time here");
   add_world_options(*cmd, a.world);
@@ -189,10 +195,34 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
   return 0;
 }
 
+int run_protocol(const BenchArgs& a, std::ostream& out, std::ostream& err) {
+  bench::ProtocolBenchOptions o;
+  o.frames = a.quick ? 100'000 : a.frames;
+  o.seed = a.seed;
+  o.seeds = a.seeds;
+  const bench::ProtocolBenchReport r =
+      bench::run_protocol_bench(o, [&](const std::string& line) { err << "bench protocol: " << line << "\n"; });
+  if (a.json) {
+    out << bench::to_json(r).dump(2) << "\n";
+  } else {
+    out << r.frames << " frames (" << r.mutated << " with bits flipped, " << r.noise << " random) over "
+        << r.simulated_s << " s of board time; " << r.valid_frames << " decoded for the board, " << r.bad_frames
+        << " refused as bad\n"
+        << "coil switch-ons " << r.switch_ons << ", stale " << r.stale << ", watchdog trips " << r.watchdog_trips
+        << ", hold caps " << r.hold_cap_trips << ", locked refusals " << r.refused_locked << "\n"
+        << "rule violations " << r.rule_violations << ", cap violations " << r.cap_violations
+        << (r.first_violation.empty() ? "" : " (first: " + r.first_violation + ")") << "\n"
+        << "board + checker " << r.frames_per_s << " frames/s; baseline decode only "
+        << r.decode_only_frames_per_s << " frames/s\n";
+  }
+  return r.rule_violations + r.cap_violations == 0 ? 0 : 1;
+}
+
 }  // namespace
 
 int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   if (a.which == "latency") return run_latency(a, out, err);
+  if (a.which == "protocol") return run_protocol(a, out, err);
   const table::Board board = table::load_board(a.board);
   if (a.which == "tracker") return run_tracker(a, board, out, err);
   if (a.which == "detector") return run_detector(a, board, out, err);

@@ -63,7 +63,7 @@ int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 
 /// `pinball bench`
 struct BenchArgs {
-  std::string which;                                 ///< speed | tracker | latency | detector | calibration | precision | ceiling
+  std::string which;                                 ///< speed | tracker | latency | detector | calibration | precision | ceiling | protocol
   std::string board = "boards/mit1993.board";        ///< board to measure on
   std::uint64_t steps = 2'000'000;                   ///< steps per timed run
   int repeats = 3;                                   ///< timed runs per configuration
@@ -78,6 +78,8 @@ struct BenchArgs {
   std::string png;                                   ///< precision: log-log plot to write, or empty
   simlab::WorldSpec world;                           ///< ceiling: the world (default: the model of `board`)
   track::CameraModelConfig camera;                   ///< ceiling: the tracker-side players' camera
+  std::uint64_t frames = 1'000'000;                  ///< protocol: frames per seed
+  int seeds = 1;                                     ///< protocol: seeds, from --seed on
   bool json = false;                                 ///< one JSON object on stdout
 };
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& args);
