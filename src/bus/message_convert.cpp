@@ -72,6 +72,12 @@ pinball_lcm::lcmt_pinball_driver_status to_lcm_driver_status(std::int64_t utime,
   m.reconnects = static_cast<std::int64_t>(k.reconnects);
   m.tx_failures = static_cast<std::int64_t>(k.tx_failures);
   m.release_alls = static_cast<std::int64_t>(k.release_alls);
+  m.watchdog_faults = static_cast<std::int64_t>(k.watchdog_faults);
+  m.hold_cap_faults = static_cast<std::int64_t>(k.hold_cap_faults);
+  m.release_retries = static_cast<std::int64_t>(k.release_retries);
+  m.release_escalations = static_cast<std::int64_t>(k.release_escalations);
+  m.liveness_stalls = static_cast<std::int64_t>(k.liveness_stalls);
+  m.coils_dropped = static_cast<std::int64_t>(k.coils_dropped);
   return m;
 }
 

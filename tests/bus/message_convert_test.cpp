@@ -103,7 +103,13 @@ TEST(MessageConvert, DriverStatusNamesTheCoilsThatAreOn) {
   k.frames_sent = 12;
   k.bus_off = 1;
   k.reconnects = 1;
+  k.release_retries = 4;
+  k.liveness_stalls = 2;
+  k.coils_dropped = 3;
   const auto m = round_trip(to_lcm_driver_status(9, 3, firmware::BusState::kRunning, view, k));
+  EXPECT_EQ(m.release_retries, 4);  // the host's fault actions travel too
+  EXPECT_EQ(m.liveness_stalls, 2);
+  EXPECT_EQ(m.coils_dropped, 3);
   EXPECT_EQ(m.coils_on, 0b10);  // driver 1 holds, driver 0 is off
   EXPECT_EQ(m.bus_state, static_cast<std::int8_t>(firmware::BusState::kRunning));
   EXPECT_TRUE(m.board_valid);
