@@ -372,7 +372,7 @@ void DriverBus::on_message(const Message& m, double now_s) {
   if (const auto* st = std::get_if<Status>(&m.payload)) {
     bump(&DriverBusCounters::statuses);
     last_status_s_ = now_s;
-    check_coils(*st, now_s);
+    if (options_.verify_coils) check_coils(*st, now_s);
     const std::uint64_t w = (1ull << 63) | st->coil_states | (std::uint64_t{st->end_of_stroke} << 16) |
                             (std::uint64_t{st->configured} << 24) | (std::uint64_t{st->faults} << 32) |
                             (std::uint64_t{st->last_seq} << 40);
@@ -510,6 +510,18 @@ void DriverBus::send_commands(double now_s) {
 }
 
 void DriverBus::run() {
+  try {
+    loop();
+  } catch (...) {
+    // The bus thread dies: coils off first, from here; no heartbeat follows,
+    // so the board's watchdog is the second line.
+    bump(&DriverBusCounters::thread_failures);
+    release_all();
+    send_queued(steady_now_s());
+  }
+}
+
+void DriverBus::loop() {
   while (running_.load(std::memory_order_acquire)) {
     const double now = steady_now_s();
     poll_once(now);

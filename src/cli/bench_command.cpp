@@ -198,6 +198,7 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
 int run_protocol(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   bench::ProtocolBenchOptions o;
   o.frames = a.quick ? 100'000 : a.frames;
+  if (a.quick) o.release_cycles = 100;
   o.seed = a.seed;
   o.seeds = a.seeds;
   const bench::ProtocolBenchReport r =
@@ -214,8 +215,16 @@ int run_protocol(const BenchArgs& a, std::ostream& out, std::ostream& err) {
         << (r.first_violation.empty() ? "" : " (first: " + r.first_violation + ")") << "\n"
         << "board + checker " << r.frames_per_s << " frames/s; baseline decode only "
         << r.decode_only_frames_per_s << " frames/s\n";
+    for (const bench::ReleaseUnderLoss& x : r.release_under_loss) {
+      out << "release under " << x.drop_p * 100 << " % loss, closed loop " << (x.closed_loop ? "on " : "off")
+          << ": on after release p50 " << x.p50_s * 1e3 << " ms, p99 " << x.p99_s * 1e3 << " ms, worst "
+          << x.worst_s * 1e3 << " ms over " << x.cycles << " cycles (" << x.release_retries << " retries, "
+          << x.release_escalations << " escalations)\n";
+    }
   }
-  return r.rule_violations + r.cap_violations == 0 ? 0 : 1;
+  std::uint64_t violations = r.rule_violations + r.cap_violations;
+  for (const bench::ReleaseUnderLoss& x : r.release_under_loss) violations += x.cap_violations;
+  return violations == 0 ? 0 : 1;
 }
 
 }  // namespace

@@ -52,6 +52,9 @@ struct DriverBusOptions {
   /// A coil still on this long after a Status first showed it on against the
   /// host's wish gets a ReleaseAll (s).
   double release_deadline_s = 0.05;
+  /// The closed loop on Status above; false only for a benchmark's baseline
+  /// (the protocol v1 host, which never compared).
+  bool verify_coils = true;
   FrameLog* log = nullptr;                            ///< optional candump log of every frame (borrowed)
   Liveness* liveness = nullptr;                       ///< heartbeat only while these threads progress (borrowed; null: always)
 };
@@ -99,6 +102,7 @@ struct DriverBusCounters {
   /// stall, escalation): the commands in force are void.
   std::uint64_t coils_dropped = 0;
   std::uint64_t faults_unreported = 0;  ///< BusFault events lost because nobody read them in time
+  std::uint64_t thread_failures = 0;    ///< the bus thread ended by an exception (after a ReleaseAll)
 };
 
 /// What a BusFault event is about.
@@ -202,6 +206,7 @@ class DriverBus {
   void send_release(std::uint8_t driver, double now_s);
   bool chain_alive(double now_s);
   void run();
+  void loop();
   void wake();
   bool send(const Payload& p, double now_s);
   void bump(std::uint64_t DriverBusCounters::*field, std::uint64_t n = 1);
