@@ -62,7 +62,9 @@ TEST_P(FrozenChainThread, StopsTheHeartbeatAndTheBoardDropsEveryCoil) {
 }
 
 INSTANTIATE_TEST_SUITE_P(CameraAndController, FrozenChainThread, ::testing::Values(kCameraThread, kControllerThread),
-                         [](const auto& info) { return std::string(info.param == kCameraThread ? "Camera" : "Controller"); });
+                         [](const auto& param_info) {
+                           return std::string(param_info.param == kCameraThread ? "Camera" : "Controller");
+                         });
 
 // The driver thread itself frozen: no heartbeat at all, so the board's watchdog acts.
 TEST(FrozenDriverThread, TheBoardsWatchdogSwitchesEveryCoilOff) {
@@ -101,8 +103,8 @@ TEST_P(FailingThread, MakesTheCoilsSafeReportsAndEndsTheRun) {
 
 INSTANTIATE_TEST_SUITE_P(EveryWorker, FailingThread,
                          ::testing::Values(kDriverThread, kControllerThread, kCameraThread, kSimThread),
-                         [](const auto& info) {
-                           std::string n = kThreadTable[static_cast<std::size_t>(info.param)].name;
+                         [](const auto& param_info) {
+                           std::string n = kThreadTable[static_cast<std::size_t>(param_info.param)].name;
                            return n.substr(3);  // "pb-driver" -> "driver"
                          });
 
