@@ -71,16 +71,24 @@ using JsonReadArchive = ReadArchive<JsonDoc>;
 
 namespace json_detail {
 
-// Where the parser is: one entry per open object or array, for the path of a
-// repeated key ("minicontrollers[2].a").
+// One open object or array while parsing, for the path of a repeated key.
 struct OpenValue {
   bool object = false;
-  std::string path;
   std::set<std::string> keys;  // objects: the keys so far
   std::string key;             // objects: the latest key
   std::size_t index = 0;       // arrays: elements so far
-  std::string child() const { return object ? join_key(path, key) : path + "[" + std::to_string(index) + "]"; }
 };
+
+// The path ("minicontrollers[2].a") of the value being read inside the
+// innermost open value, built only when an error needs it: a path kept per
+// level would cost the square of the depth for deeply nested text.
+inline std::string path_of(const std::vector<OpenValue>& open) {
+  std::string path;
+  for (std::size_t i = 0; i + 1 < open.size(); ++i) {
+    path = open[i].object ? join_key(path, open[i].key) : path + "[" + std::to_string(open[i].index) + "]";
+  }
+  return path;
+}
 
 }  // namespace json_detail
 
@@ -98,12 +106,12 @@ inline nlohmann::json parse_json(const std::string& text, const std::string& fil
     switch (event) {
       case json::parse_event_t::object_start:
       case json::parse_event_t::array_start:
-        open.push_back({event == json::parse_event_t::object_start, open.empty() ? "" : open.back().child(), {}, {}, 0});
+        open.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
         break;
       case json::parse_event_t::key:
         open.back().key = parsed.get<std::string>();
         if (!open.back().keys.insert(open.back().key).second) {
-          throw KeyError(file, join_key(open.back().path, open.back().key), "duplicate key");
+          throw KeyError(file, join_key(json_detail::path_of(open), open.back().key), "duplicate key");
         }
         break;
       case json::parse_event_t::object_end:
