@@ -1,5 +1,6 @@
 #include "pinball/calibration/calibration_file.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -143,15 +144,19 @@ void write_calibration(const Calibration& calibration, const std::string& path) 
 
 Calibration parse_calibration(const std::string& text, const std::string& name) {
   const YAML::Node root = load_yaml(text, name);
-  // Every key is required; sections and `disagreement` are optional.
-  YamlReadArchive r(name, {.refuse_unknown_keys = false, .require_every_key = true});
-  if (!root.IsMap()) r.fail("version", "missing (not a calibration file)");
+  // The version first, whatever else the file holds: another version is refused as such.
+  YamlReadArchive first(name, {.refuse_unknown_keys = false, .require_every_key = true});
+  if (!root.IsMap()) first.fail("version", "missing (not a calibration file)");
   VersionKey v;
-  r.read(root, "", &v);
+  first.read(root, "", &v);
   if (v.version != kCalibrationFileVersion) {
-    r.fail("version", std::to_string(v.version) + " is not the supported version " +
-                          std::to_string(kCalibrationFileVersion));
+    first.fail("version", std::to_string(v.version) + " is not the supported version " +
+                              std::to_string(kCalibrationFileVersion));
   }
+  // Every key is required and no other is allowed (a misspelt key must not
+  // pass unseen); sections and `disagreement` are optional. A repeated key is
+  // refused by the reader.
+  YamlReadArchive r(name, {.refuse_unknown_keys = true, .require_every_key = true});
   Calibration c;
   r.read(root, "", &c);
   check_calibration(c, r);
@@ -207,13 +212,35 @@ vision::CameraHomography camera_homography(const Calibration& c, const std::stri
   }
 }
 
+void check_calibration_matches_board(const Calibration& c, const std::string& name, const table::Board& board) {
+  for (std::size_t i = 0; i < c.flippers.size(); ++i) {
+    const FlipperCalibration& f = c.flippers[i];
+    const std::string key = "flippers[" + std::to_string(i) + "]";
+    const auto on_board = std::find_if(board.flippers.begin(), board.flippers.end(),
+                                       [&](const table::Flipper& b) { return b.name == f.name; });
+    if (on_board == board.flippers.end()) {
+      std::string names;
+      for (const table::Flipper& b : board.flippers) names += (names.empty() ? "" : ", ") + b.name;
+      throw KeyError(name, key + ".name", "'" + f.name + "' is not a flipper of the board " + board.source +
+                                              " (its flippers: " + (names.empty() ? "none" : names) + ")");
+    }
+    if (on_board->side != f.side) {
+      throw KeyError(name, key + ".side", std::string(table::side_name(f.side)) + ", but the board's '" + f.name +
+                                              "' is a " + std::string(table::side_name(on_board->side)) + " flipper");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (c.flippers[j].name == f.name) throw KeyError(name, key + ".name", "'" + f.name + "' is calibrated twice");
+    }
+  }
+}
+
 void apply_calibration(const Calibration& c, const std::string& name, table::Board& board) {
+  check_calibration_matches_board(c, name, board);
   for (const FlipperCalibration& f : c.flippers) {
     table::Flipper* target = nullptr;
     for (table::Flipper& b : board.flippers) {
       if (b.name == f.name) target = &b;
     }
-    if (!target) throw std::runtime_error(name + ":flippers: '" + f.name + "' is not a flipper of the board");
     target->pivot = f.pivot_m;
     target->length_m = f.length_m;
     target->theta_min_rad = f.theta_min_rad;

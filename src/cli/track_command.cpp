@@ -44,7 +44,9 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
   track::TrackerConfig config = track::default_tracker_config(board, track::CameraModelConfig{});
   track::FlipperGeometry geometry = track::flipper_geometry_from_board(board);
   if (!a.calibration.empty()) {
-    calibration::apply_calibration(calibration::read_calibration(a.calibration), a.calibration, config, geometry);
+    const calibration::Calibration c = calibration::read_calibration(a.calibration);
+    calibration::check_calibration_matches_board(c, a.calibration, board);
+    calibration::apply_calibration(c, a.calibration, config, geometry);
   }
   if (a.gravity_mps2 >= 0.0) config.g_mps2 = a.gravity_mps2;
   if (a.sigma_m > 0.0) config.sigma_m = a.sigma_m;

@@ -17,23 +17,43 @@ ActionFunctionConfig uniform_partition(int k) {
 
 namespace {
 
-void check_increasing(const std::vector<double>& v, double lo, double hi, const char* what) {
+constexpr double kMaxHBorder = 100.0;  // flipper lengths: the tracker's h is about 0..1.3
+
+RangeViolation check_borders(const std::vector<double>& v, double lo, double hi, const char* key) {
+  if (v.size() >= static_cast<std::size_t>(kMaxBins)) {
+    return {key, "must have at most " + std::to_string(kMaxBins - 1) + " borders (" + std::to_string(kMaxBins) + " bins)"};
+  }
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i]) || v[i] <= lo || v[i] >= hi || (i > 0 && v[i] <= v[i - 1])) {
-      throw std::invalid_argument(std::string("action function: ") + what + " must be finite, strictly increasing and inside (" +
-                                  std::to_string(lo) + ", " + std::to_string(hi) + ")");
+      return {key, "must be finite, strictly increasing and inside (" + std::to_string(lo) + ", " + std::to_string(hi) + ")"};
     }
   }
+  return {};
 }
 
 }  // namespace
 
-ActionFunction::ActionFunction(ActionFunctionConfig config) : config_(std::move(config)) {
-  check_increasing(config_.angle_borders_rad, -std::numbers::pi / 2, std::numbers::pi / 2, "angle borders");
-  check_increasing(config_.h_borders, -1e9, 1e9, "h borders");
-  for (double g : config_.gain_range) {
-    if (!std::isfinite(g) || g < 0.0) throw std::invalid_argument("action function: gain ranges must be finite and >= 0");
+RangeViolation check_action_function_config(const ActionFunctionConfig& c) {
+  if (RangeViolation v = check_borders(c.angle_borders_rad, -std::numbers::pi / 2, std::numbers::pi / 2, "angle_borders_rad")) {
+    return v;
   }
+  if (RangeViolation v = check_borders(c.h_borders, -kMaxHBorder, kMaxHBorder, "h_borders")) return v;
+  for (double g : c.gain_range) {
+    if (!(g >= 0.0 && g <= kMaxGain)) return {"gain_range", "must each be in [0, 10]"};  // kMaxGain
+  }
+  return {};
+}
+
+RangeViolation check_minicontroller(const Minicontroller& m) {
+  for (double g : m.a) {
+    if (!(std::abs(g) <= kMaxGain)) return {"a", "must each be in [-10, 10]"};  // ±kMaxGain
+  }
+  if (m.flipper != track::kLeftFlipper && m.flipper != track::kRightFlipper) return {"flipper", "must be left or right"};
+  return {};
+}
+
+ActionFunction::ActionFunction(ActionFunctionConfig config) : config_(std::move(config)) {
+  check_input(check_action_function_config(config_), "action function");
   const int n = 2 * angle_bins() * h_bins() + (config_.rolling_minicontrollers ? 2 : 0);
   minis_.assign(static_cast<std::size_t>(n), Minicontroller{});
   for (int i = 0; i < n; ++i) minis_[static_cast<std::size_t>(i)].flipper = i < n / 2 ? 0 : 1;

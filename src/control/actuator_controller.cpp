@@ -1,9 +1,19 @@
 #include "pinball/control/actuator_controller.h"
 
+#include <string>
+
 namespace pinball::control {
 
+RangeViolation check_actuator_config(const ActuatorConfig& c) {
+  if (c.max_hold_s >= 0.0 && c.max_hold_s <= kMaxHold_s) return {};
+  return {"max_hold_s", "must be in [0, " + std::to_string(firmware::kAbsMaxHoldMs / 1000) +
+                            "] s (the driver board's hold cap; 0: no limit of its own)"};
+}
+
 ActuatorController::ActuatorController(ActionFunction action_function, const ActuatorConfig& config)
-    : action_(std::move(action_function)), config_(config) {}
+    : action_(std::move(action_function)), config_(config) {
+  check_input(check_actuator_config(config_), "actuator controller");
+}
 
 void ActuatorController::reset(std::array<bool, 2>& energized) {
   energized = {false, false};

@@ -1,6 +1,7 @@
 #include "pinball/control/controller_file.h"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 
@@ -32,6 +33,19 @@ struct LauncherSection {
   }
 };
 
+// Fails at `key` for a setting out of its range (a RangeViolation names the sub-key).
+void refuse(const JsonReadArchive& r, const std::string& path, const RangeViolation& v) {
+  if (v) r.fail(join_key(path, v.key), v.rule);
+}
+
+// A shot's integer field, written as a number: refused unless it is exactly
+// one of lo..hi, and only then converted (a cast of 1e300 is undefined).
+bool small_integer(double v, int lo, int hi, int* out) {
+  if (!(v >= lo && v <= hi) || v != std::floor(v)) return false;
+  *out = static_cast<int>(v);
+  return true;
+}
+
 // A key the format requires; the others keep their defaults when absent.
 const json& need(const JsonReadArchive& r, const json& parent, const std::string& path, const char* key) {
   if (!parent.is_object() || !parent.contains(key)) r.fail(join_key(path, key), "missing");
@@ -61,9 +75,14 @@ ShotTable shot_table_from_json(const json& j, JsonReadArchive& r) {
   }
   ImitationConfig c;
   r.read(&j, "imitation", &c);
+  refuse(r, "imitation", check_imitation_config(c));
   // The shots are rows of numbers, not keyed structs: read as lists, then checked here.
+  const json& shots = need(r, j, "imitation", "shots");
+  if (shots.is_array() && shots.size() > kMaxShots) {
+    r.fail("imitation.shots", "more than " + std::to_string(kMaxShots) + " shots");
+  }
   std::vector<std::vector<double>> rows;
-  r.read(&need(r, j, "imitation", "shots"), "imitation.shots", &rows);
+  r.read(&shots, "imitation.shots", &rows);
   std::vector<ShotExample> examples;
   examples.reserve(rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -71,15 +90,17 @@ ShotTable shot_table_from_json(const json& j, JsonReadArchive& r) {
     const std::vector<double>& v = rows[i];
     if (v.size() != kShotFieldCount) r.fail(where, "must have 8 numbers (see imitation.shot_fields)");
     ShotExample e;
-    e.flipper = static_cast<int>(v[0]);
-    e.rolling = v[1] != 0.0;
+    int rolling = 0;
+    if (!small_integer(v[0], 0, 1, &e.flipper)) r.fail(where, "flipper must be 0 (left) or 1 (right)");
+    if (!small_integer(v[1], 0, 1, &rolling)) r.fail(where, "rolling must be 0 or 1");
+    if (!small_integer(v[5], -1, 1, &e.fired_flipper)) r.fail(where, "fired_flipper must be -1 (pass), 0 or 1");
+    e.rolling = rolling == 1;
     e.angle_rad = v[2];
     e.h = v[3];
     e.speed_mps = v[4];
-    e.fired_flipper = static_cast<int>(v[5]);
     e.d_fire_m = v[6];
     e.hold_s = v[7];
-    if (v[0] != e.flipper || v[5] != e.fired_flipper) r.fail(where, "flipper numbers must be integers");
+    if (const RangeViolation bad = check_shot_example(e)) r.fail(where, bad.key + " " + bad.rule);
     examples.push_back(e);
   }
   try {
@@ -93,8 +114,9 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
   if (!j.is_object()) r.fail("(file)", "must be a JSON object");
   const json& format = need(r, j, "", "format");
   if (!format.is_string() || format.get<std::string>() != kFormat) r.fail("format", "must be \"pinball-controller\"");
+  // Compared as a 64-bit integer: get<int>() would truncate 4294967297 to 1.
   const json& version = need(r, j, "", "version");
-  if (!version.is_number_integer() || version.get<int>() != kControllerFileVersion) {
+  if (!version.is_number_integer() || version.get<std::int64_t>() != kControllerFileVersion) {
     r.fail("version", "unsupported (this build reads version " + std::to_string(kControllerFileVersion) + ")");
   }
   ControllerSpec s;
@@ -103,6 +125,7 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
   need(r, part, "partition", "angle_borders_rad");
   ActionFunctionConfig c;
   r.read(&part, "partition", &c);
+  refuse(r, "partition", check_action_function_config(c));
   try {
     s.action_function = ActionFunction(c);
   } catch (const std::invalid_argument& e) {
@@ -123,11 +146,12 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
       r.fail(where + ".flipper", "must be \"left\" or \"right\"");
     }
     mc.flipper = f.get<std::string>() == "left" ? track::kLeftFlipper : track::kRightFlipper;
+    refuse(r, where, check_minicontroller(mc));
   }
   if (j.contains("imitation")) s.shot_table = std::make_shared<const ShotTable>(shot_table_from_json(j["imitation"], r));
   if (j.contains("actuator")) {
     r.read(&j["actuator"], "actuator", &s.actuator);
-    if (s.actuator.max_hold_s < 0.0) r.fail("actuator.max_hold_s", "must be >= 0");
+    refuse(r, "actuator", check_actuator_config(s.actuator));
   }
   if (j.contains("launcher")) {
     LauncherSection l{s.launcher_pull, s.randomise_launch, s.launch_pull_min, s.launch_pull_max};
@@ -188,12 +212,7 @@ std::string controller_to_json(const ControllerSpec& s) {
 
 ControllerSpec controller_from_json(const std::string& text, const std::string& src) {
   try {
-    json j;
-    try {
-      j = json::parse(text);
-    } catch (const json::parse_error& e) {
-      throw KeyError(src, "(file)", std::string("not valid JSON: ") + e.what());
-    }
+    const json j = parse_json(text, src);  // refuses a repeated key too
     JsonReadArchive r(src, {.refuse_unknown_keys = false});  // unknown keys are ignored (the format says nothing)
     return spec_from_json(j, r);
   } catch (const KeyError& e) {

@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
+#include <initializer_list>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -12,6 +13,33 @@ namespace pinball::control {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+
+// Bounds of a shot's numbers (check_shot_example).
+constexpr double kMaxShotH = 100.0;        // flipper lengths
+constexpr double kMaxShotSpeed_mps = 100.0;
+constexpr double kMaxShotD_m = 10.0;
+
+// Lookup settings (check_imitation_config).
+constexpr double kMinScale = 1e-3;
+constexpr double kMaxHScale = 10.0;
+constexpr double kMaxSpeedScale_mps = 100.0;
+constexpr double kMaxLead_s = 0.1;  // 20 frames at 200 fps: more is no lead for one frame
+
+// "must be in [lo, hi]<unit>" when lo <= x <= hi fails (NaN fails too).
+RangeViolation outside(const char* key, double x, double lo, double hi, const char* unit) {
+  if (x >= lo && x <= hi) return {};
+  std::ostringstream rule;
+  rule << "must be in [" << lo << ", " << hi << "]" << unit;
+  return {key, rule.str()};
+}
+
+// The first violation of a list, or none.
+RangeViolation first_of(std::initializer_list<RangeViolation> checks) {
+  for (const RangeViolation& v : checks) {
+    if (v) return v;
+  }
+  return {};
+}
 
 std::size_t line_index(int flipper, bool rolling) {
   return static_cast<std::size_t>(flipper) * 2 + (rolling ? 1 : 0);
@@ -50,32 +78,37 @@ struct ShotTable::Neighbours {
   }
 };
 
+RangeViolation check_imitation_config(const ImitationConfig& c) {
+  if (c.neighbours < 1 || c.neighbours > kMaxNeighbours) {
+    return {"neighbours", "must be in [1, " + std::to_string(kMaxNeighbours) + "]"};
+  }
+  return first_of({outside("angle_scale_rad", c.angle_scale_rad, kMinScale, kPi, " rad"),
+                   outside("h_scale", c.h_scale, kMinScale, kMaxHScale, " flipper lengths"),
+                   outside("speed_scale_mps", c.speed_scale_mps, kMinScale, kMaxSpeedScale_mps, " m/s"),
+                   outside("max_hold_s", c.max_hold_s, 0.0, kMaxHold_s, " s (0: no limit of its own)"),
+                   outside("lead_s", c.lead_s, 0.0, kMaxLead_s, " s")});
+}
+
+RangeViolation check_shot_example(const ShotExample& e) {
+  if (e.flipper != track::kLeftFlipper && e.flipper != track::kRightFlipper) {
+    return {"flipper", "must be 0 (left) or 1 (right)"};
+  }
+  if (e.fired_flipper < -1 || e.fired_flipper > 1) return {"fired_flipper", "must be -1 (pass), 0 or 1"};
+  return first_of({outside("angle_rad", e.angle_rad, -kPi, kPi, " rad"),
+                   outside("h", e.h, -kMaxShotH, kMaxShotH, " flipper lengths"),
+                   outside("speed_mps", e.speed_mps, 0.0, kMaxShotSpeed_mps, " m/s"),
+                   outside("d_fire_m", e.d_fire_m, -kMaxShotD_m, kMaxShotD_m, " m"),
+                   outside("hold_s", e.hold_s, 0.0, kMaxHold_s, " s")});
+}
+
 ShotTable::ShotTable(std::vector<ShotExample> examples, const ImitationConfig& config)
     : examples_(std::move(examples)), config_(config) {
-  if (config.neighbours < 1 || config.neighbours > kMaxNeighbours) {
-    throw std::invalid_argument("shot table: neighbours must be in [1, " + std::to_string(kMaxNeighbours) + "]");
-  }
-  if (!(config.angle_scale_rad > 0.0 && config.h_scale > 0.0 && config.speed_scale_mps > 0.0)) {
-    throw std::invalid_argument("shot table: the distance scales must be > 0");
-  }
-  if (!(config.max_hold_s >= 0.0)) throw std::invalid_argument("shot table: max hold must be >= 0");
-  if (!(config.lead_s >= 0.0 && config.lead_s < 1.0)) throw std::invalid_argument("shot table: lead must be in [0, 1) s");
-  if (examples_.size() >= std::numeric_limits<std::uint32_t>::max()) throw std::invalid_argument("shot table: too many examples");
+  check_input(check_imitation_config(config), "shot table");
+  check_input(examples_.size() <= kMaxShots, "shot table", "more than " + std::to_string(kMaxShots) + " shots");
   std::array<std::vector<std::uint32_t>, 4> members;
   for (std::size_t i = 0; i < examples_.size(); ++i) {
     const ShotExample& e = examples_[i];
-    const std::string where = "shot table: example " + std::to_string(i) + ": ";
-    if (e.flipper != track::kLeftFlipper && e.flipper != track::kRightFlipper) {
-      throw std::invalid_argument(where + "flipper must be 0 (left) or 1 (right)");
-    }
-    if (e.fired_flipper < -1 || e.fired_flipper > 1) {
-      throw std::invalid_argument(where + "fired flipper must be -1 (pass), 0 or 1");
-    }
-    if (!std::isfinite(e.angle_rad) || !std::isfinite(e.h) || !std::isfinite(e.speed_mps) ||
-        !std::isfinite(e.d_fire_m) || !std::isfinite(e.hold_s)) {
-      throw std::invalid_argument(where + "numbers must be finite");
-    }
-    if (e.hold_s < 0.0) throw std::invalid_argument(where + "hold must be >= 0");
+    check_input(check_shot_example(e), "shot table: example " + std::to_string(i));
     members[line_index(e.flipper, e.rolling)].push_back(static_cast<std::uint32_t>(i));
   }
   for (std::size_t l = 0; l < lines_.size(); ++l) build_line(lines_[l], members[l]);
@@ -95,11 +128,21 @@ double theta_position(double angle_rad) {
   return t;
 }
 
+// Halves the longest axis until the grid has at most `max_cells` cells. Cells
+// only get wider, so every unseen example stays at least r cells, each at
+// least one scale wide, away after shell r, and the search stays exact.
+void fit_grid(int& a, int& b, int& c, std::size_t max_cells) {
+  while (static_cast<std::size_t>(a) * static_cast<std::size_t>(b) * static_cast<std::size_t>(c) > max_cells) {
+    int& longest = a >= b && a >= c ? a : (b >= c ? b : c);
+    longest = (longest + 1) / 2;
+  }
+}
+
 }  // namespace
 
 void ShotTable::build_line(Line& line, const std::vector<std::uint32_t>& members) {
+  // The scales are bounded (check_imitation_config), so the cast is safe: at most π / 0.001 cells.
   line.n_theta = std::max(1, static_cast<int>(std::floor(kPi / config_.angle_scale_rad)));
-  line.cell_theta_rad = kPi / line.n_theta;
   double h_min = 0.0, h_max = 0.0, s_min = 0.0, s_max = 0.0;
   for (std::size_t j = 0; j < members.size(); ++j) {
     const ShotExample& e = examples_[members[j]];
@@ -108,12 +151,18 @@ void ShotTable::build_line(Line& line, const std::vector<std::uint32_t>& members
     s_min = j == 0 ? e.speed_mps : std::min(s_min, e.speed_mps);
     s_max = j == 0 ? e.speed_mps : std::max(s_max, e.speed_mps);
   }
-  // Cells one scale wide; a pathological spread is capped (cells get wider, the search stays exact).
+  // Cells one scale wide, at most 512 a side and not many more cells than
+  // examples: a sparse table gets wider cells, not a grid of empty ones.
   constexpr double kMaxCellsPerAxis = 512.0;
   line.h0 = h_min;
   line.s0 = s_min;
+  line.n_theta = std::min(line.n_theta, static_cast<int>(kMaxCellsPerAxis));
   line.n_h = static_cast<int>(std::min(kMaxCellsPerAxis, std::floor((h_max - h_min) / config_.h_scale) + 1.0));
   line.n_s = static_cast<int>(std::min(kMaxCellsPerAxis, std::floor((s_max - s_min) / config_.speed_scale_mps) + 1.0));
+  fit_grid(line.n_theta, line.n_h, line.n_s, std::max<std::size_t>(64, 2 * members.size()));
+  line.cell_theta_rad = kPi / line.n_theta;
+  line.cell_h = std::max(config_.h_scale, (h_max - h_min) / line.n_h);
+  line.cell_s = std::max(config_.speed_scale_mps, (s_max - s_min) / line.n_s);
   const std::size_t cells = static_cast<std::size_t>(line.n_theta) * line.n_h * line.n_s;
   std::vector<std::uint32_t> cell(members.size());
   line.start.assign(cells + 1, 0);
@@ -121,8 +170,8 @@ void ShotTable::build_line(Line& line, const std::vector<std::uint32_t>& members
     const ShotExample& e = examples_[members[j]];
     cell[j] = static_cast<std::uint32_t>(
         cell_of(line, clamp_cell(theta_position(e.angle_rad) / line.cell_theta_rad, line.n_theta),
-                clamp_cell((e.h - line.h0) / config_.h_scale, line.n_h),
-                clamp_cell((e.speed_mps - line.s0) / config_.speed_scale_mps, line.n_s)));
+                clamp_cell((e.h - line.h0) / line.cell_h, line.n_h),
+                clamp_cell((e.speed_mps - line.s0) / line.cell_s, line.n_s)));
     ++line.start[cell[j] + 1];
   }
   for (std::size_t c = 0; c < cells; ++c) line.start[c + 1] += line.start[c];
@@ -181,30 +230,40 @@ ImitationDecision ShotTable::decide(const track::TrajectoryProjection& p) const 
   const Line& line = lines_[line_index(p.flipper == track::kRightFlipper ? 1 : 0, p.rolling)];
   if (line.items.empty()) return vote(n);
   const int qt = clamp_cell(theta_position(p.angle_rad) / line.cell_theta_rad, line.n_theta);
-  const int qh = clamp_cell((p.h - line.h0) / config_.h_scale, line.n_h);
-  const int qs = clamp_cell((p.speed_mps - line.s0) / config_.speed_scale_mps, line.n_s);
+  const int qh = clamp_cell((p.h - line.h0) / line.cell_h, line.n_h);
+  const int qs = clamp_cell((p.speed_mps - line.s0) / line.cell_s, line.n_s);
   // θ offsets that reach each θ cell exactly once around the circle.
   const int t_lo = -(line.n_theta - 1) / 2;
   const int t_hi = line.n_theta - 1 + t_lo;
   const int r_max = std::max({t_hi, -t_lo, line.n_h, line.n_s});
+  // The work is bounded: a step is a row of cells, a cell or a shot
+  // considered, and once the steps outnumber the line's shots a scan of the
+  // line is the cheaper way to finish, so a decision costs at most about two
+  // scans (a sparse table, whose shots lie many empty cells from the query,
+  // once took 40 ms for one decision). The loops stay inside the grid.
+  const std::size_t budget = line.items.size() + 64;
+  std::size_t steps = 0;
+  auto visit = [&](int it, int ih, int is) {
+    const auto c = static_cast<std::size_t>(cell_of(line, it, ih, is));
+    for (std::uint32_t j = line.start[c]; j < line.start[c + 1]; ++j) consider(line.items[j], p, n);
+    steps += 1 + (line.start[c + 1] - line.start[c]);
+  };
   for (int r = 0; r <= r_max; ++r) {
     for (int dt = std::max(-r, t_lo); dt <= std::min(r, t_hi); ++dt) {
       const int it = ((qt + dt) % line.n_theta + line.n_theta) % line.n_theta;
-      for (int dh = -r; dh <= r; ++dh) {
+      for (int dh = std::max(-r, -qh); dh <= std::min(r, line.n_h - 1 - qh); ++dh) {
         const int ih = qh + dh;
-        if (ih < 0 || ih >= line.n_h) continue;
-        const bool edge_th = std::abs(dt) == r || std::abs(dh) == r;
-        for (int ds = -r; ds <= r; ds += (edge_th ? 1 : 2 * std::max(r, 1))) {  // inside the shell: only ds = ±r
-          const int is = qs + ds;
-          if (is < 0 || is >= line.n_s) continue;
-          const int c = cell_of(line, it, ih, is);
-          for (std::uint32_t j = line.start[static_cast<std::size_t>(c)]; j < line.start[static_cast<std::size_t>(c) + 1]; ++j) {
-            consider(line.items[j], p, n);
-          }
+        ++steps;
+        if (std::abs(dt) == r || std::abs(dh) == r) {  // a face of the shell: every s cell in reach
+          for (int ds = std::max(-r, -qs); ds <= std::min(r, line.n_s - 1 - qs); ++ds) visit(it, ih, qs + ds);
+        } else {  // inside the shell: only s = ±r
+          if (qs - r >= 0) visit(it, ih, qs - r);
+          if (qs + r < line.n_s) visit(it, ih, qs + r);
         }
+        if (steps > budget) return decide_by_scan(p);
       }
     }
-    // Every example not yet seen lies at least r cells (each at least one scale wide) away.
+    // Every example not yet seen lies more than r cells (each at least one scale wide) away.
     if (n.full() && n.worst() < static_cast<double>(r) * static_cast<double>(r)) break;
   }
   return vote(n);

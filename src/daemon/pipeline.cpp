@@ -152,6 +152,7 @@ TrackingSetup tracking_setup_for(const DaemonConfig& config, const table::Board&
   TrackingSetup s{track::default_tracker_config(board, camera_model), track::flipper_geometry_from_board(board), {}};
   if (!config.calibration.empty()) {
     const calibration::Calibration c = calibration::read_calibration(config.calibration);
+    calibration::check_calibration_matches_board(c, config.calibration, board);  // a misnamed flipper is refused
     calibration::apply_calibration(c, config.calibration, s.tracker, s.geometry);
     if (c.camera) s.homography = calibration::camera_homography(c, config.calibration);
   }

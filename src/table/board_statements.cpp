@@ -15,6 +15,51 @@ namespace {
 
 constexpr std::string_view kObstacleAttributes = "rho score kick contact eat hidden bank name";
 
+// Physical bounds, SI. A table is about 0.5 m x 1 m, its ball 27 mm across and
+// at most a few m/s fast; the bounds are loose around that. They are here so
+// that a typo (a missing `units mm`, an exponent too many) is refused at its
+// line instead of making the simulator spin (dt 1e-12), allocate (a 1e9 m
+// table) or overflow (a coordinate of 1e300).
+constexpr double kMaxLength_m = 10.0;        // size W and H, every radius and flipper length
+constexpr double kMaxCoordinate_m = 100.0;   // every position, either axis
+constexpr double kMaxBallRadius_m = 0.1;     // a pinball is 13.5 mm
+constexpr double kMaxSpeed_mps = 100.0;      // SPEED_MAX, kick, kickout: twenty times a hard shot
+constexpr double kMaxGravity_mps2 = 10.0;    // along the table: at most g itself (9.81), with rounding
+constexpr double kMaxRho = 2.0;              // reflectivity: > 1 kicks; 2 already doubles the normal speed
+// Below 1 µs a ball takes millions of steps a second of play (1e-12: never
+// ends); above 10 ms a 5 m/s ball jumps 5 cm, through any post.
+constexpr double kMinDt_s = 1e-6;
+constexpr double kMaxDt_s = 0.01;
+
+/// The file's length unit as messages spell it.
+std::string unit_name(const LoadState& state) { return state.length_scale == 1.0 ? "m" : "mm"; }
+
+/// Requires `v`, read in the file's length unit (per second with per = "/s",
+/// ...), to be at most `max_si`; the message states the bound in the file's unit.
+void require_at_most(const LoadState& state, const Reader& r, double v, const std::string& label, double max_si,
+                     const std::string& per = "") {
+  r.require(v * state.length_scale <= max_si, label, "at most " + fmt(max_si / state.length_scale) + " " +
+                                                          unit_name(state) + per, v);
+}
+
+/// A position read in the file's unit, in metres; refused beyond kMaxCoordinate_m on either axis.
+Vec2 position(const LoadState& state, const Reader& r, double x, double y, const std::string& label) {
+  const Vec2 p = Vec2{x, y} * state.length_scale;
+  if (!(std::abs(p.x()) <= kMaxCoordinate_m && std::abs(p.y()) <= kMaxCoordinate_m)) {
+    r.fail(label + " must lie within " + fmt(kMaxCoordinate_m / state.length_scale) + " " + unit_name(state) +
+           " of the origin on each axis, got (" + fmt(x) + ", " + fmt(y) + ")");
+  }
+  return p;
+}
+
+/// A reflectivity attribute: [0, kMaxRho].
+double rho_attribute(const Reader& r, double fallback) {
+  const double rho = r.attribute("rho", fallback);
+  r.require(rho >= 0, "attribute rho", ">= 0", rho);
+  r.require(rho <= kMaxRho, "attribute rho", "at most " + fmt(kMaxRho), rho);
+  return rho;
+}
+
 // ---- header and constants ----
 
 void header(LoadState&, const Reader& r) {
@@ -45,6 +90,8 @@ void size(LoadState& state, const Reader& r) {
   const auto v = r.numbers(0, {"W", "H"});
   r.require(v[0] > 0, "field W (width)", "> 0", v[0]);
   r.require(v[1] > 0, "field H (height)", "> 0", v[1]);
+  require_at_most(state, r, v[0], "field W (width)", kMaxLength_m);
+  require_at_most(state, r, v[1], "field H (height)", kMaxLength_m);
   state.board.width_m = v[0] * state.length_scale;
   state.board.height_m = v[1] * state.length_scale;
 }
@@ -53,6 +100,8 @@ void ball(LoadState& state, const Reader& r) {
   const auto v = r.numbers(0, {"R", "SPEED_MAX"});
   r.require(v[0] > 0, "field R (radius)", "> 0", v[0]);
   r.require(v[1] > 0, "field SPEED_MAX", "> 0", v[1]);
+  require_at_most(state, r, v[0], "field R (radius)", kMaxBallRadius_m);
+  require_at_most(state, r, v[1], "field SPEED_MAX", kMaxSpeed_mps, "/s");
   state.board.ball.radius_m = v[0] * state.length_scale;
   state.board.ball.speed_max_mps = v[1] * state.length_scale;
 }
@@ -60,12 +109,15 @@ void ball(LoadState& state, const Reader& r) {
 void gravity(LoadState& state, const Reader& r) {
   const double g = r.numbers(0, {"G"})[0];
   r.require(g >= 0, "field G", ">= 0", g);
+  require_at_most(state, r, g, "field G", kMaxGravity_mps2, "/s^2");
   state.board.gravity_mps2 = g * state.length_scale;
 }
 
 void dt(LoadState& state, const Reader& r) {
   const double dt = r.numbers(0, {"DT"})[0];
   r.require(dt > 0, "field DT (seconds)", "> 0", dt);
+  r.require(dt >= kMinDt_s && dt <= kMaxDt_s, "field DT (seconds)", "in [" + fmt(kMinDt_s) + ", " + fmt(kMaxDt_s) + "]",
+            dt);
   state.board.dt_s = dt;
 }
 
@@ -79,7 +131,7 @@ void balls(LoadState& state, const Reader& r) {
 void launcher(LoadState& state, const Reader& r) {
   const auto v = r.numbers(0, {"X", "Y"});
   Launcher& l = state.board.launcher;
-  l.position = Vec2{v[0], v[1]} * state.length_scale;
+  l.position = position(state, r, v[0], v[1], "fields X Y");
   l.pull = r.attribute("pull", 1.0);
   r.require(l.pull > 0 && l.pull <= 1, "attribute pull", "in (0, 1]", l.pull);
   l.noise_max = r.attribute("noise", 0.03);
@@ -88,8 +140,7 @@ void launcher(LoadState& state, const Reader& r) {
 
 void defaults(LoadState& state, const Reader& r) {
   if (r.arg_count() != 0) r.fail("takes only attributes (rho=R), got '" + std::string(r.arg(0)) + "'");
-  state.default_rho = r.attribute("rho", state.default_rho);
-  r.require(state.default_rho >= 0, "attribute rho", ">= 0", state.default_rho);
+  state.default_rho = rho_attribute(r, state.default_rho);
 }
 
 int bank_index(const Board& board, std::string_view name) {
@@ -115,11 +166,11 @@ std::string default_name(const Reader& r) { return std::string(r.keyword()) + "@
 /// The attributes every shape of one obstacle statement shares.
 Obstacle obstacle_attributes(const LoadState& state, const Reader& r) {
   Obstacle o;
-  o.rho = r.attribute("rho", state.default_rho);
-  r.require(o.rho >= 0, "attribute rho", ">= 0", o.rho);
+  o.rho = rho_attribute(r, state.default_rho);
   o.action.score = r.attribute("score", 0.0);
   const double kick = r.attribute("kick", 0.0);
   r.require(kick >= 0, "attribute kick", ">= 0", kick);
+  require_at_most(state, r, kick, "attribute kick", kMaxSpeed_mps, "/s");
   o.action.kick_mps = kick * state.length_scale;
   o.action.contact_score_per_s = r.attribute("contact", 0.0);
   o.action.eats_ball = r.flag("eat");
@@ -146,7 +197,7 @@ void add(Board& board, const Shape& shape, const Obstacle& o) {
 std::pair<Vec2, Vec2> segment(const LoadState& state, const Reader& r, std::size_t first) {
   const auto v = r.numbers(first, {"X1", "Y1", "X2", "Y2"});
   if (v[0] == v[2] && v[1] == v[3]) r.fail("zero-length segment");
-  return {Vec2{v[0], v[1]} * state.length_scale, Vec2{v[2], v[3]} * state.length_scale};
+  return {position(state, r, v[0], v[1], "fields X1 Y1"), position(state, r, v[2], v[3], "fields X2 Y2")};
 }
 
 void line(LoadState& state, const Reader& r) {
@@ -165,19 +216,21 @@ void wall(LoadState& state, const Reader& r) {
 
 void point(LoadState& state, const Reader& r) {
   const auto v = r.numbers(0, {"X", "Y"});
-  add(state.board, make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, 0.0), obstacle_attributes(state, r));
+  add(state.board, make_circle_shape(position(state, r, v[0], v[1], "fields X Y"), 0.0), obstacle_attributes(state, r));
 }
 
 void circle(LoadState& state, const Reader& r) {
   const auto v = r.numbers(0, {"X", "Y", "R"});
   r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
-  add(state.board, make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale),
+  require_at_most(state, r, v[2], "field R (radius)", kMaxLength_m);
+  add(state.board, make_circle_shape(position(state, r, v[0], v[1], "fields X Y"), v[2] * state.length_scale),
       obstacle_attributes(state, r));
 }
 
-/// Vertices in file units, checked for zero-length edges (closed: also last -> first).
-std::vector<Vec2> path(const Reader& r, std::size_t min_count, bool closed) {
+/// Vertices in file units, checked for zero-length edges (closed: also last -> first) and range.
+std::vector<Vec2> path(const LoadState& state, const Reader& r, std::size_t min_count, bool closed) {
   const std::vector<Vec2> v = r.vertices(0, min_count);
+  for (std::size_t i = 0; i < v.size(); ++i) (void)position(state, r, v[i].x(), v[i].y(), "vertex " + std::to_string(i + 1));
   const std::size_t edges = closed ? v.size() : v.size() - 1;
   for (std::size_t i = 0; i < edges; ++i) {
     const std::size_t j = (i + 1) % v.size();
@@ -189,7 +242,7 @@ std::vector<Vec2> path(const Reader& r, std::size_t min_count, bool closed) {
 }
 
 void polyline(LoadState& state, const Reader& r) {
-  const std::vector<Vec2> v = path(r, 2, false);
+  const std::vector<Vec2> v = path(state, r, 2, false);
   const Obstacle o = obstacle_attributes(state, r);
   const bool two_sided = r.flag("two-sided");
   for (std::size_t i = 0; i + 1 < v.size(); ++i) {
@@ -200,7 +253,7 @@ void polyline(LoadState& state, const Reader& r) {
 }
 
 void polygon(LoadState& state, const Reader& r) {
-  std::vector<Vec2> v = path(r, 3, true);
+  std::vector<Vec2> v = path(state, r, 3, true);
   double twice_area = 0.0;
   for (std::size_t i = 0; i < v.size(); ++i) twice_area += cross(v[i], v[(i + 1) % v.size()]);
   if (twice_area == 0.0) r.fail("the vertices enclose no area");
@@ -223,15 +276,15 @@ void flipper(LoadState& state, const Reader& r) {
   f.side = *parsed;
   const auto v = r.numbers(1, {"PX", "PY", "LENGTH", "THETA_MIN", "THETA_MAX", "OMEGA"});
   r.require(v[2] > 0, "field LENGTH", "> 0", v[2]);
+  require_at_most(state, r, v[2], "field LENGTH", kMaxLength_m);
   if (!(v[3] < v[4])) r.fail("field THETA_MIN (" + fmt(v[3]) + ") must be less than THETA_MAX (" + fmt(v[4]) + ")");
   r.require(v[5] > 0, "field OMEGA", "> 0", v[5]);
-  f.pivot = Vec2{v[0], v[1]} * state.length_scale;
+  f.pivot = position(state, r, v[0], v[1], "fields PX PY");
   f.length_m = v[2] * state.length_scale;
   f.theta_min_rad = v[3] * state.angle_scale;
   f.theta_max_rad = v[4] * state.angle_scale;
   f.omega_rad_s = v[5] * state.angle_scale;
-  f.rho = r.attribute("rho", state.default_rho);
-  r.require(f.rho >= 0, "attribute rho", ">= 0", f.rho);
+  f.rho = rho_attribute(r, state.default_rho);
   f.mu = r.attribute("mu", 1.0);
   r.require(f.mu >= 0, "attribute mu", ">= 0", f.mu);
   f.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
@@ -256,7 +309,8 @@ void sensor(LoadState& state, const Reader& r) {
   } else if (shape == "circle") {
     const auto v = r.numbers(1, {"X", "Y", "R"});
     r.require(v[2] >= 0, "field R (radius)", ">= 0", v[2]);
-    s.shape = make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale);
+    require_at_most(state, r, v[2], "field R (radius)", kMaxLength_m);
+    s.shape = make_circle_shape(position(state, r, v[0], v[1], "fields X Y"), v[2] * state.length_scale);
   } else {
     r.fail("field SHAPE must be 'line' or 'circle', got '" + std::string(shape) + "'");
   }
@@ -268,8 +322,9 @@ void hole(LoadState& state, const Reader& r) {
   Sensor s;
   const auto v = r.numbers(0, {"X", "Y", "R"});
   r.require(v[2] > 0, "field R (radius)", "> 0", v[2]);
+  require_at_most(state, r, v[2], "field R (radius)", kMaxLength_m);
   s.kind = SensorKind::kHole;
-  s.shape = make_circle_shape(Vec2{v[0], v[1]} * state.length_scale, v[2] * state.length_scale);
+  s.shape = make_circle_shape(position(state, r, v[0], v[1], "fields X Y"), v[2] * state.length_scale);
   const bool eat = r.flag("eat");
   if (eat == r.flag("kickout")) r.fail("needs exactly one of 'eat' or 'kickout=VX,VY'");
   if (!eat) {
@@ -277,9 +332,10 @@ void hole(LoadState& state, const Reader& r) {
     const std::size_t comma = k.find(',');
     if (comma == std::string_view::npos) r.fail("attribute kickout must be VX,VY, got '" + std::string(k) + "'");
     s.has_kickout = true;
-    s.kickout_mps = Vec2{r.number(k.substr(0, comma), "attribute kickout VX"),
-                         r.number(k.substr(comma + 1), "attribute kickout VY")} *
-                    state.length_scale;
+    const double vx = r.number(k.substr(0, comma), "attribute kickout VX");
+    const double vy = r.number(k.substr(comma + 1), "attribute kickout VY");
+    require_at_most(state, r, std::hypot(vx, vy), "attribute kickout speed", kMaxSpeed_mps, "/s");
+    s.kickout_mps = Vec2{vx, vy} * state.length_scale;
   }
   finish_sensor(state, r, s);
 }

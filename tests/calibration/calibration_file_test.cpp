@@ -116,6 +116,49 @@ TEST(CalibrationFile, ErrorsNameFileAndKey) {
   expect_error("just text", "lab.yaml:version");
 }
 
+TEST(CalibrationFile, UnknownAndRepeatedKeysAreRefused) {
+  const std::string good = calibration_to_yaml(sample());
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = good;
+    const std::size_t at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return t.replace(at, from.size(), to);
+  };
+  // A misspelt key used to pass unseen.
+  expect_error(with("  markers_used:", "  markers_usde: 7\n  markers_used:"), "lab.yaml:camera.markers_usde: unknown key");
+  expect_error(with("gravity:", "gravty: {g_mps2: 9.81}\ngravity:"), "lab.yaml:gravty: unknown key");
+  expect_error(with("    points: 4\n", "    points: 4\n    pionts: 4\n"), "lab.yaml:flippers[0].pionts: unknown key");
+  // yaml-cpp keeps both values of a repeated key; which one counts is not the file's to leave open.
+  expect_error(with("  g_mps2:", "  g_mps2: 9.81\n  g_mps2:"), "lab.yaml:gravity.g_mps2: duplicate key");
+  expect_error(with("version: 1\n", "version: 1\nversion: 1\n"), "lab.yaml:version: duplicate key");
+  expect_error(good + "---\nversion: 1\n", "a second YAML document");
+}
+
+TEST(CalibrationFile, FlippersMustBeTheBoards) {
+  const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
+  EXPECT_NO_THROW(check_calibration_matches_board(sample(), "lab.yaml", board));
+  auto error_of = [&](const Calibration& c) -> std::string {
+    try {
+      check_calibration_matches_board(c, "lab.yaml", board);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  Calibration typo = sample();
+  typo.flippers[1].name = "rigth_flipper";
+  EXPECT_EQ(error_of(typo).rfind("lab.yaml:flippers[1].name: 'rigth_flipper' is not a flipper of the board", 0), 0u)
+      << error_of(typo);
+  Calibration swapped = sample();
+  swapped.flippers[0].side = table::Side::kRight;
+  EXPECT_EQ(error_of(swapped), "lab.yaml:flippers[0].side: right, but the board's 'left_flipper' is a left flipper");
+  Calibration twice = sample();
+  twice.flippers[1] = twice.flippers[0];
+  EXPECT_EQ(error_of(twice), "lab.yaml:flippers[1].name: 'left_flipper' is calibrated twice");
+  table::Board b = board;
+  EXPECT_THROW(apply_calibration(typo, "lab.yaml", b), std::runtime_error);
+}
+
 TEST(CalibrationFile, AppliesToTrackerAndBoard) {
   const Calibration c = sample();
   const table::Board board = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 namespace pinball::control {
 namespace {
 
@@ -117,13 +119,72 @@ TEST(ControllerFile, BadShotTablesNameTheField) {
   expect_error(short_row, "imitation.shots[0]: must have 8 numbers");
   std::string bad_flipper = good;
   bad_flipper.replace(bad_flipper.find("[0,0,"), 5, "[7,0,");
-  expect_error(bad_flipper, "imitation: shot table: example 0: flipper");
+  expect_error(bad_flipper, "imitation.shots[0]: flipper must be 0 (left) or 1 (right)");
   std::string half = good;
   half.replace(half.find("[0,0,"), 5, "[0.5,0,");
-  expect_error(half, "imitation.shots[0]: flipper numbers must be integers");
+  expect_error(half, "imitation.shots[0]: flipper must be 0 (left) or 1 (right)");
   std::string k = good;
   k.replace(k.find("\"neighbours\": 5"), 15, "\"neighbours\": 0");
-  expect_error(k, "imitation: shot table: neighbours");
+  expect_error(k, "imitation.neighbours: must be in [1, 32]");
+}
+
+// `text` with its first `from` replaced by `to`.
+std::string with(std::string text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+TEST(ControllerFile, ShotTableSettingsHaveSaneRanges) {
+  const std::string good = controller_to_json(with_shots());
+  // A scale of 1e-6 made the lookup spin for ever, 1.5e-9 asked for an oversized allocation.
+  for (const char* scale : {"1e-06", "1.5e-09", "0", "-0.1", "4"}) {
+    expect_error(with(good, "\"angle_scale_rad\": 0.07", std::string("\"angle_scale_rad\": ") + scale),
+                 "bad.json: imitation.angle_scale_rad: must be in [0.001, 3.14159] rad");
+  }
+  expect_error(with(good, "\"h_scale\": 0.2", "\"h_scale\": 1e-5"), "imitation.h_scale: must be in [0.001, 10]");
+  expect_error(with(good, "\"speed_scale_mps\": 0.4", "\"speed_scale_mps\": 500"),
+               "imitation.speed_scale_mps: must be in [0.001, 100] m/s");
+  expect_error(with(good, "\"max_hold_s\": 0.8", "\"max_hold_s\": 60"), "imitation.max_hold_s: must be in [0, 10] s");
+  expect_error(with(good, "\"lead_s\": 0.001", "\"lead_s\": 0.5"), "imitation.lead_s: must be in [0, 0.1] s");
+}
+
+TEST(ControllerFile, ShotsOutOfRangeAreRefusedBeforeAnyCast) {
+  const std::string good = controller_to_json(with_shots());
+  const std::string row = "[0,0,-0.3333333333333333,0.5,2.25,1,0.0512345678901234,0.03]";
+  ASSERT_NE(good.find(row), std::string::npos) << good;
+  auto shot = [&](const std::string& r) { return with(good, row, r); };
+  // Integers written as huge numbers: refused, not cast (UBSan float-cast-overflow stays silent).
+  expect_error(shot("[1e300,0,0.1,0.5,2.0,1,0.05,0.03]"), "imitation.shots[0]: flipper must be 0 (left) or 1 (right)");
+  expect_error(shot("[0,0,0.1,0.5,2.0,-1e300,0.05,0.03]"), "imitation.shots[0]: fired_flipper must be -1 (pass), 0 or 1");
+  expect_error(shot("[0,2,0.1,0.5,2.0,1,0.05,0.03]"), "imitation.shots[0]: rolling must be 0 or 1");
+  expect_error(shot("[0,0,7,0.5,2.0,1,0.05,0.03]"), "imitation.shots[0]: angle_rad must be in [-3.14159, 3.14159] rad");
+  expect_error(shot("[0,0,0.1,1e200,2.0,1,0.05,0.03]"), "imitation.shots[0]: h must be in [-100, 100]");
+  expect_error(shot("[0,0,0.1,0.5,-2,1,0.05,0.03]"), "imitation.shots[0]: speed_mps must be in [0, 100] m/s");
+  expect_error(shot("[0,0,0.1,0.5,2.0,1,50,0.03]"), "imitation.shots[0]: d_fire_m must be in [-10, 10] m");
+  expect_error(shot("[0,0,0.1,0.5,2.0,1,0.05,3600]"), "imitation.shots[0]: hold_s must be in [0, 10] s");
+}
+
+TEST(ControllerFile, GainsHoldsAndPartitionsHaveSaneRanges) {
+  ControllerSpec s;
+  const std::string good = controller_to_json(s);
+  expect_error(with(good, "\"max_hold_s\": 1.0", "\"max_hold_s\": 11"), "bad.json: actuator.max_hold_s: must be in [0, 10] s");
+  expect_error(with(good, "\"max_hold_s\": 1.0", "\"max_hold_s\": -1"), "actuator.max_hold_s: must be in [0, 10] s");
+  expect_error(with(good, "\"a\": [\n        0.0", "\"a\": [\n        1e6"), "minicontrollers[0].a: must each be in [-10, 10]");
+  expect_error(with(good, "\"gain_range\": [\n      0.12", "\"gain_range\": [\n      50"),
+               "partition.gain_range: must each be in [0, 10]");
+  ActionFunctionConfig many;
+  for (int i = 0; i < kMaxBins; ++i) many.h_borders.push_back(i);  // 65 bins
+  const std::string borders = nlohmann::json(many.h_borders).dump();
+  expect_error(with(good, "\"h_borders\": []", "\"h_borders\": " + borders),
+               "partition.h_borders: must have at most 63 borders (64 bins)");
+}
+
+TEST(ControllerFile, IntegersAreNotTruncatedNorKeysRepeated) {
+  const std::string good = controller_to_json(ControllerSpec{});
+  expect_error(with(good, "\"version\": 1", "\"version\": 4294967297"), "bad.json: version: unsupported");
+  expect_error(with(good, "\"version\": 1", "\"version\": 1, \"version\": 1"), "bad.json: version: duplicate key");
+  expect_error(with(good, "\"max_hold_s\": 1.0", "\"max_hold_s\": 1e400"), "bad.json: (file): not valid JSON");
 }
 
 }  // namespace

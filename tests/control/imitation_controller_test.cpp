@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -92,6 +93,81 @@ TEST(ShotTable, RejectsBadSettingsAndExamples) {
   EXPECT_THROW(ShotTable({fire(0, 0, 0, 1, 0.1, 3)}, k_of(1)), std::invalid_argument);
   EXPECT_THROW(ShotTable({fire(0, std::nan(""), 0, 1, 0.1)}, k_of(1)), std::invalid_argument);
   EXPECT_THROW(ShotTable({fire(0, 0, 0, 1, 0.1, 0, -0.1)}, k_of(1)), std::invalid_argument);
+}
+
+TEST(ShotTable, SettingsAndShotsHaveSaneRanges) {
+  // 1e-6 rad made the lookup spin for ever; 1.5e-9 asked for an oversized grid.
+  for (const double scale : {1e-6, 1.5e-9, 4.0}) {
+    ImitationConfig c;
+    c.angle_scale_rad = scale;
+    EXPECT_EQ(check_imitation_config(c).key, "angle_scale_rad") << scale;
+    EXPECT_THROW(ShotTable({}, c), std::invalid_argument) << scale;
+  }
+  ImitationConfig c;
+  c.max_hold_s = kMaxHold_s + 1.0;  // longer than the driver board lets a coil hold
+  EXPECT_EQ(check_imitation_config(c).key, "max_hold_s");
+  c = ImitationConfig{};
+  c.speed_scale_mps = 1e-4;
+  EXPECT_EQ(check_imitation_config(c).key, "speed_scale_mps");
+  EXPECT_FALSE(check_imitation_config(ImitationConfig{}));
+  EXPECT_EQ(check_shot_example(fire(0, 4.0, 0.5, 1, 0.1)).key, "angle_rad");
+  EXPECT_EQ(check_shot_example(fire(0, 0, 1e9, 1, 0.1)).key, "h");
+  EXPECT_EQ(check_shot_example(fire(0, 0, 0.5, 1e3, 0.1)).key, "speed_mps");
+  EXPECT_EQ(check_shot_example(fire(0, 0, 0.5, 1, 1e3)).key, "d_fire_m");
+  EXPECT_EQ(check_shot_example(fire(0, 0, 0.5, 1, 0.1, 0, 60.0)).key, "hold_s");
+  EXPECT_THROW(ShotTable({fire(0, 0, 0.5, 1, 0.1, 0, 60.0)}, k_of(1)), std::invalid_argument);
+}
+
+TEST(ShotTable, ASparseTableAnswersInBoundedTime) {
+  // A few shots at the corners of a wide (θ, h, s) box with the finest
+  // scales: a grid of one-scale cells would be 512^3 cells, and a query in the
+  // middle would walk hundreds of empty shells (a sparse table once took
+  // 40 ms a decision). The grid shrinks to the shots and the search is capped.
+  ImitationConfig c = k_of(3);
+  c.angle_scale_rad = c.h_scale = c.speed_scale_mps = 1e-3;
+  std::vector<ShotExample> shots;
+  for (const double h : {0.0, 1.3}) {
+    for (const double s : {0.0, 5.0}) {
+      for (const double a : {-1.5, 0.0, 1.5}) shots.push_back(fire(0, a, h, s, 0.05));
+    }
+  }
+  const ShotTable t(shots, c);
+  Rng rng(5);
+  const auto start = std::chrono::steady_clock::now();
+  for (int q = 0; q < 200; ++q) {
+    const track::TrajectoryProjection p =
+        hittable_projection(0, rng.uniform(-kPi / 2, kPi / 2), rng.uniform(-1.0, 2.0), rng.uniform(0.0, 8.0), 0.0);
+    const ImitationDecision a = t.decide(p);
+    const ImitationDecision b = t.decide_by_scan(p);
+    ASSERT_EQ(a.neighbours, b.neighbours);
+    ASSERT_EQ(a.d_critical_m, b.d_critical_m);
+  }
+  const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(elapsed_s, 1.0) << "200 decisions (sanitizer builds included)";
+}
+
+TEST(ShotTable, AFarQueryFallsBackToTheScanAndStaysExact) {
+  // Dense shots in one corner, queries across the table: the shell search
+  // gives up once it has done a scan's worth of work and scans, with the same answer.
+  Rng rng(9);
+  std::vector<ShotExample> shots;
+  for (int i = 0; i < 5000; ++i) {
+    shots.push_back(fire(1, rng.uniform(-1.5, -1.4), rng.uniform(0.0, 0.05), rng.uniform(0.0, 0.1), rng.uniform(0.0, 0.1),
+                         rng.uniform01() < 0.5 ? -1 : 1));
+  }
+  shots.push_back(fire(1, 1.5, 1.3, 5.0, 0.05));
+  ImitationConfig c = k_of(7);
+  c.angle_scale_rad = c.h_scale = c.speed_scale_mps = 1e-3;
+  const ShotTable t(shots, c);
+  for (int q = 0; q < 50; ++q) {
+    const track::TrajectoryProjection p =
+        hittable_projection(1, rng.uniform(-kPi / 2, kPi / 2), rng.uniform(0.0, 1.3), rng.uniform(0.0, 5.0), 0.0);
+    const ImitationDecision a = t.decide(p);
+    const ImitationDecision b = t.decide_by_scan(p);
+    ASSERT_EQ(a.fire, b.fire);
+    ASSERT_EQ(a.d_critical_m, b.d_critical_m);
+    ASSERT_EQ(a.hold_s, b.hold_s);
+  }
 }
 
 TEST(ShotTable, TheGridSearchFindsExactlyWhatAFullScanFinds) {

@@ -69,5 +69,25 @@ TEST(JsonReadArchive, TypesAreTheDocumentsOwn) {
   EXPECT_EQ(error_of(R"({"count": 4})"), "");
 }
 
+TEST(JsonReadArchive, ParseJsonRefusesWhatNlohmannWouldResolveSilently) {
+  auto error_of = [](const std::string& text) -> std::string {
+    try {
+      (void)parse_json(text, "t.json");
+    } catch (const KeyError& k) {
+      return k.what();
+    }
+    return "";
+  };
+  // nlohmann keeps the last of two equal keys; a reader of the file cannot tell which counts.
+  EXPECT_EQ(error_of(R"({"count": 1, "count": 2})"), "t.json:count: duplicate key");
+  EXPECT_EQ(error_of(R"({"inner": {"x_m": 1, "x_m": 1}})"), "t.json:inner.x_m: duplicate key");
+  EXPECT_EQ(error_of(R"({"inners": [{}, [3, {"a": 1}], {"label": "a", "label": "b"}]})"),
+            "t.json:inners[2].label: duplicate key");
+  EXPECT_EQ(error_of(R"({"a": {"b": 1}, "c": {"b": 2}})"), "");  // the same key in two objects is fine
+  // A number past a double's range is nlohmann's out_of_range, not a parse error.
+  EXPECT_EQ(error_of(R"({"g_mps2": 1e400})").rfind("t.json:(file): not valid JSON: ", 0), 0u);
+  EXPECT_NE(error_of("{\"count\": 1,\n \"x\": }").find("line 2"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace pinball

@@ -88,6 +88,29 @@ TEST(YamlReadArchive, UnknownKeysAreNamedUnlessAllowed) {
   EXPECT_EQ(read("cuont: 4", {.refuse_unknown_keys = false}).count, 3);
 }
 
+TEST(YamlReadArchive, RepeatedKeysAreRefused) {
+  // yaml-cpp keeps both entries and find() answers the first: the file's
+  // reader and this program would disagree on the value.
+  EXPECT_EQ(error_of("count: 1\ncount: 2"), "t.yaml:count: duplicate key");
+  EXPECT_EQ(error_of("inner: {x_m: 1, x_m: 2}"), "t.yaml:inner.x_m: duplicate key");
+  EXPECT_EQ(error_of("inners: [{}, {label: a, label: b}]"), "t.yaml:inners[1].label: duplicate key");
+  EXPECT_EQ(error_of("cuont: 1\ncuont: 2", {.refuse_unknown_keys = false}), "t.yaml:cuont: duplicate key");
+}
+
+TEST(YamlReadArchive, AFileHoldsOneDocument) {
+  try {
+    load_yaml("count: 1\n---\ncount: 2\n", "t.yaml");
+    FAIL() << "a second document was accepted";
+  } catch (const YamlSyntaxError& e) {
+    EXPECT_EQ(e.key(), "3");  // the line where it starts
+    EXPECT_EQ(e.message(), "a second YAML document (after ---): a file holds one");
+  }
+  EXPECT_THROW(load_yaml("count: 1\n---\n", "t.yaml"), YamlSyntaxError);
+  EXPECT_TRUE(load_yaml("", "t.yaml").IsNull());
+  EXPECT_TRUE(load_yaml("# a comment only\n", "t.yaml").IsNull());
+  EXPECT_EQ(read("---\ncount: 5\n...\n").count, 5);  // one document, marked out, is fine
+}
+
 TEST(YamlReadArchive, WrongTypesSayWhatWasExpected) {
   EXPECT_EQ(error_of("count: many"), "t.yaml:count: expected an integer");
   EXPECT_EQ(error_of("count: 2.5"), "t.yaml:count: expected an integer");

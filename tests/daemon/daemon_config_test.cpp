@@ -16,8 +16,9 @@ std::string error_of(const std::string& yaml) {
   return "";
 }
 
-TEST(DaemonConfig, EmptyFileGivesTheEmbeddedSimulation) {
-  const DaemonConfig c = daemon_config_from_yaml("", "t.yaml");
+TEST(DaemonConfig, TheDefaultsAreTheEmbeddedSimulation) {
+  const DaemonConfig c;
+  EXPECT_NO_THROW(validate_daemon_config(c, "defaults"));
   EXPECT_EQ(c.mode, "sim");
   EXPECT_EQ(c.sim.board, "boards/mit1993.board");
   EXPECT_EQ(c.sim.balls, 10);
@@ -26,6 +27,65 @@ TEST(DaemonConfig, EmptyFileGivesTheEmbeddedSimulation) {
   EXPECT_FALSE(c.sim.realtime);
   EXPECT_EQ(c.threads.chain_cpu, "auto");
   EXPECT_EQ(c.threads.cpu_dma_latency_us, -1);
+  EXPECT_EQ(daemon_config_from_yaml("version: 1", "t.yaml").mode, "sim");  // a file may say no more
+}
+
+TEST(DaemonConfig, AnEmptyFileIsRefusedNotTheSimulation) {
+  // A wrong path, /dev/null or a truncated copy must not start the simulation.
+  EXPECT_EQ(error_of(""), "t.yaml: (file): is empty (pinballd without --config runs the embedded simulation)");
+  EXPECT_EQ(error_of("# nothing but a comment\n"),
+            "t.yaml: (file): is empty (pinballd without --config runs the embedded simulation)");
+  try {
+    load_daemon_config("/dev/null");
+    FAIL() << "/dev/null was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("/dev/null: (file): is empty", 0), 0u) << e.what();
+  }
+}
+
+TEST(DaemonConfig, OneDocumentAndEachKeyOnce) {
+  EXPECT_EQ(error_of("sim: {balls: 3}\n---\nmode: lab\n"),
+            "t.yaml:3: not valid YAML: a second YAML document (after ---): a file holds one");
+  EXPECT_EQ(error_of("coils:\n  hold_duty_pct: 20\n  hold_duty_pct: 45\n"), "t.yaml: coils.hold_duty_pct: duplicate key");
+  EXPECT_EQ(error_of("mode: sim\nmode: lab\n"), "t.yaml: mode: duplicate key");
+}
+
+TEST(DaemonConfig, CoilLimitsAreTheProtocolsAbsoluteOnes) {
+  // Refused when the file is read, by key: not later as "DriverBusOptions: drivers[0]: ...".
+  EXPECT_EQ(error_of("coils: {hold_duty_pct: 60}"),
+            "t.yaml: coils.hold_duty_pct: must be in [0, 50] % (the protocol's absolute hold duty)");
+  EXPECT_NO_THROW(daemon_config_from_yaml("coils: {hold_duty_pct: 50}", "t.yaml"));
+  EXPECT_EQ(error_of("coils: {max_pulse_ms: 101}"),
+            "t.yaml: coils.max_pulse_ms: must be in [1, 100] ms (the protocol's absolute pulse cap)");
+  EXPECT_EQ(error_of("coils: {max_pulse_ms: 0}"),
+            "t.yaml: coils.max_pulse_ms: must be in [1, 100] ms (the protocol's absolute pulse cap)");
+  EXPECT_EQ(error_of("coils: {pulse_ms: 41}"), "t.yaml: coils.pulse_ms: must be in [1, max_pulse_ms] (40 ms)");
+  EXPECT_EQ(error_of("coils: {pulse_ms: 0}"), "t.yaml: coils.pulse_ms: must be in [1, max_pulse_ms] (40 ms)");
+  EXPECT_EQ(error_of("coils: {max_hold_ms: 10001}"),
+            "t.yaml: coils.max_hold_ms: must be in [1, 10000] ms (the protocol's absolute hold cap)");
+  EXPECT_EQ(error_of("coils: {max_hold_ms: 0}"),
+            "t.yaml: coils.max_hold_ms: must be in [1, 10000] ms (the protocol's absolute hold cap)");
+  EXPECT_EQ(error_of("coils: {recycle_ms: 256}"), "t.yaml: coils.recycle_ms: expected an integer in [0, 255]");
+  EXPECT_NO_THROW(daemon_config_from_yaml("coils: {pulse_ms: 100, max_pulse_ms: 100, max_hold_ms: 10000, recycle_ms: 0}",
+                                          "t.yaml"));
+}
+
+TEST(DaemonConfig, TimesAndCountsHavePhysicalBounds) {
+  EXPECT_EQ(error_of("can: {watchdog_timeout_s: 0.005}"),
+            "t.yaml: can.watchdog_timeout_s: must be in [0.01, 1] s (the protocol's watchdog range)");
+  EXPECT_EQ(error_of("can: {watchdog_timeout_s: 2}"),
+            "t.yaml: can.watchdog_timeout_s: must be in [0.01, 1] s (the protocol's watchdog range)");
+  EXPECT_EQ(error_of("can: {heartbeat_period_s: 0.0005}"), "t.yaml: can.heartbeat_period_s: must be at least 0.001 s");
+  EXPECT_EQ(error_of("can: {heartbeat_period_s: 0.04}"),
+            "t.yaml: can.watchdog_timeout_s: must be at least 3 heartbeat periods");
+  EXPECT_NO_THROW(daemon_config_from_yaml("can: {heartbeat_period_s: 0.001, watchdog_timeout_s: 0.01}", "t.yaml"));
+  EXPECT_EQ(error_of("camera: {stall_timeout_s: 0}"), "t.yaml: camera.stall_timeout_s: must be in (0, 1) s");
+  EXPECT_EQ(error_of("camera: {stall_timeout_s: 1}"), "t.yaml: camera.stall_timeout_s: must be in (0, 1) s");
+  EXPECT_EQ(error_of("camera: {stall_timeout_s: 1e300}"), "t.yaml: camera.stall_timeout_s: must be in (0, 1) s");
+  EXPECT_EQ(error_of("camera: {background_frames: 0}"), "t.yaml: camera.background_frames: must be in [1, 10000]");
+  EXPECT_EQ(error_of("camera: {background_frames: 10001}"), "t.yaml: camera.background_frames: must be in [1, 10000]");
+  EXPECT_EQ(error_of("camera: {width_px: 100000}"), "t.yaml: camera.width_px: must be in [1, 8192] px");
+  EXPECT_EQ(error_of("camera: {height_px: 0}"), "t.yaml: camera.height_px: must be in [1, 8192] px");
 }
 
 TEST(DaemonConfig, ReadsEverySection) {
@@ -59,7 +119,8 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
   EXPECT_EQ(error_of("camera: {fsp: 200}"), "t.yaml: camera.fsp: unknown key");
   EXPECT_EQ(error_of("sim: {balls: many}"), "t.yaml: sim.balls: expected an integer");
   EXPECT_EQ(error_of("version: 2"), "t.yaml: version: is 2, this build reads 1");
-  EXPECT_EQ(error_of("coils: {hold_duty_pct: 150}"), "t.yaml: coils.hold_duty_pct: must be in [0, 100]");
+  EXPECT_EQ(error_of("coils: {hold_duty_pct: 150}"),
+            "t.yaml: coils.hold_duty_pct: must be in [0, 50] % (the protocol's absolute hold duty)");
   EXPECT_EQ(error_of("camera: {fps: 0}"), "t.yaml: camera.fps: must be in (0, 10000]");
   EXPECT_EQ(error_of("can: {watchdog_timeout_s: 0.03}"),
             "t.yaml: can.watchdog_timeout_s: must be at least 3 heartbeat periods");
@@ -85,7 +146,7 @@ TEST(DaemonConfig, TheWorldIsReadApartFromTheBelief) {
   EXPECT_EQ(c.sim.board, "a.board");
   EXPECT_EQ(c.sim.world_board, "b.board");
   EXPECT_EQ(c.sim.stepper, sim::StepperKind::kEvent);
-  EXPECT_EQ(daemon_config_from_yaml("", "t.yaml").sim.stepper, sim::StepperKind::kThesis);
+  EXPECT_EQ(daemon_config_from_yaml("version: 1", "t.yaml").sim.stepper, sim::StepperKind::kThesis);
   EXPECT_EQ(error_of("sim: {stepper: euler}"),
             "t.yaml: sim.stepper: unknown stepper 'euler' (expected thesis or event)");
 }

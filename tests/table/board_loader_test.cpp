@@ -350,6 +350,52 @@ TEST(BoardLoaderErrors, OutOfRangeFields) {
   expect_body_error("flipper left 0.1 0.2 0.07 -0.5 0.5 35 mu=-1\n", 8, "attribute mu must be >= 0, got -1");
 }
 
+TEST(BoardLoaderErrors, TimeStepIsBounded) {
+  // 1e-12 s would make every ball take forever; 0.1 s jumps through posts.
+  expect_error("pinball-board 1\ndt 1e-12\n", 2, "dt: field DT (seconds) must be in [1e-06, 0.01], got 1e-12");
+  expect_error("pinball-board 1\ndt 0.1\n", 2, "dt: field DT (seconds) must be in [1e-06, 0.01], got 0.1");
+  std::string head = kHead;
+  for (const char* dt : {"dt 1e-6\n", "dt 0.01\n"}) {
+    const std::string text = head.replace(head.find("dt 0.0005\n"), 10, dt);
+    EXPECT_NO_THROW(parse_board(text, "x.board")) << dt;
+    head = kHead;
+  }
+}
+
+TEST(BoardLoaderErrors, SizesSpeedsAndGravityAreBounded) {
+  expect_error("pinball-board 1\nsize 20 1\n", 2, "size: field W (width) must be at most 10 m, got 20");
+  // The bound is stated in the file's unit.
+  expect_error("pinball-board 1\nunits mm\nsize 510 1070000\n", 3,
+               "size: field H (height) must be at most 10000 mm, got 1.07e+06");
+  expect_error("pinball-board 1\nball 0.5 5\n", 2, "ball: field R (radius) must be at most 0.1 m, got 0.5");
+  expect_error("pinball-board 1\nball 0.0135 500\n", 2, "ball: field SPEED_MAX must be at most 100 m/s, got 500");
+  expect_error("pinball-board 1\ngravity 11\n", 2, "gravity: field G must be at most 10 m/s^2, got 11");
+  expect_error("pinball-board 1\nunits mm\ngravity 98100\n", 3, "gravity: field G must be at most 10000 mm/s^2");
+  expect_body_error("circle 0.1 0.5 20\n", 8, "circle: field R (radius) must be at most 10 m, got 20");
+  expect_body_error("hole 0.1 0.5 11 eat\n", 8, "hole: field R (radius) must be at most 10 m, got 11");
+  expect_body_error("flipper left 0.1 0.2 50 -0.5 0.5 1\n", 8, "flipper: field LENGTH must be at most 10 m, got 50");
+  EXPECT_NO_THROW(parse("circle 0.9 0.9 0.01 rho=2 kick=100\n"));
+}
+
+TEST(BoardLoaderErrors, RestitutionAndKicksAreBounded) {
+  expect_body_error("circle 0.1 0.5 0.01 rho=2.5\n", 8, "circle: attribute rho must be at most 2, got 2.5");
+  expect_body_error("defaults rho=3\n", 8, "defaults: attribute rho must be at most 2, got 3");
+  expect_body_error("flipper left 0.1 0.2 0.07 -0.5 0.5 35 rho=5\n", 8, "flipper: attribute rho must be at most 2, got 5");
+  expect_body_error("circle 0.1 0.5 0.01 kick=200\n", 8, "circle: attribute kick must be at most 100 m/s, got 200");
+  expect_body_error("hole 0.1 0.5 0.02 kickout=1000,0\n", 8,
+                    "hole: attribute kickout speed must be at most 100 m/s, got 1000");
+}
+
+TEST(BoardLoaderErrors, PositionsAreBounded) {
+  expect_body_error("point 1e300 0.5\n", 8,
+                    "point: fields X Y must lie within 100 m of the origin on each axis, got (1e+300, 0.5)");
+  expect_body_error("line 0 0 0.1 -200\n", 8, "line: fields X2 Y2 must lie within 100 m");
+  expect_body_error("polyline 0 0 1 1 0 1e9\n", 8, "polyline: vertex 3 must lie within 100 m");
+  expect_body_error("flipper left 1e6 0.2 0.07 -0.5 0.5 35\n", 8, "flipper: fields PX PY must lie within 100 m");
+  expect_error("pinball-board 1\nunits mm\nlauncher 450 -1e6\n", 3,
+               "launcher: fields X Y must lie within 100000 mm of the origin on each axis, got (450, -1e+06)");
+}
+
 TEST(BoardLoaderErrors, ZeroLengthSegments) {
   expect_body_error("line 0.1 0.2 0.1 0.2\n", 8, "line: zero-length segment");
   expect_body_error("wall 0.1 0.2 0.1 0.2\n", 8, "wall: zero-length segment");
@@ -417,8 +463,10 @@ TEST(BoardLoaderErrors, DuplicateSingleton) {
 }
 
 TEST(BoardLoaderErrors, UnitsAndAnglesAfterGeometry) {
-  expect_error("pinball-board 1\nsize 510 1070\nunits mm\n", 3,
+  expect_error("pinball-board 1\nsize 0.51 1.07\nunits mm\n", 3,
                "units: must come before the first statement that uses a length or angle (line 2)");
+  // Millimetres read as metres are refused at once: the table would be half a kilometre wide.
+  expect_error("pinball-board 1\nsize 510 1070\nunits mm\n", 2, "size: field W (width) must be at most 10 m, got 510");
   expect_body_error("angles deg\n", 8, "angles: must come before the first statement that uses a length or angle");
   // Statements without lengths may come first.
   EXPECT_NO_THROW(parse_board(

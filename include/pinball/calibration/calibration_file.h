@@ -5,7 +5,9 @@
 // calibrate` kind writes its own and keeps the others); what a consumer needs
 // it asks for by name, and a missing or bad key is reported as file:key.
 // Format field by field: docs/calibration.md. Each struct lists its keys once,
-// in Serialize(); core/yaml_read_archive.h reads them, every key required.
+// in Serialize(); core/yaml_read_archive.h reads them, every key required,
+// no unknown key and none twice. Whether the flippers are the board's is
+// checked where the board is known (check_calibration_matches_board).
 
 #include <array>
 #include <optional>
@@ -161,8 +163,8 @@ void write_calibration(const Calibration& calibration, const std::string& path);
 std::string calibration_to_yaml(const Calibration& calibration);
 
 /// Reads a calibration file. Throws std::runtime_error "path:key: what is
-/// wrong" for a missing, mistyped or out-of-range key, a wrong version, or
-/// YAML that does not parse ("path:line: ...").
+/// wrong" for a missing, unknown, repeated, mistyped or out-of-range key, a
+/// wrong version, or YAML that does not parse ("path:line: ...").
 Calibration read_calibration(const std::string& path);
 
 /// Parses YAML text; `name` stands for the file in messages.
@@ -184,9 +186,16 @@ void apply_calibration(const Calibration& calibration, const std::string& name, 
 /// std::runtime_error "name:camera: missing" without one.
 vision::CameraHomography camera_homography(const Calibration& calibration, const std::string& name);
 
+/// Checks that every calibrated flipper is one of the board's, on its side,
+/// and calibrated once: a typo in a name must not leave a flipper on the
+/// board's geometry unnoticed. Throws std::runtime_error (a KeyError)
+/// "name:flippers[i].name: ..." or "...side: ...".
+void check_calibration_matches_board(const Calibration& calibration, const std::string& name,
+                                     const table::Board& board);
+
 /// Copies the calibrated flippers into a board (pivot, length, stops, by
-/// name), for the simulator and the daemon. Throws std::runtime_error naming a
-/// calibrated flipper the board lacks.
+/// name), for the simulator and the daemon. Throws std::runtime_error
+/// (check_calibration_matches_board) unless the flippers are the board's.
 void apply_calibration(const Calibration& calibration, const std::string& name, table::Board& board);
 
 }  // namespace pinball::calibration

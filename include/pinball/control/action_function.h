@@ -9,15 +9,23 @@
 #include <cstdint>
 #include <vector>
 
+#include "pinball/core/check.h"
 #include "pinball/core/name_value.h"
 #include "pinball/core/rng.h"
 #include "pinball/track/projection.h"
 
 namespace pinball::control {
 
+/// Largest |gain| of a minicontroller and largest gain range: fifty times the
+/// widest range the learner draws from; beyond it d_critical lies metres past any table.
+inline constexpr double kMaxGain = 10.0;
+/// Most angle bins, and most h bins, of a partition: sixteen times the shipped
+/// 4 (each partition needs balls to learn); it bounds the minicontroller count.
+inline constexpr int kMaxBins = 64;
+
 /// One local linear controller (thesis 5.2.4): d_critical = a1·θ + a2·h + a3·s + a4 (m).
 struct Minicontroller {
-  std::array<double, 4> a{};      ///< a1 (m/rad), a2 (m per flipper length), a3 (s), a4 (m)
+  std::array<double, 4> a{};      ///< a1 (m/rad), a2 (m per flipper length), a3 (s), a4 (m); each within ±kMaxGain
   int flipper = track::kLeftFlipper;  ///< which flipper this partition fires
 };
 
@@ -26,11 +34,12 @@ struct ActionFunctionConfig {
   /// Interior impact-angle borders γ (rad), strictly increasing inside (−π/2, π/2);
   /// k − 1 of them make k bins. A θ equal to a border belongs to the bin above it.
   std::vector<double> angle_borders_rad;
-  /// Interior h borders (flipper lengths), strictly increasing; empty: no h partition (the thesis).
+  /// Interior h borders (flipper lengths), strictly increasing inside (−100, 100); empty: no h partition (the thesis).
   std::vector<double> h_borders;
   /// A separate minicontroller for a ball rolling on each flipper (thesis 7.1).
   bool rolling_minicontrollers = false;
-  /// Random gains are uniform in [−gain_range[i], +gain_range[i]] (thesis 6.1.3: symmetric about 0).
+  /// Random gains are uniform in [−gain_range[i], +gain_range[i]] (thesis 6.1.3: symmetric about 0);
+  /// each in [0, kMaxGain].
   std::array<double, 4> gain_range{0.12, 0.2, 0.08, 0.2};
 
   /// The keys of a controller file (docs/learning.md).
@@ -46,6 +55,14 @@ struct ActionFunctionConfig {
 /// k uniform angle bins over [−π/2, π/2] (the thesis's choice, 6.1.1). Throws for k < 1.
 ActionFunctionConfig uniform_partition(int k);
 
+/// The first setting outside its range: borders finite, strictly increasing
+/// and inside their interval, at most kMaxBins − 1 of each kind, gain ranges
+/// in [0, kMaxGain].
+RangeViolation check_action_function_config(const ActionFunctionConfig& config);
+
+/// Gains outside ±kMaxGain (key "a") or a flipper that is neither (key "flipper").
+RangeViolation check_minicontroller(const Minicontroller& minicontroller);
+
 /// The action: fire `flipper` once d <= d_critical_m.
 struct Action {
   int partition = -1;        ///< index of the responsible minicontroller
@@ -56,8 +73,8 @@ struct Action {
 /// A set of minicontrollers over a fixed partition.
 class ActionFunction {
  public:
-  /// Throws std::invalid_argument for borders out of range or not increasing,
-  /// or a gain range that is negative or not finite.
+  /// Throws std::invalid_argument for a setting out of range
+  /// (check_action_function_config).
   explicit ActionFunction(ActionFunctionConfig config);
 
   /// Number of angle bins k, h bins, and partitions in all.

@@ -14,7 +14,8 @@ namespace pinball::control {
 /// Settings of the actuator controller.
 struct ActuatorConfig {
   /// Release a flipper held this long with no launch seen (a cradled ball), and
-  /// allow a new approach; 0 disables (the thesis: launch or loss only).
+  /// allow a new approach; 0 disables (the thesis: launch or loss only; the
+  /// driver board's hold cap still applies). 0..kMaxHold_s.
   double max_hold_s = 1.0;
 
   /// The keys of a controller file (docs/learning.md).
@@ -24,9 +25,13 @@ struct ActuatorConfig {
   }
 };
 
+/// A setting outside its range (max_hold_s in [0, kMaxHold_s]).
+RangeViolation check_actuator_config(const ActuatorConfig& config);
+
 /// The action function driving the flippers.
 class ActuatorController final : public FlipperController {
  public:
+  /// Throws std::invalid_argument for a setting out of range (check_actuator_config).
   ActuatorController(ActionFunction action_function, const ActuatorConfig& config = {});
 
   void update(const track::TrackerOutput& output, double now_s, std::array<bool, 2>& energized) override;

@@ -6,9 +6,14 @@
 
 #include <array>
 
+#include "pinball/firmware/protocol.h"
 #include "pinball/track/tracker.h"
 
 namespace pinball::control {
+
+/// Longest hold a controller setting may ask for (s): the CAN protocol's
+/// absolute hold cap, past which the driver board cuts the coil anyway.
+inline constexpr double kMaxHold_s = firmware::kAbsMaxHoldMs * 1e-3;
 
 /// Anything that decides flipper commands from tracker output.
 class FlipperController {

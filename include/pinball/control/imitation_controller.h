@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "pinball/control/flipper_controller.h"
+#include "pinball/core/check.h"
 #include "pinball/core/name_value.h"
 #include "pinball/track/projection.h"
 
@@ -36,16 +37,16 @@ struct ShotExample {
   double hold_s = 0.0;                ///< how long the teacher held the flipper up (s)
 };
 
-/// Settings of the nearest-neighbour lookup.
+/// Settings of the nearest-neighbour lookup (ranges: check_imitation_config).
 struct ImitationConfig {
   int neighbours = 7;             ///< k (1..kMaxNeighbours)
-  double angle_scale_rad = 0.10;  ///< θ distance worth one unit
-  double h_scale = 0.10;          ///< h distance worth one unit
-  double speed_scale_mps = 0.30;  ///< s distance worth one unit
-  double max_hold_s = 1.0;        ///< release a flipper held this long with no launch seen
+  double angle_scale_rad = 0.10;  ///< θ distance worth one unit, 0.001..π rad
+  double h_scale = 0.10;          ///< h distance worth one unit, 0.001..10 flipper lengths
+  double speed_scale_mps = 0.30;  ///< s distance worth one unit, 0.001..100 m/s
+  double max_hold_s = 1.0;        ///< release a flipper held this long with no launch seen, 0..10 s (0: never)
   /// Fire when d − s·lead_s <= d_critical: the teacher fired at the frame whose d
   /// was nearest its choice, so firing at the first frame with d <= d_critical
-  /// would be half a frame late on average. Half a 200 fps frame by default.
+  /// would be half a frame late on average. Half a 200 fps frame by default; 0..0.1 s.
   double lead_s = 0.0025;
 
   /// The keys of a controller file (docs/learning.md).
@@ -63,6 +64,22 @@ struct ImitationConfig {
 /// Largest k the controller supports (it keeps the neighbours in a fixed array).
 inline constexpr int kMaxNeighbours = 32;
 
+/// Most shots a table holds, about five times the shipped one (44273): a
+/// lookup costs at most about two scans of one line's shots (ShotTable::decide),
+/// a few milliseconds at this size.
+inline constexpr std::size_t kMaxShots = 250'000;
+
+/// The first setting outside its range. The scales are the widths of the
+/// lookup grid's cells: below 0.001 nothing the tracker measures is that fine,
+/// and the grid and its search grow without bound (an angle scale of 1e-6 once
+/// made a lookup spin for ever, 1.5e-9 asked for an oversized allocation).
+RangeViolation check_imitation_config(const ImitationConfig& config);
+
+/// The first field of a shot outside its range (keys: ShotTable's `shot_fields`):
+/// flipper 0 or 1, fired flipper −1, 0 or 1, |θ| <= π, |h| <= 100 flipper
+/// lengths, 0 <= s <= 100 m/s, |d| <= 10 m, 0 <= hold <= 10 s, all finite.
+RangeViolation check_shot_example(const ShotExample& example);
+
 /// What the table says for one projection.
 struct ImitationDecision {
   bool fire = false;         ///< most neighbours fired
@@ -73,14 +90,18 @@ struct ImitationDecision {
 };
 
 /// The shot table and its lookup. Allocates nothing after construction. The
-/// examples of each line are bucketed in a grid over (θ, h, s) with cells one
-/// scale wide, searched in growing shells around the query's cell, so a lookup
-/// visits a few cells rather than every example; the answer is the exact k
-/// nearest (ties: the lower example index), the same as a full scan.
+/// examples of each line are bucketed in a grid over (θ, h, s) with cells at
+/// least one scale wide and not many more cells than examples, searched in
+/// growing shells around the query's cell, so a lookup visits a few cells
+/// rather than every example; the answer is the exact k nearest (ties: the
+/// lower example index), the same as a full scan. A lookup's cost is bounded:
+/// once the shell search has done as much work as a scan of the line would,
+/// it scans the line instead, so a lookup costs at most about two scans.
 class ShotTable {
  public:
-  /// Throws std::invalid_argument for a bad k, a scale <= 0, or an example
-  /// with a bad flipper, non-finite numbers or a negative hold.
+  /// Throws std::invalid_argument for a setting out of range
+  /// (check_imitation_config), a shot out of range (check_shot_example) or
+  /// more than kMaxShots shots.
   ShotTable(std::vector<ShotExample> examples, const ImitationConfig& config);
 
   /// The decision for a projection (valid or not: the caller checks validity).
@@ -98,6 +119,7 @@ class ShotTable {
     int n_theta = 1, n_h = 1, n_s = 1;  // cells per axis
     double h0 = 0.0, s0 = 0.0;          // lower edges of the h and s axes
     double cell_theta_rad = 0.0;        // θ cell width: π / n_theta, at least one scale
+    double cell_h = 0.0, cell_s = 0.0;  // h and s cell widths, at least one scale
     std::vector<std::uint32_t> start;   // first item of each cell; size cells + 1
     std::vector<std::uint32_t> items;   // example indices, cell by cell
   };

@@ -4,6 +4,7 @@
 // includes it links nlohmann_json.
 
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -67,5 +68,68 @@ struct JsonDoc {
 
 /// Reads JSON into Serialize() structs.
 using JsonReadArchive = ReadArchive<JsonDoc>;
+
+namespace json_detail {
+
+// One open object or array while parsing, for the path of a repeated key.
+struct OpenValue {
+  bool object = false;
+  std::set<std::string> keys;  // objects: the keys so far
+  std::string key;             // objects: the latest key
+  std::size_t index = 0;       // arrays: elements so far
+};
+
+// The path ("minicontrollers[2].a") of the value being read inside the
+// innermost open value, built only when an error needs it: a path kept per
+// level would cost the square of the depth for deeply nested text.
+inline std::string path_of(const std::vector<OpenValue>& open) {
+  std::string path;
+  for (std::size_t i = 0; i + 1 < open.size(); ++i) {
+    path = open[i].object ? join_key(path, open[i].key) : path + "[" + std::to_string(open[i].index) + "]";
+  }
+  return path;
+}
+
+}  // namespace json_detail
+
+/// Parses JSON text. Throws KeyError: key "(file)" for text that is not JSON
+/// (nlohmann's message says where: "at line 3, column 7") or a number too
+/// large for a double; the key's path for a key given twice, which nlohmann
+/// would otherwise resolve silently by keeping the last.
+inline nlohmann::json parse_json(const std::string& text, const std::string& file) {
+  using nlohmann::json;
+  std::vector<json_detail::OpenValue> open;
+  const auto element_done = [&] {
+    if (!open.empty() && !open.back().object) ++open.back().index;
+  };
+  const json::parser_callback_t watch = [&](int, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        open.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
+        break;
+      case json::parse_event_t::key:
+        open.back().key = parsed.get<std::string>();
+        if (!open.back().keys.insert(open.back().key).second) {
+          throw KeyError(file, join_key(json_detail::path_of(open), open.back().key), "duplicate key");
+        }
+        break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        open.pop_back();
+        element_done();
+        break;
+      case json::parse_event_t::value:
+        element_done();
+        break;
+    }
+    return true;
+  };
+  try {
+    return json::parse(text, watch);
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for 1e400
+    throw KeyError(file, "(file)", std::string("not valid JSON: ") + e.what());
+  }
+}
 
 }  // namespace pinball

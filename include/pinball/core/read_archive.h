@@ -2,8 +2,8 @@
 // The one checked key reader: fills any struct with a Serialize() (see
 // name_value.h) from a YAML or JSON document, naming `file:key.path` in every
 // error and refusing wrong types ("expected an integer"), integers that do
-// not fit the field, non-finite numbers and, unless told otherwise, unknown
-// keys. `Doc` adapts one document type (yaml_read_archive.h,
+// not fit the field, non-finite numbers, keys given twice and, unless told
+// otherwise, unknown keys. `Doc` adapts one document type (yaml_read_archive.h,
 // json_read_archive.h); this file knows no parser.
 
 #include <charconv>
@@ -159,6 +159,7 @@ class ReadArchive {
   void read_struct(const Node& n, const std::string& path, T* out) {
     if (Doc::is_null(n) && !options_.require_every_key) return;  // an empty section keeps its defaults
     if (!Doc::is_map(n)) fail(path.empty() ? "(top)" : path, "expected a mapping");
+    refuse_repeated_keys(n, path);
     Frame frame{n, path, {}};
     Frame* const outer = std::exchange(frame_, &frame);
     out->Serialize(this);
@@ -166,6 +167,15 @@ class ReadArchive {
     if (!options_.refuse_unknown_keys) return;
     for (const std::string& k : Doc::keys(n)) {
       if (!frame.used.count(k)) fail(join_key(path, k), "unknown key");
+    }
+  }
+
+  // A key given twice is refused: which of the two values counts would
+  // depend on the parser, and a reader of the file cannot tell.
+  void refuse_repeated_keys(const Node& n, const std::string& path) const {
+    std::set<std::string> seen;
+    for (const std::string& k : Doc::keys(n)) {
+      if (!seen.insert(k).second) fail(join_key(path, k), "duplicate key");
     }
   }
 

@@ -14,7 +14,9 @@
 namespace pinball {
 
 /// yaml-cpp as a ReadArchive document. Scalars are text; numbers and
-/// booleans are parsed from it.
+/// booleans are parsed from it. yaml-cpp keeps both entries of a repeated
+/// key (and find() answers the first): keys() lists both, and ReadArchive
+/// refuses the repeat.
 struct YamlDoc {
   using Node = YAML::Node;
   static bool is_null(const Node& n) { return !n || n.IsNull(); }
@@ -58,13 +60,21 @@ class YamlSyntaxError : public KeyError {
   using KeyError::KeyError;
 };
 
-/// Parses YAML text. Throws YamlSyntaxError.
+/// Parses YAML text holding at most one document (none: a null node).
+/// Throws YamlSyntaxError, also for a second document after `---`: yaml-cpp's
+/// Load would keep the first and silently drop the rest.
 inline YAML::Node load_yaml(const std::string& text, const std::string& file) {
+  std::vector<YAML::Node> documents;
   try {
-    return YAML::Load(text);
+    documents = YAML::LoadAll(text);
   } catch (const YAML::ParserException& e) {
     throw YamlSyntaxError(file, std::to_string(e.mark.line + 1), e.msg);
   }
+  if (documents.size() > 1) {
+    throw YamlSyntaxError(file, std::to_string(documents[1].Mark().line + 1),
+                          "a second YAML document (after ---): a file holds one");
+  }
+  return documents.empty() ? YAML::Node() : documents.front();
 }
 
 }  // namespace pinball

@@ -1,8 +1,11 @@
 #pragma once
 // pinballd's configuration: one YAML file (config/lab.example.yaml documents
 // every key). Without a file the defaults run the embedded simulation of
-// boards/mit1993.board over memq:// with the shipped controller. Loading is
-// all or nothing: a bad file throws ConfigError naming the file and the key.
+// boards/mit1993.board over memq:// with the shipped controller; an empty
+// file is refused, not read as that. Loading is all or nothing: a bad file
+// throws ConfigError naming the file and the key, range checks included (the
+// coil limits are the CAN protocol's absolute ones), so nothing out of range
+// reaches DriverBus. One YAML document per file; a repeated key is refused.
 // Each struct lists its keys once, in Serialize(); core/yaml_read_archive.h
 // reads them (unknown keys refused, missing keys keep the defaults below).
 
@@ -25,11 +28,11 @@ inline constexpr int kConfigVersion = 1;
 struct CameraSettings {
   std::string source = "sim";     ///< sim (rendered board), v4l2 (a camera device), file (a video), lcm (observations)
   std::string device;             ///< v4l2: /dev/videoN; file: the video's path
-  int width_px = 640;             ///< requested frame width (px)
-  int height_px = 480;            ///< requested frame height (px)
+  int width_px = 640;             ///< requested frame width (px), 1..8192
+  int height_px = 480;            ///< requested frame height (px), 1..8192
   double fps = 200.0;             ///< requested frame rate (frames per second)
-  double stall_timeout_s = 0.02;  ///< no frame (or no ball while a flipper is up) this long: release all (s)
-  int background_frames = 30;     ///< ball-free frames averaged into the detector's background at start
+  double stall_timeout_s = 0.02;  ///< no frame (or no ball while a flipper is up) this long: release all (s), in (0, 1)
+  int background_frames = 30;     ///< ball-free frames averaged into the detector's background at start, 1..10000
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -47,8 +50,8 @@ struct CameraSettings {
 struct CanSettings {
   std::string interface = "sim";     ///< sim (the virtual board over a socket pair) or a SocketCAN interface (can0)
   int board_id = 0;                  ///< driver board number 0..15
-  double heartbeat_period_s = 0.02;  ///< heartbeat period (s)
-  double watchdog_timeout_s = 0.1;   ///< the board switches everything off after this silence (s)
+  double heartbeat_period_s = 0.02;  ///< heartbeat period (s), 0.001 .. watchdog_timeout_s / 3
+  double watchdog_timeout_s = 0.1;   ///< the board switches everything off after this silence (s), 0.01..1
   std::string log;                   ///< candump-format log of every frame (empty: none); in the lab `candump -l` does the same
 
   template <class Archive>
@@ -136,7 +139,7 @@ struct DaemonConfig {
   std::string board;             ///< lab: the table's board file (flipper and ball geometry)
   std::string calibration;       ///< lab: calibration file (docs/calibration.md); empty: the board's geometry
   CanSettings can;               ///< CAN link
-  firmware::DriverConfig coils;  ///< pulse, hold, caps and recycle time of every flipper coil
+  firmware::DriverConfig coils;  ///< pulse, hold, caps and recycle time of every flipper coil (protocol limits)
   std::string controller = "controllers/best.json";  ///< controller file (docs/learning.md)
   std::string lcm_url = "memq://";                   ///< LCM provider URL
   ThreadSettings threads;                            ///< scheduling
@@ -167,7 +170,8 @@ class ConfigError : public std::runtime_error {
 DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string& source_name);
 /// Reads a configuration file.
 DaemonConfig load_daemon_config(const std::string& path);
-/// Checks cross-key rules (sim mode needs camera.source sim and can.interface sim, ...).
+/// Checks every key's range and the cross-key rules (sim mode needs
+/// camera.source sim and can.interface sim, ...). Throws ConfigError.
 void validate_daemon_config(const DaemonConfig& config, const std::string& source_name);
 
 }  // namespace pinball::daemon

@@ -186,7 +186,8 @@ struct TrackingSetup {
   std::optional<vision::CameraHomography> homography;  ///< from the calibration's camera section, if any
 };
 /// The setup for `config` on `board` (the table's board file). Throws
-/// std::runtime_error naming the calibration file and key when it is bad.
+/// std::runtime_error naming the calibration file and key when it is bad or
+/// calibrates a flipper the board lacks.
 TrackingSetup tracking_setup_for(const DaemonConfig& config, const table::Board& board);
 /// The controller stage's settings for `config` on `board`.
 ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const table::Board& board);
