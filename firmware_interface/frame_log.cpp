@@ -1,11 +1,23 @@
 #include "pinball/firmware/frame_log.h"
 
+#include <fcntl.h>
 #include <linux/can.h>
+#include <poll.h>
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <vector>
+
+#include "pinball/core/check.h"
+#include "pinball/core/clock.h"
 
 namespace pinball::firmware {
 namespace {
@@ -80,21 +92,63 @@ std::optional<LogEntry> parse_log_line(std::string_view line) {
   return e;
 }
 
-FrameLog::FrameLog(const std::string& path, std::string interface) : interface_(std::move(interface)) {
-  file_ = std::fopen(path.c_str(), "w");
-  if (file_ == nullptr) throw std::runtime_error("FrameLog: cannot open " + path + ": " + std::strerror(errno));
+namespace {
+
+constexpr std::size_t kBatchLines = 512;  // lines formatted before one write(2)
+constexpr auto kIdle = std::chrono::milliseconds(5);  // the writer's nap when the queue is empty
+constexpr int kPollMs = 50;  // a blocked sink is re-checked this often, and for close()
+constexpr int kQueueFullKind = -1;  // report kinds beside errno values
+constexpr int kCloseKind = -2;
+
+// A write to a pipe whose reader has gone raises SIGPIPE, which kills a process that has not
+// ignored it. Blocked in the writer thread, it stays pending there and write(2) returns EPIPE.
+void block_sigpipe() {
+  sigset_t s;
+  sigemptyset(&s);
+  sigaddset(&s, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &s, nullptr);
 }
 
-FrameLog::~FrameLog() {
-  if (file_ != nullptr) std::fclose(file_);
+// Takes back the SIGPIPE that the failed write left pending on this thread.
+void consume_sigpipe() {
+  sigset_t s;
+  sigemptyset(&s);
+  sigaddset(&s, SIGPIPE);
+  const timespec zero{0, 0};
+  while (sigtimedwait(&s, nullptr, &zero) == SIGPIPE) {
+  }
 }
+
+}  // namespace
+
+// The lines of one write(2): text, and where each line ends in it.
+struct FrameLog::Batch {
+  std::string text;
+  std::vector<std::size_t> ends;  // offset one past each line's newline
+  std::size_t prefix = 0;         // 1 when text starts with the newline that ends a partial line
+};
+
+FrameLog::FrameLog(const std::string& path, std::string interface, double close_timeout_s)
+    : path_(path), interface_(std::move(interface)), close_timeout_s_(close_timeout_s), queue_(std::make_unique<Queue>()) {
+  check_input(close_timeout_s >= 0.0, "FrameLog", "close_timeout_s must be >= 0");
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd_ < 0) throw std::runtime_error("FrameLog: cannot open " + path + ": " + std::strerror(errno));
+  // Non-blocking from here on: a pipe nobody reads makes write(2) return EAGAIN instead of
+  // holding the writer, so that close() always ends.
+  const int flags = ::fcntl(fd_, F_GETFL);
+  if (flags >= 0) ::fcntl(fd_, F_SETFL, flags | O_NONBLOCK);
+  try {
+    writer_ = std::thread([this] { run(); });
+  } catch (...) {
+    ::close(fd_);
+    throw;
+  }
+}
+
+FrameLog::~FrameLog() { close(); }
 
 void FrameLog::record(const CanFrame& frame, double time_s) {
-  const std::string line = format_log_line(frame, time_s, interface_);
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::fputs(line.c_str(), file_);
-  std::fputc('\n', file_);
-  ++lines_;
+  if (!queue_->try_push(Entry{frame, time_s})) dropped_queue_full_.add();
 }
 
 void FrameLog::record(const CanFrame& frame) {
@@ -105,14 +159,174 @@ void FrameLog::record(const CanFrame& frame) {
   record(frame, t);
 }
 
-void FrameLog::flush() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  std::fflush(file_);
+bool FrameLog::flush() {
+  const std::uint64_t target = queue_->pushed();
+  wake_.notify_one();
+  const double deadline_s = steady_now_s() + close_timeout_s_;
+  while (resolved_.load() < target) {
+    if (writer_done_.load(std::memory_order_acquire) || steady_now_s() > deadline_s) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
 }
 
-std::uint64_t FrameLog::lines() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return lines_;
+void FrameLog::close() {
+  if (writer_.joinable()) {
+    deadline_s_ = steady_now_s() + close_timeout_s_;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stopping_.store(true, std::memory_order_release);
+    }
+    wake_.notify_all();
+    writer_.join();
+    const std::uint64_t left = dropped_at_close_.load() + queue_->size();
+    if (left > 0) {
+      char why[96];
+      std::snprintf(why, sizeof why, "%llu frames not written within %.1f s at close were dropped",
+                    static_cast<unsigned long long>(left), close_timeout_s_);
+      report(why, kCloseKind);
+    }
+  }
+  if (fd_ >= 0) {
+    // Some file systems (NFS) report a failed write only here.
+    if (::close(fd_) != 0) {
+      const int err = errno;
+      {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (first_errno_ == 0) first_errno_ = err;
+      }
+      report(std::string("close failed: ") + std::strerror(err), err);
+    }
+    fd_ = -1;
+  }
+}
+
+FrameLogCounters FrameLog::counters() const {
+  FrameLogCounters c;
+  c.written = written_.load();
+  c.dropped_queue_full = dropped_queue_full_.load();
+  c.dropped_write_error = dropped_write_error_.load();
+  // Once the writer is gone nothing leaves the queue: what is in it was recorded too late.
+  c.dropped_at_close = dropped_at_close_.load() + (writer_done_.load(std::memory_order_acquire) ? queue_->size() : 0);
+  const std::lock_guard<std::mutex> lock(mutex_);
+  c.first_errno = first_errno_;
+  c.first_error = first_error_;
+  return c;
+}
+
+void FrameLog::run() {
+  pthread_setname_np(pthread_self(), "pb-canlog");
+  block_sigpipe();
+  Batch batch;
+  batch.text.reserve(kBatchLines * 64);
+  batch.ends.reserve(kBatchLines);
+  for (;;) {
+    report_queue_full();
+    if (fill(batch)) {
+      write_batch(batch);
+      if (past_deadline()) break;
+      continue;
+    }
+    if (stopping_.load(std::memory_order_acquire)) break;  // empty: everything recorded before close() is out
+    std::unique_lock<std::mutex> lock(mutex_);
+    wake_.wait_for(lock, kIdle, [this] { return stopping_.load(std::memory_order_acquire); });
+  }
+  report_queue_full();
+  writer_done_.store(true, std::memory_order_release);
+}
+
+// Formats up to kBatchLines queued frames; false when none waited.
+bool FrameLog::fill(Batch& b) {
+  b.text.clear();
+  b.ends.clear();
+  b.prefix = mid_line_ ? 1 : 0;
+  if (mid_line_) b.text.push_back('\n');
+  Entry e;
+  while (b.ends.size() < kBatchLines && queue_->try_pop(e)) {
+    b.text += format_log_line(e.frame, e.time_s, interface_);
+    b.text.push_back('\n');
+    b.ends.push_back(b.text.size());
+  }
+  return !b.ends.empty();
+}
+
+void FrameLog::write_batch(Batch& b) {
+  std::size_t off = 0;
+  bool abandoned = false;
+  while (off < b.text.size() && !sink_gone_) {
+    const ssize_t n = ::write(fd_, b.text.data() + off, b.text.size() - off);
+    if (n > 0) {
+      off += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      if (!wait_writable()) {
+        abandoned = true;
+        break;
+      }
+    } else {
+      on_write_error(n < 0 ? errno : EIO);
+      break;
+    }
+  }
+  std::size_t done = 0;
+  while (done < b.ends.size() && b.ends[done] <= off) ++done;
+  written_.add(done);
+  const std::size_t lost = b.ends.size() - done;
+  if (lost > 0) (abandoned ? dropped_at_close_ : dropped_write_error_).add(lost);
+  // A partial line left in the sink would run into the next one: the next batch starts with a newline.
+  if (off > 0) mid_line_ = off != (done == 0 ? b.prefix : b.ends[done - 1]);
+  resolved_.add(b.ends.size());
+}
+
+// Waits until the sink takes bytes again; false when close()'s time ran out first.
+bool FrameLog::wait_writable() {
+  for (;;) {
+    report_queue_full();
+    int timeout_ms = kPollMs;
+    if (stopping_.load(std::memory_order_acquire)) {
+      const double left_s = deadline_s_ - steady_now_s();
+      if (left_s <= 0.0) return false;
+      timeout_ms = std::min(kPollMs, static_cast<int>(std::ceil(left_s * 1e3)));
+    }
+    pollfd p{fd_, POLLOUT, 0};
+    if (::poll(&p, 1, timeout_ms) > 0) return true;  // writable, or an error that the next write names
+  }
+}
+
+bool FrameLog::past_deadline() const {
+  return stopping_.load(std::memory_order_acquire) && steady_now_s() > deadline_s_;
+}
+
+void FrameLog::on_write_error(int err) {
+  if (err == EPIPE) consume_sigpipe();
+  // A pipe without a reader or a bad descriptor never takes bytes again; a full disk may.
+  if (err == EPIPE || err == EBADF || err == EINVAL) sink_gone_ = true;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (first_errno_ == 0) first_errno_ = err;
+  }
+  report(std::string("write failed: ") + std::strerror(err) +
+             (sink_gone_ ? "; every further frame is dropped (counted)" : "; frames are dropped (counted) while it fails"),
+         err);
+}
+
+// Once per kind (an errno, a full queue, the close): the first goes to stderr at once.
+void FrameLog::report(const std::string& problem, int kind) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (!reported_kinds_.insert(kind).second) return;
+  const std::string line = "CAN log " + path_ + ": " + problem;
+  if (first_error_.empty()) first_error_ = line;
+  std::fprintf(stderr, "%s\n", line.c_str());
+}
+
+void FrameLog::report_queue_full() {
+  const std::uint64_t n = dropped_queue_full_.load();
+  if (n == queue_full_reported_) return;
+  queue_full_reported_ = n;
+  report("the writer fell behind (queue of " + std::to_string(kQueueFrames) +
+             " frames full); frames are dropped (counted)",
+         kQueueFullKind);
 }
 
 }  // namespace pinball::firmware

@@ -3,13 +3,28 @@
 //   (1700000000.123456) can0 123#DEADBEEF
 // so that lab engineers read it with their eyes and replay it with
 // `canplayer -I FILE` (can-utils).
+//
+// DriverBus records every frame from the driver and controller threads,
+// inside its bus lock, so recording must never wait on the file: record()
+// only copies the frame into a fixed-size lock-free queue, and a writer
+// thread of the FrameLog formats and writes the lines. Whatever the sink
+// does (fills a disk, a pipe whose reader stopped reading or went away), the
+// bus carries on; the frames that could not be written are dropped and
+// counted, and the first error of each kind is reported on stderr at once.
 
-#include <cstdio>
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
+#include <thread>
 
+#include "pinball/core/single_writer_counter.h"
+#include "pinball/core/spsc_ring.h"
 #include "pinball/firmware/can_frame.h"
 
 namespace pinball::firmware {
@@ -27,29 +42,94 @@ std::string format_log_line(const CanFrame& frame, double time_s, std::string_vi
 /// Parses one line; std::nullopt when it is not a candump log line.
 std::optional<LogEntry> parse_log_line(std::string_view line);
 
-/// Appends frames to a file; safe to call from several threads.
+/// What a FrameLog did with the frames it was given (monotonic). Every
+/// recorded frame ends up written or in exactly one of the dropped counts
+/// (frames still queued while the log runs are in neither).
+struct FrameLogCounters {
+  std::uint64_t written = 0;              ///< lines the sink accepted
+  std::uint64_t dropped_queue_full = 0;   ///< dropped by record(): the queue was full (the sink fell behind)
+  std::uint64_t dropped_write_error = 0;  ///< dropped because a write failed (ENOSPC, EPIPE, EIO, ...)
+  std::uint64_t dropped_at_close = 0;     ///< still queued when close()'s time ran out (a blocked sink)
+  int first_errno = 0;                    ///< errno of the first failed write or close, 0 when none
+  std::string first_error;                ///< the first problem, for people ("" when none)
+
+  /// Frames recorded but not written.
+  std::uint64_t dropped() const { return dropped_queue_full + dropped_write_error + dropped_at_close; }
+  /// Every frame recorded is in the sink (a failed close may have lost written ones).
+  bool complete() const { return dropped() == 0 && first_errno == 0; }
+};
+
+/// Writes frames to a file, a pipe or a device without ever blocking the caller.
 class FrameLog {
  public:
-  /// Opens (truncates) `path`; throws std::runtime_error naming the file when it cannot.
-  FrameLog(const std::string& path, std::string interface = "can0");
+  /// Frames the queue holds: about two seconds of a saturated 500 kbit/s bus.
+  static constexpr std::size_t kQueueFrames = 8192;
+
+  /// Opens (truncates) `path` and starts the writer thread; throws
+  /// std::runtime_error naming the file when it cannot be opened. A named
+  /// pipe waits here, as with any open, until its reader comes. close() and
+  /// the destructor give the sink at most `close_timeout_s` to take the rest.
+  FrameLog(const std::string& path, std::string interface = "can0", double close_timeout_s = 1.0);
+  /// close().
   ~FrameLog();
   FrameLog(const FrameLog&) = delete;
   FrameLog& operator=(const FrameLog&) = delete;
 
-  /// Writes one frame stamped `time_s` (s since the epoch).
+  /// Queues one frame stamped `time_s` (s since the epoch). Real-time safe: no
+  /// lock, no allocation, no system call; a full queue drops the frame
+  /// (counted). One caller at a time: callers on several threads serialise
+  /// (DriverBus records under its own mutex).
   void record(const CanFrame& frame, double time_s);
-  /// Writes one frame stamped with its rx_time_ns, or the wall clock when 0.
+  /// Queues one frame stamped with its rx_time_ns, or the wall clock when 0.
   void record(const CanFrame& frame);
-  /// Flushes the file.
-  void flush();
-  /// Lines written.
-  std::uint64_t lines() const;
+  /// Waits until every frame recorded so far is written or dropped, at most
+  /// close_timeout_s; false when the time ran out (not a real-time call).
+  bool flush();
+  /// Writes what it can within close_timeout_s, counts the rest as dropped,
+  /// stops the writer and closes the file. Frames recorded afterwards are
+  /// counted as dropped at close. Idempotent.
+  void close();
+  /// The counters so far (any thread).
+  FrameLogCounters counters() const;
 
  private:
-  mutable std::mutex mutex_;
-  std::FILE* file_ = nullptr;
+  struct Entry {
+    CanFrame frame;
+    double time_s = 0.0;
+  };
+  using Queue = SpscRing<Entry, kQueueFrames>;
+  struct Batch;
+
+  void run();
+  bool fill(Batch& batch);
+  void write_batch(Batch& batch);
+  bool wait_writable();
+  bool past_deadline() const;
+  void on_write_error(int err);
+  void report(const std::string& problem, int err);
+  void report_queue_full();
+
+  std::string path_;
   std::string interface_;
-  std::uint64_t lines_ = 0;
+  double close_timeout_s_;
+  int fd_ = -1;
+  std::unique_ptr<Queue> queue_;  // on the heap: 256 KiB
+  // Written by the producer (one at a time) and by the writer thread respectively.
+  SingleWriterCounter dropped_queue_full_;
+  SingleWriterCounter written_, dropped_write_error_, dropped_at_close_, resolved_;
+  std::atomic<bool> stopping_{false};
+  std::atomic<bool> writer_done_{false};
+  double deadline_s_ = 0.0;  // steady clock; set before stopping_ is
+  bool sink_gone_ = false;   // the writer's: EPIPE/EBADF, nothing more can be written
+  bool mid_line_ = false;    // the writer's: a failed write left a partial line
+  std::uint64_t queue_full_reported_ = 0;  // the writer's
+  // The writer's idle wait, and the reports (never touched by record()).
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  int first_errno_ = 0;
+  std::string first_error_;
+  std::set<int> reported_kinds_;  // errno values and the kinds below zero
+  std::thread writer_;
 };
 
 }  // namespace pinball::firmware
