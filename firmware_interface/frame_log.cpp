@@ -1,16 +1,10 @@
 #include "pinball/firmware/frame_log.h"
 
-#include <fcntl.h>
 #include <linux/can.h>
-#include <poll.h>
 #include <pthread.h>
-#include <signal.h>
-#include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -96,26 +90,14 @@ namespace {
 
 constexpr std::size_t kBatchLines = 512;  // lines formatted before one write(2)
 constexpr auto kIdle = std::chrono::milliseconds(5);  // the writer's nap when the queue is empty
-constexpr int kPollMs = 50;  // a blocked sink is re-checked this often, and for close()
 constexpr int kQueueFullKind = -1;  // report kinds beside errno values
 constexpr int kCloseKind = -2;
 
-// A write to a pipe whose reader has gone raises SIGPIPE, which kills a process that has not
-// ignored it. Blocked in the writer thread, it stays pending there and write(2) returns EPIPE.
-void block_sigpipe() {
-  sigset_t s;
-  sigemptyset(&s);
-  sigaddset(&s, SIGPIPE);
-  pthread_sigmask(SIG_BLOCK, &s, nullptr);
-}
-
-// Takes back the SIGPIPE that the failed write left pending on this thread.
-void consume_sigpipe() {
-  sigset_t s;
-  sigemptyset(&s);
-  sigaddset(&s, SIGPIPE);
-  const timespec zero{0, 0};
-  while (sigtimedwait(&s, nullptr, &zero) == SIGPIPE) {
+FileSink open_sink(const std::string& path) {
+  try {
+    return FileSink(path);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string("FrameLog: ") + e.what());
   }
 }
 
@@ -129,20 +111,12 @@ struct FrameLog::Batch {
 };
 
 FrameLog::FrameLog(const std::string& path, std::string interface, double close_timeout_s)
-    : path_(path), interface_(std::move(interface)), close_timeout_s_(close_timeout_s), queue_(std::make_unique<Queue>()) {
+    : interface_(std::move(interface)),
+      close_timeout_s_(close_timeout_s),
+      sink_(open_sink(path)),
+      queue_(std::make_unique<Queue>()) {
   check_input(close_timeout_s >= 0.0, "FrameLog", "close_timeout_s must be >= 0");
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd_ < 0) throw std::runtime_error("FrameLog: cannot open " + path + ": " + std::strerror(errno));
-  // Non-blocking from here on: a pipe nobody reads makes write(2) return EAGAIN instead of
-  // holding the writer, so that close() always ends.
-  const int flags = ::fcntl(fd_, F_GETFL);
-  if (flags >= 0) ::fcntl(fd_, F_SETFL, flags | O_NONBLOCK);
-  try {
-    writer_ = std::thread([this] { run(); });
-  } catch (...) {
-    ::close(fd_);
-    throw;
-  }
+  writer_ = std::thread([this] { run(); });
 }
 
 FrameLog::~FrameLog() { close(); }
@@ -171,33 +145,28 @@ bool FrameLog::flush() {
 }
 
 void FrameLog::close() {
-  if (writer_.joinable()) {
-    deadline_s_ = steady_now_s() + close_timeout_s_;
+  if (!writer_.joinable()) return;
+  deadline_s_ = steady_now_s() + close_timeout_s_;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stopping_.store(true, std::memory_order_release);
+  }
+  wake_.notify_all();
+  writer_.join();
+  const std::uint64_t left = dropped_at_close_.load() + queue_->size();
+  if (left > 0) {
+    char why[96];
+    std::snprintf(why, sizeof why, "%llu frames not written within %.1f s at close were dropped",
+                  static_cast<unsigned long long>(left), close_timeout_s_);
+    report(why, kCloseKind);
+  }
+  // Some file systems (NFS) report a failed write only here.
+  if (const int err = sink_.close(); err != 0) {
     {
       const std::lock_guard<std::mutex> lock(mutex_);
-      stopping_.store(true, std::memory_order_release);
+      if (first_errno_ == 0) first_errno_ = err;
     }
-    wake_.notify_all();
-    writer_.join();
-    const std::uint64_t left = dropped_at_close_.load() + queue_->size();
-    if (left > 0) {
-      char why[96];
-      std::snprintf(why, sizeof why, "%llu frames not written within %.1f s at close were dropped",
-                    static_cast<unsigned long long>(left), close_timeout_s_);
-      report(why, kCloseKind);
-    }
-  }
-  if (fd_ >= 0) {
-    // Some file systems (NFS) report a failed write only here.
-    if (::close(fd_) != 0) {
-      const int err = errno;
-      {
-        const std::lock_guard<std::mutex> lock(mutex_);
-        if (first_errno_ == 0) first_errno_ = err;
-      }
-      report(std::string("close failed: ") + std::strerror(err), err);
-    }
-    fd_ = -1;
+    report(std::string("close failed: ") + std::strerror(err), err);
   }
 }
 
@@ -216,7 +185,7 @@ FrameLogCounters FrameLog::counters() const {
 
 void FrameLog::run() {
   pthread_setname_np(pthread_self(), "pb-canlog");
-  block_sigpipe();
+  block_sigpipe_in_this_thread();
   Batch batch;
   batch.text.reserve(kBatchLines * 64);
   batch.ends.reserve(kBatchLines);
@@ -250,48 +219,21 @@ bool FrameLog::fill(Batch& b) {
   return !b.ends.empty();
 }
 
-void FrameLog::write_batch(Batch& b) {
-  std::size_t off = 0;
-  bool abandoned = false;
-  while (off < b.text.size() && !sink_gone_) {
-    const ssize_t n = ::write(fd_, b.text.data() + off, b.text.size() - off);
-    if (n > 0) {
-      off += static_cast<std::size_t>(n);
-    } else if (n < 0 && errno == EINTR) {
-      continue;
-    } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-      if (!wait_writable()) {
-        abandoned = true;
-        break;
-      }
-    } else {
-      on_write_error(n < 0 ? errno : EIO);
-      break;
-    }
-  }
+void FrameLog::write_batch(const Batch& b) {
+  // A blocked sink is waited on until close()'s time runs out; meanwhile the queue fills and says so.
+  const SinkWrite w = sink_.write(b.text.data(), b.text.size(), [this] {
+    report_queue_full();
+    return past_deadline();
+  });
+  if (w.error != 0 && w.error != ETIMEDOUT) on_write_error(w.error);
   std::size_t done = 0;
-  while (done < b.ends.size() && b.ends[done] <= off) ++done;
+  while (done < b.ends.size() && b.ends[done] <= w.bytes) ++done;
   written_.add(done);
   const std::size_t lost = b.ends.size() - done;
-  if (lost > 0) (abandoned ? dropped_at_close_ : dropped_write_error_).add(lost);
+  if (lost > 0) (w.error == ETIMEDOUT ? dropped_at_close_ : dropped_write_error_).add(lost);
   // A partial line left in the sink would run into the next one: the next batch starts with a newline.
-  if (off > 0) mid_line_ = off != (done == 0 ? b.prefix : b.ends[done - 1]);
+  if (w.bytes > 0) mid_line_ = w.bytes != (done == 0 ? b.prefix : b.ends[done - 1]);
   resolved_.add(b.ends.size());
-}
-
-// Waits until the sink takes bytes again; false when close()'s time ran out first.
-bool FrameLog::wait_writable() {
-  for (;;) {
-    report_queue_full();
-    int timeout_ms = kPollMs;
-    if (stopping_.load(std::memory_order_acquire)) {
-      const double left_s = deadline_s_ - steady_now_s();
-      if (left_s <= 0.0) return false;
-      timeout_ms = std::min(kPollMs, static_cast<int>(std::ceil(left_s * 1e3)));
-    }
-    pollfd p{fd_, POLLOUT, 0};
-    if (::poll(&p, 1, timeout_ms) > 0) return true;  // writable, or an error that the next write names
-  }
 }
 
 bool FrameLog::past_deadline() const {
@@ -299,15 +241,12 @@ bool FrameLog::past_deadline() const {
 }
 
 void FrameLog::on_write_error(int err) {
-  if (err == EPIPE) consume_sigpipe();
-  // A pipe without a reader or a bad descriptor never takes bytes again; a full disk may.
-  if (err == EPIPE || err == EBADF || err == EINVAL) sink_gone_ = true;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     if (first_errno_ == 0) first_errno_ = err;
   }
   report(std::string("write failed: ") + std::strerror(err) +
-             (sink_gone_ ? "; every further frame is dropped (counted)" : "; frames are dropped (counted) while it fails"),
+             (sink_.gone() ? "; every further frame is dropped (counted)" : "; frames are dropped (counted) while it fails"),
          err);
 }
 
@@ -315,7 +254,7 @@ void FrameLog::on_write_error(int err) {
 void FrameLog::report(const std::string& problem, int kind) {
   const std::lock_guard<std::mutex> lock(mutex_);
   if (!reported_kinds_.insert(kind).second) return;
-  const std::string line = "CAN log " + path_ + ": " + problem;
+  const std::string line = "CAN log " + sink_.path() + ": " + problem;
   if (first_error_.empty()) first_error_ = line;
   std::fprintf(stderr, "%s\n", line.c_str());
 }

@@ -23,6 +23,7 @@
 #include <string_view>
 #include <thread>
 
+#include "pinball/core/file_sink.h"
 #include "pinball/core/single_writer_counter.h"
 #include "pinball/core/spsc_ring.h"
 #include "pinball/firmware/can_frame.h"
@@ -102,17 +103,15 @@ class FrameLog {
 
   void run();
   bool fill(Batch& batch);
-  void write_batch(Batch& batch);
-  bool wait_writable();
+  void write_batch(const Batch& batch);
   bool past_deadline() const;
   void on_write_error(int err);
   void report(const std::string& problem, int err);
   void report_queue_full();
 
-  std::string path_;
   std::string interface_;
   double close_timeout_s_;
-  int fd_ = -1;
+  FileSink sink_;  // the writer thread's, and close()'s once it is joined
   std::unique_ptr<Queue> queue_;  // on the heap: 256 KiB
   // Written by the producer (one at a time) and by the writer thread respectively.
   SingleWriterCounter dropped_queue_full_;
@@ -120,7 +119,6 @@ class FrameLog {
   std::atomic<bool> stopping_{false};
   std::atomic<bool> writer_done_{false};
   double deadline_s_ = 0.0;  // steady clock; set before stopping_ is
-  bool sink_gone_ = false;   // the writer's: EPIPE/EBADF, nothing more can be written
   bool mid_line_ = false;    // the writer's: a failed write left a partial line
   std::uint64_t queue_full_reported_ = 0;  // the writer's
   // The writer's idle wait, and the reports (never touched by record()).

@@ -1,0 +1,61 @@
+#pragma once
+// Where a recording goes (a file, a pipe, a device), opened so that writing
+// to it never holds its thread for good and never kills the process: the
+// descriptor is non-blocking, a full pipe is waited on in short polls that
+// the caller may cut, and a pipe whose reader left is an error (EPIPE), not
+// SIGPIPE. The CAN log's and the LCM log's writer threads write through it;
+// they count what a failed write cost them.
+
+#include <cstddef>
+#include <functional>
+#include <string>
+
+namespace pinball {
+
+/// What one FileSink::write did.
+struct SinkWrite {
+  std::size_t bytes = 0;  ///< bytes the sink took (a prefix of what was given)
+  int error = 0;          ///< errno when it stopped short; ETIMEDOUT when the caller gave up waiting
+};
+
+/// A file opened for writing by one thread.
+class FileSink {
+ public:
+  /// Opens `path` (truncated, or appended to with `append`); throws
+  /// std::runtime_error naming the file when it cannot. A named pipe waits
+  /// here, as with any open, until its reader comes.
+  explicit FileSink(const std::string& path, bool append = false);
+  /// Closes (errors ignored: call close() to see them).
+  ~FileSink();
+  FileSink(const FileSink&) = delete;
+  FileSink& operator=(const FileSink&) = delete;
+
+  /// Writes `size` bytes. While the sink is full (a pipe nobody reads), waits
+  /// in polls of at most `poll_s` and asks `give_up()` (may be empty: wait on)
+  /// between them. Stops at the first error; a sink that will never take
+  /// bytes again (EPIPE, EBADF) is gone() from then on.
+  SinkWrite write(const char* data, std::size_t size, const std::function<bool()>& give_up = {},
+                  double poll_s = 0.05);
+  /// Closes the file; the errno of a failed close (some file systems report a
+  /// failed write only here), 0 otherwise. Idempotent.
+  int close();
+  /// True once the sink cannot take anything again (its reader left).
+  bool gone() const { return gone_; }
+  /// The path it was opened with.
+  const std::string& path() const { return path_; }
+
+ private:
+  bool wait_writable(const std::function<bool()>& give_up, double poll_s) const;
+
+  std::string path_;
+  int fd_ = -1;
+  bool gone_ = false;
+};
+
+/// Blocks SIGPIPE in the calling thread, so that a write there to a pipe
+/// without a reader returns EPIPE even where the process has not ignored
+/// the signal (FileSink::write takes back the pending signal). For the
+/// threads that own a FileSink.
+void block_sigpipe_in_this_thread();
+
+}  // namespace pinball
