@@ -2,16 +2,35 @@
 
 #include <pthread.h>
 
+#include <cerrno>
 #include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
 #include "pinball/bus/channels.h"
+#include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/message_convert.h"
+#include "pinball/core/clock.h"
 
 namespace pinball::bus {
 
 namespace {
+
+constexpr double kStopGraceS = 1.0;  // what stop() gives a log file that takes nothing (a pipe nobody reads)
+
+// The file:// log of `url` opened, or nullptr for every URL that liblcm serves.
+std::unique_ptr<FileSink> open_log(const std::string& url) {
+  const std::optional<LcmLogTarget> target = lcm_log_target(url);
+  if (!target) return nullptr;
+  try {
+    return std::make_unique<FileSink>(target->path, target->append);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("lcm: cannot open '" + url + "': " + e.what());
+  }
+}
 
 extern "C" void raw_callback(const lcm_recv_buf_t* rbuf, const char*, void* user_data) {
   (*static_cast<RawHandler*>(user_data))(rbuf->data, static_cast<int>(rbuf->data_size));
@@ -19,13 +38,32 @@ extern "C" void raw_callback(const lcm_recv_buf_t* rbuf, const char*, void* user
 
 }  // namespace
 
+std::optional<LcmLogTarget> lcm_log_target(const std::string& url) {
+  const std::string scheme = "file://";
+  if (url.rfind(scheme, 0) != 0) return std::nullopt;
+  const std::size_t query = url.find('?');
+  LcmLogTarget t;
+  t.path = url.substr(scheme.size(), query == std::string::npos ? std::string::npos : query - scheme.size());
+  std::string mode = "r";  // liblcm's default: a log to play
+  for (std::size_t at = query; at != std::string::npos && at < url.size();) {
+    const std::size_t end = url.find('&', at + 1);
+    const std::string arg = url.substr(at + 1, end == std::string::npos ? std::string::npos : end - at - 1);
+    if (arg.rfind("mode=", 0) == 0) mode = arg.substr(5);
+    at = end;
+  }
+  if (mode != "w" && mode != "a") return std::nullopt;
+  t.append = mode == "a";
+  return t;
+}
+
 void subscribe_raw(lcm::LCM& lcm, const char* channel, RawHandler& handler) {
   lcm_subscribe(lcm.getUnderlyingLCM(), channel, &raw_callback, &handler);
 }
 
 LcmBus::LcmBus(const std::string& url)
-    : lcm_(std::make_unique<lcm::LCM>(url)),
+    : lcm_(std::make_unique<lcm::LCM>(lcm_log_target(url) ? std::string("memq://") : url)),
       url_(url),
+      log_(open_log(url)),
       observations_{{}, kObservationChannel},
       projections_{{}, kProjectionChannel},
       commands_{{}, kFlipperCommandChannel},
@@ -40,14 +78,20 @@ void LcmBus::start(std::function<void(lcm::LCM&)> periodic, double period_s, std
   if (running_.exchange(true)) throw std::logic_error("lcm bus already running");
   thread_ = std::thread([this, periodic = std::move(periodic), period_s, on_start = std::move(on_start)] {
     pthread_setname_np(pthread_self(), "pb-lcm");
+    block_sigpipe_in_this_thread();  // a log's reader that leaves is a failed publish, not death
     if (on_start) on_start();
     run(periodic, period_s);
   });
 }
 
 void LcmBus::stop() {
+  stop_deadline_s_.store(steady_now_s() + kStopGraceS, std::memory_order_relaxed);  // seen once running_ is
   if (!running_.exchange(false)) return;
   if (thread_.joinable()) thread_.join();
+  // Some file systems (NFS) report a failed write only at close: the log may miss anything.
+  if (log_) {
+    if (const int err = log_->close(); err != 0) on_publish_failed("(closing the log)", err);
+  }
 }
 
 template <class T, std::size_t N>
@@ -85,21 +129,70 @@ void LcmBus::on_observation(const void* data, int size) {
   }
 }
 
+bool LcmBus::publish_encoded(const char* channel, const std::uint8_t* data, std::size_t size) {
+  int err = 0;
+  bool ok = false;
+  if (log_) {
+    err = write_log_event(channel, data, size);
+    ok = err == 0;
+  } else {
+    errno = 0;
+    ok = lcm_->publish(channel, data, static_cast<unsigned>(size)) == 0;
+    err = errno;
+  }
+  if (ok) {
+    published_.fetch_add(1, std::memory_order_relaxed);
+    return true;
+  }
+  on_publish_failed(channel, err);
+  return false;
+}
+
+// One event appended to the log; 0, or the errno that stopped it (ETIMEDOUT: given up after stop()).
+int LcmBus::write_log_event(const char* channel, const std::uint8_t* data, std::size_t size) {
+  const std::int64_t utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch())
+                                 .count();
+  log_event_.clear();
+  append_lcm_event(log_event_, log_events_, utime, channel, data, size);
+  const SinkWrite w = log_->write(log_event_.data(), log_event_.size(), [this] {
+    return !running_.load(std::memory_order_acquire) && steady_now_s() > stop_deadline_s_.load(std::memory_order_relaxed);
+  });
+  if (w.bytes == log_event_.size()) {
+    ++log_events_;
+    return 0;
+  }
+  return w.error != 0 ? w.error : EIO;
+}
+
+// Returns the messages taken from the ring, published or not.
 template <class T, std::size_t N>
 int LcmBus::drain(Outbox<T, N>& box) {
   int n = 0;
   T m;
   while (box.ring.try_pop(m)) {
-    lcm_->publish(box.channel, &m);
+    publish_now(box.channel, m);
     ++n;
   }
   return n;
 }
 
 int LcmBus::drain() {
-  const int n = drain(observations_) + drain(projections_) + drain(commands_) + drain(statuses_) + drain(games_);
-  published_.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
-  return n;
+  return drain(observations_) + drain(projections_) + drain(commands_) + drain(statuses_) + drain(games_);
+}
+
+// A refused publish is a hole in every recording of the bus (a file:// log on a full disk):
+// counted, and the first one said at once.
+void LcmBus::on_publish_failed(const char* channel, int err) {
+  publish_failed_.fetch_add(1, std::memory_order_relaxed);
+  if (has_first_failure_.load(std::memory_order_relaxed)) return;
+  const std::string why = err == ETIMEDOUT ? std::string(": the log took nothing in the grace stop() gives it")
+                          : err != 0       ? std::string(": ") + std::strerror(err)
+                                           : std::string();
+  first_failure_ = "lcm: publishing " + std::string(channel) + " on '" + url_ + "' failed" + why +
+                   "; refused messages are counted (publish_failed)";
+  has_first_failure_.store(true, std::memory_order_release);
+  std::fprintf(stderr, "%s\n", first_failure_.c_str());
 }
 
 void LcmBus::run(const std::function<void(lcm::LCM&)>& periodic, double period_s) {
@@ -126,8 +219,14 @@ void LcmBus::run(const std::function<void(lcm::LCM&)>& periodic, double period_s
 }
 
 LcmBusCounters LcmBus::counters() const {
-  return {published_.load(std::memory_order_relaxed), overflows_.load(std::memory_order_relaxed),
-          received_.load(std::memory_order_relaxed), malformed_.load(std::memory_order_relaxed)};
+  LcmBusCounters c;
+  c.published = published_.load(std::memory_order_relaxed);
+  c.publish_failed = publish_failed_.load(std::memory_order_relaxed);
+  c.overflows = overflows_.load(std::memory_order_relaxed);
+  c.received = received_.load(std::memory_order_relaxed);
+  c.malformed = malformed_.load(std::memory_order_relaxed);
+  if (has_first_failure_.load(std::memory_order_acquire)) c.first_failure = first_failure_;
+  return c;
 }
 
 }  // namespace pinball::bus

@@ -1,10 +1,13 @@
 #include "pinball/bus/lcm_bus.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <vector>
 #include <thread>
 
@@ -57,6 +60,138 @@ TEST(LcmBus, AFullRingDropsAndCountsInsteadOfBlocking) {
   for (int i = 0; i < 300; ++i) accepted += bus.try_publish(m) ? 1 : 0;
   EXPECT_EQ(accepted, 256);
   EXPECT_EQ(bus.counters().overflows, 44u);
+}
+
+// Publishes `n` projections (seq 0..n-1), waiting while the ring is full.
+void publish_projections(LcmBus& bus, int n) {
+  for (int i = 0; i < n; ++i) {
+    pinball_lcm::lcmt_pinball_projection m{};
+    m.seq = i;
+    while (!bus.try_publish(m)) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+std::string temp_path(const std::string& name) {
+  return ::testing::TempDir() + "/lcm_bus_" + std::to_string(getpid()) + "_" + name;
+}
+
+TEST(LcmBus, FileUrlsThatWriteAreFoundAndOthersLeftToLiblcm) {
+  const auto w = lcm_log_target("file:///tmp/game.lcmlog?mode=w");
+  ASSERT_TRUE(w.has_value());
+  EXPECT_EQ(w->path, "/tmp/game.lcmlog");
+  EXPECT_FALSE(w->append);
+  const auto a = lcm_log_target("file://game.lcmlog?speed=2&mode=a");
+  ASSERT_TRUE(a.has_value());
+  EXPECT_EQ(a->path, "game.lcmlog");
+  EXPECT_TRUE(a->append);
+  EXPECT_FALSE(lcm_log_target("file:///tmp/game.lcmlog").has_value());  // read mode, liblcm's default
+  EXPECT_FALSE(lcm_log_target("file:///tmp/game.lcmlog?mode=r").has_value());
+  EXPECT_FALSE(lcm_log_target("memq://").has_value());
+  EXPECT_FALSE(lcm_log_target("udpm://239.255.76.67:7667?ttl=0").has_value());
+}
+
+TEST(LcmBus, AFileLogHoldsEveryMessageInOrderForLiblcm) {
+  const std::string path = temp_path("all.lcmlog");
+  {
+    LcmBus bus("file://" + path + "?mode=w");
+    bus.start([](lcm::LCM&) {}, 1.0);
+    publish_projections(bus, 500);
+    bus.stop();
+    const LcmBusCounters c = bus.counters();
+    EXPECT_EQ(c.published, 500u);
+    EXPECT_EQ(c.publish_failed, 0u);
+    EXPECT_EQ(c.first_failure, "");
+  }
+  lcm::LogFile in(path, "r");
+  ASSERT_TRUE(in.good());
+  std::int64_t n = 0;
+  for (const lcm::LogEvent* e = in.readNextEvent(); e != nullptr; e = in.readNextEvent()) {
+    EXPECT_EQ(e->eventnum, n);
+    EXPECT_EQ(e->channel, kProjectionChannel);
+    pinball_lcm::lcmt_pinball_projection m{};
+    ASSERT_GE(m.decode(e->data, 0, static_cast<int>(e->datalen)), 0);
+    EXPECT_EQ(m.seq, n);
+    ++n;
+  }
+  EXPECT_EQ(n, 500);
+  std::remove(path.c_str());
+}
+
+// liblcm's own file provider ignores its write errors (it reported all of
+// these as published); the bus writes file:// logs itself and counts them.
+TEST(LcmBus, AFileLogOnAFullDiskCountsRefusedPublishesApart) {
+  ::testing::internal::CaptureStderr();
+  constexpr int kMessages = 600;
+  LcmBusCounters c;
+  {
+    LcmBus bus("file:///dev/full?mode=w");
+    bus.start();
+    publish_projections(bus, kMessages);
+    bus.stop();
+    c = bus.counters();
+  }
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(c.published, 0u);
+  EXPECT_EQ(c.publish_failed, static_cast<std::uint64_t>(kMessages));
+  EXPECT_NE(c.first_failure.find("file:///dev/full?mode=w"), std::string::npos) << c.first_failure;
+  EXPECT_NE(c.first_failure.find(kProjectionChannel), std::string::npos) << c.first_failure;
+  EXPECT_NE(c.first_failure.find("No space left on device"), std::string::npos) << c.first_failure;
+  // Said at once, and once.
+  const std::size_t first = err.find(c.first_failure);
+  ASSERT_NE(first, std::string::npos) << err;
+  EXPECT_EQ(err.find(c.first_failure, first + 1), std::string::npos) << err;
+}
+
+// The pipe's write end by path, as `--lcm-url 'file:///dev/stdout?mode=w' | reader` would.
+std::string pipe_url(int fd) { return "file:///proc/self/fd/" + std::to_string(fd) + "?mode=w"; }
+
+TEST(LcmBus, APipeNobodyReadsNeitherHoldsStopNorPassesForPublished) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  ::testing::internal::CaptureStderr();
+  constexpr int kMessages = 1000;  // far more than a 64 KiB pipe holds
+  LcmBusCounters c;
+  double stop_s = 0.0;
+  {
+    LcmBus bus(pipe_url(fds[1]));
+    bus.start();
+    for (int i = 0; i < kMessages; ++i) {
+      pinball_lcm::lcmt_pinball_projection m{};
+      m.seq = i;
+      bus.try_publish(m);  // a full ring drops (overflows): the bus thread waits on the pipe
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    bus.stop();
+    stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    c = bus.counters();
+  }
+  ::testing::internal::GetCapturedStderr();
+  EXPECT_LT(stop_s, 3.0);  // one second of grace, and a poll period
+  EXPECT_GT(c.publish_failed, 0u);
+  EXPECT_EQ(c.published + c.publish_failed + c.overflows, static_cast<std::uint64_t>(kMessages));
+  ::close(fds[0]);
+  ::close(fds[1]);
+}
+
+TEST(LcmBus, APipeWhoseReaderLeftCountsFailuresAndDoesNotKillTheProcess) {
+  // SIGPIPE keeps its default action (death) in this process.
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  ::testing::internal::CaptureStderr();
+  LcmBusCounters c;
+  {
+    LcmBus bus(pipe_url(fds[1]));
+    ::close(fds[0]);
+    ::close(fds[1]);
+    bus.start();
+    publish_projections(bus, 100);
+    bus.stop();
+    c = bus.counters();
+  }
+  ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(c.published, 0u);
+  EXPECT_EQ(c.publish_failed, 100u);
+  EXPECT_NE(c.first_failure.find("Broken pipe"), std::string::npos) << c.first_failure;
 }
 
 TEST(LcmBus, MalformedObservationsAreCountedAndIgnored) {

@@ -73,6 +73,10 @@ TEST(FileSink, APipeNobodyReadsWaitsOnlyUntilTheCallerGivesUp) {
   EXPECT_LT(w.bytes, block.size());
   EXPECT_EQ(asked, 3);
   EXPECT_LT(waited_s, 1.0);
+  // Once the caller has given up, a further write does not wait at all.
+  const auto t1 = std::chrono::steady_clock::now();
+  EXPECT_EQ(sink.write(block.data(), block.size(), [] { return true; }, 10.0).error, ETIMEDOUT);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count(), 1.0);
   ::close(fds[0]);
   ::close(fds[1]);
 }

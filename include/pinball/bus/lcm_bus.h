@@ -6,16 +6,26 @@
 // no place on the camera or controller thread. The bus thread also receives
 // (observations from an external camera process or lcm-logplayer) and counts
 // what it cannot decode instead of passing it on.
-
+//
+// A recording is only as good as its failures are visible: every message
+// liblcm refuses is counted (publish_failed) and the first is said on stderr
+// at once. A file:// URL in write or append mode (`file:///tmp/game.lcmlog?mode=w`)
+// is written by the bus itself in LCM's log format (lcm_log_format.h),
+// because liblcm's file provider ignores its write errors: a full disk, a
+// pipe whose reader left, or one that stopped reading past stop()'s second
+// are publish failures like any other, and never hold the bus thread for good.
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "pinball/core/file_sink.h"
 #include "pinball/core/spsc_ring.h"
 #include "pinball_lcm/lcmt_pinball_daemon_stats.hpp"
 #include "pinball_lcm/lcmt_pinball_driver_status.hpp"
@@ -28,11 +38,23 @@ namespace pinball::bus {
 
 /// Counters of the bus (monotonic).
 struct LcmBusCounters {
-  std::uint64_t published = 0;  ///< messages published
-  std::uint64_t overflows = 0;  ///< messages dropped because their ring was full
-  std::uint64_t received = 0;   ///< messages received and accepted
-  std::uint64_t malformed = 0;  ///< messages received that failed to decode or check, ignored
+  std::uint64_t published = 0;       ///< messages liblcm accepted
+  std::uint64_t publish_failed = 0;  ///< messages refused (a send error, a full disk under file://): lost
+  std::uint64_t overflows = 0;       ///< messages dropped because their ring was full
+  std::uint64_t received = 0;        ///< messages received and accepted
+  std::uint64_t malformed = 0;       ///< messages received that failed to decode or check, ignored
+  std::string first_failure;         ///< the first refused publish, for people ("" when none)
 };
+
+/// Where a file:// URL in write ("mode=w") or append ("mode=a") mode writes.
+struct LcmLogTarget {
+  std::string path;     ///< the file
+  bool append = false;  ///< mode=a
+};
+
+/// The log file of a file:// URL that writes; std::nullopt for every other
+/// URL (other providers, file:// in read mode, which is liblcm's default).
+std::optional<LcmLogTarget> lcm_log_target(const std::string& url);
 
 /// A handler of raw messages: the encoded bytes of one message.
 using RawHandler = std::function<void(const void* data, int size)>;
@@ -58,8 +80,9 @@ using ObservationRing = SpscRing<pinball_lcm::lcmt_pinball_observation, 1024>;
 /// One LCM instance and the thread that serves it.
 class LcmBus {
  public:
-  /// Opens LCM at `url` ("memq://", "udpm://239.255.76.67:7667?ttl=0", ...).
-  /// Throws std::runtime_error naming the URL when LCM cannot start.
+  /// Opens LCM at `url` ("memq://", "udpm://239.255.76.67:7667?ttl=0",
+  /// "file:///tmp/game.lcmlog?mode=w", ...). Throws std::runtime_error naming
+  /// the URL when LCM or the log file cannot be opened.
   explicit LcmBus(const std::string& url);
   ~LcmBus();
   LcmBus(const LcmBus&) = delete;
@@ -81,13 +104,23 @@ class LcmBus {
   bool try_publish(const pinball_lcm::lcmt_pinball_driver_status& m);
   bool try_publish(const pinball_lcm::lcmt_pinball_game_event& m);
 
+  /// Publishes `m` at once and counts it like the queued messages; false when
+  /// it was refused. For the bus thread only (start()'s `periodic`).
+  template <class T>
+  bool publish_now(const char* channel, const T& m) {
+    encoded_.resize(static_cast<std::size_t>(m.getEncodedSize()));
+    m.encode(encoded_.data(), 0, static_cast<int>(encoded_.size()));
+    return publish_encoded(channel, encoded_.data(), encoded_.size());
+  }
+
   /// Receive PINBALL_OBSERVATION into `ring` (call before start()). Messages
   /// that do not decode, or carry bad fields, are counted as malformed.
   void subscribe_observations(ObservationRing& ring);
 
   /// Counters so far.
   LcmBusCounters counters() const;
-  /// The LCM instance (for publishing from a non-real-time thread).
+  /// The LCM instance (subscriptions; for a file:// URL that writes, an
+  /// in-process memq:// one that nothing reaches the log through).
   lcm::LCM& lcm() { return *lcm_; }
 
  private:
@@ -103,9 +136,17 @@ class LcmBus {
   template <class T, std::size_t N>
   bool push(Outbox<T, N>& box, const T& m);
   void on_observation(const void* data, int size);
+  bool publish_encoded(const char* channel, const std::uint8_t* data, std::size_t size);
+  int write_log_event(const char* channel, const std::uint8_t* data, std::size_t size);
+  void on_publish_failed(const char* channel, int err);
 
   std::unique_ptr<lcm::LCM> lcm_;
   std::string url_;
+  std::unique_ptr<FileSink> log_;  // file:// that writes: the log, written by the bus thread
+  std::int64_t log_events_ = 0;    // events whole in the log (the next event number)
+  std::string log_event_;          // scratch: one event's bytes
+  std::vector<std::uint8_t> encoded_;  // scratch: one encoded message
+  std::atomic<double> stop_deadline_s_{0.0};  // steady clock: a blocked log is given up after it
   Outbox<pinball_lcm::lcmt_pinball_observation, 1024> observations_;
   Outbox<pinball_lcm::lcmt_pinball_projection, 1024> projections_;
   Outbox<pinball_lcm::lcmt_pinball_flipper_command, 256> commands_;
@@ -114,6 +155,9 @@ class LcmBus {
   ObservationRing* inbox_ = nullptr;
   RawHandler observation_handler_;
   std::atomic<std::uint64_t> published_{0};
+  std::atomic<std::uint64_t> publish_failed_{0};
+  std::string first_failure_;                  // written once by the bus thread, before...
+  std::atomic<bool> has_first_failure_{false};  // ...this is set
   std::atomic<std::uint64_t> overflows_{0};
   std::atomic<std::uint64_t> received_{0};
   std::atomic<std::uint64_t> malformed_{0};

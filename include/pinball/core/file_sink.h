@@ -30,9 +30,9 @@ class FileSink {
   FileSink(const FileSink&) = delete;
   FileSink& operator=(const FileSink&) = delete;
 
-  /// Writes `size` bytes. While the sink is full (a pipe nobody reads), waits
-  /// in polls of at most `poll_s` and asks `give_up()` (may be empty: wait on)
-  /// between them. Stops at the first error; a sink that will never take
+  /// Writes `size` bytes. While the sink is full (a pipe nobody reads), asks
+  /// `give_up()` (may be empty: wait on) and waits in polls of at most
+  /// `poll_s` between the questions. Stops at the first error; a sink that will never take
   /// bytes again (EPIPE, EBADF) is gone() from then on.
   SinkWrite write(const char* data, std::size_t size, const std::function<bool()>& give_up = {},
                   double poll_s = 0.05);
