@@ -1,16 +1,20 @@
 // A game recorded by pinballd into an LCM log replays to the same decisions;
-// a log whose decisions were altered does not; bad messages are skipped.
+// a log whose decisions were altered does not; bad messages are skipped; a
+// damaged log (tests/bad_input/lcm/) is refused naming the byte.
 
 #include "pinball/daemon/replay.h"
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -108,6 +112,76 @@ TEST(Replay, AFileThatIsNoLcmLogIsRefusedNamingIt) {
   std::ofstream(empty).close();
   EXPECT_THROW(replay_log(empty, config_for_test()), std::runtime_error);
   std::filesystem::remove(empty);
+}
+
+// The first `bytes` bytes of `from`, written to `to`.
+void copy_prefix(const std::string& from, const std::string& to, std::uintmax_t bytes) {
+  std::ifstream in(from, std::ios::binary);
+  std::string data(static_cast<std::size_t>(bytes), '\0');
+  in.read(data.data(), static_cast<std::streamsize>(bytes));
+  std::ofstream(to, std::ios::binary) << data;
+}
+
+// A recording cut short (a full disk, a killed logger) used to replay as
+// "reproduced": its decisions up to the cut still matched.
+TEST(Replay, ATruncatedRecordingIsRefusedNamingTheByte) {
+  const std::uintmax_t size = std::filesystem::file_size(recorded_log());
+  const std::string cut = ::testing::TempDir() + "/pinballd_replay_cut_" + std::to_string(getpid()) + ".lcmlog";
+  for (const std::uintmax_t bytes : {size - 1, std::uintmax_t{40}, std::uintmax_t{20}}) {
+    copy_prefix(recorded_log(), cut, bytes);
+    try {
+      replay_log(cut, config_for_test());
+      FAIL() << "cut at " << bytes;
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(cut + ": damaged LCM log at byte "), std::string::npos) << what;
+      EXPECT_NE(what.find("truncated event"), std::string::npos) << what;
+    }
+  }
+  std::remove(cut.c_str());
+}
+
+struct BadLog {
+  const char* file;   // in tests/bad_input/lcm/ (make_bad_lcm_logs.py)
+  const char* words;  // what the error says after the file's name
+};
+constexpr BadLog kBadLogs[] = {
+    {"empty.lcmlog", ": is empty (0 bytes), not an LCM log"},
+    {"random_bytes.lcmlog", ": not an LCM log (no LCM event header at byte 0)"},
+    {"truncated_header.lcmlog", ": damaged LCM log at byte 134: truncated event header (12 of 28 bytes)"},
+    {"truncated_payload.lcmlog", ": damaged LCM log at byte 134: truncated event"},
+    {"huge_length.lcmlog", ": damaged LCM log at byte 0: truncated event: channel length 19 and data length 2147483647"},
+    {"huge_channel_length.lcmlog", ": damaged LCM log at byte 134: bad channel length 2147483647"},
+    {"bad_sync_mid_file.lcmlog", ": damaged LCM log at byte 67: no event starts here (sync word 0xDEADBEEF"},
+};
+
+std::string bad_log(const BadLog& b) { return kSource + "/tests/bad_input/lcm/" + b.file; }
+
+TEST(Replay, DamagedLogsAreRefusedBeforeLiblcmReadsThem) {
+  for (const BadLog& b : kBadLogs) {
+    try {
+      replay_log(bad_log(b), config_for_test());
+      FAIL() << b.file;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(bad_log(b) + b.words), std::string::npos) << e.what();
+    }
+  }
+}
+
+// As users run it: exit 1 and one line naming the file and the byte (huge_length.lcmlog was a
+// segfault in liblcm 1.3.1, the others "NOT reproduced" or "reproduced").
+TEST(Replay, PinballReplayExitsOneOnEachDamagedLog) {
+  for (const BadLog& b : kBadLogs) {
+    const std::string err = ::testing::TempDir() + "/pinball_replay_bad_" + std::to_string(getpid()) + ".err";
+    const std::string cmd = std::string(PINBALL_EXE) + " replay " + bad_log(b) + " > /dev/null 2> " + err;
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << b.file << " died";
+    EXPECT_EQ(WEXITSTATUS(status), 1) << b.file;
+    std::ifstream in(err);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("pinball: " + bad_log(b) + b.words), std::string::npos) << text;
+    std::remove(err.c_str());
+  }
 }
 
 TEST(Replay, MissingLogIsNamed) {
