@@ -245,27 +245,26 @@ void FrameLog::on_write_error(int err) {
     const std::lock_guard<std::mutex> lock(mutex_);
     if (first_errno_ == 0) first_errno_ = err;
   }
-  report(std::string("write failed: ") + std::strerror(err) +
-             (sink_.gone() ? "; every further frame is dropped (counted)" : "; frames are dropped (counted) while it fails"),
-         err);
+  report(std::string("write failed: ") + std::strerror(err), err,
+         sink_.gone() ? "every further frame is dropped (counted)" : "frames are dropped (counted) while it fails");
 }
 
-// Once per kind (an errno, a full queue, the close): the first goes to stderr at once.
-void FrameLog::report(const std::string& problem, int kind) {
+// Once per kind (an errno, a full queue, the close): the first goes to stderr at once, with
+// what follows from it; the first of all is kept.
+void FrameLog::report(const std::string& problem, int kind, const char* consequence) {
   const std::lock_guard<std::mutex> lock(mutex_);
   if (!reported_kinds_.insert(kind).second) return;
   const std::string line = "CAN log " + sink_.path() + ": " + problem;
   if (first_error_.empty()) first_error_ = line;
-  std::fprintf(stderr, "%s\n", line.c_str());
+  std::fprintf(stderr, "%s%s%s\n", line.c_str(), *consequence != '\0' ? "; " : "", consequence);
 }
 
 void FrameLog::report_queue_full() {
   const std::uint64_t n = dropped_queue_full_.load();
   if (n == queue_full_reported_) return;
   queue_full_reported_ = n;
-  report("the writer fell behind (queue of " + std::to_string(kQueueFrames) +
-             " frames full); frames are dropped (counted)",
-         kQueueFullKind);
+  report("the writer fell behind (queue of " + std::to_string(kQueueFrames) + " frames full)", kQueueFullKind,
+         "frames are dropped (counted)");
 }
 
 }  // namespace pinball::firmware

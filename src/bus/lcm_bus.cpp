@@ -189,10 +189,9 @@ void LcmBus::on_publish_failed(const char* channel, int err) {
   const std::string why = err == ETIMEDOUT ? std::string(": the log took nothing in the grace stop() gives it")
                           : err != 0       ? std::string(": ") + std::strerror(err)
                                            : std::string();
-  first_failure_ = "lcm: publishing " + std::string(channel) + " on '" + url_ + "' failed" + why +
-                   "; refused messages are counted (publish_failed)";
+  first_failure_ = "lcm: publishing " + std::string(channel) + " on '" + url_ + "' failed" + why;
   has_first_failure_.store(true, std::memory_order_release);
-  std::fprintf(stderr, "%s\n", first_failure_.c_str());
+  std::fprintf(stderr, "%s; refused messages are counted (publish_failed)\n", first_failure_.c_str());
 }
 
 void LcmBus::run(const std::function<void(lcm::LCM&)>& periodic, double period_s) {

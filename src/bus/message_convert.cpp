@@ -128,6 +128,10 @@ pinball_lcm::lcmt_pinball_daemon_stats to_lcm_daemon_stats(std::int64_t utime, s
   m.camera_stalls = static_cast<std::int64_t>(counts.camera_stalls);
   m.malformed_messages = static_cast<std::int64_t>(counts.malformed_messages);
   m.ring_overflows = static_cast<std::int64_t>(counts.ring_overflows);
+  m.can_log_written = static_cast<std::int64_t>(counts.can_log_written);
+  m.can_log_dropped = static_cast<std::int64_t>(counts.can_log_dropped);
+  m.lcm_published = static_cast<std::int64_t>(counts.lcm_published);
+  m.lcm_publish_failed = static_cast<std::int64_t>(counts.lcm_publish_failed);
   return m;
 }
 

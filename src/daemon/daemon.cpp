@@ -383,6 +383,7 @@ DaemonReport Daemon::Impl::report() const {
   r.frames_dropped = h.frames_dropped.load() + (capture ? capture->counters().dropped : 0);
   r.ring_overflows = h.ring_overflows.load();
   r.lcm = lcm->counters();
+  if (frame_log) r.can_log = frame_log->counters();
   r.driver = bus->counters();
   r.wall_s = steady_now_s() - start_wall_s;
   r.sim_s = h.sim_time_s.load();
@@ -419,7 +420,7 @@ DaemonReport Daemon::Impl::report() const {
   return r;
 }
 
-void Daemon::Impl::publish_stats(lcm::LCM& l) {
+void Daemon::Impl::publish_stats(lcm::LCM&) {
   const DaemonReport r = report();
   std::array<bus::StageLatency, kStageCount> stages;
   for (int s = 0; s < kStageCount; ++s) {
@@ -435,9 +436,15 @@ void Daemon::Impl::publish_stats(lcm::LCM& l) {
   counts.camera_stalls = r.camera_stalls;
   counts.malformed_messages = r.lcm.malformed;
   counts.ring_overflows = r.ring_overflows + r.lcm.overflows;
+  counts.lcm_published = r.lcm.published;
+  counts.lcm_publish_failed = r.lcm.publish_failed;
+  if (r.can_log) {
+    counts.can_log_written = r.can_log->written;
+    counts.can_log_dropped = r.can_log->dropped();
+  }
   const pinball_lcm::lcmt_pinball_daemon_stats m =
       bus::to_lcm_daemon_stats(to_utime(steady_now_s()), stats_seq++, stages, counts);
-  l.publish(bus::kStatsChannel, &m);
+  lcm->publish_now(bus::kStatsChannel, m);  // counted like every other message
 }
 
 Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>()) {
@@ -537,9 +544,11 @@ DaemonReport Daemon::run() {
   driver.join();
   d.shutdown();
   d.report_faults();
+  // The CAN log's last frame is the shutdown's ReleaseAll: closed (what the sink takes within its
+  // grace, the rest counted) before the LCM thread's last PINBALL_STATS, which carries its counters.
+  if (d.frame_log) d.frame_log->close();
   d.lcm->stop();
   d.threads_joined.store(true, std::memory_order_release);  // nothing else runs: the board may be read
-  if (d.frame_log) d.frame_log->flush();
   return d.report();
 }
 
@@ -568,6 +577,21 @@ void Daemon::inject_fault(int thread, double freeze_s, bool fail) {
   InjectedFault& f = impl_->h.injected[static_cast<std::size_t>(thread)];
   f.freeze_s.store(freeze_s, std::memory_order_relaxed);
   f.fail.store(fail, std::memory_order_relaxed);
+}
+
+std::string recording_problems(const DaemonReport& r) {
+  std::string lost;
+  if (r.can_log && !r.can_log->complete()) {
+    const firmware::FrameLogCounters& c = *r.can_log;
+    lost = std::to_string(c.dropped()) + " CAN frames dropped (" + std::to_string(c.dropped_queue_full) +
+           " queue full, " + std::to_string(c.dropped_write_error) + " write errors, " +
+           std::to_string(c.dropped_at_close) + " at close), first: " + c.first_error;
+  }
+  if (r.lcm.publish_failed > 0) {
+    if (!lost.empty()) lost += "; ";
+    lost += std::to_string(r.lcm.publish_failed) + " LCM messages refused, first: " + r.lcm.first_failure;
+  }
+  return lost;
 }
 
 nlohmann::json report_to_json(const DaemonReport& r) {
@@ -599,8 +623,16 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["bus_fault_releases"] = r.bus_fault_releases;
   j["fires_deferred"] = r.fires_deferred;
   j["ring_overflows"] = r.ring_overflows;
-  j["lcm"] = {{"published", r.lcm.published}, {"overflows", r.lcm.overflows}, {"received", r.lcm.received},
+  j["lcm"] = {{"published", r.lcm.published}, {"publish_failed", r.lcm.publish_failed},
+              {"first_failure", r.lcm.first_failure}, {"overflows", r.lcm.overflows}, {"received", r.lcm.received},
               {"malformed", r.lcm.malformed}};
+  j["can_log"] = nullptr;
+  if (const auto& c = r.can_log) {
+    j["can_log"] = {{"written", c->written}, {"dropped", c->dropped()}, {"dropped_queue_full", c->dropped_queue_full},
+                    {"dropped_write_error", c->dropped_write_error}, {"dropped_at_close", c->dropped_at_close},
+                    {"first_errno", c->first_errno}, {"first_error", c->first_error}};
+  }
+  j["recording_complete"] = recording_problems(r).empty();
   j["can"] = {{"frames_sent", r.driver.frames_sent}, {"heartbeats", r.driver.heartbeats},
               {"fires", r.driver.fires}, {"releases", r.driver.releases}, {"release_alls", r.driver.release_alls},
               {"bus_off", r.driver.bus_off}, {"reconnects", r.driver.reconnects},
@@ -645,6 +677,10 @@ std::string report_to_text(const DaemonReport& r) {
     o << std::left << std::setw(24) << stage_name(s) << std::right << std::setw(10) << x.count << std::setw(10)
       << x.p50_us << std::setw(10) << x.p99_us << std::setw(10) << x.max_us << "\n";
   }
+  o << "recordings: ";
+  if (r.can_log) o << "CAN log " << r.can_log->written << " frames written, " << r.can_log->dropped() << " dropped; ";
+  o << "LCM " << r.lcm.published << " published, " << r.lcm.publish_failed << " refused\n";
+  if (const std::string lost = recording_problems(r); !lost.empty()) o << "recording INCOMPLETE: " << lost << "\n";
   o << "threads: " << r.cpus << "\n";
   const firmware::DriverBusCounters& k = r.driver;
   if (r.fault_count + k.release_retries + k.liveness_stalls > 0) {

@@ -49,6 +49,11 @@ int main(int argc, char** argv) {
   using namespace pinball::daemon;
   CLI::App app("pinballd: the real-time pinball controller (camera -> tracker -> controller -> CAN)");
   app.set_version_flag("--version", std::string("pinballd ") + PINBALL_VERSION);
+  app.footer(
+      "Exit status: 0 ran (every ball played, or SIGINT/SIGTERM); 1 bad configuration or file, or a thread "
+      "failed; 2 bad argument; "
+      "3 ran, but a recording is incomplete (the --can-log file dropped frames, or LCM refused messages, e.g. a "
+      "file:// log on a full disk): the report says what was lost.");
   std::string config_path, sim_board, world_board, stepper, controller, lcm_url, can_log;
   int balls = -1;
   long long seed = -1;
@@ -67,7 +72,9 @@ int main(int argc, char** argv) {
   app.add_option("--balls", balls, "balls to play in simulation (default 10)")->check(CLI::Range(0, 1000000));
   app.add_option("--seed", seed, "launch noise seed in simulation")->check(CLI::NonNegativeNumber);
   app.add_option("--lcm-url", lcm_url, "LCM provider, e.g. memq:// or udpm://239.255.76.67:7667?ttl=0");
-  app.add_option("--can-log", can_log, "write every CAN frame to this file in candump's log format");
+  app.add_option("--can-log", can_log,
+                 "write every CAN frame to this file in candump's log format (frames it cannot write are "
+                 "dropped, counted, and make the exit status 3)");
   app.add_flag("--realtime", realtime, "simulation paced to the wall clock (default: lockstep virtual clock)");
   app.add_flag("--json", json, "print the report as one JSON object on stdout");
   app.add_flag("--threads", threads, "print the thread table and exit");
@@ -84,6 +91,9 @@ int main(int argc, char** argv) {
   install(SIGINT, on_stop_signal);
   install(SIGTERM, on_stop_signal);
   install(SIGUSR1, on_stats_signal);
+  // A reader of a recording (or of stdout) that leaves makes a write fail with EPIPE, which the
+  // recorders count; the signal would kill the daemon before it released the coils and reported.
+  install(SIGPIPE, SIG_IGN);
   try {
     DaemonConfig config;
     if (!config_path.empty()) config = load_daemon_config(config_path);
@@ -119,7 +129,13 @@ int main(int argc, char** argv) {
       std::cout << report_to_text(report);
     }
     for (const std::string& f : report.thread_failures) std::fprintf(stderr, "pinballd: thread failed: %s\n", f.c_str());
-    return report.thread_failures.empty() ? 0 : 1;
+    if (!report.thread_failures.empty()) return 1;  // a failed thread outranks a hole in a recording
+    if (const std::string lost = recording_problems(report); !lost.empty()) {
+      std::fprintf(stderr, "pinballd: the recording is incomplete (exit %d): %s\n", kExitRecordingIncomplete,
+                   lost.c_str());
+      return kExitRecordingIncomplete;
+    }
+    return 0;
   } catch (const ConfigError& e) {
     std::fprintf(stderr, "pinballd: %s\n", e.what());
     return 1;

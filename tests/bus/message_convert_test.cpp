@@ -120,6 +120,23 @@ TEST(MessageConvert, DriverStatusNamesTheCoilsThatAreOn) {
   EXPECT_EQ(to_lcm_driver_status(9, 4, firmware::BusState::kHandshake, view, k).coils_on, 0);
 }
 
+TEST(MessageConvert, DaemonStatsCarryTheRecordingCounts) {
+  const StageLatency stages[1] = {{"capture->detection", 10, 1.0, 2.0, 3.0}};
+  DaemonStatsCounts counts;
+  counts.frames = 10;
+  counts.can_log_written = 40;
+  counts.can_log_dropped = 2;
+  counts.lcm_published = 50;
+  counts.lcm_publish_failed = 3;
+  const pinball_lcm::lcmt_pinball_daemon_stats m = to_lcm_daemon_stats(7, 1, stages, counts);
+  EXPECT_EQ(m.num_stages, 1);
+  EXPECT_EQ(m.frames, 10);
+  EXPECT_EQ(m.can_log_written, 40);
+  EXPECT_EQ(m.can_log_dropped, 2);
+  EXPECT_EQ(m.lcm_published, 50);
+  EXPECT_EQ(m.lcm_publish_failed, 3);
+}
+
 TEST(MessageConvert, FlipperCommandRange) {
   pinball_lcm::lcmt_pinball_flipper_command m{};
   m.flipper = 1;

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -22,6 +23,7 @@
 #include "pinball/bus/channels.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/core/running_stats.h"
+#include "pinball/firmware/frame_log.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/table/board_loader.h"
 
@@ -169,10 +171,15 @@ struct StatsCounter {
   std::atomic<std::int64_t> frames{0};
   std::atomic<int> stages{0};
   std::atomic<int> games{0};
+  std::atomic<std::int64_t> can_log_written{-1}, can_log_dropped{-1}, lcm_published{-1}, lcm_publish_failed{-1};
   bus::RawHandler on_stats = bus::typed_handler<pinball_lcm::lcmt_pinball_daemon_stats>(
       [this](const pinball_lcm::lcmt_pinball_daemon_stats& m) {
         frames = m.frames;
         stages = m.num_stages;
+        can_log_written = m.can_log_written;
+        can_log_dropped = m.can_log_dropped;
+        lcm_published = m.lcm_published;
+        lcm_publish_failed = m.lcm_publish_failed;
         ++n;
       });
   bus::RawHandler on_game =
@@ -192,6 +199,52 @@ TEST(Daemon, PublishesStatsAndGameEventsOnLcm) {
   EXPECT_EQ(c.frames.load(), static_cast<std::int64_t>(r.frames));
   EXPECT_GE(c.games.load(), 2);  // launch and loss
   EXPECT_EQ(r.lcm.overflows, 0u);
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// The CAN log is written off the real-time threads now: a normal run must
+// still hold every frame, in candump's format to the byte, and say so.
+TEST(Daemon, ACanLogHoldsEveryFrameAndTheReportAndStatsSaySo) {
+  const std::string path = ::testing::TempDir() + "/pinballd_can_" + std::to_string(getpid()) + ".log";
+  DaemonConfig config = sim_config(2, 6);
+  config.can.log = path;
+  StatsCounter c;
+  Daemon d(config);
+  bus::subscribe_raw(d.lcm_bus().lcm(), bus::kStatsChannel, c.on_stats);
+  const DaemonReport r = d.run();
+  ASSERT_TRUE(r.can_log.has_value());
+  EXPECT_EQ(r.can_log->dropped(), 0u);
+  EXPECT_EQ(r.can_log->first_error, "");
+  // Every frame sent is recorded (so are those received).
+  EXPECT_GE(r.can_log->written, r.driver.frames_sent);
+  EXPECT_EQ(recording_problems(r), "");
+  EXPECT_TRUE(report_to_json(r)["recording_complete"].get<bool>());
+  EXPECT_EQ(report_to_json(r)["can_log"]["written"].get<std::uint64_t>(), r.can_log->written);
+  EXPECT_NE(report_to_text(r).find("recordings: CAN log " + std::to_string(r.can_log->written) + " frames written, 0 dropped"),
+            std::string::npos);
+  // The last PINBALL_STATS comes after the log is closed: its counts are the final ones.
+  EXPECT_EQ(c.can_log_written.load(), static_cast<std::int64_t>(r.can_log->written));
+  EXPECT_EQ(c.can_log_dropped.load(), 0);
+  EXPECT_GT(c.lcm_published.load(), 0);
+  EXPECT_EQ(c.lcm_publish_failed.load(), 0);
+  const std::string text = read_text(path);
+  std::uint64_t lines = 0;
+  std::size_t start = 0;
+  for (std::size_t end = text.find('\n'); end != std::string::npos; start = end + 1, end = text.find('\n', start)) {
+    const std::string line = text.substr(start, end - start);
+    const auto e = firmware::parse_log_line(line);
+    ASSERT_TRUE(e.has_value()) << line;
+    EXPECT_EQ(e->interface, "simcan");
+    EXPECT_EQ(firmware::format_log_line(e->frame, e->time_s, "simcan"), line);  // candump's format, to the byte
+    ++lines;
+  }
+  EXPECT_EQ(start, text.size());  // nothing after the last newline
+  EXPECT_EQ(lines, r.can_log->written);
+  std::remove(path.c_str());
 }
 
 // Every command the controller gave is on PINBALL_FLIPPER_CMD, the shutdown's
@@ -337,6 +390,55 @@ void write_file(const std::string& path, const std::string& text) {
   ASSERT_NE(f, nullptr) << path;
   std::fputs(text.c_str(), f);
   std::fclose(f);
+}
+
+// A recording that lost anything is not a success: exit 3, and the report and stderr say what was lost.
+TEST(Pinballd, ACanLogOnAFullDiskExitsThreeAndTheReportSaysSo) {
+  const std::string out = ::testing::TempDir() + "/pinballd_full_" + std::to_string(getpid()) + ".json";
+  std::string text;
+  // stderr to `text`, the JSON report to `out`.
+  const int status =
+      run_shell(std::string(PINBALLD_EXE) + " --balls 1 --seed 2 --json --can-log /dev/full 2>&1 > " + out, text);
+  EXPECT_EQ(status, kExitRecordingIncomplete) << text;
+  EXPECT_NE(text.find("CAN log /dev/full: write failed: No space left on device"), std::string::npos) << text;
+  EXPECT_NE(text.find("pinballd: the recording is incomplete (exit 3): "), std::string::npos) << text;
+  EXPECT_NE(text.find("CAN frames dropped (0 queue full, "), std::string::npos) << text;
+  const nlohmann::json j = nlohmann::json::parse(read_text(out));
+  EXPECT_FALSE(j["recording_complete"].get<bool>());
+  EXPECT_EQ(j["can_log"]["written"].get<int>(), 0);
+  EXPECT_GT(j["can_log"]["dropped_write_error"].get<int>(), 0);
+  EXPECT_EQ(j["can_log"]["first_errno"].get<int>(), ENOSPC);
+  EXPECT_TRUE(j["coils_off_at_exit"].get<bool>());  // the run itself went on as ever
+  EXPECT_EQ(j["balls"].get<int>(), 1);
+  std::remove(out.c_str());
+}
+
+TEST(Pinballd, AnLcmFileLogOnAFullDiskExitsThree) {
+  std::string text;
+  const int status = run_shell(std::string(PINBALLD_EXE) +
+                                   " --balls 1 --seed 2 --json --lcm-url 'file:///dev/full?mode=w' 2>&1 >/dev/null",
+                               text);
+  EXPECT_EQ(status, kExitRecordingIncomplete) << text;
+  EXPECT_NE(text.find("lcm: publishing"), std::string::npos) << text;
+  EXPECT_NE(text.find("No space left on device"), std::string::npos) << text;
+  EXPECT_NE(text.find("pinballd: the recording is incomplete (exit 3): "), std::string::npos) << text;
+  EXPECT_NE(text.find(" LCM messages refused, first: lcm: publishing"), std::string::npos) << text;
+}
+
+// The CAN log's reader leaves mid-run (`--can-log /dev/stdout | head -c 100`): the daemon
+// neither dies of SIGPIPE (exit 141, no ReleaseAll) nor hangs; the log's frames are counted.
+TEST(Pinballd, ACanLogReaderThatLeavesCostsTheLogNotTheRun) {
+  const std::string base = ::testing::TempDir() + "/pinballd_head_" + std::to_string(getpid());
+  std::string text;
+  run_shell("( " + std::string(PINBALLD_EXE) + " --balls 1 --seed 2 --can-log /dev/stdout 2> " + base +
+                ".err; echo $? > " + base + ".status ) | head -c 100 > /dev/null",
+            text);
+  EXPECT_EQ(read_text(base + ".status"), "3\n");
+  const std::string err = read_text(base + ".err");
+  EXPECT_NE(err.find("CAN log /dev/stdout: write failed: Broken pipe"), std::string::npos) << err;
+  EXPECT_NE(err.find("pinballd: the recording is incomplete (exit 3)"), std::string::npos) << err;
+  std::remove((base + ".err").c_str());
+  std::remove((base + ".status").c_str());
 }
 
 TEST(Pinballd, VersionNamesTheProgramAndItsVersion) {

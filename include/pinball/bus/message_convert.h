@@ -58,6 +58,8 @@ struct StageLatency {
 struct DaemonStatsCounts {
   std::uint64_t frames = 0, frames_dropped = 0, detections = 0, projections = 0, commands = 0, camera_stalls = 0,
                 malformed_messages = 0, ring_overflows = 0;
+  std::uint64_t can_log_written = 0, can_log_dropped = 0;    ///< the CAN log's frames (0, 0 when none)
+  std::uint64_t lcm_published = 0, lcm_publish_failed = 0;  ///< LCM messages published and refused
 };
 
 /// A daemon statistics message.

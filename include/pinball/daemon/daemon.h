@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@
 #include "pinball/daemon/latency_histogram.h"
 #include "pinball/simlab/sim_world.h"
 #include "pinball/firmware/driver_bus.h"
+#include "pinball/firmware/frame_log.h"
 #include "pinball/firmware/virtual_driver_board.h"
 
 namespace pinball::daemon {
@@ -65,7 +67,8 @@ struct DaemonReport {
   std::uint64_t bus_fault_releases = 0;      ///< releases because the CAN session dropped
   std::uint64_t fires_deferred = 0;          ///< fires held back for the coil's recycle time
   std::uint64_t ring_overflows = 0;          ///< records dropped between threads
-  bus::LcmBusCounters lcm;                   ///< LCM traffic
+  bus::LcmBusCounters lcm;                   ///< LCM traffic (publish_failed: lost to every recording)
+  std::optional<firmware::FrameLogCounters> can_log;  ///< the CAN log (can.log), when one is written
   firmware::DriverBusCounters driver;        ///< CAN host side
   firmware::BoardCounters board;             ///< virtual board (sim)
   double wall_s = 0.0;                       ///< run time (s)
@@ -81,6 +84,15 @@ struct DaemonReport {
 
 /// Faults listed one by one in a report (the rest are counted).
 inline constexpr std::size_t kMaxReportedFaults = 100;
+
+/// pinballd's exit status when it ran but a recording is incomplete: the CAN
+/// log dropped frames or LCM refused messages (0: ran, 1: bad configuration
+/// or file, or a thread failed, 2: bad argument).
+constexpr int kExitRecordingIncomplete = 3;
+
+/// What the run's recordings lost (the CAN log, LCM), for people; "" when
+/// they are complete.
+std::string recording_problems(const DaemonReport& report);
 
 /// The report as one JSON object (the --json output).
 nlohmann::json report_to_json(const DaemonReport& report);

@@ -52,7 +52,7 @@ struct FrameLogCounters {
   std::uint64_t dropped_write_error = 0;  ///< dropped because a write failed (ENOSPC, EPIPE, EIO, ...)
   std::uint64_t dropped_at_close = 0;     ///< still queued when close()'s time ran out (a blocked sink)
   int first_errno = 0;                    ///< errno of the first failed write or close, 0 when none
-  std::string first_error;                ///< the first problem, for people ("" when none)
+  std::string first_error;                ///< the first problem, naming the file ("" when none)
 
   /// Frames recorded but not written.
   std::uint64_t dropped() const { return dropped_queue_full + dropped_write_error + dropped_at_close; }
@@ -106,7 +106,7 @@ class FrameLog {
   void write_batch(const Batch& batch);
   bool past_deadline() const;
   void on_write_error(int err);
-  void report(const std::string& problem, int err);
+  void report(const std::string& problem, int kind, const char* consequence = "");
   void report_queue_full();
 
   std::string interface_;
