@@ -3,8 +3,10 @@
 
 #include "pinball/daemon/daemon.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -439,6 +441,49 @@ TEST(Pinballd, ACanLogReaderThatLeavesCostsTheLogNotTheRun) {
   EXPECT_NE(err.find("pinballd: the recording is incomplete (exit 3)"), std::string::npos) << err;
   std::remove((base + ".err").c_str());
   std::remove((base + ".status").c_str());
+}
+
+// The finding behind the CAN log's writer thread: a log into a pipe whose reader stopped
+// reading held the driver thread inside the bus lock, so the heartbeats stopped (the
+// board's watchdog tripped) and SIGINT could not end the daemon.
+TEST(Pinballd, ACanLogPipeNobodyReadsHoldsNeitherHeartbeatsNorSigint) {
+  const std::string base = ::testing::TempDir() + "/pinballd_stalled_" + std::to_string(getpid());
+  const std::string fifo = base + ".fifo";
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const int reader = open(fifo.c_str(), O_RDONLY | O_NONBLOCK);  // there, and never reads
+  ASSERT_GE(reader, 0);
+  ASSERT_GT(fcntl(reader, F_SETPIPE_SZ, 4096), 0);  // full within a second of frames
+  const std::string cmd = std::string(PINBALLD_EXE) + " --balls 1000 --realtime --json --can-log " + fifo + " > " +
+                          base + ".json 2> " + base + ".err";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(3000));
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  pid_t done = 0;
+  for (int i = 0; i < 100 && done == 0; ++i) {  // 10 s: the log's grace is 1 s
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    done = waitpid(pid, &status, WNOHANG);
+  }
+  if (done == 0) {
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+    FAIL() << "pinballd did not end within 10 s of SIGINT";
+  }
+  close(reader);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), kExitRecordingIncomplete) << read_text(base + ".err");
+  const nlohmann::json j = nlohmann::json::parse(read_text(base + ".json"));
+  EXPECT_EQ(j["board"]["watchdog_trips"].get<int>(), 0);  // the heartbeats went on
+  EXPECT_TRUE(j["coils_off_at_exit"].get<bool>());
+  EXPECT_GT(j["can_log"]["written"].get<int>(), 0);
+  EXPECT_GT(j["can_log"]["dropped"].get<int>(), 0);
+  for (const char* ext : {".json", ".err", ".fifo"}) std::remove((base + ext).c_str());
 }
 
 TEST(Pinballd, VersionNamesTheProgramAndItsVersion) {
