@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the packages, builds the release preset and runs every test.
+# Installs the packages, builds the release preset and runs every test, then
+# the bad-input corpus under ASan + UBSan (its target alone).
 # Usage: scripts/test.sh   (as root on a fresh Debian machine, or any user once
 # the packages are installed)
 set -euo pipefail
@@ -8,3 +9,4 @@ scripts/install-deps.sh
 cmake --preset release >/dev/null
 cmake --build --preset release
 ctest --preset release
+scripts/test-bad-input.sh

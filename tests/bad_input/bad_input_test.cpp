@@ -24,6 +24,7 @@
 #include "pinball/control/controller_file.h"
 #include "pinball/daemon/daemon_config.h"
 #include "pinball/daemon/pipeline.h"
+#include "pinball/daemon/replay.h"
 #include "pinball/table/board_loader.h"
 
 namespace pinball {
@@ -53,6 +54,15 @@ void load_calibration(const std::string& path) {
   (void)daemon::tracking_setup_for(config, board);
 }
 
+// As `pinball replay LOG` reads a recording: the log is checked whole before
+// liblcm sees it, then replayed through the shipped board and controller.
+void load_lcm_log(const std::string& path) {
+  daemon::DaemonConfig config;
+  config.sim.board = std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board";
+  config.controller = std::string(PINBALL_SOURCE_DIR) + "/controllers/best.json";
+  (void)daemon::replay_log(path, config);
+}
+
 /// One kind of input file: its directory under tests/bad_input and its loader.
 struct Kind {
   const char* dir;
@@ -62,8 +72,8 @@ struct Kind {
 // Test names and failures show the directory.
 void PrintTo(const Kind& kind, std::ostream* out) { *out << kind.dir; }
 
-// LCM logs (the recordings' loader) go here as {"lcm_log", &load_lcm_log}.
 constexpr Kind kKinds[] = {
+    {"lcm", &load_lcm_log},
     {"board", &load_board},
     {"config", &load_config},
     {"controller", &load_controller},

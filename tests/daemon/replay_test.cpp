@@ -142,7 +142,7 @@ TEST(Replay, ATruncatedRecordingIsRefusedNamingTheByte) {
 }
 
 struct BadLog {
-  const char* file;   // in tests/bad_input/lcm/ (make_bad_lcm_logs.py)
+  const char* file;   // in tests/bad_input/lcm/ (tests/bad_input/make_lcm_logs.py)
   const char* words;  // what the error says after the file's name
 };
 constexpr BadLog kBadLogs[] = {

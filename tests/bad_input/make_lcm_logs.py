@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the damaged LCM logs of this folder (checked in; rerun to remake them).
+"""Writes the damaged LCM logs of lcm/ and the good one of good/lcm/ (checked in; rerun to remake them).
 
 LCM's log format (lcm-logger, liblcm's eventlog.c), integers big-endian:
   uint32 sync 0xEDA1DA01, int64 event number, int64 timestamp (us),
@@ -12,6 +12,8 @@ import os
 import struct
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+BAD = os.path.join(HERE, "lcm")
+GOOD = os.path.join(HERE, "good", "lcm")
 CHANNEL = b"PINBALL_OBSERVATION"
 
 
@@ -26,6 +28,10 @@ def payload(number):
 
 def good(n):
     return b"".join(event(i, payload(i)) for i in range(n))
+
+
+def good_other(n):
+    return b"".join(event(i, payload(i), channel=b"PINBALL_NOTES") for i in range(n))
 
 
 LOGS = {
@@ -45,8 +51,13 @@ LOGS = {
     "bad_sync_mid_file.lcmlog": event(0, payload(0)) + event(1, payload(1), sync=0xDEADBEEF) + event(2, payload(2)),
 }
 
+# Whole and well formed, on a channel replay does not read: it must load.
+GOOD_LOGS = {"two_events.lcmlog": good_other(2)}
+
 if __name__ == "__main__":
-    for name, data in LOGS.items():
-        with open(os.path.join(HERE, name), "wb") as f:
-            f.write(data)
-        print(f"{name}: {len(data)} bytes")
+    os.makedirs(GOOD, exist_ok=True)
+    for folder, logs in ((BAD, LOGS), (GOOD, GOOD_LOGS)):
+        for name, data in logs.items():
+            with open(os.path.join(folder, name), "wb") as f:
+                f.write(data)
+            print(f"{os.path.relpath(folder, HERE)}/{name}: {len(data)} bytes")
