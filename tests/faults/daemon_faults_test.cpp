@@ -108,5 +108,24 @@ INSTANTIATE_TEST_SUITE_P(EveryWorker, FailingThread,
                            return n.substr(3);  // "pb-driver" -> "driver"
                          });
 
+// SIGINT while the daemon learns its background or waits for the board: the
+// start-up ends, nothing plays, every coil is off.
+TEST(StopDuringStartUp, EndsTheStartUpInsteadOfWaitingItOut) {
+  DaemonConfig c = sim_config(5, false);
+  c.camera.background_frames = 10000;  // tens of seconds of rendering
+  Daemon d(c);
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    d.request_stop();
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  const DaemonReport r = d.run();
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  stopper.join();
+  EXPECT_LT(took_s, 5.0);  // a hang guard, not a speed figure
+  EXPECT_EQ(r.balls, 0);
+  EXPECT_TRUE(r.coils_off_at_exit);
+}
+
 }  // namespace
 }  // namespace pinball::daemon
