@@ -14,6 +14,14 @@
 namespace pinball::vision {
 namespace {
 
+// A pixel coordinate as an int for cv::Rect, clamped first: a prediction from
+// an extreme homography or a wild velocity must not overflow the cast (UBSan's
+// float-cast-overflow); the rectangles are cut to the image afterwards.
+int pixel_index(double v) {
+  constexpr double kFar = 1e6;
+  return static_cast<int>(std::isfinite(v) ? std::clamp(v, -kFar, kFar) : 0.0);
+}
+
 // Second moments of a uniform stadium of radius 1 and length k (k = L / r), per unit area.
 double stadium_major(double k) {
   return (k * k * k / 6.0 + std::numbers::pi * k * k / 4.0 + 4.0 * k / 3.0 + std::numbers::pi / 4.0) /
@@ -488,13 +496,13 @@ Detection BallDetector::detect(const Frame& frame, const cv::Point2d* predicted_
     motion_px = cv::norm(step);
     have_prediction = true;
   }
-  if (config_.use_roi && have_prediction && image.contains(cv::Point(static_cast<int>(predicted.x),
-                                                                     static_cast<int>(predicted.y)))) {
+  if (config_.use_roi && have_prediction && predicted.x >= 0.0 && predicted.y >= 0.0 && predicted.x < image.width &&
+      predicted.y < image.height) {
     const double half = config_.roi_radius_factor * expected_radius_px(predicted) + motion_px + 2.0;
-    const cv::Rect roi = cv::Rect(cv::Point(static_cast<int>(std::floor(predicted.x - half)),
-                                            static_cast<int>(std::floor(predicted.y - half))),
-                                  cv::Point(static_cast<int>(std::ceil(predicted.x + half)) + 1,
-                                            static_cast<int>(std::ceil(predicted.y + half)) + 1)) &
+    const cv::Rect roi = cv::Rect(cv::Point(pixel_index(std::floor(predicted.x - half)),
+                                            pixel_index(std::floor(predicted.y - half))),
+                                  cv::Point(pixel_index(std::ceil(predicted.x + half)) + 1,
+                                            pixel_index(std::ceil(predicted.y + half)) + 1)) &
                          image;
     if (roi.area() > 0) found = search(roi, roi != image, frame.t_s, out);
   }
@@ -519,8 +527,8 @@ Detection BallDetector::detect(const Frame& frame, const cv::Point2d* predicted_
     if (found || have_prediction) {
       const cv::Point2d c = found ? out.uv_px : predicted;
       const double half = 2.5 * expected_radius_px(c) + motion_px + 4.0;
-      exclude = cv::Rect(cv::Point(static_cast<int>(c.x - half), static_cast<int>(c.y - half)),
-                         cv::Point(static_cast<int>(c.x + half) + 1, static_cast<int>(c.y + half) + 1));
+      exclude = cv::Rect(cv::Point(pixel_index(c.x - half), pixel_index(c.y - half)),
+                         cv::Point(pixel_index(c.x + half) + 1, pixel_index(c.y + half) + 1));
     }
     background_.update(frame.gray, config_.background_rate, exclude);
   }

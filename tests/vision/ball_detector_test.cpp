@@ -78,6 +78,22 @@ void for_clear_points(Scene& s, int n, std::uint64_t seed, F&& f) {
   }
 }
 
+// A prediction far outside any int (a wild homography or velocity) must not
+// overflow a cast (UBSan float-cast-overflow in the asan preset): it is
+// ignored and the whole frame is searched.
+TEST(BallDetector, APredictionFarOffTheImageFallsBackToAFullSearch) {
+  Scene s;
+  const Vec2 p{0.3, 0.6};
+  std::vector<Vec2> path(8, p);
+  s.camera.render(path, s.t_s, s.frame);
+  for (const cv::Point2d far : {cv::Point2d{1e12, -1e12}, cv::Point2d{-3e9, 5.0}}) {
+    const Detection d = s.detector.detect(s.frame, &far);
+    EXPECT_TRUE(d.found);
+    EXPECT_FALSE(d.from_roi);
+    EXPECT_LT(s.error_px(d), 0.5);
+  }
+}
+
 TEST(BallDetector, StaticBallCentroidIsSubPixel) {
   Scene s;
   std::vector<double> errors;
