@@ -74,13 +74,21 @@ LcmBus::LcmBus(const std::string& url)
 
 LcmBus::~LcmBus() { stop(); }
 
-void LcmBus::start(std::function<void(lcm::LCM&)> periodic, double period_s, std::function<void()> on_start) {
+void LcmBus::start(std::function<void(lcm::LCM&)> periodic, double period_s, std::function<void()> on_start,
+                   std::function<void(const std::string&)> on_failure) {
   if (running_.exchange(true)) throw std::logic_error("lcm bus already running");
-  thread_ = std::thread([this, periodic = std::move(periodic), period_s, on_start = std::move(on_start)] {
+  thread_ = std::thread([this, periodic = std::move(periodic), period_s, on_start = std::move(on_start),
+                         on_failure = std::move(on_failure)] {
     pthread_setname_np(pthread_self(), "pb-lcm");
     block_sigpipe_in_this_thread();  // a log's reader that leaves is a failed publish, not death
-    if (on_start) on_start();
-    run(periodic, period_s);
+    try {
+      if (on_start) on_start();
+      run(periodic, period_s);
+    } catch (const std::exception& e) {
+      if (on_failure) on_failure(e.what());
+    } catch (...) {
+      if (on_failure) on_failure("unknown exception");
+    }
   });
 }
 

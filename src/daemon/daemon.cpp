@@ -421,6 +421,7 @@ DaemonReport Daemon::Impl::report() const {
 }
 
 void Daemon::Impl::publish_stats(lcm::LCM&) {
+  h.take_injected_fault(kLcmThread);  // the LCM thread's loop is LcmBus's: its hook is here, once a second
   const DaemonReport r = report();
   std::array<bus::StageLatency, kStageCount> stages;
   for (int s = 0; s < kStageCount; ++s) {
@@ -498,7 +499,8 @@ DaemonReport Daemon::run() {
   d.learn_background();
   d.warm_up_bus();
   d.lcm->start([&d](lcm::LCM& l) { d.guarded(kLcmThread, [&] { d.publish_stats(l); }); }, 1.0,
-               [&d] { d.enter_thread(kLcmThread); });
+               [&d] { d.enter_thread(kLcmThread); },
+               [&d](const std::string& what) { d.fail_thread(kLcmThread, what); });
   d.make_workers();
   // The simulated clock's offset before any thread reads it: the driver
   // thread's first poll must not see the steady clock's epoch (a false

@@ -5,10 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <chrono>
 #include <functional>
 
 #include "../firmware/board_harness.h"
 #include "pinball/firmware/driver_bus.h"
+#include "pinball/firmware/frame_log.h"
 #include "pinball/firmware/liveness.h"
 #include "pinball/simlab/faulty_link.h"
 #include "protocol_bench.h"
@@ -256,6 +260,41 @@ TEST_F(CoilFaults, AStaleRefusalReachesTheHostAsAFault) {
   run(bus, 0.02);
   EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
   EXPECT_EQ(bus.counters().stale_faults, 1u);
+}
+
+// The CAN log on a pipe nobody reads: the bus's polls (heartbeats, Status,
+// commands) never wait for it; the log drops and counts once its queue is
+// full. Before, one full pipe stopped the heartbeats.
+TEST_F(CoilFaults, ACanLogThatBlocksNeverHoldsTheBus) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);  // the read end is never read
+  {
+    FrameLog log("/dev/fd/" + std::to_string(fds[1]), "can0", 0.1);
+    DriverBusOptions o = options();
+    o.log = &log;
+    DriverBus bus(*host_, o);
+    double slowest_poll_s = 0.0;
+    auto poll_timed = [&] {
+      const auto t0 = std::chrono::steady_clock::now();
+      bus.poll_once(t_);
+      slowest_poll_s = std::max(slowest_poll_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    };
+    for (int k = 0; k < 20'000; ++k) {  // 20 s of bus time: about 3000 frames, far more than a pipe's 64 KiB
+      t_ += kTick_s;
+      if (k % 100 == 50) bus.fire(k % 2);
+      if (k % 100 == 90) bus.release(k % 2);
+      poll_timed();
+      board_.service(*link_, t_);
+    }
+    EXPECT_EQ(board_.counters().watchdog_trips, 0u);
+    EXPECT_GT(bus.counters().heartbeats, 900u);
+    EXPECT_LT(slowest_poll_s, 0.05);  // a hang guard: no poll waits on the pipe
+    log.close();
+    EXPECT_GT(log.counters().dropped(), 0u);
+    EXPECT_GT(log.counters().written, 0u);
+  }
+  ::close(fds[0]);
+  ::close(fds[1]);
 }
 
 }  // namespace

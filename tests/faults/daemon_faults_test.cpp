@@ -108,6 +108,17 @@ INSTANTIATE_TEST_SUITE_P(EveryWorker, FailingThread,
                            return n.substr(3);  // "pb-driver" -> "driver"
                          });
 
+// The LCM thread (its stats callback, once a second) fails the same way.
+TEST(FailingLcmThread, MakesTheCoilsSafeReportsAndEndsTheRun) {
+  Daemon d(sim_config(200, false));
+  d.inject_fault(kLcmThread, 0.0, /*fail=*/true);
+  const DaemonReport r = d.run();
+  ASSERT_EQ(r.thread_failures.size(), 1u);
+  EXPECT_EQ(r.thread_failures[0], "pb-lcm: injected failure of pb-lcm");
+  EXPECT_LT(r.balls, 200);
+  EXPECT_TRUE(r.coils_off_at_exit);
+}
+
 // SIGINT while the daemon learns its background or waits for the board: the
 // start-up ends, nothing plays, every coil is off.
 TEST(StopDuringStartUp, EndsTheStartUpInsteadOfWaitingItOut) {

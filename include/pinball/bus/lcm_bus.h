@@ -90,9 +90,11 @@ class LcmBus {
 
   /// Starts the bus thread. `periodic` (may be empty) runs on it every
   /// `period_s` with the LCM instance (the daemon's stats); `on_start` (may be
-  /// empty) runs first on the new thread (naming and scheduling it).
+  /// empty) runs first on the new thread (naming and scheduling it). An
+  /// exception on the thread ends it and goes to `on_failure` (may be empty)
+  /// with its what(), on that thread: the daemon makes the coils safe.
   void start(std::function<void(lcm::LCM&)> periodic = {}, double period_s = 1.0,
-             std::function<void()> on_start = {});
+             std::function<void()> on_start = {}, std::function<void(const std::string&)> on_failure = {});
   /// Publishes what is queued, runs `periodic` once more, stops the thread.
   void stop();
 
