@@ -26,6 +26,9 @@ int hex_digit(char c) {
 }  // namespace
 
 std::string format_log_line(const CanFrame& frame, double time_s, std::string_view interface) {
+  // A stamp no clock gives (NaN, negative, past the year 30000) is written as
+  // 0 rather than overflowing the cast (UBSan float-cast-overflow).
+  if (!(time_s >= 0.0 && time_s < 1e12)) time_s = 0.0;
   const auto whole = static_cast<long long>(time_s);
   long long micros = static_cast<long long>((time_s - static_cast<double>(whole)) * 1e6 + 0.5);
   long long secs = whole;

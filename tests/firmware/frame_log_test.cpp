@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -27,6 +28,8 @@ TEST(FrameLog, FormatsLikeCandump) {
   EXPECT_EQ(to_candump(make_error_frame(CAN_ERR_BUSOFF)), "20000040#0000000000000000");
   f.len = 0;
   EXPECT_EQ(format_log_line(f, 1.9999999, "vcan0"), "(2.000000) vcan0 123#");
+  // No stamp overflows the cast (UBSan float-cast-overflow): impossible ones are written as 0.
+  for (const double bad : {std::nan(""), -1.0, 1e300}) EXPECT_EQ(format_log_line(f, bad, "can0"), "(0.000000) can0 123#");
 }
 
 TEST(FrameLog, ParsesWhatItWrites) {
