@@ -59,13 +59,13 @@ TEST(JsonReadArchive, TypesAreTheDocumentsOwn) {
     }
     return "";
   };
-  EXPECT_EQ(error_of(R"({"count": "3"})"), "t.json:count: expected an integer");
-  EXPECT_EQ(error_of(R"({"count": 3.5})"), "t.json:count: expected an integer");
-  EXPECT_EQ(error_of(R"({"small": 256})"), "t.json:small: expected an integer in [0, 255]");
-  EXPECT_EQ(error_of(R"({"seed": -1})"), "t.json:seed: expected an integer in [0, 18446744073709551615]");
-  EXPECT_EQ(error_of(R"({"flag": 1})"), "t.json:flag: expected true or false");
+  EXPECT_EQ(error_of(R"({"count": "3"})"), "t.json:count: expected an integer (int32), got text '3'");
+  EXPECT_EQ(error_of(R"({"count": 3.5})"), "t.json:count: expected an integer (int32), got 3.5");
+  EXPECT_EQ(error_of(R"({"small": 256})"), "t.json:small: expected an integer in [0, 255], got 256");
+  EXPECT_EQ(error_of(R"({"seed": -1})"), "t.json:seed: expected an integer in [0, 18446744073709551615], got -1");
+  EXPECT_EQ(error_of(R"({"flag": 1})"), "t.json:flag: expected true or false, got 1");
   EXPECT_EQ(error_of(R"({"inner": {"lable": "x"}})"), "t.json:inner.lable: unknown key");
-  EXPECT_EQ(error_of(R"({"g_mps2": null})"), "t.json:g_mps2: expected a finite number");
+  EXPECT_EQ(error_of(R"({"g_mps2": null})"), "t.json:g_mps2: expected a number (double), got null");
   EXPECT_EQ(error_of(R"({"count": 4})"), "");
 }
 

@@ -112,35 +112,44 @@ TEST(YamlReadArchive, AFileHoldsOneDocument) {
 }
 
 TEST(YamlReadArchive, WrongTypesSayWhatWasExpected) {
-  EXPECT_EQ(error_of("count: many"), "t.yaml:count: expected an integer");
-  EXPECT_EQ(error_of("count: 2.5"), "t.yaml:count: expected an integer");
-  EXPECT_EQ(error_of("flag: 3"), "t.yaml:flag: expected true or false");
-  EXPECT_EQ(error_of("g_mps2: fast"), "t.yaml:g_mps2: expected a finite number");
-  EXPECT_EQ(error_of("name: [a]"), "t.yaml:name: expected text");
+  EXPECT_EQ(error_of("count: many"), "t.yaml:count: expected an integer (int32), got 'many' (line 1)");
+  EXPECT_EQ(error_of("count: 2.5"), "t.yaml:count: expected an integer (int32), got '2.5' (line 1)");
+  EXPECT_EQ(error_of("flag: 3"), "t.yaml:flag: expected true or false, got '3' (line 1)");
+  EXPECT_EQ(error_of("g_mps2: fast"), "t.yaml:g_mps2: expected a number (double), got 'fast' (line 1)");
+  EXPECT_EQ(error_of("name: [a]"), "t.yaml:name: expected text, got a list of 1 (line 1)");
   EXPECT_EQ(error_of("colour: blue"), "t.yaml:colour: expected red or green");
-  EXPECT_EQ(error_of("values: 3"), "t.yaml:values: expected a list");
-  EXPECT_EQ(error_of("values: [1, x]"), "t.yaml:values[1]: expected a finite number");
-  EXPECT_EQ(error_of("triple: [1, 2]"), "t.yaml:triple: expected a list of 3");
-  EXPECT_EQ(error_of("p_m: [1, 2, 3]"), "t.yaml:p_m: expected a list of 2");
-  EXPECT_EQ(error_of("inner: 5"), "t.yaml:inner: expected a mapping");
-  EXPECT_EQ(error_of("inners: [{x_m: y}]"), "t.yaml:inners[0].x_m: expected a finite number");
-  EXPECT_EQ(error_of("[1, 2]"), "t.yaml:(top): expected a mapping");
+  EXPECT_EQ(error_of("values: 3"), "t.yaml:values: expected a list, got '3' (line 1)");
+  EXPECT_EQ(error_of("values: [1, x]"), "t.yaml:values[1]: expected a number (double), got 'x' (line 1)");
+  EXPECT_EQ(error_of("triple: [1, 2]"), "t.yaml:triple: expected a list of 3, got a list of 2 (line 1)");
+  EXPECT_EQ(error_of("p_m: [1, 2, 3]"), "t.yaml:p_m: expected a list of 2, got a list of 3 (line 1)");
+  EXPECT_EQ(error_of("inner: 5"), "t.yaml:inner: expected a mapping, got '5' (line 1)");
+  EXPECT_EQ(error_of("inners: [{x_m: y}]"), "t.yaml:inners[0].x_m: expected a number (double), got 'y' (line 1)");
+  EXPECT_EQ(error_of("[1, 2]"), "t.yaml:(top): expected a mapping, got a list of 2 (line 1)");
+}
+
+TEST(YamlReadArchive, AWrongTypeNamesItsLine) {
+  EXPECT_EQ(error_of("count: 3\n\n# a comment\ng_mps2: fast\n"),
+            "t.yaml:g_mps2: expected a number (double), got 'fast' (line 4)");
+  EXPECT_EQ(error_of("inner:\n  label: a\n  x_m:\n    - 2\n"),
+            "t.yaml:inner.x_m: expected a number (double), got a list of 1 (line 4)");
+  EXPECT_EQ(error_of("name: ~"), "t.yaml:name: expected text, got nothing (line 1)");
 }
 
 TEST(YamlReadArchive, IntegersThatDoNotFitAreRefusedNotTruncated) {
-  EXPECT_EQ(error_of("small: 256"), "t.yaml:small: expected an integer in [0, 255]");
-  EXPECT_EQ(error_of("small: -1"), "t.yaml:small: expected an integer in [0, 255]");
-  EXPECT_EQ(error_of("count: 2147483648"), "t.yaml:count: expected an integer in [-2147483648, 2147483647]");
+  EXPECT_EQ(error_of("small: 256"), "t.yaml:small: expected an integer in [0, 255], got '256' (line 1)");
+  EXPECT_EQ(error_of("small: -1"), "t.yaml:small: expected an integer in [0, 255], got '-1' (line 1)");
+  EXPECT_EQ(error_of("count: 2147483648"), "t.yaml:count: expected an integer in [-2147483648, 2147483647], got '2147483648' (line 1)");
   EXPECT_EQ(error_of("big: 9223372036854775808"),
-            "t.yaml:big: expected an integer in [-9223372036854775808, 9223372036854775807]");
-  EXPECT_EQ(error_of("seed: 18446744073709551616"), "t.yaml:seed: expected an integer in [0, 18446744073709551615]");
-  EXPECT_EQ(error_of("seed: -1"), "t.yaml:seed: expected an integer in [0, 18446744073709551615]");
+            "t.yaml:big: expected an integer in [-9223372036854775808, 9223372036854775807], got '9223372036854775808' (line 1)");
+  EXPECT_EQ(error_of("seed: 18446744073709551616"), "t.yaml:seed: expected an integer in [0, 18446744073709551615], got '18446744073709551616' (line 1)");
+  EXPECT_EQ(error_of("seed: -1"), "t.yaml:seed: expected an integer in [0, 18446744073709551615], got '-1' (line 1)");
 }
 
 TEST(YamlReadArchive, NonFiniteNumbersAreRefused) {
-  EXPECT_EQ(error_of("g_mps2: .nan"), "t.yaml:g_mps2: expected a finite number");
-  EXPECT_EQ(error_of("g_mps2: .inf"), "t.yaml:g_mps2: expected a finite number");
-  EXPECT_EQ(error_of("values: [1, -.inf]"), "t.yaml:values[1]: expected a finite number");
+  EXPECT_EQ(error_of("g_mps2: .nan"), "t.yaml:g_mps2: expected a finite number (double), got '.nan' (line 1)");
+  EXPECT_EQ(error_of("g_mps2: .inf"), "t.yaml:g_mps2: expected a finite number (double), got '.inf' (line 1)");
+  EXPECT_EQ(error_of("values: [1, -.inf]"),
+            "t.yaml:values[1]: expected a finite number (double), got '-.inf' (line 1)");
 }
 
 TEST(YamlReadArchive, ErrorsCarryFileKeyAndMessageApart) {
@@ -150,7 +159,7 @@ TEST(YamlReadArchive, ErrorsCarryFileKeyAndMessageApart) {
   } catch (const KeyError& e) {
     EXPECT_EQ(e.file(), "t.yaml");
     EXPECT_EQ(e.key(), "inner.x_m");
-    EXPECT_EQ(e.message(), "expected a finite number");
+    EXPECT_EQ(e.message(), "expected a number (double), got 'no' (line 1)");
   }
   try {
     load_yaml("a: [1", "t.yaml");

@@ -48,6 +48,14 @@ struct JsonDoc {
     *out = n->get<std::string>();
     return true;
   }
+  static std::string describe(Node n) {
+    if (is_null(n)) return "null";
+    if (n->is_object()) return "an object";
+    if (n->is_array()) return "a list of " + std::to_string(n->size());
+    if (n->is_string()) return "text " + quote_value(n->get<std::string>());
+    return n->dump();  // a number or a boolean, as written
+  }
+  static int line(Node) { return 0; }  // nlohmann keeps no positions
   static IntegerParse get_int(Node n, std::int64_t* out) {
     if (n->is_number_unsigned()) {
       const auto u = n->get<std::uint64_t>();

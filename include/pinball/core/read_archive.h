@@ -1,9 +1,11 @@
 #pragma once
 // The one checked key reader: fills any struct with a Serialize() (see
 // name_value.h) from a YAML or JSON document, naming `file:key.path` in every
-// error and refusing wrong types ("expected an integer"), integers that do
-// not fit the field, non-finite numbers, keys given twice and, unless told
-// otherwise, unknown keys. `Doc` adapts one document type (yaml_read_archive.h,
+// error and refusing wrong types (saying which type was expected, what the
+// file holds and, where the document knows it, the line: "expected a number
+// (double), got 'fast' (line 3)"), integers that do not fit the field,
+// non-finite numbers, keys given twice and, unless told otherwise, unknown
+// keys. `Doc` adapts one document type (yaml_read_archive.h,
 // json_read_archive.h); this file knows no parser.
 
 #include <charconv>
@@ -44,9 +46,32 @@ IntegerParse parse_decimal_integer(const std::string& text, I* out) {
   return ec == std::errc() && end == last ? IntegerParse::kOk : IntegerParse::kNotInteger;
 }
 
+/// A value from a file, quoted for a message: cut at 40 characters, bytes
+/// outside printable ASCII shown as '?' (a binary file must not garble the terminal).
+inline std::string quote_value(const std::string& text) {
+  constexpr std::size_t kMax = 40;
+  std::string out = "'";
+  for (std::size_t i = 0; i < text.size() && i < kMax; ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    out += c >= 0x20 && c < 0x7f ? static_cast<char>(c) : '?';
+  }
+  return out + (text.size() > kMax ? "...'" : "'");
+}
+
+/// The name of an arithmetic field's type in messages: "double", "int32", "uint8".
+template <class T>
+std::string number_type_name() {
+  if constexpr (std::is_floating_point_v<T>) {
+    return sizeof(T) == sizeof(float) ? "float" : "double";
+  } else {
+    return std::string(std::is_signed_v<T> ? "int" : "uint") + std::to_string(8 * sizeof(T));
+  }
+}
+
 /// Reads documents of one kind into Serialize() structs. `Doc` gives `Node`
 /// and is_null, is_map, is_list, find, keys, size, at, get_bool, get_int,
-/// get_uint, get_double, get_string.
+/// get_uint, get_double, get_string, describe (what a value is, for messages:
+/// "'fast'", "a list") and line (1-based; 0 where the document has none).
 template <class Doc>
 class ReadArchive {
  public:
@@ -98,15 +123,16 @@ class ReadArchive {
   void read_value(const Node& n, const std::string& key, T* out) {
     using archive_detail::FixedList;
     if constexpr (std::is_same_v<T, bool>) {
-      if (!Doc::get_bool(n, out)) fail(key, "expected true or false");
+      if (!Doc::get_bool(n, out)) fail_type(n, key, "expected true or false");
     } else if constexpr (std::is_integral_v<T>) {
       read_integer(n, key, out);
     } else if constexpr (std::is_floating_point_v<T>) {
       double v = 0.0;
-      if (!Doc::get_double(n, &v) || !std::isfinite(v)) fail(key, "expected a finite number");
+      if (!Doc::get_double(n, &v)) fail_type(n, key, "expected a number (" + number_type_name<T>() + ")");
+      if (!std::isfinite(v)) fail_type(n, key, "expected a finite number (" + number_type_name<T>() + ")");
       *out = static_cast<T>(v);
     } else if constexpr (std::is_same_v<T, std::string>) {
-      if (!Doc::get_string(n, out)) fail(key, "expected text");
+      if (!Doc::get_string(n, out)) fail_type(n, key, "expected text");
     } else if constexpr (std::is_enum_v<T>) {
       std::string text;
       read_value(n, key, &text);
@@ -118,17 +144,28 @@ class ReadArchive {
     } else if constexpr (archive_detail::kIsOptional<T>) {
       read_value(n, key, &out->emplace());
     } else if constexpr (archive_detail::kIsVector<T>) {
-      if (!Doc::is_list(n)) fail(key, "expected a list");
+      if (!Doc::is_list(n)) fail_type(n, key, "expected a list");
       out->assign(Doc::size(n), typename T::value_type{});
       for (std::size_t i = 0; i < out->size(); ++i) read_value(Doc::at(n, i), index_key(key, i), &(*out)[i]);
     } else if constexpr (FixedList<T>) {
       constexpr std::size_t size = archive_detail::fixed_size<T>();
-      if (!Doc::is_list(n) || Doc::size(n) != size) fail(key, "expected a list of " + std::to_string(size));
+      if (!Doc::is_list(n) || Doc::size(n) != size) fail_type(n, key, "expected a list of " + std::to_string(size));
       for (std::size_t i = 0; i < size; ++i) read_value(Doc::at(n, i), index_key(key, i), &(*out)[i]);
     } else {
       static_assert(requires(T& t, ReadArchive* a) { t.Serialize(a); }, "a field type the archive cannot read");
       read_struct(n, key, out);
     }
+  }
+
+  // " (line 3)" where the document knows the line, else "".
+  static std::string where(const Node& n) {
+    const int line = Doc::line(n);
+    return line > 0 ? " (line " + std::to_string(line) + ")" : "";
+  }
+
+  // A value of the wrong type: what was expected, what the file holds, where.
+  [[noreturn]] void fail_type(const Node& n, const std::string& key, const std::string& expected) const {
+    fail(key, expected + ", got " + Doc::describe(n) + where(n));
   }
 
   // Integers go through 64 bits and must fit the field: 300 is refused for a
@@ -150,15 +187,16 @@ class ReadArchive {
       if (fits) *out = static_cast<T>(u);
     }
     if (fits) return;
-    if (r == IntegerParse::kNotInteger) fail(key, "expected an integer");
-    fail(key, "expected an integer in [" + std::to_string(std::numeric_limits<T>::min()) + ", " +
+    if (r == IntegerParse::kNotInteger) fail_type(n, key, "expected an integer (" + number_type_name<T>() + ")");
+    fail_type(n, key,
+              "expected an integer in [" + std::to_string(std::numeric_limits<T>::min()) + ", " +
                   std::to_string(std::numeric_limits<T>::max()) + "]");
   }
 
   template <class T>
   void read_struct(const Node& n, const std::string& path, T* out) {
     if (Doc::is_null(n) && !options_.require_every_key) return;  // an empty section keeps its defaults
-    if (!Doc::is_map(n)) fail(path.empty() ? "(top)" : path, "expected a mapping");
+    if (!Doc::is_map(n)) fail_type(n, path.empty() ? "(top)" : path, "expected a mapping");
     refuse_repeated_keys(n, path);
     Frame frame{n, path, {}};
     Frame* const outer = std::exchange(frame_, &frame);

@@ -43,6 +43,13 @@ struct YamlDoc {
     *out = n.Scalar();
     return true;
   }
+  static std::string describe(const Node& n) {
+    if (is_null(n)) return "nothing";
+    if (n.IsMap()) return "a mapping";
+    if (n.IsSequence()) return "a list of " + std::to_string(n.size());
+    return quote_value(n.Scalar());
+  }
+  static int line(const Node& n) { return n ? n.Mark().line + 1 : 0; }
   static IntegerParse get_int(const Node& n, std::int64_t* out) {
     return n.IsScalar() ? parse_decimal_integer(n.Scalar(), out) : IntegerParse::kNotInteger;
   }
