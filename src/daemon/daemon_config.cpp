@@ -1,9 +1,11 @@
 #include "pinball/daemon/daemon_config.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "pinball/core/yaml_read_archive.h"
 #include "pinball/daemon/thread_table.h"
@@ -46,12 +48,15 @@ void check_camera(const CameraSettings& c, const std::string& s) {
 }
 
 void check_can(const CanSettings& c, const std::string& s) {
+  // ISO 11898's classic CAN rates run from 10 kbit/s to 1 Mbit/s.
+  require(c.bitrate_bps >= 10'000 && c.bitrate_bps <= 1'000'000, s, "can.bitrate_bps",
+          "must be in [10000, 1000000] bit/s (PROTOCOL.md: " + std::to_string(firmware::kBitrate_bps) + ")");
   require(c.board_id >= 0 && c.board_id < firmware::kMaxBoards, s, "can.board_id", "must be in [0, 15]");
   // The board accepts a watchdog of 10..1000 ms in Hello (firmware/protocol.h).
   require(std::isfinite(c.watchdog_timeout_s) && c.watchdog_timeout_s * 1e3 >= firmware::kMinWatchdogMs &&
               c.watchdog_timeout_s * 1e3 <= firmware::kMaxWatchdogMs,
           s, "can.watchdog_timeout_s", "must be in [0.01, 1] s (the protocol's watchdog range)");
-  // Faster than 1 ms the heartbeats alone take about a tenth of a 1 Mbit/s bus.
+  // Faster than 1 ms the heartbeats alone take about a fifth of the 500 kbit/s bus.
   require(positive(c.heartbeat_period_s) && c.heartbeat_period_s >= 1e-3, s, "can.heartbeat_period_s",
           "must be at least 0.001 s");
   // One lost heartbeat must not trip the watchdog.
@@ -104,7 +109,9 @@ void check_threads(const ThreadSettings& c, const std::string& s) {
 
 void check_mode(const DaemonConfig& c, const std::string& s) {
   if (c.mode == "sim") {
-    require(c.camera.source == "sim", s, "camera.source", "must be sim in mode sim");
+    // lcm: observations recorded or replayed (lcm-logplayer) drive the
+    // tracker, and the coils drive the virtual driver board; no world runs.
+    require(c.camera.source == "sim" || c.camera.source == "lcm", s, "camera.source", "must be sim or lcm in mode sim");
     require(c.can.interface == "sim", s, "can.interface", "must be sim in mode sim");
     require(!c.sim.board.empty(), s, "sim.board", "is required in mode sim");
   } else {
@@ -115,6 +122,123 @@ void check_mode(const DaemonConfig& c, const std::string& s) {
             "must name a SocketCAN interface (can0) in mode lab");
   }
 }
+
+// ---- paths ----
+
+// What a path key names, and so what is checked at load.
+enum class PathUse {
+  kRead,    // a file the daemon reads: it must exist
+  kWrite,   // a file the daemon writes: its folder must exist
+  kUnused,  // not used in this mode (or this source): resolved, not checked
+};
+
+// One key that names a file: its dotted key, the field, and its use in `c`'s mode.
+struct PathField {
+  const char* key;
+  std::string* value;
+  PathUse use;
+};
+
+// The LCM URL's log file: file://PATH?... (liblcm reads a log, or we write one).
+struct LcmFilePart {
+  std::string path;  // empty: not a file:// URL
+  bool writes = false;
+};
+
+LcmFilePart lcm_file_part(const std::string& url) {
+  const std::string scheme = "file://";
+  if (url.rfind(scheme, 0) != 0) return {};
+  const std::size_t query = url.find('?');
+  LcmFilePart p;
+  p.path = url.substr(scheme.size(), query == std::string::npos ? std::string::npos : query - scheme.size());
+  const std::string args = query == std::string::npos ? "" : url.substr(query);
+  p.writes = args.find("mode=w") != std::string::npos || args.find("mode=a") != std::string::npos;
+  return p;
+}
+
+std::vector<PathField> path_fields(DaemonConfig& c) {
+  const bool sim = c.mode == "sim";
+  const bool world = sim && c.camera.source == "sim";
+  const auto use = [](bool used, PathUse u) { return used ? u : PathUse::kUnused; };
+  return {
+      {"sim.board", &c.sim.board, use(sim, PathUse::kRead)},
+      {"sim.world_board", &c.sim.world_board, use(world, PathUse::kRead)},
+      {"board", &c.board, use(!sim, PathUse::kRead)},
+      {"calibration", &c.calibration, PathUse::kRead},
+      {"controller", &c.controller, PathUse::kRead},
+      {"camera.device", &c.camera.device, use(c.camera.source == "file", PathUse::kRead)},
+      {"can.log", &c.can.log, PathUse::kWrite},
+  };
+}
+
+// True when the file gives the dotted key. Const lookups only: yaml-cpp's
+// non-const operator[] and Node assignment change the tree.
+bool file_gives(const YAML::Node& map, const std::string& dotted) {
+  if (!map.IsMap()) return false;
+  const std::size_t dot = dotted.find('.');
+  const YAML::Node child = map[dotted.substr(0, dot)];
+  if (!child) return false;
+  return dot == std::string::npos || file_gives(child, dotted.substr(dot + 1));
+}
+
+// Makes `value` (given at `key` of the file) absolute against `base_dir` and
+// checks it for its use. Messages: "file: key: 'cal.yaml' is /dir/cal.yaml
+// (relative paths are relative to the configuration's folder), which does not exist".
+void resolve_one(const std::string& source, const std::string& key, std::string* value, PathUse use,
+                 const std::filesystem::path& base_dir) {
+  namespace fs = std::filesystem;
+  if (value->empty()) return;
+  const fs::path given(*value);
+  const fs::path resolved = given.is_absolute() ? given : (base_dir / given).lexically_normal();
+  const std::string said = given.is_absolute()
+                               ? "'" + resolved.string() + "'"
+                               : "'" + *value + "' is " + resolved.string() +
+                                     " (a relative path is relative to the configuration's folder)";
+  *value = resolved.string();
+  std::error_code ec;
+  if (use == PathUse::kRead) {
+    require(fs::exists(resolved, ec), source, key, said + ", which does not exist");
+    require(!fs::is_directory(resolved, ec), source, key, said + ", which is a folder, not a file");
+  } else if (use == PathUse::kWrite) {
+    const fs::path folder = resolved.parent_path();
+    require(fs::is_directory(folder, ec), source, key, said + ": its folder " + folder.string() + " does not exist");
+  }
+}
+
+void resolve_paths(DaemonConfig& c, const YAML::Node& root, const std::string& source,
+                   const std::filesystem::path& base_dir) {
+  for (const PathField& f : path_fields(c)) {
+    if (!file_gives(root, f.key)) continue;  // a default: looked up as pinballd always did (find_data_file)
+    resolve_one(source, f.key, f.value, f.use, base_dir);
+  }
+  // lcm_url: file://PATH?mode=w writes a log there; file://PATH (mode=r) plays one.
+  const LcmFilePart lcm = lcm_file_part(c.lcm_url);
+  if (file_gives(root, "lcm_url") && !lcm.path.empty()) {
+    std::string path = lcm.path;
+    resolve_one(source, "lcm_url", &path, lcm.writes ? PathUse::kWrite : PathUse::kRead, base_dir);
+    c.lcm_url = "file://" + path + c.lcm_url.substr(std::string("file://").size() + lcm.path.size());
+  }
+}
+
+// Collects the dotted key of every field a Serialize() visits.
+class KeyListArchive {
+ public:
+  template <class T>
+  void Visit(const NameValue<T>& field) {
+    const std::string key = join_key(path_, field.name);
+    if constexpr (requires(T& t, KeyListArchive* a) { t.Serialize(a); }) {
+      const std::string outer = std::exchange(path_, key);
+      field.value->Serialize(this);
+      path_ = outer;
+    } else {
+      keys.push_back(key);
+    }
+  }
+  std::vector<std::string> keys;
+
+ private:
+  std::string path_;
+};
 
 // The version alone, read first: a file from another version is refused as
 // such, not for the keys it has.
@@ -128,10 +252,12 @@ struct VersionKey {
 
 }  // namespace
 
-DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string& source_name) {
+DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string& source_name,
+                                     const std::string& base_dir) {
   DaemonConfig c;
+  YAML::Node root;
   try {
-    const YAML::Node root = load_yaml(text, source_name);
+    root = load_yaml(text, source_name);
     // An empty file is a mistake (a wrong path, /dev/null, a truncated copy),
     // not a request for the embedded simulation: pinballd without --config is.
     require(!YamlDoc::is_null(root), source_name, "(file)",
@@ -148,6 +274,7 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
     throw ConfigError(source_name + ": " + e.key() + ": " + e.message());
   }
   validate_daemon_config(c, source_name);
+  if (!base_dir.empty()) resolve_paths(c, root, source_name, base_dir);
   return c;
 }
 
@@ -156,7 +283,25 @@ DaemonConfig load_daemon_config(const std::string& path) {
   if (!in) throw ConfigError(path + ": cannot open");
   std::stringstream ss;
   ss << in.rdbuf();
-  return daemon_config_from_yaml(ss.str(), path);
+  // The folder of the file as an absolute path: its relative paths mean the
+  // same whatever the working directory.
+  const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
+  return daemon_config_from_yaml(ss.str(), path, folder.string());
+}
+
+std::vector<std::string> daemon_config_keys() {
+  DaemonConfig c;
+  KeyListArchive a;
+  c.Serialize(&a);
+  return a.keys;
+}
+
+std::vector<std::string> daemon_config_path_keys() {
+  DaemonConfig c;
+  std::vector<std::string> out;
+  for (const PathField& f : path_fields(c)) out.push_back(f.key);
+  out.push_back("lcm_url");  // a file:// URL's path
+  return out;
 }
 
 void validate_daemon_config(const DaemonConfig& c, const std::string& s) {

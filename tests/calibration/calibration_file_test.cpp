@@ -110,7 +110,7 @@ TEST(CalibrationFile, ErrorsNameFileAndKey) {
   expect_error(without("  g_mps2:"), "lab.yaml:gravity.g_mps2: missing");
   std::string bad = good;
   bad.replace(bad.find("length_m: 0.078"), 15, "length_m: long");
-  expect_error(bad, "lab.yaml:flippers[0].length_m: expected a finite number");
+  expect_error(bad, "lab.yaml:flippers[0].length_m: expected a number (double), got 'long'");
   expect_error("version: 2\ndate: x\nboard: b\n", "lab.yaml:version: 2 is not the supported version");
   expect_error("version: [1\n", "lab.yaml:");
   expect_error("just text", "lab.yaml:version");

@@ -1,8 +1,18 @@
 #include "pinball/daemon/daemon_config.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace pinball::daemon {
 namespace {
@@ -65,7 +75,8 @@ TEST(DaemonConfig, CoilLimitsAreTheProtocolsAbsoluteOnes) {
             "t.yaml: coils.max_hold_ms: must be in [1, 10000] ms (the protocol's absolute hold cap)");
   EXPECT_EQ(error_of("coils: {max_hold_ms: 0}"),
             "t.yaml: coils.max_hold_ms: must be in [1, 10000] ms (the protocol's absolute hold cap)");
-  EXPECT_EQ(error_of("coils: {recycle_ms: 256}"), "t.yaml: coils.recycle_ms: expected an integer in [0, 255]");
+  EXPECT_EQ(error_of("coils: {recycle_ms: 256}"),
+            "t.yaml: coils.recycle_ms: expected an integer in [0, 255], got '256' (line 1)");
   EXPECT_NO_THROW(daemon_config_from_yaml("coils: {pulse_ms: 100, max_pulse_ms: 100, max_hold_ms: 10000, recycle_ms: 0}",
                                           "t.yaml"));
 }
@@ -117,7 +128,7 @@ lcm_url: "udpm://239.255.76.67:7667?ttl=0"
 
 TEST(DaemonConfig, ErrorsNameTheKey) {
   EXPECT_EQ(error_of("camera: {fsp: 200}"), "t.yaml: camera.fsp: unknown key");
-  EXPECT_EQ(error_of("sim: {balls: many}"), "t.yaml: sim.balls: expected an integer");
+  EXPECT_EQ(error_of("sim: {balls: many}"), "t.yaml: sim.balls: expected an integer (int32), got 'many' (line 1)");
   EXPECT_EQ(error_of("version: 2"), "t.yaml: version: is 2, this build reads 1");
   EXPECT_EQ(error_of("coils: {hold_duty_pct: 150}"),
             "t.yaml: coils.hold_duty_pct: must be in [0, 50] % (the protocol's absolute hold duty)");
@@ -125,10 +136,10 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
   EXPECT_EQ(error_of("can: {watchdog_timeout_s: 0.03}"),
             "t.yaml: can.watchdog_timeout_s: must be at least 3 heartbeat periods");
   EXPECT_EQ(error_of("mode: arcade"), "t.yaml: mode: must be sim or lab");
-  EXPECT_EQ(error_of("camera: 5"), "t.yaml: camera: expected a mapping");
+  EXPECT_EQ(error_of("camera: 5"), "t.yaml: camera: expected a mapping, got '5' (line 1)");
   EXPECT_EQ(error_of("threads: {priorities: {camera: 120}}"), "t.yaml: threads.priorities.camera: must be in [0, 99]");
   EXPECT_EQ(error_of("threads: {priorities: {gpu: 1}}"), "t.yaml: threads.priorities.gpu: unknown key");
-  EXPECT_EQ(error_of("coils: {pulse_ms: 300}"), "t.yaml: coils.pulse_ms: expected an integer in [0, 255]");
+  EXPECT_EQ(error_of("coils: {pulse_ms: 300}"), "t.yaml: coils.pulse_ms: expected an integer in [0, 255], got '300' (line 1)");
   EXPECT_EQ(error_of("sim: {stepper: rk4}"), "t.yaml: sim.stepper: unknown stepper 'rk4' (expected thesis or event)");
   EXPECT_EQ(error_of("threads: {chain_cpu: fast}"), "t.yaml: threads.chain_cpu: must be auto, off or a CPU number");
   EXPECT_EQ(error_of("threads: {chain_cpu: -3}"), "t.yaml: threads.chain_cpu: must be auto, off or a CPU number");
@@ -166,6 +177,148 @@ TEST(DaemonConfig, TheLabExampleLoads) {
   EXPECT_EQ(c.mode, "lab");
   EXPECT_EQ(c.can.interface, "can0");
   EXPECT_EQ(c.camera.source, "v4l2");
+}
+
+// The case: `fps: fast` names the file, the line, the key and the type.
+TEST(DaemonConfig, AWrongTypeSaysWhichTypeWasExpected) {
+  EXPECT_EQ(error_of("version: 1\ncamera:\n  fps: fast\n"),
+            "t.yaml: camera.fps: expected a number (double), got 'fast' (line 3)");
+  EXPECT_EQ(error_of("threads:\n  realtime: sometimes\n"),
+            "t.yaml: threads.realtime: expected true or false, got 'sometimes' (line 2)");
+  EXPECT_EQ(error_of("can: {interface: [can0]}"), "t.yaml: can.interface: expected text, got a list of 1 (line 1)");
+}
+
+TEST(DaemonConfig, SimModeMayTakeObservationsFromLcm) {
+  const DaemonConfig c = daemon_config_from_yaml("mode: sim\ncamera: {source: lcm}\n", "t.yaml");
+  EXPECT_EQ(c.camera.source, "lcm");
+  EXPECT_EQ(error_of("camera: {source: v4l2, device: /dev/video0}"),
+            "t.yaml: camera.source: must be sim or lcm in mode sim");
+}
+
+TEST(DaemonConfig, TheBitrateIsTheProtocols) {
+  EXPECT_EQ(daemon_config_from_yaml("version: 1", "t.yaml").can.bitrate_bps, 500000u);
+  EXPECT_EQ(error_of("can: {bitrate_bps: 5000000}"),
+            "t.yaml: can.bitrate_bps: must be in [10000, 1000000] bit/s (PROTOCOL.md: 500000)");
+}
+
+// ---- paths ----
+
+// A folder of its own under the test's temporary folder, made empty.
+std::filesystem::path fresh_dir(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+// Runs `body` with the working directory set to `dir`, then restores it.
+template <class Body>
+void in_dir(const std::filesystem::path& dir, Body body) {
+  const std::filesystem::path before = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  try {
+    body();
+  } catch (...) {
+    std::filesystem::current_path(before);
+    throw;
+  }
+  std::filesystem::current_path(before);
+}
+
+std::string load_error(const std::string& path) {
+  try {
+    load_daemon_config(path);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The case: `calibration: cal.yaml` beside the configuration loads
+// from another working directory, and every path key is the file's folder's.
+TEST(DaemonConfig, RelativePathsAreRelativeToTheConfigurationsFolder) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fresh_dir("config_paths");
+  const std::string source = PINBALL_SOURCE_DIR;
+  fs::copy_file(source + "/calibration/lab.example.yaml", dir / "cal.yaml");
+  fs::copy_file(source + "/boards/mit1993.board", dir / "table.board");
+  fs::create_directories(dir / "logs");
+  fs::create_directories(dir / "controllers");
+  fs::copy_file(source + "/controllers/best.json", dir / "controllers" / "mine.json");
+  write_file(dir / "pinballd.yaml",
+             "version: 1\nmode: sim\ncalibration: cal.yaml\ncontroller: controllers/mine.json\n"
+             "sim: {board: table.board, world_board: ./table.board}\ncan: {log: logs/can.log}\n"
+             "lcm_url: \"file://logs/game.lcmlog?mode=w\"\n");
+  DaemonConfig c;
+  in_dir("/", [&] { c = load_daemon_config((dir / "pinballd.yaml").string()); });
+  EXPECT_EQ(c.calibration, (dir / "cal.yaml").string());
+  EXPECT_EQ(c.controller, (dir / "controllers" / "mine.json").string());
+  EXPECT_EQ(c.sim.board, (dir / "table.board").string());
+  EXPECT_EQ(c.sim.world_board, (dir / "table.board").string());
+  EXPECT_EQ(c.can.log, (dir / "logs" / "can.log").string());
+  EXPECT_EQ(c.lcm_url, "file://" + (dir / "logs" / "game.lcmlog").string() + "?mode=w");
+  // A relative --config works the same from the file's folder's parent.
+  in_dir(dir.parent_path(), [&] { c = load_daemon_config("config_paths/pinballd.yaml"); });
+  EXPECT_EQ(c.calibration, (dir / "cal.yaml").string());
+  // Keys left out keep their defaults, found as before (the working directory, then the source tree).
+  write_file(dir / "pinballd.yaml", "version: 1\n");
+  in_dir("/", [&] { c = load_daemon_config((dir / "pinballd.yaml").string()); });
+  EXPECT_EQ(c.controller, "controllers/best.json");
+}
+
+TEST(DaemonConfig, AMissingFileNamesTheConfigurationTheKeyAndThePath) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fresh_dir("config_missing");
+  const std::string file = (dir / "pinballd.yaml").string();
+  write_file(file, "version: 1\ncalibration: cal.yaml\n");
+  std::string what;
+  in_dir("/", [&] { what = load_error(file); });
+  EXPECT_EQ(what, file + ": calibration: 'cal.yaml' is " + (dir / "cal.yaml").string() +
+                      " (a relative path is relative to the configuration's folder), which does not exist");
+  write_file(file, "version: 1\ncan: {log: nowhere/can.log}\n");
+  EXPECT_EQ(load_error(file), file + ": can.log: 'nowhere/can.log' is " + (dir / "nowhere" / "can.log").string() +
+                                  " (a relative path is relative to the configuration's folder): its folder " +
+                                  (dir / "nowhere").string() + " does not exist");
+  write_file(file, "version: 1\ncontroller: /nonexistent/c.json\n");
+  EXPECT_EQ(load_error(file), file + ": controller: '/nonexistent/c.json', which does not exist");
+  write_file(file, "version: 1\nsim: {board: ../config_missing}\n");
+  EXPECT_EQ(load_error(file), file + ": sim.board: '../config_missing' is " + dir.string() +
+                                  " (a relative path is relative to the configuration's folder), which is a "
+                                  "folder, not a file");
+  // A file the mode does not read is not required: the lab board in mode sim.
+  write_file(file, "version: 1\nboard: lab.board\n");
+  EXPECT_EQ(load_error(file), "");
+}
+
+// True when the mapping has the dotted key (const lookups: they never change the tree).
+bool gives(const YAML::Node& map, const std::string& dotted) {
+  if (!map.IsMap()) return false;
+  const std::size_t dot = dotted.find('.');
+  const YAML::Node child = map[dotted.substr(0, dot)];
+  return child.IsDefined() && (dot == std::string::npos || gives(child, dotted.substr(dot + 1)));
+}
+
+// Every key the loader accepts is shown in config/lab.example.yaml, so the
+// example cannot fall behind the loader (and loading it proves the reverse:
+// a key the loader does not know is refused).
+TEST(DaemonConfig, TheLabExampleShowsEveryKey) {
+  const std::string path = std::string(PINBALL_SOURCE_DIR) + "/config/lab.example.yaml";
+  (void)load_daemon_config(path);
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  const YAML::Node root = YAML::Load(text.str());
+  const std::vector<std::string> keys = daemon_config_keys();
+  EXPECT_GT(keys.size(), 40u);
+  for (const std::string& key : keys) EXPECT_TRUE(gives(root, key)) << key << " is missing from " << path;
+  EXPECT_EQ(std::set<std::string>(keys.begin(), keys.end()).count("can.log"), 1u);
+  // The choices are listed beside the keys that take one.
+  EXPECT_NE(text.str().find("# sim | lab"), std::string::npos);
+  EXPECT_NE(text.str().find("# sim | v4l2 | file | lcm"), std::string::npos);
 }
 
 TEST(DaemonConfig, MissingFileIsNamed) {

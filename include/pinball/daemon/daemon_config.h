@@ -8,15 +8,22 @@
 // reaches DriverBus. One YAML document per file; a repeated key is refused.
 // Each struct lists its keys once, in Serialize(); core/yaml_read_archive.h
 // reads them (unknown keys refused, missing keys keep the defaults below).
+// A relative path in a file is relative to that file's folder, never to the
+// working directory (Mission Pinball Framework's rule for its machine
+// folder); load_daemon_config makes every such path absolute and checks, at
+// load, that the files the mode reads exist and that the folders it writes
+// into do, naming the file, the key and the resolved path.
 
 #include <array>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "pinball/core/name_value.h"
 #include "pinball/firmware/flipper_actuation.h"
 #include "pinball/firmware/messages.h"
+#include "pinball/firmware/protocol.h"
 #include "pinball/sim/world.h"
 
 namespace pinball::daemon {
@@ -26,7 +33,7 @@ inline constexpr int kConfigVersion = 1;
 
 /// Where frames come from.
 struct CameraSettings {
-  std::string source = "sim";     ///< sim (rendered board), v4l2 (a camera device), file (a video), lcm (observations)
+  std::string source = "sim";     ///< sim (rendered board), v4l2 (a camera device), file (a video), lcm (observations on PINBALL_OBSERVATION)
   std::string device;             ///< v4l2: /dev/videoN; file: the video's path
   int width_px = 640;             ///< requested frame width (px), 1..8192
   int height_px = 480;            ///< requested frame height (px), 1..8192
@@ -49,6 +56,9 @@ struct CameraSettings {
 /// The CAN link to the solenoid driver board.
 struct CanSettings {
   std::string interface = "sim";     ///< sim (the virtual board over a socket pair) or a SocketCAN interface (can0)
+  /// The bus's bit rate (bit/s), PROTOCOL.md's 500 kbit/s: pinballd refuses
+  /// a SocketCAN interface set to another (a virtual one, vcan, has none).
+  std::uint32_t bitrate_bps = firmware::kBitrate_bps;
   int board_id = 0;                  ///< driver board number 0..15
   double heartbeat_period_s = 0.02;  ///< heartbeat period (s), 0.001 .. watchdog_timeout_s / 3
   double watchdog_timeout_s = 0.1;   ///< the board switches everything off after this silence (s), 0.01..1
@@ -57,6 +67,7 @@ struct CanSettings {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(PINBALL_NVP(interface));
+    a->Visit(PINBALL_NVP(bitrate_bps));
     a->Visit(PINBALL_NVP(board_id));
     a->Visit(PINBALL_NVP(heartbeat_period_s));
     a->Visit(PINBALL_NVP(watchdog_timeout_s));
@@ -166,10 +177,20 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Parses YAML text; `source_name` is used in messages. Unknown keys are errors.
-DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string& source_name);
-/// Reads a configuration file.
+/// Parses YAML text; `source_name` is used in messages. Unknown keys are
+/// errors. With a `base_dir`, the relative paths the text gives are resolved
+/// against it and checked as load_daemon_config does; without one they are
+/// kept as written.
+DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string& source_name,
+                                     const std::string& base_dir = "");
+/// Reads a configuration file; its relative paths are relative to its folder.
 DaemonConfig load_daemon_config(const std::string& path);
+
+/// Every key the loader accepts, dotted ("can.log", "threads.priorities.lcm"),
+/// in file order: config/lab.example.yaml must show each (a test checks).
+std::vector<std::string> daemon_config_keys();
+/// The keys that name a file or folder (resolved against the file's folder).
+std::vector<std::string> daemon_config_path_keys();
 /// Checks every key's range and the cross-key rules (sim mode needs
 /// camera.source sim and can.interface sim, ...). Throws ConfigError.
 void validate_daemon_config(const DaemonConfig& config, const std::string& source_name);

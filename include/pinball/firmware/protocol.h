@@ -25,6 +25,9 @@ inline constexpr int kMaxDrivers = 8;
 /// Boards on one bus (the low nibble of the id).
 inline constexpr int kMaxBoards = 16;
 
+/// The bus's bit rate (bit/s): every board and host on it runs at this one.
+inline constexpr std::uint32_t kBitrate_bps = 500'000;
+
 /// 11-bit id layout: 0b001 KKKK BBBB (K = message kind, B = board).
 inline constexpr std::uint32_t kIdBase = 0x100;
 /// Mask selecting the fixed bits of our ids (for receive filters).
