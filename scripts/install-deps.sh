@@ -13,7 +13,7 @@ packages=(
   libbenchmark-dev
   libyaml-cpp-dev
   nlohmann-json3-dev libcli11-dev
-  can-utils
+  can-utils libsocketcan-dev
 )
 
 missing=()

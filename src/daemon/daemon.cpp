@@ -13,6 +13,7 @@
 
 #include "pinball/bus/channels.h"
 #include "pinball/bus/message_convert.h"
+#include "pinball/daemon/can_link_check.h"
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/core/running_stats.h"
@@ -188,6 +189,7 @@ void Daemon::Impl::build() {
     host_link = std::move(host);
     board_link = std::move(far);
   } else {
+    if (std::string note = check_can_link(config.can); !note.empty()) warnings.push_back(note);
     firmware::SocketCanOptions o;
     o.interface = config.can.interface;
     host_link = std::make_unique<firmware::SocketCanTransport>(o);

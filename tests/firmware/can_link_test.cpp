@@ -1,0 +1,102 @@
+#include "pinball/firmware/can_link.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace pinball::firmware {
+namespace {
+
+// A real controller, up, error-active, at `bitrate_bps`.
+CanLinkStatus healthy(std::uint32_t bitrate_bps = 500000) {
+  CanLinkStatus s;
+  s.exists = true;
+  s.up = true;
+  s.is_can = true;
+  s.state = CanControllerState::kErrorActive;
+  s.bitrate_bps = bitrate_bps;
+  return s;
+}
+
+TEST(CanLink, AHealthyInterfaceAtTheBusRateStarts) {
+  const CanLinkVerdict v = judge_can_link(healthy(), "can0", 500000);
+  EXPECT_TRUE(v.ok);
+  EXPECT_EQ(v.message, "");
+}
+
+TEST(CanLink, AnotherBitRateIsRefusedSayingBoth) {
+  const CanLinkVerdict v = judge_can_link(healthy(1000000), "can0", 500000);
+  EXPECT_FALSE(v.ok);
+  EXPECT_EQ(v.message,
+            "can0 runs at 1000000 bit/s, the bus at 500000 (sudo ip link set can0 down; sudo ip link set can0 up "
+            "type can bitrate 500000 restart-ms 100)");
+  CanLinkStatus unset = healthy(0);
+  EXPECT_FALSE(judge_can_link(unset, "can0", 500000).ok);
+}
+
+TEST(CanLink, DownStoppedAsleepOrBusOffIsRefused) {
+  CanLinkStatus down = healthy();
+  down.up = false;
+  down.state = CanControllerState::kStopped;
+  CanLinkVerdict v = judge_can_link(down, "can0", 500000);
+  EXPECT_FALSE(v.ok);
+  EXPECT_EQ(v.message.rfind("can0 is down (sudo ip link set can0 down; sudo ip link set can0 up type can bitrate "
+                            "500000 restart-ms 100)", 0),
+            0u)
+      << v.message;
+  for (CanControllerState state : {CanControllerState::kStopped, CanControllerState::kSleeping,
+                                   CanControllerState::kBusOff, CanControllerState::kUnknown}) {
+    CanLinkStatus s = healthy();
+    s.state = state;
+    v = judge_can_link(s, "can0", 500000);
+    EXPECT_FALSE(v.ok) << static_cast<int>(state);
+    EXPECT_NE(v.message.find("can0"), std::string::npos) << v.message;
+  }
+  CanLinkStatus off = healthy();
+  off.state = CanControllerState::kBusOff;
+  EXPECT_NE(judge_can_link(off, "can0", 500000).message.find("bus-off"), std::string::npos);
+}
+
+TEST(CanLink, ErrorPassiveStartsWithAWarning) {
+  CanLinkStatus s = healthy();
+  s.state = CanControllerState::kErrorPassive;
+  const CanLinkVerdict v = judge_can_link(s, "can0", 500000);
+  EXPECT_TRUE(v.ok);
+  EXPECT_NE(v.message.find("error-passive"), std::string::npos) << v.message;
+}
+
+TEST(CanLink, AVirtualInterfaceHasNoBitRateAndIsAccepted) {
+  CanLinkStatus s;
+  s.exists = true;
+  s.up = true;
+  s.is_can = true;
+  s.is_virtual = true;
+  const CanLinkVerdict v = judge_can_link(s, "vcan0", 500000);
+  EXPECT_TRUE(v.ok);
+  EXPECT_EQ(v.message, "vcan0 is a virtual interface: no controller, no bit rate to check");
+  s.up = false;
+  EXPECT_FALSE(judge_can_link(s, "vcan0", 500000).ok);  // but it must be up
+}
+
+TEST(CanLink, AMissingInterfaceIsNamed) {
+  const CanLinkStatus s = read_can_link("nosuchcan7");
+  EXPECT_FALSE(s.exists);
+  const CanLinkVerdict v = judge_can_link(s, "nosuchcan7", 500000);
+  EXPECT_FALSE(v.ok);
+  EXPECT_EQ(v.message.rfind("no interface nosuchcan7", 0), 0u) << v.message;
+}
+
+// The loopback interface exists and is up, and is no CAN controller: the
+// reader must say so without throwing, and the judge refuse it.
+TEST(CanLink, ANonCanInterfaceIsRefused) {
+  const CanLinkStatus s = read_can_link("lo");
+  if (!s.exists) GTEST_SKIP() << "no loopback interface here";
+  EXPECT_TRUE(s.up);
+  EXPECT_FALSE(s.is_can);
+  const CanLinkVerdict v = judge_can_link(s, "lo", 500000);
+  EXPECT_FALSE(v.ok);
+  EXPECT_EQ(v.message, "lo is not a CAN interface; `ip -details link show type can` lists them");
+}
+
+}  // namespace
+}  // namespace pinball::firmware
