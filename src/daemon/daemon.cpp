@@ -36,6 +36,7 @@
 #include "frame_handoff.h"
 #include "handoffs.h"
 #include "sim_worker.h"
+#include "virtual_board_runner.h"
 
 namespace pinball::daemon {
 
@@ -86,6 +87,7 @@ struct Daemon::Impl {
   // CAN.
   std::unique_ptr<firmware::CanTransport> host_link;
   std::unique_ptr<firmware::StreamTransport> board_link;  // sim: the virtual board's end
+  std::unique_ptr<VirtualBoardRunner> board_runner;  // sim without a world (camera.source lcm): that board's thread
   std::unique_ptr<firmware::FrameLog> frame_log;  // optional candump log
   std::unique_ptr<firmware::Liveness> liveness;  // camera and controller progress, behind the heartbeat
   std::unique_ptr<firmware::DriverBus> bus;
@@ -172,12 +174,14 @@ std::string find_data_file(const std::string& path) {
 
 void Daemon::Impl::build() {
   sim_mode = config.mode == "sim";
+  // Mode sim with camera.source lcm plays no world: observations come from LCM (virtual_board_runner.h).
+  const bool plays_world = sim_mode && config.camera.source != "lcm";
   cpus = plan_cpus(config.threads.chain_cpu);
   config.sim.board = find_data_file(config.sim.board);
   if (!config.sim.world_board.empty()) config.sim.world_board = find_data_file(config.sim.world_board);
   config.board = find_data_file(config.board);
   config.controller = find_data_file(config.controller);
-  lockstep = sim_mode && !config.sim.realtime;
+  lockstep = plays_world && !config.sim.realtime;
   board = table::load_board(sim_mode ? config.sim.board : config.board);
   spec = control::load_controller(config.controller);
   controller = control::make_flipper_controller(spec);
@@ -215,7 +219,11 @@ void Daemon::Impl::build() {
   tracker = std::make_unique<track::Tracker>(setup.geometry, setup.tracker);
 
   cv::Size frame_size(config.camera.width_px, config.camera.height_px);
-  if (sim_mode) {
+  if (sim_mode && !plays_world) {
+    board_runner = std::make_unique<VirtualBoardRunner>(
+        *board_link, firmware::VirtualDriverBoardOptions{.board_id = static_cast<std::uint8_t>(config.can.board_id),
+                                                         .driver_count = drivers});
+  } else if (sim_mode) {
     simlab::SimCameraConfig cc;
     cc.width_px = config.camera.width_px;
     cc.height_px = config.camera.height_px;
@@ -259,7 +267,7 @@ void Daemon::Impl::build() {
 
   lcm = std::make_unique<bus::LcmBus>(config.lcm_url);
   if (config.camera.source == "lcm") lcm->subscribe_observations(lcm_observations);
-  clock = std::make_unique<PipelineClock>(h, sim_mode, lockstep);
+  clock = std::make_unique<PipelineClock>(h, plays_world, lockstep);
   for (auto& slot : h.pool) slot.frame.gray.create(frame_size, CV_8UC1);
 }
 

@@ -115,11 +115,14 @@ int main(int argc, char** argv) {
     g_daemon = &daemon;
     if (g_stop_pending) daemon.request_stop();
     std::fprintf(stderr, "pinballd: %s, %s, LCM %s, controller %s\n",
-                 config.mode == "sim" ? ("simulating " + config.sim.board + ", " + std::to_string(config.sim.balls) +
-                                         " balls")
-                                            .c_str()
-                                      : "lab",
-                 config.mode == "sim" ? (config.sim.realtime ? "real-time clock" : "lockstep clock") : "steady clock",
+                 config.mode != "sim"            ? "lab"
+                 : config.camera.source == "lcm" ? "observations from LCM, virtual driver board (until SIGINT)"
+                                                 : ("simulating " + config.sim.board + ", " +
+                                                    std::to_string(config.sim.balls) + " balls")
+                                                       .c_str(),
+                 config.mode == "sim" && config.camera.source == "sim"
+                     ? (config.sim.realtime ? "real-time clock" : "lockstep clock")
+                     : "steady clock",
                  config.lcm_url.c_str(), config.controller.c_str());
     const DaemonReport report = daemon.run();
     g_daemon = nullptr;
