@@ -99,7 +99,7 @@ CalibrationReport run_calibration_bench(const table::Board& board, const Calibra
   CalibrationReport r;
   r.board = board.source;
   r.options = options;
-  simlab::SimLabOptions lab_options;
+  simlab::SimLabOptions lab_options = simlab::with_mounting_error({});  // the routines must find the machine, not the drawing
   lab_options.seed = options.seed;
   simlab::SimLab lab(board, lab_options);
   const table::Board& truth = lab.truth();

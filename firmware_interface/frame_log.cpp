@@ -129,11 +129,11 @@ void FrameLog::record(const CanFrame& frame, double time_s) {
 }
 
 void FrameLog::record(const CanFrame& frame) {
-  double t = static_cast<double>(frame.rx_time_ns) * 1e-9;
-  if (frame.rx_time_ns == 0) {
-    t = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  if (clock_s_) {
+    record(frame, clock_s_());
+    return;
   }
-  record(frame, t);
+  record(frame, frame.rx_time_ns != 0 ? static_cast<double>(frame.rx_time_ns) * 1e-9 : epoch_now_s());
 }
 
 bool FrameLog::flush() {

@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -69,6 +70,7 @@ LcmBus::LcmBus(const std::string& url)
       commands_{{}, kFlipperCommandChannel},
       statuses_{{}, kDriverStatusChannel},
       games_{{}, kGameChannel} {
+  log_anchor_us_ = to_utime(epoch_now_s() - steady_now_s());
   if (!lcm_->good()) throw std::runtime_error("lcm: cannot open '" + url + "'");
 }
 
@@ -137,11 +139,11 @@ void LcmBus::on_observation(const void* data, int size) {
   }
 }
 
-bool LcmBus::publish_encoded(const char* channel, const std::uint8_t* data, std::size_t size) {
+bool LcmBus::publish_encoded(const char* channel, const std::uint8_t* data, std::size_t size, std::int64_t utime) {
   int err = 0;
   bool ok = false;
   if (log_) {
-    err = write_log_event(channel, data, size);
+    err = write_log_event(channel, data, size, utime);
     ok = err == 0;
   } else {
     errno = 0;
@@ -157,36 +159,64 @@ bool LcmBus::publish_encoded(const char* channel, const std::uint8_t* data, std:
 }
 
 // One event appended to the log; 0, or the errno that stopped it (ETIMEDOUT: given up after stop()).
-int LcmBus::write_log_event(const char* channel, const std::uint8_t* data, std::size_t size) {
-  const std::int64_t utime = std::chrono::duration_cast<std::chrono::microseconds>(
-                                 std::chrono::system_clock::now().time_since_epoch())
-                                 .count();
+// The event is stamped on the run's clock: the message's utime plus the anchor.
+int LcmBus::write_log_event(const char* channel, const std::uint8_t* data, std::size_t size, std::int64_t utime) {
+  const std::int64_t event_utime = std::max(last_event_utime_, utime + log_anchor_us_);
   log_event_.clear();
-  append_lcm_event(log_event_, log_events_, utime, channel, data, size);
+  append_lcm_event(log_event_, log_events_, event_utime, channel, data, size);
   const SinkWrite w = log_->write(log_event_.data(), log_event_.size(), [this] {
     return !running_.load(std::memory_order_acquire) && steady_now_s() > stop_deadline_s_.load(std::memory_order_relaxed);
   });
   if (w.bytes == log_event_.size()) {
     ++log_events_;
+    last_event_utime_ = event_utime;
     return 0;
   }
   return w.error != 0 ? w.error : EIO;
 }
 
-// Returns the messages taken from the ring, published or not.
+// True when `box` has a message to publish (its head), taken from its ring if need be.
 template <class T, std::size_t N>
-int LcmBus::drain(Outbox<T, N>& box) {
-  int n = 0;
-  T m;
-  while (box.ring.try_pop(m)) {
-    publish_now(box.channel, m);
-    ++n;
-  }
-  return n;
+bool LcmBus::refill(Outbox<T, N>& box) {
+  if (!box.has_head) box.has_head = box.ring.try_pop(box.head);
+  return box.has_head;
 }
 
+// Publishes everything queued, the earliest utime first across the channels
+// (each ring is in order already): a log's events then follow the game.
+// Returns the messages published or refused.
 int LcmBus::drain() {
-  return drain(observations_) + drain(projections_) + drain(commands_) + drain(statuses_) + drain(games_);
+  int n = 0;
+  for (;;) {
+    std::int64_t earliest = 0;
+    int which = -1;
+    int i = 0;
+    const auto consider = [&](auto& box) {
+      if (refill(box) && (which < 0 || box.head.utime < earliest)) {
+        earliest = box.head.utime;
+        which = i;
+      }
+      ++i;
+    };
+    consider(observations_);
+    consider(projections_);
+    consider(commands_);
+    consider(statuses_);
+    consider(games_);
+    if (which < 0) return n;
+    i = 0;
+    const auto publish_chosen = [&](auto& box) {
+      if (i++ != which) return;
+      publish_now(box.channel, box.head);
+      box.has_head = false;
+    };
+    publish_chosen(observations_);
+    publish_chosen(projections_);
+    publish_chosen(commands_);
+    publish_chosen(statuses_);
+    publish_chosen(games_);
+    ++n;
+  }
 }
 
 // A refused publish is a hole in every recording of the bus (a file:// log on a full disk):

@@ -52,6 +52,17 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--out", a.out, "calibration file to write, or update keeping its other sections");
   cmd->add_option("--png", a.png, "picture of the detected markers, fitted circles or gravity fit");
   cmd->add_option("--seed", a.seed, "--sim: seed of the simulated lab");
+  cmd->add_option("--sim-pivot-offset-mm", a.sim_pivot_offset_mm,
+                  "--sim: the machine's pivots sit X Y mm off the board file (default 0 0: the board file's machine)")
+      ->expected(2)
+      ->check(CLI::Range(-20.0, 20.0))
+      ->needs(sim);
+  cmd->add_option("--sim-length-offset-mm", a.sim_length_offset_mm, "--sim: the machine's flippers are this much longer (mm)")
+      ->check(CLI::Range(-20.0, 20.0))
+      ->needs(sim);
+  cmd->add_option("--sim-theta-offset-deg", a.sim_theta_offset_deg, "--sim: both flipper stops this much higher (degrees)")
+      ->check(CLI::Range(-10.0, 10.0))
+      ->needs(sim);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -267,7 +278,13 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
   if (!a.sim_board.empty()) {
     simlab::SimLabOptions o;
     o.seed = a.seed;
+    o.pivot_offset_m = Vec2{a.sim_pivot_offset_mm.at(0), a.sim_pivot_offset_mm.at(1)} * 1e-3;
+    o.length_offset_m = a.sim_length_offset_mm * 1e-3;
+    o.theta_offset_rad = a.sim_theta_offset_deg / kDeg;
     c.lab = std::make_unique<simlab::SimLab>(c.board, o);
+    c.report["sim_mounting_error"] = {{"pivot_offset_mm", a.sim_pivot_offset_mm},
+                                      {"length_offset_mm", a.sim_length_offset_mm},
+                                      {"theta_offset_deg", a.sim_theta_offset_deg}};
   }
   // --out updates an existing file: the other sections stay.
   if (!a.out.empty() && std::filesystem::exists(a.out)) c.cal = calibration::read_calibration(a.out);

@@ -134,6 +134,12 @@ struct CalibrateArgs {
   std::string out;                   ///< calibration file to write or update
   std::string png;                   ///< picture of what was detected and fitted
   std::uint64_t seed = 1;            ///< --sim: the simulated lab's seed
+  /// --sim: the simulated machine's flippers mounted off the board file
+  /// (pivot x, y in mm; length in mm; both stops in degrees); zero: the
+  /// machine the board file describes, as pinballd simulates it.
+  std::vector<double> sim_pivot_offset_mm{0.0, 0.0};
+  double sim_length_offset_mm = 0.0;
+  double sim_theta_offset_deg = 0.0;
   bool json = false;                 ///< one JSON object on stdout
 };
 CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& args);

@@ -116,6 +116,9 @@ struct Daemon::Impl {
   mutable std::mutex warnings_mutex;
   std::vector<std::string> warnings;
   double start_wall_s = 0.0;
+  double recording_anchor_s = 0.0;  // epoch time of the pipeline clock's zero (start_recording_clock)
+  bool recording_clock_started = false;  // written before the threads start
+  double can_log_last_s = 0.0;           // the frame log's caller's (one at a time, under DriverBus's lock)
   std::atomic<bool> coils_off_at_exit{true};  // written by shutdown() while the LCM thread may report
   std::atomic<bool> threads_joined{false};    // every thread is done: the simulator's own state may be read
   // Faults, read by the main thread alone (DriverBus::pop_fault has one reader).
@@ -125,6 +128,24 @@ struct Daemon::Impl {
   std::vector<std::string> thread_failures;  // guarded by warnings_mutex
   std::int64_t stats_seq = 0;  // PINBALL_STATS sequence (the LCM thread only)
 
+
+  // One clock for every recording of the run (docs/daemon.md): the pipeline's
+  // clock moved onto the epoch as of now. LCM log events are stamped with
+  // their message's utime plus this anchor and CAN frames with the anchored
+  // clock, so a lockstep run's logs play back at the game's pace, together.
+  // Before it starts (the bus's warm-up) frames are stamped with the epoch
+  // clock itself, which the anchored clock continues.
+  void start_recording_clock() {
+    recording_anchor_s = epoch_now_s() - clock->now_s();
+    recording_clock_started = true;
+    lcm->set_log_anchor_us(to_utime(recording_anchor_s));
+  }
+  // A CAN log line's stamp: never back, neither when the simulator's start
+  // refreshes its offset nor when a frame's receipt is logged after a send.
+  double can_log_stamp_s() {
+    can_log_last_s = std::max(can_log_last_s, recording_clock_started ? recording_anchor_s + clock->now_s() : epoch_now_s());
+    return can_log_last_s;
+  }
 
   // Names the calling thread and applies its scheduling and CPUs; a refusal becomes a warning.
   void enter_thread(ThreadId id) {
@@ -182,6 +203,10 @@ void Daemon::Impl::build() {
   config.board = find_data_file(config.board);
   config.controller = find_data_file(config.controller);
   lockstep = plays_world && !config.sim.realtime;
+  if (const std::string w = lcm_pace_warning(config); !w.empty()) {
+    std::fprintf(stderr, "pinballd: warning: %s\n", w.c_str());
+    warnings.push_back(w);
+  }
   board = table::load_board(sim_mode ? config.sim.board : config.board);
   spec = control::load_controller(config.controller);
   controller = control::make_flipper_controller(spec);
@@ -211,6 +236,7 @@ void Daemon::Impl::build() {
   if (!config.can.log.empty()) {
     frame_log = std::make_unique<firmware::FrameLog>(config.can.log,
                                                      config.can.interface == "sim" ? "simcan" : config.can.interface);
+    frame_log->stamp_with([this] { return can_log_stamp_s(); });
     bo.log = frame_log.get();
   }
   bus = std::make_unique<firmware::DriverBus>(*host_link, bo);
@@ -394,6 +420,7 @@ DaemonReport Daemon::Impl::report() const {
   r.ring_overflows = h.ring_overflows.load();
   r.lcm = lcm->counters();
   if (frame_log) r.can_log = frame_log->counters();
+  r.recording_anchor_s = recording_anchor_s;
   r.driver = bus->counters();
   r.wall_s = steady_now_s() - start_wall_s;
   r.sim_s = h.sim_time_s.load();
@@ -454,7 +481,7 @@ void Daemon::Impl::publish_stats(lcm::LCM&) {
     counts.can_log_dropped = r.can_log->dropped();
   }
   const pinball_lcm::lcmt_pinball_daemon_stats m =
-      bus::to_lcm_daemon_stats(to_utime(steady_now_s()), stats_seq++, stages, counts);
+      bus::to_lcm_daemon_stats(to_utime(clock->now_s()), stats_seq++, stages, counts);
   lcm->publish_now(bus::kStatsChannel, m);  // counted like every other message
 }
 
@@ -508,14 +535,15 @@ DaemonReport Daemon::run() {
   }
   d.learn_background();
   d.warm_up_bus();
-  d.lcm->start([&d](lcm::LCM& l) { d.guarded(kLcmThread, [&] { d.publish_stats(l); }); }, 1.0,
-               [&d] { d.enter_thread(kLcmThread); },
-               [&d](const std::string& what) { d.fail_thread(kLcmThread, what); });
-  d.make_workers();
   // The simulated clock's offset before any thread reads it: the driver
   // thread's first poll must not see the steady clock's epoch (a false
   // Status timeout); the simulator thread refreshes it when it starts.
   if (d.world) d.h.wall_offset_s.store(steady_now_s() - d.world->time_s(), std::memory_order_release);
+  d.start_recording_clock();
+  d.lcm->start([&d](lcm::LCM& l) { d.guarded(kLcmThread, [&] { d.publish_stats(l); }); }, 1.0,
+               [&d] { d.enter_thread(kLcmThread); },
+               [&d](const std::string& what) { d.fail_thread(kLcmThread, what); });
+  d.make_workers();
   std::thread driver([&d] {
     d.guarded(kDriverThread, [&d] {
       d.enter_thread(kDriverThread);
@@ -606,6 +634,15 @@ std::string recording_problems(const DaemonReport& r) {
   return lost;
 }
 
+std::string lcm_pace_warning(const DaemonConfig& config) {
+  const bool lockstep = config.mode == "sim" && config.camera.source != "lcm" && !config.sim.realtime;
+  if (!lockstep || config.lcm_url.rfind("udpm://", 0) != 0) return "";
+  return "lcm_url '" + config.lcm_url +
+         "' with the lockstep clock: the run publishes many times faster than real time and a logger on the "
+         "network loses messages it cannot keep up with; record with --lcm-url 'file:///PATH?mode=w' (every "
+         "message, stamped on the game's clock) or run --realtime";
+}
+
 nlohmann::json report_to_json(const DaemonReport& r) {
   nlohmann::json j;
   j["mode"] = r.mode;
@@ -645,6 +682,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
                     {"first_errno", c->first_errno}, {"first_error", c->first_error}};
   }
   j["recording_complete"] = recording_problems(r).empty();
+  j["recording_anchor_s"] = r.recording_anchor_s;
   j["can"] = {{"frames_sent", r.driver.frames_sent}, {"heartbeats", r.driver.heartbeats},
               {"fires", r.driver.fires}, {"releases", r.driver.releases}, {"release_alls", r.driver.release_alls},
               {"bus_off", r.driver.bus_off}, {"reconnects", r.driver.reconnects},

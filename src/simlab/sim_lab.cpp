@@ -57,6 +57,13 @@ class SweepSource final : public vision::FrameSource {
 
 }  // namespace
 
+SimLabOptions with_mounting_error(SimLabOptions options) {
+  options.pivot_offset_m = Vec2{0.003, -0.002};
+  options.length_offset_m = 0.002;
+  options.theta_offset_rad = 0.012;
+  return options;
+}
+
 SimLab::SimLab(const table::Board& nominal, const SimLabOptions& options)
     : nominal_(nominal), truth_(nominal), options_(options) {
   for (table::Flipper& f : truth_.flippers) {

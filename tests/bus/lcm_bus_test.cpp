@@ -117,6 +117,41 @@ TEST(LcmBus, AFileLogHoldsEveryMessageInOrderForLiblcm) {
   std::remove(path.c_str());
 }
 
+// A log's events follow the game: queued messages of several channels are
+// written earliest utime first, each stamped utime + the run's anchor
+// (never the moment the bus thread wrote it).
+TEST(LcmBus, AFileLogIsInUtimeOrderStampedUtimePlusTheAnchor) {
+  const std::string path = temp_path("clock.lcmlog");
+  constexpr std::int64_t kAnchorUs = 1'700'000'000'000'000;
+  {
+    LcmBus bus("file://" + path + "?mode=w");
+    bus.set_log_anchor_us(kAnchorUs);
+    // Queued before the thread starts, so that one drain sees them all.
+    for (int i = 0; i < 10; ++i) {
+      pinball_lcm::lcmt_pinball_projection p{};
+      p.utime = 2 * i * 1000;  // 0, 2, 4, ... ms
+      p.seq = i;
+      ASSERT_TRUE(bus.try_publish(p));
+      pinball_lcm::lcmt_pinball_game_event g{};
+      g.utime = (2 * i + 1) * 1000;  // 1, 3, 5, ... ms
+      g.seq = i;
+      ASSERT_TRUE(bus.try_publish(g));
+    }
+    bus.start([](lcm::LCM&) {}, 1.0);
+    bus.stop();
+  }
+  lcm::LogFile in(path, "r");
+  ASSERT_TRUE(in.good());
+  std::int64_t n = 0;
+  for (const lcm::LogEvent* e = in.readNextEvent(); e != nullptr; e = in.readNextEvent()) {
+    EXPECT_EQ(e->channel, n % 2 == 0 ? kProjectionChannel : kGameChannel);
+    EXPECT_EQ(e->timestamp, kAnchorUs + n * 1000) << "event " << n;
+    ++n;
+  }
+  EXPECT_EQ(n, 20);
+  std::remove(path.c_str());
+}
+
 // liblcm's own file provider ignores its write errors (it reported all of
 // these as published); the bus writes file:// logs itself and counts them.
 TEST(LcmBus, AFileLogOnAFullDiskCountsRefusedPublishesApart) {

@@ -10,6 +10,7 @@
 
 #include "common/command_test.h"
 #include "pinball/calibration/calibration_file.h"
+#include "pinball/table/board_loader.h"
 
 namespace {
 
@@ -45,6 +46,16 @@ TEST_F(Calibrate, SimulatedLabEndToEnd) {
   EXPECT_NEAR(j.at("gravity").at("g_mps2").get<double>(), 1.11, 0.011);
   EXPECT_EQ(j.at("gravity").at("rolls_used"), 3);
 
+  // The practice machine is the board file's: what the calibration finds is
+  // what pinballd's simulated table has (it was 3.6 mm off by default).
+  const pinball::calibration::Calibration practice = pinball::calibration::read_calibration(file);
+  const pinball::table::Board board = pinball::table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  ASSERT_EQ(practice.flippers.size(), board.flippers.size());
+  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+    EXPECT_LT((practice.flippers[i].pivot_m - board.flippers[i].pivot).norm(), 0.001) << "flipper " << i;
+    EXPECT_NEAR(practice.flippers[i].length_m, board.flippers[i].length_m, 0.001) << "flipper " << i;
+  }
+
   // Every section survived the updates.
   const pinball::calibration::Calibration c = pinball::calibration::read_calibration(file);
   EXPECT_TRUE(c.camera);
@@ -69,6 +80,26 @@ TEST_F(Calibrate, BadInputsExitWithOne) {
                 " --calibration " + bad)
                 .exit_code,
             1);
+}
+
+// A mounting error is there when asked for, and the calibration finds it.
+TEST_F(Calibrate, TheSimulatedMachineIsMountedOffOnlyWhenAsked) {
+  const std::string file = (dir_ / "off.yaml").string();
+  Result r = run("calibrate camera --sim boards/mit1993.board --out " + file + " --json");
+  ASSERT_EQ(r.exit_code, 0);
+  r = run("calibrate flippers --sim boards/mit1993.board --sim-pivot-offset-mm 3 -2 --sim-length-offset-mm 2 "
+          "--sim-theta-offset-deg 0.7 --out " + file + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("sim_mounting_error").at("pivot_offset_mm"), nlohmann::json::array({3.0, -2.0}));
+  const pinball::calibration::Calibration c = pinball::calibration::read_calibration(file);
+  const pinball::table::Board board = pinball::table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+    const pinball::Vec2 moved = c.flippers[i].pivot_m - board.flippers[i].pivot;
+    EXPECT_NEAR(moved.x(), 0.003, 0.001) << "flipper " << i;
+    EXPECT_NEAR(moved.y(), -0.002, 0.001) << "flipper " << i;
+  }
+  EXPECT_EQ(run("calibrate flippers --board boards/mit1993.board --sim-length-offset-mm 2").exit_code, 2);  // needs --sim
 }
 
 }  // namespace

@@ -19,13 +19,17 @@
 #include <iterator>
 #include <string>
 #include <thread>
+#include <variant>
 
 #include <nlohmann/json.hpp>
 
 #include "pinball/bus/channels.h"
 #include "pinball/bus/lcm_bus.h"
+#include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/message_convert.h"
+#include "pinball/firmware/codec.h"
 #include "pinball/control/controller_file.h"
+#include "pinball/core/clock.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/firmware/frame_log.h"
 #include "pinball/learn/evaluator.h"
@@ -570,6 +574,86 @@ TEST(Pinballd, RealTimeRefusedWarnsAndPlaysOrWithEnforceExitsOne) {
       EXPECT_NE(err.find("real-time scheduling refused (threads.enforce: true)"), std::string::npos) << err;
     }
   }
+}
+
+// One clock for a run's recordings. A lockstep run is many times faster than
+// real time; its LCM log events used to carry the wall clock when written
+// and its CAN log the wall clock when sent (the game squeezed about 30x),
+// while the messages' utime carried the game's time: three clocks. Now every
+// stamp is the game's time on the epoch, so lcm-logplayer and canplayer
+// replay at the game's pace and line up.
+TEST(Daemon, EveryRecordingOfALockstepRunIsStampedOnTheGamesClock) {
+  const std::string base = ::testing::TempDir() + "/pinballd_clock_" + std::to_string(getpid());
+  DaemonConfig config = sim_config(1, 6);
+  config.can.log = base + ".can";
+  config.lcm_url = "file://" + base + ".lcmlog?mode=w";
+  DaemonReport r;
+  {
+    Daemon d(config);
+    r = d.run();
+  }
+  ASSERT_GT(r.sim_s, 1.0);
+  ASSERT_LT(r.wall_s, r.sim_s);  // lockstep outruns the wall clock here; were it not, the test would prove little
+  const std::int64_t anchor_us = to_utime(r.recording_anchor_s);
+  EXPECT_NEAR(r.recording_anchor_s, epoch_now_s() - r.wall_s, 5.0);
+  EXPECT_DOUBLE_EQ(report_to_json(r)["recording_anchor_s"].get<double>(), r.recording_anchor_s);
+
+  // LCM: each event is its message's utime (the first field of every type) plus the anchor.
+  const std::string log = read_text(base + ".lcmlog");
+  std::size_t at = 0, events = 0, on_anchor = 0;
+  std::int64_t previous_event_us = 0, first_command_event_us = -1;
+  while (at + bus::kLcmEventHeaderBytes <= log.size()) {
+    const auto* p = reinterpret_cast<const unsigned char*>(log.data() + at);
+    const bus::LcmEventHeader h = bus::read_lcm_event_header(p);
+    const std::string channel = log.substr(at + bus::kLcmEventHeaderBytes, static_cast<std::size_t>(h.channel_bytes));
+    const unsigned char* data = p + bus::kLcmEventHeaderBytes + h.channel_bytes;
+    std::int64_t utime = 0;
+    for (int i = 8; i < 16; ++i) utime = (utime << 8) | data[i];  // after the 8-byte fingerprint, big-endian
+    EXPECT_GE(h.utime, previous_event_us) << "event " << events << " goes back in time";
+    previous_event_us = h.utime;
+    on_anchor += h.utime == utime + anchor_us ? 1 : 0;
+    if (channel == bus::kFlipperCommandChannel && first_command_event_us < 0) first_command_event_us = h.utime;
+    ++events;
+    at += bus::kLcmEventHeaderBytes + static_cast<std::size_t>(h.channel_bytes + h.data_bytes);
+  }
+  ASSERT_EQ(at, log.size());
+  ASSERT_GT(events, 100u);
+  EXPECT_GE(on_anchor, events * 99 / 100) << on_anchor << " of " << events << " events at utime + anchor";
+  ASSERT_GE(first_command_event_us, 0);
+
+  // CAN: the game's stretch of the log lasts as long as the game, not as
+  // long as the wall clock took, and its first Fire is where LCM has the
+  // first command (the driver sends it on the next record).
+  const std::string can = read_text(base + ".can");
+  double first_game_s = -1.0, last_s = 0.0, first_fire_s = -1.0;
+  std::size_t start = 0;
+  for (std::size_t end = can.find('\n'); end != std::string::npos; start = end + 1, end = can.find('\n', start)) {
+    const auto e = firmware::parse_log_line(can.substr(start, end - start));
+    ASSERT_TRUE(e.has_value());
+    EXPECT_GE(e->time_s, last_s) << can.substr(start, end - start);
+    last_s = e->time_s;
+    if (e->time_s >= r.recording_anchor_s && first_game_s < 0.0) first_game_s = e->time_s;
+    const firmware::DecodeResult d = firmware::decode(e->frame);
+    if (first_fire_s < 0.0 && d.ok() && std::holds_alternative<firmware::Fire>(d.message.payload)) first_fire_s = e->time_s;
+  }
+  ASSERT_GE(first_game_s, 0.0);
+  EXPECT_NEAR(last_s - r.recording_anchor_s, r.sim_s, 0.05 * r.sim_s);
+  ASSERT_GE(first_fire_s, 0.0);
+  EXPECT_NEAR(first_fire_s, from_utime(first_command_event_us), 2.0 / config.camera.fps);
+  std::remove((base + ".can").c_str());
+  std::remove((base + ".lcmlog").c_str());
+}
+
+TEST(Daemon, UdpmInLockstepWarnsThatALoggerWouldLoseMessages) {
+  DaemonConfig c = sim_config(1, 1);
+  EXPECT_EQ(lcm_pace_warning(c), "");  // memq://
+  c.lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  EXPECT_NE(lcm_pace_warning(c).find("--lcm-url 'file:///PATH?mode=w'"), std::string::npos);
+  c.sim.realtime = true;
+  EXPECT_EQ(lcm_pace_warning(c), "");  // paced by the wall clock
+  c.sim.realtime = false;
+  c.mode = "lab";
+  EXPECT_EQ(lcm_pace_warning(c), "");
 }
 
 }  // namespace

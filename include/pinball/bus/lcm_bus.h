@@ -14,6 +14,12 @@
 // because liblcm's file provider ignores its write errors: a full disk, a
 // pipe whose reader left, or one that stopped reading past stop()'s second
 // are publish failures like any other, and never hold the bus thread for good.
+//
+// One clock for a run's recordings: an event of such a log is stamped with
+// its message's utime plus the run's anchor (set_log_anchor_us), never with
+// the time the bus thread happened to write it, so lcm-logplayer replays a
+// lockstep run at the game's pace and the events line up with the CAN log's
+// stamps. The bus publishes the queued messages in utime order.
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -95,6 +101,10 @@ class LcmBus {
   /// with its what(), on that thread: the daemon makes the coils safe.
   void start(std::function<void(lcm::LCM&)> periodic = {}, double period_s = 1.0,
              std::function<void()> on_start = {}, std::function<void(const std::string&)> on_failure = {});
+  /// The offset from a message's utime to its event's timestamp in a file://
+  /// log (us): the run's epoch anchor. The default maps the steady clock (the
+  /// lab's utime) onto the epoch as of construction. Before start().
+  void set_log_anchor_us(std::int64_t anchor_us) { log_anchor_us_ = anchor_us; }
   /// Publishes what is queued, runs `periodic` once more, stops the thread.
   void stop();
 
@@ -112,7 +122,7 @@ class LcmBus {
   bool publish_now(const char* channel, const T& m) {
     encoded_.resize(static_cast<std::size_t>(m.getEncodedSize()));
     m.encode(encoded_.data(), 0, static_cast<int>(encoded_.size()));
-    return publish_encoded(channel, encoded_.data(), encoded_.size());
+    return publish_encoded(channel, encoded_.data(), encoded_.size(), m.utime);
   }
 
   /// Receive PINBALL_OBSERVATION into `ring` (call before start()). Messages
@@ -130,22 +140,26 @@ class LcmBus {
   struct Outbox {
     SpscRing<T, N> ring;
     const char* channel;
+    T head{};               // taken from the ring, not yet published (bus thread)
+    bool has_head = false;
   };
   void run(const std::function<void(lcm::LCM&)>& periodic, double period_s);
   int drain();
   template <class T, std::size_t N>
-  int drain(Outbox<T, N>& box);
+  bool refill(Outbox<T, N>& box);
   template <class T, std::size_t N>
   bool push(Outbox<T, N>& box, const T& m);
   void on_observation(const void* data, int size);
-  bool publish_encoded(const char* channel, const std::uint8_t* data, std::size_t size);
-  int write_log_event(const char* channel, const std::uint8_t* data, std::size_t size);
+  bool publish_encoded(const char* channel, const std::uint8_t* data, std::size_t size, std::int64_t utime);
+  int write_log_event(const char* channel, const std::uint8_t* data, std::size_t size, std::int64_t utime);
   void on_publish_failed(const char* channel, int err);
 
   std::unique_ptr<lcm::LCM> lcm_;
   std::string url_;
   std::unique_ptr<FileSink> log_;  // file:// that writes: the log, written by the bus thread
   std::int64_t log_events_ = 0;    // events whole in the log (the next event number)
+  std::int64_t log_anchor_us_ = 0;  // event timestamp = message utime + this (us)
+  std::int64_t last_event_utime_ = 0;  // event timestamps never go back (lcm-logplayer waits on differences)
   std::string log_event_;          // scratch: one event's bytes
   std::vector<std::uint8_t> encoded_;  // scratch: one encoded message
   std::atomic<double> stop_deadline_s_{0.0};  // steady clock: a blocked log is given up after it

@@ -25,7 +25,7 @@ constexpr std::int32_t kLcmMaxChannelBytes = 999;
 struct LcmEventHeader {
   std::uint32_t sync = 0;         ///< kLcmLogSync in a good event
   std::int64_t event_number = 0;  ///< 0, 1, ... in the order written
-  std::int64_t utime = 0;         ///< wall clock when written (us since the epoch)
+  std::int64_t utime = 0;         ///< us since the epoch (pinballd: the message's utime + the run's anchor)
   std::int32_t channel_bytes = 0; ///< length of the channel name
   std::int32_t data_bytes = 0;    ///< length of the encoded message
 };

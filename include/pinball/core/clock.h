@@ -1,6 +1,8 @@
 #pragma once
-// The wall clock of the daemon and its stand-ins: seconds on std::chrono::steady_clock. Latencies are
-// differences of it; LCM's utime is it in microseconds.
+// The clocks of the daemon and its stand-ins. Latencies are differences of
+// the steady clock; LCM's utime in the lab is it in microseconds. Recordings
+// (LCM and CAN logs) are stamped on the epoch, as candump and lcm-logger
+// do: docs/daemon.md, "One clock for a run's recordings".
 
 #include <chrono>
 #include <cstdint>
@@ -12,6 +14,11 @@ namespace pinball {
 /// Steady clock now (s).
 inline double steady_now_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// The system (epoch) clock now (s since 1970): what candump and lcm-logger stamp with.
+inline double epoch_now_s() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
 }  // namespace pinball

@@ -69,6 +69,10 @@ struct DaemonReport {
   std::uint64_t ring_overflows = 0;          ///< records dropped between threads
   bus::LcmBusCounters lcm;                   ///< LCM traffic (publish_failed: lost to every recording)
   std::optional<firmware::FrameLogCounters> can_log;  ///< the CAN log (can.log), when one is written
+  /// Epoch time (s) of the pipeline clock's zero: every recording of the run
+  /// (LCM log events, CAN log lines) is stamped anchor + pipeline time, and
+  /// an LCM message's utime is its pipeline time.
+  double recording_anchor_s = 0.0;
   firmware::DriverBusCounters driver;        ///< CAN host side
   firmware::BoardCounters board;             ///< virtual board (sim)
   double wall_s = 0.0;                       ///< run time (s)
@@ -93,6 +97,12 @@ constexpr int kExitRecordingIncomplete = 3;
 /// What the run's recordings lost (the CAN log, LCM), for people; "" when
 /// they are complete.
 std::string recording_problems(const DaemonReport& report);
+
+/// Why the LCM traffic of `config` cannot be recorded whole by a logger on
+/// the network ("" when it can): the lockstep clock publishes as fast as the
+/// simulation runs, tens of times real time, and an lcm-logger on udpm://
+/// loses messages it cannot keep up with, without a word.
+std::string lcm_pace_warning(const DaemonConfig& config);
 
 /// The report as one JSON object (the --json output).
 nlohmann::json report_to_json(const DaemonReport& report);

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -81,8 +82,14 @@ class FrameLog {
   /// (counted). One caller at a time: callers on several threads serialise
   /// (DriverBus records under its own mutex).
   void record(const CanFrame& frame, double time_s);
-  /// Queues one frame stamped with its rx_time_ns, or the wall clock when 0.
+  /// Queues one frame stamped on the log's clock (stamp_with), else with its
+  /// rx_time_ns, or the epoch clock when that is 0.
   void record(const CanFrame& frame);
+  /// Stamps every frame record(frame) takes with `clock_s()` (s since the
+  /// epoch): the daemon's one clock for a run's recordings, so that a lockstep
+  /// run's log plays back at the game's pace. Before the first record();
+  /// `clock_s` is called on the recording thread and must not block.
+  void stamp_with(std::function<double()> clock_s) { clock_s_ = std::move(clock_s); }
   /// Waits until every frame recorded so far is written or dropped, at most
   /// close_timeout_s; false when the time ran out (not a real-time call).
   bool flush();
@@ -111,6 +118,7 @@ class FrameLog {
 
   std::string interface_;
   double close_timeout_s_;
+  std::function<double()> clock_s_;  // empty: the frames' own stamps
   FileSink sink_;  // the writer thread's, and close()'s once it is joined
   std::unique_ptr<Queue> queue_;  // on the heap: 256 KiB
   // Written by the producer (one at a time) and by the writer thread respectively.
