@@ -1,6 +1,7 @@
 #include "game_rules.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "pinball/sim/collision.h"
@@ -62,6 +63,19 @@ void hit_obstacle(const table::Board& board, GameState& state, std::int32_t inde
   if (o.action.eats_ball) lose_ball(board, state, events);
 }
 
+Vec2 kickout_velocity(const table::Sensor& sensor, Rng& rng) {
+  Vec2 v = sensor.kickout_mps;
+  // Draws only what the hole has, angle first, so a hole without spread and
+  // noise leaves the random stream (and every later launch) untouched.
+  if (sensor.kickout_spread_rad > 0.0) {
+    const double a = rng.uniform(-sensor.kickout_spread_rad, sensor.kickout_spread_rad);
+    const double c = std::cos(a), s = std::sin(a);
+    v = Vec2{c * v.x() - s * v.y(), s * v.x() + c * v.y()};
+  }
+  if (sensor.kickout_noise > 0.0) v *= 1.0 - rng.uniform(0.0, sensor.kickout_noise);
+  return v;
+}
+
 void fire_sensor(const table::Board& board, GameState& state, std::int32_t index, StepEvents& events) {
   const table::Sensor& sensor = board.sensors[index];
   if (events.sensor < 0) events.sensor = index;
@@ -74,7 +88,7 @@ void fire_sensor(const table::Board& board, GameState& state, std::int32_t index
   }
   if (sensor.has_kickout) {
     state.ball.position_m = sensor.shape.p0;
-    state.ball.velocity_mps = sensor.kickout_mps;
+    state.ball.velocity_mps = kickout_velocity(sensor, state.rng);
     state.sensor_inside[index] = 1;
   }
 }

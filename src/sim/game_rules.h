@@ -27,6 +27,10 @@ void raise_flags(const table::Board& board, GameState& state, double clear_m);
 void hit_obstacle(const table::Board& board, GameState& state, std::int32_t index, const Vec2& normal,
                   StepEvents& events, double clear_m);
 
+/// A hole's kickout velocity: the nominal one turned by U[−spread, spread]
+/// and scaled by 1 − U[0, noise], drawn from `rng` (the game's stream).
+Vec2 kickout_velocity(const table::Sensor& sensor, Rng& rng);
+
 /// The ball entered sensor `index`: score, eat, or the hole's kickout.
 void fire_sensor(const table::Board& board, GameState& state, std::int32_t index, StepEvents& events);
 

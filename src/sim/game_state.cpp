@@ -31,6 +31,12 @@ void reset_game(const table::Board& board, GameState& state) {
 }
 
 void launch_ball(const table::Board& board, GameState& state, double pull) {
+  state.ball_in_play = true;
+  if (board.start) {  // served, not launched: no plunger, no noise
+    state.ball.position_m = board.start->position;
+    state.ball.velocity_mps = board.start->velocity_mps;
+    return;
+  }
   const double r = state.rng.uniform(0.0, board.launcher.noise_max);
   state.ball.position_m = board.launcher.position;
   state.ball.velocity_mps = Vec2{0.0, pull * (1.0 - r) * board.ball.speed_max_mps};

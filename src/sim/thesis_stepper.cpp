@@ -25,6 +25,37 @@ void clamp_speed(Vec2& v, double speed_max) {
   if (s2 > speed_max * speed_max) v *= speed_max / std::sqrt(s2);
 }
 
+/// The contacts of one step, kept for a wedged ball (no allocation).
+struct StepContacts {
+  Vec2 normal[kMaxContactsPerStep];
+  Vec2 point[kMaxContactsPerStep];
+  int count = 0;
+};
+
+/// Projects v onto the cone of velocities that move into none of `normals`
+/// ({u : u·nᵢ ≥ 0}): the closest such velocity, found among v itself, v with
+/// one normal component removed, and 0 (the cone's apex; in 2-D no other
+/// point can be nearest). A projection onto a convex cone through 0 never
+/// lengthens v, so this takes energy away and never adds it.
+Vec2 project_onto_free_cone(const Vec2& v, const Vec2* normals, int n) {
+  const double tol = 1e-12 * v.norm();
+  const auto free = [&](const Vec2& u) {
+    for (int i = 0; i < n; ++i) {
+      if (u.dot(normals[i]) < -tol) return false;
+    }
+    return true;
+  };
+  if (free(v)) return v;
+  Vec2 best = Vec2::Zero();
+  for (int i = 0; i < n; ++i) {
+    const double vn = v.dot(normals[i]);
+    if (vn >= 0.0) continue;
+    const Vec2 u = v - vn * normals[i];
+    if (free(u) && u.squaredNorm() > best.squaredNorm()) best = u;
+  }
+  return best;
+}
+
 }  // namespace
 
 ThesisStepper::ThesisStepper(const table::Board& board, ThesisStepperOptions options) : board_(board), options_(options) {
@@ -135,6 +166,8 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
   const auto candidates = obstacle_candidates(start);
   const double flipper_reach = r + board_.ball.speed_max_mps * dt + options_.separation_m;
   double remaining = dt;
+  StepContacts contacts;
+  bool wedged = true;  // until the step ends with its time used up
   for (int contact = 0; contact < kMaxContactsPerStep; ++contact) {
     Contact best;
     best.t_s = INFINITY;
@@ -169,6 +202,7 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
     }
     if (hit_obstacle < 0 && hit_flipper < 0) {
       p += remaining * v;
+      wedged = false;
       break;
     }
     // Stop short of contact by the separation, measured along the normal, so
@@ -177,6 +211,9 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
     const double t_move = std::max(0.0, best.t_s - options_.separation_m / approach);
     p += t_move * v;
     remaining -= t_move;
+    contacts.normal[contacts.count] = best.normal;
+    contacts.point[contacts.count] = best.point;
+    ++contacts.count;
     if (hit_obstacle >= 0) {
       apply_obstacle_hit(state, hit_obstacle, best.normal, events);
     } else {
@@ -190,6 +227,21 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
     // broadphase's reach, so the clamp applies at once.
     clamp_speed(v, board_.ball.speed_max_mps);
     if (!state.ball_in_play) return;  // eaten by the obstacle's action
+  }
+  if (wedged && remaining > 0.0) {
+    // The contacts ran out with time left: the ball is wedged between
+    // surfaces (a narrow V) and the rest of the step is dropped, which holds
+    // its position. Its velocity must not keep what gravity feeds it while it
+    // is held, or it gathers speed step after step (|v| ≈ 3720·dt and energy
+    // from nowhere in a 1.2° V, issue 17): the components into the surfaces it
+    // still touches go, an inelastic rest on all of them at once.
+    Vec2 touching[kMaxContactsPerStep];
+    int n = 0;
+    for (int k = 0; k < contacts.count; ++k) {
+      const double gap_m = (p - contacts.point[k]).dot(contacts.normal[k]) - r;
+      if (gap_m <= options_.contact_tolerance_m) touching[n++] = contacts.normal[k];
+    }
+    v = project_onto_free_cone(v, touching, n);
   }
 
   update_sensors(state, start, events);

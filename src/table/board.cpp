@@ -78,6 +78,30 @@ double max_stable_dt_s(const Board& board) {
   return dt;
 }
 
+double min_launch_speed_mps(const Board& board) {
+  const double g = board.gravity_mps2;
+  return std::sqrt(2.0 * g * board.ball.radius_m + kLauncherStillSpeed_mps * kLauncherStillSpeed_mps) +
+         g * board.dt_s;
+}
+
+double slowest_launch_mps(const Board& board, double pull) {
+  return pull * (1.0 - board.launcher.noise_max) * board.ball.speed_max_mps;
+}
+
+void check_launch_pull(const Board& board, double pull) {
+  if (board.start) return;
+  const double slowest = slowest_launch_mps(board, pull);
+  const double needed = min_launch_speed_mps(board);
+  if (!(slowest >= needed)) {
+    std::ostringstream msg;
+    msg << "launch pull " << pull << " gives launches as slow as " << slowest << " m/s (pull*(1 - noise)*speed_max), "
+        << "below the " << needed << " m/s a ball needs to rise more than its radius (" << board.ball.radius_m
+        << " m) above the launcher against g = " << board.gravity_mps2
+        << " m/s^2: it would stop there and be relaunched at its apex for ever";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
 void check_flipper_time_step(const Board& board, double dt_s) {
   for (const Flipper& f : board.flippers) {
     const double half_sweep = f.omega_rad_s * dt_s / 2.0;

@@ -33,6 +33,66 @@ void check_launcher_clear(const LoadState& state) {
   }
 }
 
+/// The board's own pull must launch the ball out of the launcher: a launch
+/// slower than min_launch_speed_mps stops within one radius of the launch
+/// point and is relaunched at its apex for ever. A board with `start`
+/// never launches.
+void check_launch_speed(const LoadState& state) {
+  const Board& board = state.board;
+  if (board.start) return;
+  const double slowest = slowest_launch_mps(board, board.launcher.pull);
+  const double needed = min_launch_speed_mps(board);
+  if (slowest >= needed) return;
+  throw BoardError(state.file, state.seen.at("launcher"),
+                   "launcher: attribute pull=" + fmt(board.launcher.pull) + " launches as slowly as " + fmt(slowest) +
+                       " m/s (pull x (1 - noise) x SPEED_MAX), below the " + fmt(needed) +
+                       " m/s the ball needs to rise above its own radius against G (sqrt(2 G R + " +
+                       fmt(kLauncherStillSpeed_mps) + "^2) + G dt): it would be relaunched at its apex for ever");
+}
+
+/// The start must put the ball on the table, clear of every obstacle, flipper
+/// and hole, and not where it would count as resting in the launcher.
+void check_start(const LoadState& state) {
+  const Board& board = state.board;
+  if (!board.start) return;
+  const Vec2 p = board.start->position;
+  const Vec2 v = board.start->velocity_mps;
+  const double r = board.ball.radius_m;
+  const int line = state.seen.at("start");
+  const auto fail = [&](const std::string& what) { throw BoardError(state.file, line, "start: " + what); };
+  if (!(p.x() >= 0.0 && p.x() <= board.width_m && p.y() >= 0.0 && p.y() <= board.height_m)) {
+    fail("fields X Y (" + fmt(p.x()) + ", " + fmt(p.y()) + ") m lie outside the table (0..W, 0..H = " +
+         fmt(board.width_m) + ", " + fmt(board.height_m) + " m)");
+  }
+  if (!(v.norm() <= board.ball.speed_max_mps)) {
+    fail("speed of fields VX VY (" + fmt(v.norm()) + " m/s) exceeds the ball's SPEED_MAX (" +
+         fmt(board.ball.speed_max_mps) + " m/s)");
+  }
+  for (std::size_t i = 0; i < board.shapes.size(); ++i) {
+    const double d = distance_to_shape(board.shapes[i], p);
+    if (d < r) {
+      fail("ball at fields X Y overlaps '" + board.obstacles[i].name + "' (distance " + fmt(d) + " m, ball radius " +
+           fmt(r) + " m)");
+    }
+  }
+  for (const Flipper& f : board.flippers) {
+    const double d = distance_point_segment(p, f.pivot, flipper_tip(f, f.theta_min_rad));
+    if (d < r) {
+      fail("ball at fields X Y overlaps flipper '" + f.name + "' in its down position (distance " + fmt(d) +
+           " m, ball radius " + fmt(r) + " m)");
+    }
+  }
+  for (const Sensor& sensor : board.sensors) {
+    if (sensor.kind == SensorKind::kHole && (p - sensor.shape.p0).norm() <= sensor.shape.radius_m) {
+      fail("ball at fields X Y starts inside hole '" + sensor.name + "'");
+    }
+  }
+  if ((p - board.launcher.position).norm() < r && v.norm() < min_launch_speed_mps(board)) {
+    fail("a ball at fields X Y this slow (" + fmt(v.norm()) + " m/s) counts as resting in the launcher and "
+         "would be served again for ever");
+  }
+}
+
 }  // namespace
 
 void check_whole_file(const LoadState& state) {
@@ -60,6 +120,8 @@ void check_whole_file(const LoadState& state) {
     }
   }
   check_launcher_clear(state);
+  check_launch_speed(state);
+  check_start(state);
 }
 
 }  // namespace pinball::table::loader

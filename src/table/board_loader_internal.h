@@ -103,7 +103,8 @@ struct StatementKind {
 const StatementKind* find_kind(std::string_view keyword);
 
 /// The checks that need the whole file (required statements, banks with
-/// members, flipper time step, launcher clear); throws BoardError.
+/// members, flipper time step, launcher clear, launch speed, start); throws
+/// BoardError.
 void check_whole_file(const LoadState& state);
 
 }  // namespace pinball::table::loader

@@ -138,6 +138,15 @@ void launcher(LoadState& state, const Reader& r) {
   r.require(l.noise_max >= 0 && l.noise_max <= 0.5, "attribute noise", "in [0, 0.5]", l.noise_max);
 }
 
+void start(LoadState& state, const Reader& r) {
+  const auto v = r.numbers(0, {"X", "Y", "VX", "VY"});
+  BallStart b;
+  b.position = position(state, r, v[0], v[1], "fields X Y");
+  require_at_most(state, r, std::hypot(v[2], v[3]), "speed of fields VX VY", kMaxSpeed_mps, "/s");
+  b.velocity_mps = Vec2{v[2], v[3]} * state.length_scale;
+  state.board.start = b;
+}
+
 void defaults(LoadState& state, const Reader& r) {
   if (r.arg_count() != 0) r.fail("takes only attributes (rho=R), got '" + std::string(r.arg(0)) + "'");
   state.default_rho = rho_attribute(r, state.default_rho);
@@ -336,6 +345,14 @@ void hole(LoadState& state, const Reader& r) {
     const double vy = r.number(k.substr(comma + 1), "attribute kickout VY");
     require_at_most(state, r, std::hypot(vx, vy), "attribute kickout speed", kMaxSpeed_mps, "/s");
     s.kickout_mps = Vec2{vx, vy} * state.length_scale;
+    const double spread = r.attribute("spread", kDefaultKickoutSpread_rad / state.angle_scale);
+    r.require(spread >= 0 && spread * state.angle_scale <= std::numbers::pi / 2, "attribute spread",
+              "in [0, " + fmt(std::numbers::pi / 2 / state.angle_scale) + "]", spread);
+    s.kickout_spread_rad = spread * state.angle_scale;
+    s.kickout_noise = r.attribute("noise", kDefaultKickoutNoise);
+    r.require(s.kickout_noise >= 0 && s.kickout_noise <= 0.5, "attribute noise", "in [0, 0.5]", s.kickout_noise);
+  } else if (r.flag("spread") || r.flag("noise")) {
+    r.fail("attributes spread and noise need kickout=VX,VY (an eating hole has no kickout to spread)");
   }
   finish_sensor(state, r, s);
 }
@@ -354,6 +371,7 @@ const StatementKind* find_kind(std::string_view keyword) {
       {"dt", &dt, true, false, ""},
       {"balls", &balls, true, false, ""},
       {"launcher", &launcher, true, true, "pull noise"},
+      {"start", &start, true, true, ""},
       {"defaults", &defaults, false, false, "rho"},
       {"bank", &bank, false, false, "bonus"},
       {"line", &line, false, true, kObstacleAttributes},
@@ -364,7 +382,7 @@ const StatementKind* find_kind(std::string_view keyword) {
       {"polygon", &polygon, false, true, kObstacleAttributes},
       {"flipper", &flipper, false, true, "rho mu name"},
       {"sensor", &sensor, false, true, "score eat name"},
-      {"hole", &hole, false, true, "score eat kickout name"},
+      {"hole", &hole, false, true, "score eat kickout spread noise name"},
   };
   for (const StatementKind& k : kKinds) {
     if (k.keyword == keyword) return &k;

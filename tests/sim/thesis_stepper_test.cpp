@@ -181,6 +181,51 @@ TEST(ThesisStepper, SpeedClampHoldsEveryStep) {
   EXPECT_TRUE(s.ball_in_play);
 }
 
+// A ball bouncing across a slot 1 µm wider than itself meets more walls in
+// one step than the step resolves; the rest of the step is dropped, and the
+// speed into the walls goes with it (an inelastic rest on both), while the
+// speed along them is kept: it falls down the slot as if the walls were not there.
+TEST(ThesisStepperWedged, BallInASlotKeepsOnlyTheSpeedAlongTheWalls) {
+  const double g = 1.11, dt = 1e-3;
+  table::Board b = empty_board(1.0, 2.0, g, dt);
+  const double left = 0.5 - kR - 0.5e-6, right = 0.5 + kR + 0.5e-6;
+  add_line(b, {left, 1.9}, {left, 0.1}, 1.0);    // normal +x: faces the slot
+  add_line(b, {right, 0.1}, {right, 1.9}, 1.0);  // normal -x: faces the slot
+  const ThesisStepper stepper(b, ThesisStepperOptions{.dt_s = dt});
+  GameState s = state_with_ball(b, {0.5, 1.5}, {2.0, -0.5});
+  stepper.step(s);
+  EXPECT_EQ(s.ball.velocity_mps.x(), 0.0);
+  EXPECT_NEAR(s.ball.velocity_mps.y(), -0.5 - g * dt, 1e-12);
+  for (int i = 0; i < 100; ++i) {
+    stepper.step(s);
+    ASSERT_LE(s.ball.velocity_mps.norm(), 0.5 + g * dt * (i + 2) + 1e-12) << "step " << i;
+  }
+  EXPECT_NEAR(s.ball.velocity_mps.y(), -0.5 - 101 * g * dt, 1e-9);
+  EXPECT_LT(s.ball.position_m.y(), 1.5 - 0.5 * 100 * dt);  // it fell
+  EXPECT_LT(max_penetration_m(b, s), 1e-6);
+}
+
+// In a V of 1.2° the contacts run out in every step; before the fix the ball
+// was held in place while gravity fed its velocity (issue 17: |v| ≈ 3720·dt).
+TEST(ThesisStepperWedged, BallWedgedInANarrowVStaysSlow) {
+  const double g = 1.11, dt = 1e-3;
+  const double half = 0.6 * M_PI / 180.0;
+  const double wedge_h = kR / std::sin(half);
+  table::Board b = empty_board(1.0, wedge_h + 0.5, g, dt);
+  const Vec2 apex{0.5, 0.05};
+  add_wall(b, apex, apex + (wedge_h + 0.3) * Vec2{-std::sin(half), std::cos(half)}, 0.5);
+  add_wall(b, apex, apex + (wedge_h + 0.3) * Vec2{std::sin(half), std::cos(half)}, 0.5);
+  const ThesisStepper stepper(b, ThesisStepperOptions{.dt_s = dt});
+  GameState s = state_with_ball(b, apex + Vec2{0.0, wedge_h + 1e-4}, Vec2::Zero());
+  const double e0 = 0.5 * s.ball.velocity_mps.squaredNorm() + g * s.ball.position_m.y();
+  for (int i = 0; i < 10000; ++i) {
+    stepper.step(s);
+    ASSERT_LT(s.ball.velocity_mps.norm(), 0.05) << "step " << i;
+    ASSERT_LE(0.5 * s.ball.velocity_mps.squaredNorm() + g * s.ball.position_m.y(), e0 + 1e-9) << "step " << i;
+  }
+  EXPECT_LT(max_penetration_m(b, s), 1e-6);
+}
+
 TEST(LaunchBall, SpeedWithinNoiseBand) {
   table::Board b = empty_board();
   b.ball.speed_max_mps = 5.0;
@@ -394,9 +439,12 @@ TEST(ThesisStepperSensors, HoleWithKickoutPlacesBallAtCentre) {
   hole.action.score = 100.0;
   hole.has_kickout = true;
   hole.kickout_mps = {-0.8, 1.5};
+  hole.kickout_spread_rad = 0.0;  // the exact kickout; the spread has its own test below
+  hole.kickout_noise = 0.0;
   b.sensors.push_back(hole);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.3, 0.505}, {1.0, 0.0});
+  const Rng rng_before = s.rng;
   int fired = 0;
   bool checked = false;
   for (int i = 0; i < 1000; ++i) {
@@ -413,8 +461,53 @@ TEST(ThesisStepperSensors, HoleWithKickoutPlacesBallAtCentre) {
     }
   }
   EXPECT_EQ(fired, 1);  // the kicked-out ball leaves without re-entering
+  Rng a = rng_before, b2 = s.rng;
+  EXPECT_EQ(a.next_u64(), b2.next_u64()) << "an exact kickout draws nothing from the game's stream";
   EXPECT_TRUE(checked);
   EXPECT_LT(s.ball.position_m.x(), 0.5 - 0.1);
+}
+
+// A saucer's kickout scatters (issue 17): each kickout is the nominal one
+// turned by U[−spread, spread] and slowed by U[0, noise], drawn from the
+// game's stream, so the same seed gives the same kickouts and different seeds
+// different ones.
+TEST(ThesisStepperSensors, HoleKickoutScattersWithinItsSpreadFromTheGameSeed) {
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  table::Sensor hole;
+  hole.kind = table::SensorKind::kHole;
+  hole.shape = table::make_circle_shape({0.5, 0.5}, 0.01);
+  hole.has_kickout = true;
+  hole.kickout_mps = {-0.8, 1.5};
+  hole.kickout_spread_rad = 0.1;
+  hole.kickout_noise = 0.2;
+  b.sensors.push_back(hole);
+  const ThesisStepper stepper(b);
+  const double nominal_angle = std::atan2(1.5, -0.8), nominal_speed = std::hypot(0.8, 1.5);
+  auto kickout = [&](std::uint64_t seed) {
+    GameState s = state_with_ball(b, {0.3, 0.505}, {1.0, 0.0}, seed);
+    for (int i = 0; i < 1000; ++i) {
+      if (stepper.step(s).has(StepEvents::kSensor)) return s.ball.velocity_mps;
+    }
+    ADD_FAILURE() << "the ball never reached the hole";
+    return Vec2(Vec2::Zero());
+  };
+  double min_da = INFINITY, max_da = -INFINITY, min_f = INFINITY, max_f = -INFINITY;
+  for (std::uint64_t seed = 1; seed <= 200; ++seed) {
+    const Vec2 v = kickout(seed);
+    EXPECT_EQ(v, kickout(seed)) << "same seed, same kickout";
+    const double da = std::remainder(std::atan2(v.y(), v.x()) - nominal_angle, 2.0 * M_PI);
+    const double f = v.norm() / nominal_speed;
+    ASSERT_LE(std::abs(da), 0.1 + 1e-12) << seed;
+    ASSERT_GT(f, 0.8 - 1e-12) << seed;
+    ASSERT_LE(f, 1.0 + 1e-12) << seed;
+    min_da = std::min(min_da, da), max_da = std::max(max_da, da);
+    min_f = std::min(min_f, f), max_f = std::max(max_f, f);
+  }
+  // 200 draws cover most of each band.
+  EXPECT_LT(min_da, -0.08);
+  EXPECT_GT(max_da, 0.08);
+  EXPECT_LT(min_f, 0.84);
+  EXPECT_GT(max_f, 0.96);
 }
 
 TEST(ThesisStepperSensors, HoleWithoutKickoutEatsBall) {

@@ -266,6 +266,89 @@ TEST(BoardLoader, SensorsAndHoles) {
   EXPECT_EQ(b.sensors[3].source_line, 11);
 }
 
+TEST(BoardLoader, HoleKickoutSpreadAndNoise) {
+  // Defaults: 5 degrees either way and up to 10 % slower.
+  const Board d = parse("hole 0.1 0.9 0.02 kickout=0.5,-1\n");
+  EXPECT_DOUBLE_EQ(d.sensors[0].kickout_spread_rad, kDefaultKickoutSpread_rad);
+  EXPECT_NEAR(d.sensors[0].kickout_spread_rad, 5 * kDeg, 1e-15);
+  EXPECT_DOUBLE_EQ(d.sensors[0].kickout_noise, kDefaultKickoutNoise);
+  // In the file's angle unit; 0 and 0 give the exact kickout of old.
+  const Board e = parse_board(
+      "pinball-board 1\nangles deg\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\ndt 0.0005\nballs 3\n"
+      "launcher 0.45 0.05\nhole 0.1 0.9 0.02 kickout=0.5,-1 spread=2 noise=0.05\n"
+      "hole 0.3 0.9 0.02 kickout=0.5,-1 spread=0 noise=0\n",
+      "t.board");
+  EXPECT_NEAR(e.sensors[0].kickout_spread_rad, 2 * kDeg, 1e-15);
+  EXPECT_DOUBLE_EQ(e.sensors[0].kickout_noise, 0.05);
+  EXPECT_EQ(e.sensors[1].kickout_spread_rad, 0.0);
+  EXPECT_EQ(e.sensors[1].kickout_noise, 0.0);
+  const Board rad = parse("hole 0.1 0.9 0.02 kickout=0.5,-1 spread=0.1\n");
+  EXPECT_DOUBLE_EQ(rad.sensors[0].kickout_spread_rad, 0.1);
+}
+
+TEST(BoardLoaderErrors, HoleKickoutSpreadAndNoiseAreBounded) {
+  expect_body_error("hole 0.1 0.9 0.02 kickout=0.5,-1 spread=-0.1\n", 8,
+                    "hole: attribute spread must be in [0, 1.5708], got -0.1");
+  expect_body_error("hole 0.1 0.9 0.02 kickout=0.5,-1 spread=2\n", 8, "attribute spread must be in [0, 1.5708], got 2");
+  expect_body_error("hole 0.1 0.9 0.02 kickout=0.5,-1 noise=0.6\n", 8, "hole: attribute noise must be in [0, 0.5], got 0.6");
+  expect_body_error("hole 0.1 0.9 0.02 eat spread=0.1\n", 8, "hole: attributes spread and noise need kickout=VX,VY");
+  expect_body_error("hole 0.1 0.9 0.02 kickout=0.5,-1 noise=lots\n", 8, "attribute noise is not a finite number: 'lots'");
+}
+
+TEST(BoardLoader, StartServesTheBallAtAPositionAndVelocity) {
+  const Board none = parse("");
+  EXPECT_FALSE(none.start.has_value());
+  const Board b = parse("start 0.1 0.9 1.5 -0.5\n");
+  ASSERT_TRUE(b.start.has_value());
+  EXPECT_TRUE(b.start->position.isApprox(Vec2(0.1, 0.9)));
+  EXPECT_TRUE(b.start->velocity_mps.isApprox(Vec2(1.5, -0.5)));
+  // In the file's length unit, velocities per second; at rest is allowed.
+  const Board mm = parse_board(
+      "pinball-board 1\nunits mm\nsize 510 1070\nball 13.5 5000\ngravity 1110\ndt 0.0005\nballs 1\n"
+      "launcher 450 50\nstart 255 800 -300 0\n",
+      "t.board");
+  ASSERT_TRUE(mm.start.has_value());
+  EXPECT_TRUE(mm.start->position.isApprox(Vec2(0.255, 0.8)));
+  EXPECT_TRUE(mm.start->velocity_mps.isApprox(Vec2(-0.3, 0.0)));
+  EXPECT_TRUE(parse("start 0.25 0.5 0 0\n").start.has_value());
+}
+
+TEST(BoardLoaderErrors, StartIsOnTheTableClearAndFinite) {
+  expect_body_error("start 0.1 0.9 1.5\n", 8, "start: expected 4 numbers (X Y VX VY), got 3");
+  expect_body_error("start 0.1 nan 1.5 0\n", 8, "start: field Y is not a finite number: 'nan'");
+  expect_body_error("start 0.1 0.9 inf 0\n", 8, "start: field VX is not a finite number: 'inf'");
+  expect_body_error("start 0.1 0.9 1000 0\n", 8, "start: speed of fields VX VY must be at most 100 m/s, got 1000");
+  expect_body_error("start 0.1 0.9 1 0\nstart 0.2 0.9 1 0\n", 9, "duplicate 'start' statement (first at line 8)");
+  expect_body_error("start 0.1 1.2 0 0\n", 8, "start: fields X Y (0.1, 1.2) m lie outside the table");
+  expect_body_error("start -0.01 0.5 0 0\n", 8, "start: fields X Y (-0.01, 0.5) m lie outside the table");
+  expect_body_error("start 0.1 0.9 6 0\n", 8, "start: speed of fields VX VY (6 m/s) exceeds the ball's SPEED_MAX (5 m/s)");
+  expect_body_error("start 0.1 0.5 0 0\ncircle 0.1 0.52 0.01 name=post\n", 8,
+                    "start: ball at fields X Y overlaps 'post' (distance 0.01 m, ball radius 0.0135 m)");
+  expect_body_error("start 0.1 0.5 0 0\nflipper left 0.05 0.505 0.076 0 0.5 35 name=lf\n", 8,
+                    "start: ball at fields X Y overlaps flipper 'lf' in its down position");
+  expect_body_error("start 0.1 0.5 0 0\nhole 0.1 0.51 0.02 eat name=drain\n", 8,
+                    "start: ball at fields X Y starts inside hole 'drain'");
+  expect_body_error("start 0.45 0.055 0 0.1\n", 8, "counts as resting in the launcher");
+}
+
+TEST(BoardLoaderErrors, LaunchTooSlowToLeaveTheLauncher) {
+  // √(2·1.11·0.0135 + 0.05²) + 1.11·0.0005 ≈ 0.1807 m/s; 0.03·0.97·5 = 0.1455.
+  const std::string head =
+      "pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\ndt 0.0005\nballs 3\n";
+  expect_error(head + "launcher 0.45 0.05 pull=0.03\n", 7,
+               "launcher: attribute pull=0.03 launches as slowly as 0.1455 m/s (pull x (1 - noise) x SPEED_MAX), "
+               "below the 0.180749 m/s");
+  EXPECT_NO_THROW(parse_board(head + "launcher 0.45 0.05 pull=0.04\n", "t.board"));  // 0.194 m/s
+  // The noise counts: the slowest launch is the one that matters.
+  expect_error(head + "launcher 0.45 0.05 pull=0.04 noise=0.5\n", 7, "launches as slowly as 0.1 m/s");
+  // Without gravity a launch still has to beat the launcher's still speed.
+  expect_error("pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 0\ndt 0.0005\nballs 3\n"
+               "launcher 0.45 0.05 pull=0.005 noise=0\n",
+               7, "attribute pull=0.005 launches as slowly as 0.025 m/s");
+  // A board that serves from `start` never launches.
+  EXPECT_NO_THROW(parse_board(head + "launcher 0.45 0.05 pull=0.03\nstart 0.25 0.5 0 0\n", "t.board"));
+}
+
 TEST(BoardLoader, CommentsBlankLinesTabsAndCrlf) {
   const Board b = parse_board(
       "# a comment line\r\n"

@@ -109,5 +109,31 @@ TEST(CheckFlipperTimeStep, ThrowsAboveTheLimitNamingTheFlipper) {
   }
 }
 
+TEST(MinLaunchSpeed, RisesAboveOneRadiusAgainstGravityPlusOneEulerStep) {
+  Board b = empty_board(0.51, 1.07, 1.11, 5e-4);
+  const double v_still = kLauncherStillSpeed_mps;
+  EXPECT_DOUBLE_EQ(min_launch_speed_mps(b), std::sqrt(2 * 1.11 * 0.0135 + v_still * v_still) + 1.11 * 5e-4);
+  b.gravity_mps2 = 0.0;
+  EXPECT_DOUBLE_EQ(min_launch_speed_mps(b), v_still);
+}
+
+TEST(CheckLaunchPull, RefusesAPullThatCannotLeaveTheLauncher) {
+  Board b = empty_board(0.51, 1.07, 1.11, 5e-4);
+  b.ball.speed_max_mps = 5.0;
+  b.launcher.noise_max = 0.03;
+  EXPECT_DOUBLE_EQ(slowest_launch_mps(b, 0.5), 0.5 * 0.97 * 5.0);
+  EXPECT_NO_THROW(check_launch_pull(b, 0.95));
+  EXPECT_NO_THROW(check_launch_pull(b, 0.04));  // 0.194 m/s
+  try {
+    check_launch_pull(b, 0.03);  // 0.1455 m/s, below 0.1807
+    FAIL() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("launch pull 0.03"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("relaunched at its apex for ever"), std::string::npos) << e.what();
+  }
+  b.start = BallStart{{0.2, 0.5}, {0.0, 0.0}};  // served, never launched
+  EXPECT_NO_THROW(check_launch_pull(b, 0.01));
+}
+
 }  // namespace
 }  // namespace pinball::table

@@ -28,7 +28,9 @@ struct BallResult {
   bool left_table = false;   ///< lost by leaving the table's bounds rather than by a drain
 };
 
-/// Starts the next ball: a new game if the last one is over, then the world's launch.
+/// Starts the next ball: a new game if the last one is over, then the world's
+/// launch. Throws std::invalid_argument (table::check_launch_pull) if `pull`
+/// can launch the ball too slowly to leave the launcher.
 void begin_ball(World& world, GameState& state, double pull);
 
 /// True when a ball in play has rolled back to the launcher and stopped there.

@@ -48,7 +48,7 @@ struct GameState {
   std::vector<std::uint8_t> visible;   ///< per obstacle: a Visibility (banks, thesis 3.4)
   int rising_flags = 0;                ///< obstacles in state kRising
   std::vector<std::uint8_t> sensor_inside;  ///< per sensor: 1 while the ball is on it
-  Rng rng;                             ///< launch noise; part of the state so runs replay bit for bit
+  Rng rng;                             ///< launch and kickout noise; part of the state so runs replay bit for bit
 };
 
 /// A fresh game: flippers down, all obstacles at their initial visibility, the
@@ -61,6 +61,8 @@ void reset_game(const table::Board& board, GameState& state);
 
 /// Places the ball in the launcher and launches it with pull fraction `pull`
 /// (thesis 3.3.1): v = (0, pull·(1 − R)·speed_max), R ~ U[0, noise_max].
+/// On a board with a `start` the ball is served there instead, with the
+/// start's velocity (no noise, no random draw; `pull` is ignored).
 void launch_ball(const table::Board& board, GameState& state, double pull);
 
 }  // namespace pinball::sim

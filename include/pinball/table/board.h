@@ -56,13 +56,22 @@ enum class SensorKind : std::uint8_t {
   kHole,       ///< fires when the ball's centre enters the circle (the ball falls in)
 };
 
+/// Default half-width of a kickout's direction spread (rad): 5°. A saucer's
+/// kicker never strikes the ball the same way twice; without a spread a table
+/// can hold the ball in a loop that repeats to the bit (issue 17).
+inline constexpr double kDefaultKickoutSpread_rad = 0.087266462599716474;
+/// Default kickout speed noise: the speed is scaled by 1 − R, R ~ U[0, 0.1].
+inline constexpr double kDefaultKickoutNoise = 0.1;
+
 /// A proximity sensor or a hole. Fires once per entry.
 struct Sensor {
   SensorKind kind = SensorKind::kProximity;  ///< proximity or hole
   Shape shape;                               ///< line or circle (holes: circle)
   Action action;                             ///< score, eat
   bool has_kickout = false;                  ///< hole that ejects the ball instead of eating it
-  Vec2 kickout_mps = Vec2::Zero();           ///< velocity the ball leaves a hole with (m/s)
+  Vec2 kickout_mps = Vec2::Zero();           ///< nominal velocity the ball leaves a hole with (m/s)
+  double kickout_spread_rad = kDefaultKickoutSpread_rad;  ///< kickout turned by U[−spread, spread] (rad)
+  double kickout_noise = kDefaultKickoutNoise;            ///< kickout speed × (1 − R), R ~ U[0, noise]
   std::string name;                          ///< for traces and errors
   int source_line = 0;                       ///< line of the board file it came from
 };
@@ -103,6 +112,17 @@ struct Launcher {
   double noise_max = 0.03;       ///< launch speed is P·(1 − R)·speed_max with R ~ U[0, noise_max]
 };
 
+/// A ball in play within one ball radius of the launch point and slower than
+/// this is back in the launcher and is launched again (thesis 5.1).
+inline constexpr double kLauncherStillSpeed_mps = 0.05;
+
+/// Where a ball is served and how fast, in place of the plunger's launch
+/// (board statement `start`; scenes and tests).
+struct BallStart {
+  Vec2 position = Vec2::Zero();      ///< centre (m)
+  Vec2 velocity_mps = Vec2::Zero();  ///< velocity (m/s)
+};
+
 /// Ball constants (thesis 3.2.1).
 struct BallSpec {
   double radius_m = 0.0135;     ///< ball radius (m)
@@ -119,6 +139,7 @@ struct Board {
   double dt_s = 0.0005;          ///< default time step of the thesis stepper (s)
   int balls_per_game = 3;        ///< balls before the game resets
   Launcher launcher;             ///< plunger
+  std::optional<BallStart> start;  ///< serve every ball from here instead of launching it; none: the plunger
   std::vector<Shape> shapes;     ///< reflecting obstacles' geometry (hot)
   std::vector<Obstacle> obstacles;  ///< reflecting obstacles' attributes, same index as shapes (cold)
   std::vector<Sensor> sensors;   ///< proximity sensors and holes
@@ -159,6 +180,23 @@ std::pair<int, double> nearest_flipper_at_rest(const Board& board, const Vec2& p
 /// The largest time step for which a flipper moving at its θ̇₀ cannot jump
 /// over the ball: l·sin(θ̇₀·dt/2) < r (thesis 3.3.3). Infinite with no flippers.
 double max_stable_dt_s(const Board& board);
+
+/// The slowest launch that leaves the launcher (m/s): a ball launched
+/// straight up at v rises v²/(2g), and while it is within one radius of the
+/// launch point and slower than kLauncherStillSpeed_mps it counts as back in
+/// the launcher and is launched again, for ever. So v must exceed
+/// √(2·g·r + v_still²), plus g·dt for the thesis stepper's Euler lag (its
+/// apex falls short of v²/(2g) by up to v·dt/2).
+double min_launch_speed_mps(const Board& board);
+
+/// The slowest launch the plunger gives at pull fraction `pull` (m/s):
+/// pull·(1 − noise_max)·speed_max (thesis 3.3.1).
+double slowest_launch_mps(const Board& board, double pull);
+
+/// Throws std::invalid_argument if launches at `pull` can be slower than
+/// min_launch_speed_mps (the ball would be relaunched at its apex for ever).
+/// A board with a `start` never launches: any pull passes.
+void check_launch_pull(const Board& board, double pull);
 
 /// Throws std::invalid_argument naming the flipper if dt_s violates
 /// l·sin(θ̇₀·dt/2) < r for any flipper.
