@@ -52,6 +52,7 @@ SimWorld::SimWorld(const sim::World& world, firmware::CanTransport& board_link, 
   driver_board_.add_listener(&coil_watch_);
   results_.resize(static_cast<std::size_t>(options.balls));
   pull_ = options.launcher_pull >= 0.0 ? options.launcher_pull : board.launcher.pull;
+  table::check_launch_pull(board, pull_);  // a launch that cannot leave would be relaunched for ever
 }
 
 void SimWorld::render_background(vision::Frame& frame, double t_s) {
