@@ -43,18 +43,19 @@ std::string format_count(double x) {
 
 std::string format_progress(std::string_view label, double done, double total, std::string_view unit,
                             double elapsed_s, std::string_view note) {
+  // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on "a" + b + "c" chains here.
   std::string line(label);
-  line += ": " + format_count(done) + "/" + format_count(total);
-  if (!unit.empty()) line += " " + std::string(unit);
+  line.append(": ").append(format_count(done)).append("/").append(format_count(total));
+  if (!unit.empty()) line.append(" ").append(unit);
   if (total > 0.0) {
     const double pct = std::floor(std::fmin(100.0, 100.0 * done / total));
-    line += " (" + format_count(pct) + " %)";
+    line.append(" (").append(format_count(pct)).append(" %)");
   }
-  line += ", " + format_duration(elapsed_s) + " elapsed";
+  line.append(", ").append(format_duration(elapsed_s)).append(" elapsed");
   if (done > 0.0 && total > done) {
-    line += ", ETA " + format_duration(elapsed_s / done * (total - done));
+    line.append(", ETA ").append(format_duration(elapsed_s / done * (total - done)));
   }
-  if (!note.empty()) line += "; " + std::string(note);
+  if (!note.empty()) line.append("; ").append(note);
   return line;
 }
 
