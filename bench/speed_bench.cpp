@@ -4,7 +4,7 @@
 #include <chrono>
 #include <sstream>
 
-#include "pinball/core/progress.h"
+#include "staged_progress.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/simlab/oracle_policy.h"
@@ -150,15 +150,7 @@ EventSpeedRun measure_event(const std::string& name, const table::Board& board, 
 SpeedReport run_speed_bench(const table::Board& board, const SpeedBenchOptions& options,
                             const std::function<void(const std::string&)>& report_line) {
   // Six timed configurations: each line says how far the bench is and its ETA.
-  const auto start = std::chrono::steady_clock::now();
-  int runs_done = 0;
-  std::function<void(const std::string&)> progress;
-  if (report_line) {
-    progress = [&](const std::string& line) {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      report_line(format_progress("speed", ++runs_done, 6, "runs", elapsed, line));
-    };
-  }
+  const auto progress = staged_progress(report_line, "speed", 6, "runs");
   SpeedReport report;
   report.board = board.source;
   report.dt_s = board.dt_s;
