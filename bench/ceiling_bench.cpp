@@ -7,6 +7,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "pinball/core/progress.h"
 #include "pinball/control/spastic_controller.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
@@ -103,8 +104,9 @@ CeilingPlayerReport run_player(const sim::World& world, const sim::ThesisStepper
     const int d = ++done;
     if (progress && (d % every == 0 || d == options.balls)) {
       const std::lock_guard<std::mutex> lock(progress_mutex);
-      progress(std::string(player_name(kind)) + ": " + std::to_string(d) + "/" + std::to_string(options.balls) +
-               " balls");
+      // "ceiling: 40/200 balls (20 %), 12 s elapsed, ETA 48 s"
+      progress(format_progress(player_name(kind), d, options.balls, "balls",
+                               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
     }
   });
   CeilingPlayerReport r;

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <vector>
 
+#include "pinball/core/format.h"
+
 namespace pinball::bench {
 namespace {
 
@@ -63,24 +65,26 @@ std::string to_text(const CeilingReport& r) {
   const CeilingBenchOptions& o = r.options;
   out << "ceiling reference on " << r.board << " (world: " << r.world_board << " on the " << r.world
       << " stepper): " << o.balls << " balls per player (seed " << o.seed
-      << "), cut at " << o.max_ball_time_s << " s, actuation delay " << o.actuation_delay_s * 1e3 << " ms\n"
+      << "), cut at " << format_number(o.max_ball_time_s) << " s, actuation delay "
+      << format_number(o.actuation_delay_s * 1e3) << " ms\n"
       << "the ceiling player CHEATS (true state, lookahead with the true simulator): a reference, not a "
          "controller\n";
   std::vector<const CeilingPlayerReport*> players = {&r.ceiling, &r.spastic, &r.no_flipping, &r.tracker_spastic};
   if (r.controller) players.push_back(&*r.controller);
   for (const CeilingPlayerReport* p : players) {
-    out << "  " << p->name << ": " << p->score.mean() << " +- " << p->score.ci95_half_width()
-        << " per ball (95 %), " << p->duration_s.mean() << " s per ball, " << p->flips.mean()
-        << " flips per ball, " << p->cut << " cut; drains: left outlane " << p->drains_left_outlane << ", elsewhere "
-        << p->drains_elsewhere << "; wall " << p->wall_s << " s\n";
+    out << "  " << p->name << ": " << format_mean_ci(p->score.mean(), p->score.ci95_half_width())
+        << " per ball (95 %), " << format_number(p->duration_s.mean()) << " s per ball, "
+        << format_number(p->flips.mean()) << " flips per ball, " << p->cut << " cut; drains: left outlane "
+        << p->drains_left_outlane << ", elsewhere " << p->drains_elsewhere << "; wall " << format_number(p->wall_s)
+        << " s\n";
   }
-  out << "  ceiling planning: " << r.ceiling.decisions_per_ball << " decisions, " << r.ceiling.branch_steps_per_ball
-      << " lookahead steps per ball\n"
-      << "ceiling / spastic: " << r.ceiling_over_spastic << "x; ceiling / spastic through the tracker: "
-      << r.ceiling_over_tracker_spastic << "x\n";
+  out << "  ceiling planning: " << format_number(r.ceiling.decisions_per_ball) << " decisions, "
+      << format_number(r.ceiling.branch_steps_per_ball) << " lookahead steps per ball\n"
+      << "ceiling / spastic: " << format_number(r.ceiling_over_spastic)
+      << "x; ceiling / spastic through the tracker: " << format_number(r.ceiling_over_tracker_spastic) << "x\n";
   if (r.controller) {
-    out << "controller (" << o.controller_name << ") / spastic through the tracker: " << r.controller_over_tracker_spastic
-        << "x\n";
+    out << "controller (" << o.controller_name << ") / spastic through the tracker: "
+        << format_number(r.controller_over_tracker_spastic) << "x\n";
   }
   return out.str();
 }

@@ -10,6 +10,7 @@
 #include "pinball/sim/event_stepper.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "staged_progress.h"
 
 namespace pinball::bench {
 namespace {
@@ -400,7 +401,11 @@ LogLogFit loglog_fit(const std::vector<std::pair<double, double>>& xy) {
 }
 
 PrecisionReport run_precision_bench(const Board& table, const PrecisionBenchOptions& options,
-                                    const std::function<void(const std::string&)>& progress) {
+                                    const std::function<void(const std::string&)>& report_line) {
+  // Stages: the closed-form scenes, then the table when the event stepper runs.
+  const bool with_table = !table.source.empty() && options.with_event;
+  const auto progress = staged_progress(report_line, "precision",
+                                        static_cast<int>(closed_form_scenes().size()) + (with_table ? 1 : 0), "scenes");
   PrecisionReport report;
   report.options = options;
   for (const std::string& name : closed_form_scenes()) {
@@ -414,7 +419,7 @@ PrecisionReport run_precision_bench(const Board& table, const PrecisionBenchOpti
     run_scene(scene, options, report, progress);
     compare(report, name);
   }
-  if (!table.source.empty() && options.with_event) {
+  if (with_table) {
     // The full table is chaotic: its reference is the event stepper at its
     // tightest tolerance from the same launch, over a horizon short enough
     // that the trajectories have not yet diverged.

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <sstream>
 
+#include "staged_progress.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/simlab/oracle_policy.h"
@@ -147,7 +148,9 @@ EventSpeedRun measure_event(const std::string& name, const table::Board& board, 
 }  // namespace
 
 SpeedReport run_speed_bench(const table::Board& board, const SpeedBenchOptions& options,
-                            const std::function<void(const std::string&)>& progress) {
+                            const std::function<void(const std::string&)>& report_line) {
+  // Six timed configurations: each line says how far the bench is and its ETA.
+  const auto progress = staged_progress(report_line, "speed", 6, "runs");
   SpeedReport report;
   report.board = board.source;
   report.dt_s = board.dt_s;

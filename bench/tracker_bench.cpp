@@ -16,6 +16,7 @@
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/track/tracker.h"
 #include "pinball/track/trajectory_fit.h"
+#include "staged_progress.h"
 
 namespace pinball::bench {
 
@@ -372,7 +373,7 @@ std::vector<TrackerApproach> collect_tracker_approaches(const table::Board& boar
 }
 
 TrackerReport run_tracker_bench(const table::Board& board, const TrackerBenchOptions& options,
-                                const std::function<void(const std::string&)>& progress) {
+                                const std::function<void(const std::string&)>& report_line) {
   const auto start = Clock::now();
   TrackerReport report;
   report.board = board.source;
@@ -382,6 +383,11 @@ TrackerReport run_tracker_bench(const table::Board& board, const TrackerBenchOpt
   report.flipper_length_m =
       0.5 * (geometry.lines[0].axis().norm() + geometry.lines[1].axis().norm());
 
+  // Stages: the approaches, every camera setting, every g factor, every cost point (the windows and the default).
+  const auto progress = staged_progress(
+      report_line, "tracker",
+      static_cast<int>(1 + options.fps.size() * options.m_per_px.size() * options.noise_px.size() +
+                       options.g_factors.size() + options.cost_windows.size() + 1));
   const std::vector<TrackerApproach> approaches = collect_tracker_approaches(board, options, &report.approach_counts);
   report.approaches = approaches.size();
   {

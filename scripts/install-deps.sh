@@ -14,6 +14,7 @@ packages=(
   libyaml-cpp-dev
   nlohmann-json3-dev libcli11-dev
   can-utils libsocketcan-dev
+  python3-minimal   # runs the test of the generated Python LCM bindings
 )
 
 missing=()

@@ -6,6 +6,10 @@
 #include <stdexcept>
 
 #include "camera_options.h"
+#include "data_file.h"
+#include "pinball/core/format.h"
+#include "pinball/core/progress.h"
+#include "progress_option.h"
 #include "commands.h"
 #include "world_options.h"
 #include "pinball/table/board_loader.h"
@@ -32,7 +36,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
                   "which benchmark: speed, tracker, latency, detector, calibration, precision, ceiling, protocol")
       ->required()
       ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration", "precision", "ceiling", "protocol"}));
-  cmd->add_option("--board", a.board, "board file")->check(CLI::ExistingFile);
+  cmd->add_option("--board", a.board, "board file")->transform(data_file());
   cmd->add_option("--steps", a.steps, "steps per timed run")->check(CLI::Range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
@@ -48,7 +52,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
       ->check(CLI::Range(1, 256));
   cmd->add_option("--controller", a.controller,
                   "ceiling: also play this controller file through the camera model and tracker")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "ceiling: seconds after which a ball still alive is cut")
       ->check(CLI::Range(1.0, 3600.0));
   cmd->add_option("--frames", a.frames, "protocol: random and mutated frames per seed")
@@ -59,6 +63,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   add_world_options(*cmd, a.world);
   add_camera_model_options(*cmd, a.camera);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
+  add_progress_flag(*cmd, a.progress);
   return cmd;
 }
 
@@ -207,18 +212,19 @@ int run_protocol(const BenchArgs& a, std::ostream& out, std::ostream& err) {
     out << bench::to_json(r).dump(2) << "\n";
   } else {
     out << r.frames << " frames (" << r.mutated << " with bits flipped, " << r.noise << " random) over "
-        << r.simulated_s << " s of board time; " << r.valid_frames << " decoded for the board, " << r.bad_frames
+        << format_number(r.simulated_s) << " s of board time; " << r.valid_frames << " decoded for the board, " << r.bad_frames
         << " refused as bad\n"
         << "coil switch-ons " << r.switch_ons << ", stale " << r.stale << ", watchdog trips " << r.watchdog_trips
         << ", hold caps " << r.hold_cap_trips << ", locked refusals " << r.refused_locked << "\n"
         << "rule violations " << r.rule_violations << ", cap violations " << r.cap_violations
         << (r.first_violation.empty() ? "" : " (first: " + r.first_violation + ")") << "\n"
-        << "board + checker " << r.frames_per_s << " frames/s; baseline decode only "
-        << r.decode_only_frames_per_s << " frames/s\n";
+        << "board + checker " << format_number(r.frames_per_s) << " frames/s; baseline decode only "
+        << format_number(r.decode_only_frames_per_s) << " frames/s\n";
     for (const bench::ReleaseUnderLoss& x : r.release_under_loss) {
-      out << "release under " << x.drop_p * 100 << " % loss, closed loop " << (x.closed_loop ? "on " : "off")
-          << ": on after release p50 " << x.p50_s * 1e3 << " ms, p99 " << x.p99_s * 1e3 << " ms, worst "
-          << x.worst_s * 1e3 << " ms over " << x.cycles << " cycles (" << x.release_retries << " retries, "
+      out << "release under " << format_number(x.drop_p * 100) << " % loss, closed loop "
+          << (x.closed_loop ? "on " : "off") << ": on after release p50 " << format_number(x.p50_s * 1e3)
+          << " ms, p99 " << format_number(x.p99_s * 1e3) << " ms, worst " << format_number(x.worst_s * 1e3)
+          << " ms over " << x.cycles << " cycles (" << x.release_retries << " retries, "
           << x.release_escalations << " escalations)\n";
     }
   }
@@ -229,7 +235,12 @@ int run_protocol(const BenchArgs& a, std::ostream& out, std::ostream& err) {
 
 }  // namespace
 
-int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err) {
+int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
+  BenchArgs a = args;
+  a.board = find_data_file(a.board);  // the default boards/mit1993.board from any folder
+  // Progress only on a terminal or with --progress: a stream without a buffer swallows it.
+  std::ostream no_progress(nullptr);
+  std::ostream& err = progress_wanted(a.progress) ? all_err : no_progress;
   if (a.which == "latency") return run_latency(a, out, err);
   if (a.which == "protocol") return run_protocol(a, out, err);
   const table::Board board = table::load_board(a.board);

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "commands.h"
+#include "data_file.h"
 #include "pinball/calibration/calibration_figure.h"
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/calibration/camera_calibration.h"
@@ -29,9 +30,9 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->required()
       ->check(CLI::IsMember({"camera", "flippers", "gravity"}));
   auto* sim = cmd->add_option("--sim", a.sim_board, "generate the inputs from the simulator on this board")
-                  ->check(CLI::ExistingFile);
+                  ->transform(data_file());
   cmd->add_option("--board", a.board, "the machine's board file (flipper names, sides, rough places)")
-      ->check(CLI::ExistingFile)
+      ->transform(data_file())
       ->excludes(sim);
   cmd->add_option("--image", a.image, "camera: image of the markers")->check(CLI::ExistingFile);
   cmd->add_option("--markers", a.markers, "camera: marker positions, CSV x,y (m); default: the board's default layout")
@@ -40,11 +41,13 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--up", a.up, "flippers: the same with the flippers held up")->check(CLI::ExistingFile);
   cmd->add_option("--sweep", a.sweeps, "flippers: video of one flipper swept stop to stop (repeat, board order)")
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingFile)
+      ->default_str("");
   cmd->add_option("--method", a.method, "flippers: method written to the file when both ran")
       ->check(CLI::IsMember({"markers", "markerless"}));
   cmd->add_option("--roll", a.rolls, "gravity: observation CSV (t,x,y) of one roll from rest (repeat)")
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingFile)
+      ->default_str("");
   cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")->check(CLI::Range(1, 1000));
   cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")->check(CLI::Range(1e-6, 0.1));
   cmd->add_option("--calibration", a.calibration, "calibration file holding the camera homography (default: --out)")

@@ -34,6 +34,7 @@ struct SimArgs {
   std::string actuation = "direct";  ///< direct | can: flipper commands through the CAN path
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< solenoid rise before the flipper moves (s)
   bool json = false;             ///< one JSON object on stdout
+  bool progress = false;         ///< percent and ETA on stderr even when it is not a terminal
 };
 CLI::App* add_sim_command(CLI::App& app, SimArgs& args);
 int run_sim(const SimArgs& args, std::ostream& out, std::ostream& err);
@@ -81,6 +82,7 @@ struct BenchArgs {
   std::uint64_t frames = 1'000'000;                  ///< protocol: frames per seed
   int seeds = 1;                                     ///< protocol: seeds, from --seed on
   bool json = false;                                 ///< one JSON object on stdout
+  bool progress = false;                             ///< progress on stderr even when it is not a terminal
 };
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& args);
 int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& err);
@@ -112,6 +114,7 @@ struct LearnArgs {
   track::CameraModelConfig camera;      ///< the camera the tracker sees through
   simlab::WorldSpec world;              ///< the world (default: the model of `board` on the thesis stepper)
   bool json = false;                    ///< one JSON object on stdout
+  bool progress = false;                ///< percent and ETA on stderr even when it is not a terminal
 };
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& args);
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err);

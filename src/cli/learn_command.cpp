@@ -14,7 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "camera_options.h"
+#include "data_file.h"
 #include "commands.h"
+#include "progress_option.h"
 #include "world_options.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/control/imitation_controller.h"
@@ -22,7 +24,9 @@
 #include <functional>
 #include <optional>
 #include "pinball/control/spastic_controller.h"
+#include "pinball/core/format.h"
 #include "pinball/core/json_write_archive.h"
+#include "pinball/core/progress.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/learn/cross_entropy.h"
 #include "pinball/learn/evaluator.h"
@@ -37,7 +41,7 @@ namespace pinball::cli {
 
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   CLI::App* cmd = app.add_subcommand("learn", "learn a flipper controller on the fast loop (or evaluate one)");
-  cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->transform(data_file());
   cmd->add_option("--method", a.method,
                   "tournament (thesis 6.2), relay (Hoeffding relay race, 6.3), cem (cross-entropy with common "
                   "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller); "
@@ -48,23 +52,27 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
   cmd->add_option("--seed", a.seed, "random seed; same seed, same result, whatever --threads");
   cmd->add_option("--out", a.out, "controller file to write (JSON, docs/learning.md)");
-  cmd->add_option("--controller", a.controller, "evaluate: the controller file")->check(CLI::ExistingFile);
+  cmd->add_option("--controller", a.controller, "evaluate: the controller file")->transform(data_file());
   cmd->add_option("--threads", a.threads, "worker threads")->check(CLI::Range(1, 256));
   cmd->add_option("--curve", a.curve, "write the learning curve to this CSV");
   cmd->add_option("--plot", a.plot, "draw the learning curve to this PNG");
   cmd->add_option("--eval-balls", a.eval_balls,
                   "evaluate the result on this many fresh balls (default: 0 after a search, 1000 otherwise)")
-      ->check(CLI::Range(0, 10'000'000));
+      ->check(CLI::Range(0, 10'000'000))
+      ->default_str("");  // 0: by method
   cmd->add_option("--partitions", a.partitions, "k: impact-angle partitions per flipper (uniform)")
       ->check(CLI::Range(1, 64));
   cmd->add_flag("--partition-h", a.partition_by_h, "also partition by h (pivot-to-tip | tip-to-V-centre)");
   cmd->add_flag("--rolling", a.rolling, "a separate minicontroller for a ball rolling on each flipper");
   cmd->add_flag("--randomise-launch", a.randomise_launch, "draw the launcher pull per ball from [0.5, 1]");
-  cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")->check(CLI::Range(0.01, 1.0));
+  cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")
+      ->check(CLI::Range(0.01, 1.0))
+      ->default_str("");  // -1: the board's
   cmd->add_option("--balls-per-controller", a.balls_per_controller, "tournament: balls per controller (b)")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--population", a.population, "relay / cem: population size (default 20 / 16)")
-      ->check(CLI::Range(2, 100000));
+      ->check(CLI::Range(2, 100000))
+      ->default_str("");  // 0: the method's
   cmd->add_option("--rounds", a.rounds,
                   "imitate: rounds sharing the budget; round 1 the teacher plays, later rounds the learner plays "
                   "and the teacher labels its approaches (DAgger)")
@@ -78,6 +86,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
       ->check(CLI::Range(0.1, 10.0));
   add_camera_model_options(*cmd, a.camera);
   add_world_options(*cmd, a.world);
+  add_progress_flag(*cmd, a.progress);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -234,7 +243,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     sc.budget_balls = a.budget_balls;
     sc.seed = a.seed;
     sc.threads = a.threads;
-    sc.progress = &err;
+    sc.progress = progress_wanted(a.progress) ? &err : nullptr;
     const std::string cycle_path = a.out + ".cycle.json";
     double cycle_score = -1e300;  // keep the highest-scoring cycle (a stuck ball scores little)
     sc.on_cycle = [&](const control::ControllerSpec& spec, const learn::BallOutcome& o) {
@@ -296,7 +305,9 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     double cycle_score = -1e300;  // keep the highest-scoring cycle, as the searches do
     const learn::ImitationResult im = learn::learn_by_imitation(
         board, ic, a.budget_balls, a.seed, a.threads,
-        [&](const std::string& line) { err << "learn imitate: " << line << "\n"; },
+        [&](const std::string& line) {
+          if (progress_wanted(a.progress)) err << "learn imitate: " << line << "\n";
+        },
         [&](const control::ShotTable& table, double score) {
           if (score <= cycle_score) return;
           cycle_score = score;
@@ -319,7 +330,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     for (const learn::ImitationRound& r : im.rounds) {
       rounds.push_back({{"round", r.round}, {"player", r.round == 0 ? "teacher" : "learner"}, {"balls", r.balls},
                         {"examples", r.shots}, {"mean_score_per_ball", r.mean_score},
-                        {"mean_ball_time_s", r.mean_ball_time_s}, {"cut", r.cut}, {"fires", r.fires},
+                        {"mean_ball_time_s", r.mean_ball_time_s}, {"balls_cut_at_time_limit", r.cut}, {"fires", r.fires},
                         {"unmatched_fires", r.unmatched_fires}, {"wall_s", r.wall_s}});
     }
     j["rounds"] = rounds;
@@ -352,27 +363,30 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
       out << "world            " << j["world_board"].get<std::string>() << " on the " << j["stepper"].get<std::string>()
           << " stepper\n";
     }
+    auto num = [](const nlohmann::json& x, int digits = 3) { return format_number(x.get<double>(), digits); };
     if (search) {
       out << "balls used       " << j["balls_used"] << " of " << a.budget_balls << " in " << j["generations"]
-          << " generations, " << j["search_balls_per_s"] << " balls/s\n"
-          << "best estimate    " << j["best_estimated_mean"] << " over " << j["best_estimated_balls"] << " balls\n"
+          << " generations, " << num(j["search_balls_per_s"]) << " balls/s\n"
+          << "best estimate    " << num(j["best_estimated_mean"], 4) << " over " << j["best_estimated_balls"]
+          << " balls\n"
           << "cycle found      " << (j["cycle_found"].get<bool>() ? "yes" : "no") << "\n"
           << "controller       " << a.out << "\n";
     }
     if (j.contains("rounds")) {
       for (const auto& r : j["rounds"]) {
         out << "round " << r["round"].get<int>() + 1 << " (" << r["player"].get<std::string>() << ")  "
-            << r["balls"] << " balls, " << r["mean_score_per_ball"] << " per ball, " << r["examples"]
-            << " shots so far, " << r["wall_s"] << " s\n";
+            << r["balls"] << " balls, " << num(r["mean_score_per_ball"], 4) << " per ball, " << r["examples"]
+            << " shots so far, " << num(r["wall_s"]) << " s\n";
       }
       out << "cycle found      " << (j["cycle_found"].get<bool>() ? "yes" : "no") << "\n"
           << "controller       " << a.out << "\n";
     }
     if (j.contains("evaluation")) {
       const auto& e = j["evaluation"];
-      out << "evaluation       " << e["balls"] << " fresh balls: " << e["mean_score_per_ball"] << " +/- "
-          << e["score_ci95_half_width"] << " per ball (95 %), " << e["mean_ball_time_s"] << " s per ball, "
-          << e["flips_per_ball"] << " flips per ball, " << e["balls_per_s"] << " balls/s\n";
+      out << "evaluation       " << e["balls"] << " fresh balls: "
+          << format_mean_ci(e["mean_score_per_ball"].get<double>(), e["score_ci95_half_width"].get<double>())
+          << " per ball (95 %), " << num(e["mean_ball_time_s"]) << " s per ball, " << num(e["flips_per_ball"])
+          << " flips per ball, " << num(e["balls_per_s"]) << " balls/s\n";
     }
   }
   return 0;

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "data_file.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/renderer.h"
@@ -13,7 +14,7 @@ namespace pinball::cli {
 
 CLI::App* add_render_command(CLI::App& app, RenderArgs& a) {
   CLI::App* cmd = app.add_subcommand("render", "draw a board file to a PNG");
-  cmd->add_option("board", a.board, "board file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("board", a.board, "board file")->required()->transform(data_file());
   cmd->add_option("--out", a.out, "PNG file to write")->required();
   cmd->add_option("--px-per-m", a.px_per_m, "scale in pixels per metre")->check(CLI::Range(50.0, 10000.0));
   cmd->add_flag("--normals", a.normals, "draw the normal of every line");

@@ -7,6 +7,7 @@
 #include <ostream>
 
 #include "commands.h"
+#include "data_file.h"
 #include "pinball/daemon/replay.h"
 
 namespace pinball::cli {
@@ -16,10 +17,10 @@ CLI::App* add_replay_command(CLI::App& app, ReplayArgs& a) {
       "replay", "replay the observations of an LCM log (lcm-logger, pinballd) through the tracker and controller");
   cmd->add_option("log", a.log, "LCM log file")->required()->check(CLI::ExistingFile);
   cmd->add_option("--config", a.config, "the pinballd configuration the log was recorded with (default: none)")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--board", a.board, "board file (default: the configuration's)")->check(CLI::ExistingFile);
+      ->transform(data_file());
+  cmd->add_option("--board", a.board, "board file (default: the configuration's)")->transform(data_file());
   cmd->add_option("--controller", a.controller, "controller file (default: the configuration's)")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   cmd->add_flag("--json", a.json, "print one JSON object");
   return cmd;
 }

@@ -9,6 +9,8 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   CLI::App app{"pinball: simulator and tools of the pinball controller (see README.md)", "pinball"};
   app.set_version_flag("--version", std::string("pinball ") + PINBALL_VERSION);
   app.require_subcommand(1);
+  // Every option's help shows its default ("[100]"); subcommands inherit this.
+  app.option_defaults()->always_capture_default();
   SimArgs sim;
   RenderArgs render;
   BenchArgs bench;

@@ -12,8 +12,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "camera_options.h"
+#include "data_file.h"
 #include "commands.h"
+#include "pinball/core/format.h"
+#include "pinball/core/progress.h"
 #include "pinball/core/running_stats.h"
+#include "progress_option.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/simlab/can_flipper_drive.h"
@@ -31,14 +35,14 @@ namespace pinball::cli {
 
 CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
   CLI::App* cmd = app.add_subcommand("sim", "play balls on the embedded simulator and report the scores");
-  cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->transform(data_file());
   cmd->add_option("--policy", a.policy,
                   "who flips: none, or spastic (flip the flipper the tracker's projection names whenever the "
                   "ball is within --reach of impact; sees the ball only through the camera model)")
       ->check(CLI::IsMember({"none", "spastic", "controller"}));
   cmd->add_option("--controller", a.controller,
                   "a learned controller file (docs/learning.md); implies --policy controller")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   cmd->add_option("--reach", a.reach_m, "spastic: flip when the projected impact is this close (m)")
       ->check(CLI::Range(0.0, 1.0));
   add_camera_model_options(*cmd, a.camera);
@@ -61,6 +65,7 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
   cmd->add_flag("--video-camera", a.video_camera,
                 "--video: record what the simulated camera sees (perspective, lamps, blur, noise) at --video-fps");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
+  add_progress_flag(*cmd, a.progress);
   return cmd;
 }
 
@@ -131,7 +136,8 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   std::uint64_t flips = 0;
   std::uint64_t run_hash = sim::hash_state(state);
   const auto start = std::chrono::steady_clock::now();
-  auto last_progress = start;
+  ProgressMeter progress(progress_wanted(a.progress) ? &err : nullptr, "sim", a.balls, "balls",
+                         !a.progress && progress_wanted(false));
 
   const std::uint64_t events_before = state.events;
   auto play = [&] {
@@ -166,11 +172,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     cut += r.cut ? 1 : 0;
     left_table += r.left_table ? 1 : 0;
     run_hash = sim::hash_combine_state(run_hash, state);
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_progress > std::chrono::seconds(2) || ball + 1 == a.balls) {
-      err << "sim: " << ball + 1 << "/" << a.balls << " balls, mean score " << score.mean() << "\n";
-      last_progress = now;
-    }
+    progress.update(ball + 1, "mean score " + format_number(score.mean(), 4));
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (trace) trace->close();
@@ -209,7 +211,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"balls_left_table", left_table},
         {"steps", steps},
         {"state_hash", hash_hex},
-        {"wall_time_s", wall_s},
+        {"wall_s", wall_s},
         {"steps_per_s", steps_per_s},
         {"events", events},
         {"events_per_s", events_per_s},
@@ -219,14 +221,15 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     if (!a.world.board_path.empty()) out << "world board      " << a.world.board_path << "\n";
     out << "board            " << a.board << " (policy " << policy << ", actuation " << a.actuation
         << ", stepper " << sim::stepper_kind_name(a.world.stepper) << ", dt "
-        << dt_s << " s, seed " << a.seed << ")\n"
-        << "balls            " << a.balls << " (" << cut << " cut at " << a.max_ball_time_s << " s, " << left_table
-        << " left the table)\n"
-        << "score per ball   " << score.mean() << " +/- " << score.ci95_half_width() << " (95 % interval), max "
-        << score.max() << "\n"
-        << "mean ball time   " << ball_time.mean() << " s, " << flips << " flips\n"
-        << "steps            " << steps << " in " << wall_s << " s wall = " << steps_per_s << " steps/s\n"
-        << "events           " << events << " = " << events_per_s << " events/s\n"
+        << format_number(dt_s) << " s, seed " << a.seed << ")\n"
+        << "balls            " << a.balls << " (" << cut << " cut at " << format_number(a.max_ball_time_s) << " s, "
+        << left_table << " left the table)\n"
+        << "score per ball   " << format_mean_ci(score.mean(), score.ci95_half_width()) << " (95 % interval), max "
+        << format_number(score.max()) << "\n"
+        << "mean ball time   " << format_number(ball_time.mean()) << " s, " << flips << " flips\n"
+        << "steps            " << steps << " in " << format_number(wall_s) << " s wall = " << format_number(steps_per_s)
+        << " steps/s\n"
+        << "events           " << events << " = " << format_number(events_per_s) << " events/s\n"
         << "state hash       " << hash_hex << "\n";
   }
   return 0;

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "data_file.h"
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/track/observation_io.h"
@@ -16,18 +17,21 @@ namespace pinball::cli {
 
 CLI::App* add_track_command(CLI::App& app, TrackArgs& a) {
   CLI::App* cmd = app.add_subcommand("track", "run the tracker over an observation file (t,x,y)");
-  cmd->add_option("--board", a.board, "board file: the flipper geometry")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--board", a.board, "board file: the flipper geometry")->required()->transform(data_file());
   cmd->add_option("--observations", a.observations,
                   "CSV with header t,x,y (s, m, board frame), optionally ,left_contact,right_contact (0/1)")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--gravity", a.gravity_mps2, "gravity along the table (m/s^2); default: the board's")
-      ->check(CLI::Range(0.0, 100.0));
-  cmd->add_option("--sigma", a.sigma_m, "observation noise, standard deviation per coordinate (m)")
-      ->check(CLI::Range(1e-7, 1.0));
+      ->check(CLI::Range(0.0, 100.0))
+      ->default_str("");  // -1: the board's
+  cmd->add_option("--sigma", a.sigma_m,
+                  "observation noise, standard deviation per coordinate (m); default: the default camera's")
+      ->check(CLI::Range(1e-7, 1.0))
+      ->default_str("");  // 0: the camera's
   cmd->add_option("--calibration", a.calibration,
                   "calibration file (pinball calibrate): flipper geometry and gravity instead of the board's")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   cmd->add_flag("--json", a.json, "print one JSON object instead of CSV");
   return cmd;
 }

@@ -1,5 +1,7 @@
 #include "world_options.h"
 
+#include "data_file.h"
+
 #include <map>
 #include <string>
 
@@ -9,18 +11,20 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
   cmd.add_option("--world-board", world.board_path,
                  "the world: the board the table really is (default: the belief, the board the tracker and "
                  "controller assume); same flippers required")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   const std::map<std::string, sim::StepperKind> steppers{{"thesis", sim::StepperKind::kThesis},
                                                          {"event", sim::StepperKind::kEvent}};
   cmd.add_option("--stepper", world.stepper,
                  "the world's integrator: thesis (fixed-step Euler, Ch. 3) or event (exact between events, "
                  "docs/physics.md)")
-      ->transform(CLI::CheckedTransformer(steppers))
+      ->transform(CLI::CheckedTransformer(steppers).description(""))
+      ->type_name("{thesis,event}")
       ->default_str("thesis");
   cmd.add_option("--dt", world.dt_s,
                  "the world's time step in seconds (default: the board's); for --stepper event the rate at which "
                  "the flipper commands may change")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->default_str("");  // 0: the board's
 }
 
 }  // namespace pinball::cli

@@ -58,20 +58,26 @@ int main(int argc, char** argv) {
   int balls = -1;
   long long seed = -1;
   bool realtime = false, json = false, threads = false;
+  const DaemonConfig defaults;  // what --help shows as each option's default (no --config)
   app.add_option("--config", config_path, "YAML configuration (config/lab.example.yaml); none: embedded simulation")
       ->check(CLI::ExistingFile);
-  app.add_option("--sim", sim_board, "simulate this board (default boards/mit1993.board)")->check(CLI::ExistingFile);
+  app.add_option("--sim", sim_board, "simulate this board")->check(CLI::ExistingFile)->default_str(defaults.sim.board);
   app.add_option("--world-board", world_board,
                  "simulation: the board the table really is (default: the --sim board, which stays the belief of "
                  "the tracker and the controller); same flippers required")
       ->check(CLI::ExistingFile);
-  app.add_option("--stepper", stepper, "simulation: the world's integrator, thesis or event (default thesis)")
-      ->check(CLI::IsMember({"thesis", "event"}));
-  app.add_option("--controller", controller, "controller file (default controllers/best.json)")
-      ->check(CLI::ExistingFile);
-  app.add_option("--balls", balls, "balls to play in simulation (default 10)")->check(CLI::Range(0, 1000000));
-  app.add_option("--seed", seed, "launch noise seed in simulation")->check(CLI::NonNegativeNumber);
-  app.add_option("--lcm-url", lcm_url, "LCM provider, e.g. memq:// or udpm://239.255.76.67:7667?ttl=0");
+  app.add_option("--stepper", stepper, "simulation: the world's integrator, thesis or event")
+      ->check(CLI::IsMember({"thesis", "event"}))
+      ->default_str(std::string(pinball::sim::stepper_kind_name(defaults.sim.stepper)));
+  app.add_option("--controller", controller, "controller file")
+      ->check(CLI::ExistingFile)
+      ->default_str(defaults.controller);
+  app.add_option("--balls", balls, "balls to play in simulation")->check(CLI::Range(0, 1000000))
+      ->default_str(std::to_string(defaults.sim.balls));
+  app.add_option("--seed", seed, "launch noise seed in simulation")->check(CLI::NonNegativeNumber)
+      ->default_str(std::to_string(defaults.sim.seed));
+  app.add_option("--lcm-url", lcm_url, "LCM provider, e.g. memq:// or udpm://239.255.76.67:7667?ttl=0")
+      ->default_str(defaults.lcm_url);
   app.add_option("--can-log", can_log,
                  "write every CAN frame to this file in candump's log format (frames it cannot write are "
                  "dropped, counted, and make the exit status 3)");

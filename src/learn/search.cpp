@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <ostream>
 
+#include "pinball/core/format.h"
+#include "pinball/core/progress.h"
+
 namespace pinball::learn {
 
 SearchRun::SearchRun(const BallObjective& objective, const SearchConfig& config, std::string method)
@@ -48,10 +51,15 @@ void SearchRun::end_generation(double population_mean, double generation_best) {
   p.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   result_.curve.push_back(p);
   if (config_.progress) {
-    *config_.progress << result_.method << ": generation " << p.generation << ", balls " << balls_ << "/"
-                      << config_.budget_balls << ", population mean " << population_mean << ", generation best "
-                      << generation_best << ", best so far " << p.best_so_far << ", "
-                      << (p.wall_s > 0 ? static_cast<double>(balls_) / p.wall_s : 0.0) << " balls/s\n";
+    // "tournament: 1200/6000 balls (20 %), 41 s elapsed, ETA 2 min 44 s; generation 3, ..."
+    const std::string note = "generation " + std::to_string(p.generation) + ", population mean " +
+                             format_number(population_mean, 4) + ", generation best " +
+                             format_number(generation_best, 4) + ", best so far " + format_number(p.best_so_far, 4) +
+                             ", " + format_number(p.wall_s > 0 ? static_cast<double>(balls_) / p.wall_s : 0.0) +
+                             " balls/s";
+    *config_.progress << format_progress(result_.method, static_cast<double>(balls_),
+                                         static_cast<double>(config_.budget_balls), "balls", p.wall_s, note)
+                      << "\n";
   }
 }
 

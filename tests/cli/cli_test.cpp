@@ -2,8 +2,11 @@
 // errors, exit codes, and the same seed giving the same output to the bit.
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -108,17 +111,17 @@ TEST_F(Cli, SimPlaysTheEventStepper) {
 }
 
 TEST_F(Cli, SimJsonReportsEveryFigure) {
-  const CommandResult r = run("sim boards/mit1993.board --policy spastic --balls 5 --seed 3 --json");
+  const CommandResult r = run("sim boards/mit1993.board --policy spastic --balls 5 --seed 3 --json --progress");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("balls"), 5);
   for (const char* key : {"mean_score_per_ball", "score_ci95_half_width", "mean_ball_time_s", "steps_per_s",
-                          "steps", "state_hash", "balls_cut_at_time_limit"}) {
+                          "steps", "state_hash", "balls_cut_at_time_limit", "wall_s"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_GT(j.at("mean_score_per_ball").get<double>(), 0.0);
   EXPECT_GT(j.at("steps_per_s").get<double>(), 0.0);
-  EXPECT_NE(r.err.find("5/5 balls"), std::string::npos) << "progress goes to stderr";
+  EXPECT_NE(r.err.find("sim: 5/5 balls (100 %)"), std::string::npos) << "progress goes to stderr: " << r.err;
 }
 
 TEST_F(Cli, SameSeedGivesTheSameTraceAndScores) {
@@ -137,7 +140,7 @@ TEST_F(Cli, SameSeedGivesTheSameTraceAndScores) {
   auto ja = nlohmann::json::parse(ra.out);
   auto jb = nlohmann::json::parse(rb.out);
   for (auto* j : {&ja, &jb}) {
-    j->erase("wall_time_s");
+    j->erase("wall_s");
     j->erase("steps_per_s");
   }
   EXPECT_EQ(ja, jb);
@@ -173,7 +176,7 @@ TEST_F(Cli, LearnImitateWritesAShotTableThatEvaluateAndSimPlay) {
   const std::string common = " --seed 3 --threads 2 --max-ball-time 4 --eval-balls 4 --json";
   const CommandResult r =
       run("learn boards/mit1993.board --method imitate --budget-balls 3 --rounds 2 --out " + out + " --curve " +
-          (dir_ / "imitate.csv").string() + " --plot " + (dir_ / "imitate.png").string() + common);
+          (dir_ / "imitate.csv").string() + " --plot " + (dir_ / "imitate.png").string() + common + " --progress");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("rounds").size(), 2u);
@@ -266,14 +269,14 @@ TEST_F(Cli, BenchSpeedJson) {
 }
 
 TEST_F(Cli, BenchCeilingJsonAndBadBallCount) {
-  const CommandResult r = run("bench ceiling --balls 2 --max-ball-time 3 --threads 1 --json");
+  const CommandResult r = run("bench ceiling --balls 2 --max-ball-time 3 --threads 1 --json --progress");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("benchmark"), "ceiling");
   EXPECT_EQ(j.at("balls"), 2);
   EXPECT_EQ(j.at("max_ball_time_s"), 3.0);
   EXPECT_EQ(j.at("players").size(), 4u) << "ceiling, spastic and no flipping on the true state; spastic through the tracker";
-  EXPECT_NE(r.err.find("bench ceiling: ceiling: 2/2 balls"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bench ceiling: ceiling: 2/2 balls (100 %)"), std::string::npos) << r.err;
   EXPECT_EQ(run("bench ceiling --balls 0").exit_code, 2);
 }
 
@@ -328,3 +331,81 @@ TEST_F(Cli, TrackRejectsABadObservationFileNamingTheLine) {
 }
 
 }  // namespace
+
+namespace {
+
+// Runs `pinball args` from `cwd` (not the source tree), stdout and stderr apart.
+CommandResult run_from(const fs::path& cwd, const std::string& args) {
+  const fs::path err = cwd / "stderr.txt";
+  const std::string cmd = "cd " + cwd.string() + " && " PINBALL_EXE " " + args + " 2>" + err.string();
+  CommandResult r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = slurp(err);
+  return r;
+}
+
+}  // namespace
+
+TEST_F(Cli, HelpShowsEveryDefault) {
+  const CommandResult sim = run("sim --help");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  // CLI11 2.1 writes a default after '=' ("--max-ball-time FLOAT:POSITIVE=300").
+  EXPECT_NE(sim.out.find("=300\n"), std::string::npos) << "--max-ball-time's default\n" << sim.out;
+  EXPECT_NE(sim.out.find("=0.02\n"), std::string::npos) << "--reach's default\n" << sim.out;
+  EXPECT_NE(sim.out.find("--stepper {thesis,event}=thesis"), std::string::npos) << sim.out;
+  EXPECT_EQ(sim.out.find("POSITIVE=0 "), std::string::npos) << "a sentinel (0: the board's) is not a default\n"
+                                                            << sim.out;
+  const CommandResult learn = run("learn --help");
+  EXPECT_NE(learn.out.find("=2000"), std::string::npos) << "--budget-balls' default\n" << learn.out;
+  const CommandResult bench = run("bench --help");
+  EXPECT_NE(bench.out.find("=boards/mit1993.board"), std::string::npos) << "--board's default\n" << bench.out;
+}
+
+TEST_F(Cli, FindsTheShippedBoardsAndControllersFromAnyFolder) {
+  ASSERT_FALSE(fs::exists(dir_ / "boards"));
+  const CommandResult r = run_from(dir_, "sim boards/mit1993.board --controller controllers/best.json --balls 1 "
+                                         "--max-ball-time 2 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(fs::path(j.at("board").get<std::string>()), fs::path(PINBALL_SOURCE_DIR) / "boards/mit1993.board");
+  EXPECT_EQ(fs::path(j.at("controller").get<std::string>()), fs::path(PINBALL_SOURCE_DIR) / "controllers/best.json");
+  // bench's default --board too.
+  EXPECT_EQ(run_from(dir_, "bench ceiling --balls 1 --max-ball-time 2 --threads 1 --json").exit_code, 0);
+  // A board found nowhere is still refused, naming what was typed.
+  const CommandResult missing = run_from(dir_, "sim boards/no_such.board");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("boards/no_such.board"), std::string::npos) << missing.err;
+}
+
+TEST_F(Cli, ProgressOnlyWhenAskedOrOnATerminal) {
+  // stderr here is a file, not a terminal: no progress unless --progress.
+  const CommandResult quiet = run("sim boards/mit1993.board --balls 2 --max-ball-time 2 --json");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err.find("balls ("), std::string::npos) << quiet.err;
+  const CommandResult shown = run("sim boards/mit1993.board --balls 2 --max-ball-time 2 --json --progress");
+  EXPECT_NE(shown.err.find("sim: 2/2 balls (100 %)"), std::string::npos) << shown.err;
+  EXPECT_TRUE(nlohmann::json::accept(shown.out)) << "stdout stays one JSON object";
+}
+
+TEST_F(Cli, TextReportsRoundTheirNumbers) {
+  const CommandResult r = run("sim boards/mit1993.board --policy spastic --balls 4 --seed 3 --max-ball-time 5");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(" ± "), std::string::npos) << r.out;
+  // No decimal number with more than 4 significant digits (a raw double prints 6, or 17).
+  const std::regex decimal(R"((\d+)\.(\d+))");
+  for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), decimal); it != std::sregex_iterator(); ++it) {
+    const std::string digits = (*it)[1].str() + (*it)[2].str();
+    const std::size_t first = digits.find_first_not_of('0');
+    EXPECT_LE(first == std::string::npos ? 0 : digits.size() - first, 4u) << it->str() << " in\n" << r.out;
+  }
+  const auto j = nlohmann::json::parse(run("sim boards/mit1993.board --policy spastic --balls 4 --seed 3 "
+                                           "--max-ball-time 5 --json").out);
+  const double half = j.at("score_ci95_half_width").get<double>();
+  EXPECT_NE(half * 1e4, std::round(half * 1e4)) << "JSON keeps full precision: " << half;
+}

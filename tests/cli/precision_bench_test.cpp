@@ -56,8 +56,13 @@ TEST(PrecisionBench, QuickRunErrorsAreSane) {
   const table::Board table = table::load_board(PINBALL_SOURCE_DIR "/boards/mit1993.board");
   const PrecisionBenchOptions options = quick_precision_bench_options();
   int lines = 0;
-  const PrecisionReport r = run_precision_bench(table, options, [&](const std::string&) { ++lines; });
+  std::string last;
+  const PrecisionReport r = run_precision_bench(table, options, [&](const std::string& l) {
+    ++lines;
+    last = l;
+  });
   EXPECT_EQ(lines, 6);
+  EXPECT_EQ(last.rfind("precision: 6/6 scenes (100 %)", 0), 0u) << "percent and ETA: " << last;
   std::map<std::string, std::map<double, const PrecisionPoint*>> thesis, event;
   for (const PrecisionPoint& p : r.points) {
     EXPECT_TRUE(std::isfinite(p.max_error_m)) << p.scene << " " << p.stepper << " " << p.setting;

@@ -24,7 +24,12 @@ TEST(SpeedBench, ReportComparesGridWithLinearScanOnTheSameRun) {
   options.steps = 20'000;
   options.repeats = 1;
   int progress_lines = 0;
-  const SpeedReport r = run_speed_bench(b, options, [&](const std::string&) { ++progress_lines; });
+  std::string first;
+  const SpeedReport r = run_speed_bench(b, options, [&](const std::string& l) {
+    if (++progress_lines == 1) first = l;
+  });
+  EXPECT_EQ(first.rfind("speed: 1/6 runs (16 %)", 0), 0u) << "percent and ETA: " << first;
+  EXPECT_NE(first.find(", ETA "), std::string::npos) << first;
   ASSERT_EQ(r.runs.size(), 4u);
   EXPECT_EQ(progress_lines, 6);
   EXPECT_TRUE(r.grid_matches_linear);

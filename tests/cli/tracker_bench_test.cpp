@@ -133,8 +133,13 @@ TEST(TrackerBench, ProgressLinesAndDeterminism) {
   o.g_factors = {0.9};
   o.cost_windows = {8};
   int lines = 0;
-  const TrackerReport a = run_tracker_bench(mit1993(), o, [&](const std::string&) { ++lines; });
+  std::string last;
+  const TrackerReport a = run_tracker_bench(mit1993(), o, [&](const std::string& l) {
+    ++lines;
+    last = l;
+  });
   EXPECT_EQ(lines, 1 + 2 + 2);  // approaches, two settings, two cost points
+  EXPECT_EQ(last.rfind("tracker: 5/5 stages (100 %)", 0), 0u) << "percent and ETA: " << last;
   const TrackerReport b = run_tracker_bench(mit1993(), o, nullptr);
   ASSERT_EQ(a.settings.size(), b.settings.size());
   for (std::size_t i = 0; i < a.settings.size(); ++i) {

@@ -1,0 +1,19 @@
+#pragma once
+// Numbers in text output for people: a few significant digits, never a
+// 17-digit double or an exponent ("9193 ± 5430", "0.0457", "1.23"). JSON
+// keeps full precision; only the text reports go through here.
+
+#include <string>
+
+namespace pinball {
+
+/// `x` to `digits` significant digits in fixed notation, trailing zeros
+/// dropped; a number with more integer digits than that is rounded to an
+/// integer ("9193", "12.3", "0.0457", "0.0005").
+std::string format_number(double x, int digits = 3);
+
+/// A mean and the half-width of its interval, both to the half-width's
+/// place at 2 significant digits, the mean to at least `digits` ("9193 ± 5430", "1.24 ± 0.31").
+std::string format_mean_ci(double mean, double half_width, int digits = 3);
+
+}  // namespace pinball

@@ -1,0 +1,61 @@
+// The one progress line of every long run: percent, elapsed, ETA.
+
+#include "pinball/core/progress.h"
+
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+namespace pinball {
+namespace {
+
+TEST(FormatDuration, ReadsLikeAPersonWouldSayIt) {
+  EXPECT_EQ(format_duration(0.25), "250 ms");
+  EXPECT_EQ(format_duration(12.7), "12 s");
+  EXPECT_EQ(format_duration(185.0), "3 min 05 s");
+  EXPECT_EQ(format_duration(7440.0), "2 h 04 min");
+  EXPECT_EQ(format_duration(-1.0), "?");
+}
+
+TEST(FormatProgress, ShowsPercentElapsedAndTimeLeft) {
+  EXPECT_EQ(format_progress("sim", 40, 100, "balls", 12.0, "mean score 8120"),
+            "sim: 40/100 balls (40 %), 12 s elapsed, ETA 18 s; mean score 8120");
+  // Nothing done yet: no estimate; finished: 100 % and no ETA.
+  EXPECT_EQ(format_progress("learn", 0, 6000, "balls", 0.5), "learn: 0/6000 balls (0 %), 500 ms elapsed");
+  EXPECT_EQ(format_progress("learn", 6000, 6000, "balls", 90.0), "learn: 6000/6000 balls (100 %), 1 min 30 s elapsed");
+  // 99.9 % is not yet 100 %.
+  EXPECT_NE(format_progress("x", 999, 1000, "", 1.0).find("(99 %)"), std::string::npos);
+}
+
+TEST(ProgressMeter, ShowsAtMostOncePerIntervalAndAlwaysTheEnd) {
+  std::ostringstream out;
+  ProgressMeter meter(&out, "sim", 4, "balls", false, 1.0);
+  meter.update_at(1, 0.1);
+  meter.update_at(2, 0.5);  // too soon after the first
+  meter.update_at(3, 1.2);
+  meter.update_at(4, 1.3);  // the end is always shown
+  meter.update_at(4, 5.0);  // and only once
+  EXPECT_EQ(out.str(),
+            "sim: 1/4 balls (25 %), 100 ms elapsed, ETA 300 ms\n"
+            "sim: 3/4 balls (75 %), 1 s elapsed, ETA 400 ms\n"
+            "sim: 4/4 balls (100 %), 1 s elapsed\n");
+}
+
+TEST(ProgressMeter, RewritesOneLineOnATerminal) {
+  std::ostringstream out;
+  ProgressMeter meter(&out, "bench", 2, "runs", true, 0.0);
+  meter.update_at(1, 1.0);
+  meter.update_at(2, 2.0);
+  EXPECT_EQ(out.str(),
+            "\rbench: 1/2 runs (50 %), 1 s elapsed, ETA 1 s\x1b[K"
+            "\rbench: 2/2 runs (100 %), 2 s elapsed\x1b[K\n");
+}
+
+TEST(ProgressMeter, ANullStreamShowsNothing) {
+  ProgressMeter meter(nullptr, "sim", 1, "balls");
+  meter.update_at(1, 1.0);  // must not crash
+  SUCCEED();
+}
+
+}  // namespace
+}  // namespace pinball

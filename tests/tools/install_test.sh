@@ -1,0 +1,50 @@
+#!/bin/sh
+# Installs the build into a fresh prefix and runs the installed programs from
+# a folder that is neither the source tree nor the prefix: they must start,
+# and `pinball` must find the shipped board in <prefix>/share/pinball.
+# Usage: install_test.sh BUILD_DIR WORK_DIR
+set -eu
+build=$1
+work=$2
+rm -rf "$work"
+mkdir -p "$work/elsewhere"
+prefix=$work/prefix
+fail() { echo "install_test: $*" >&2; exit 1; }
+
+cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log" >&2; fail "cmake --install failed"; }
+for f in bin/pinball bin/pinballd bin/pinball-lcm-spy \
+         share/pinball/boards/mit1993.board share/pinball/controllers/best.json \
+         share/pinball/config/lab.example.yaml share/pinball/lcmtypes/lcmt_pinball_game_event.lcm \
+         share/doc/pinball/daemon.md share/doc/pinball/README.md lib/systemd/system/pinballd.service; do
+  [ -e "$prefix/$f" ] || fail "$f not installed"
+done
+if [ -f "$build/src/bus/pinball_lcmtypes.jar" ]; then
+  [ -f "$prefix/share/pinball/java/pinball_lcmtypes.jar" ] || fail "the built types jar was not installed"
+  "$prefix/bin/pinball-lcm-spy" --print-command | grep -q "$prefix/share/pinball/java/pinball_lcmtypes.jar" \
+    || fail "the installed pinball-lcm-spy does not find the installed jar"
+elif [ -e "$prefix/share/pinball/java" ]; then
+  fail "share/pinball/java installed without a jar"
+fi
+if [ -d "$build/src/bus/python" ]; then
+  [ -f "$prefix/share/pinball/python/pinball_lcm/lcmt_pinball_game_event.py" ] || fail "python bindings not installed"
+fi
+
+cd "$work/elsewhere"
+"$prefix/bin/pinballd" --version | grep -q '^pinballd [0-9]' || fail "installed pinballd --version"
+"$prefix/bin/pinball" --version | grep -q '^pinball [0-9]' || fail "installed pinball --version"
+"$prefix/bin/pinball" --help | grep -q 'sim' || fail "installed pinball --help"
+# The board named relative to nothing here: found in the installed data, not the source tree.
+"$prefix/bin/pinball" sim boards/mit1993.board --balls 1 --json >sim.json 2>sim.err || { cat sim.err >&2; fail "installed pinball sim"; }
+grep -q "\"board\": \"$prefix/share/pinball/boards/mit1993.board\"" sim.json || { cat sim.json >&2; fail "pinball did not take the installed board"; }
+# The unit names the pinballd of this prefix.
+grep -q "^ExecStart=$prefix/bin/pinballd --config /etc/pinball/pinballd.yaml\$" "$prefix/lib/systemd/system/pinballd.service" \
+  || fail "the unit's ExecStart does not name $prefix/bin/pinballd"
+grep -q '^LimitRTPRIO=' "$prefix/lib/systemd/system/pinballd.service" || fail "the unit has no LimitRTPRIO"
+# systemd's own check, where it is installed (it needs no running systemd): any
+# complaint, an unknown key included, fails.
+if command -v systemd-analyze >/dev/null 2>&1; then
+  complaints=$(systemd-analyze verify --man=no "$prefix/lib/systemd/system/pinballd.service" 2>&1) \
+    || fail "systemd-analyze verify: $complaints"
+  [ -z "$complaints" ] || fail "systemd-analyze verify: $complaints"
+fi
+echo "install_test: installed into $prefix; the programs run from $work/elsewhere"
