@@ -71,10 +71,10 @@ for c in "${cases[@]}"; do
   fi
   "$bin/pinballd" --config "$config" --balls "$balls" --seed "$seed" --json >"$work/report$n.json" 2>"$work/pinballd.err" ||
     { cat "$work/pinballd.err" >&2; exit 1; }
-  mean=$(field mean_score "$work/report$n.json")
-  ci=$(field score_ci95 "$work/report$n.json")
+  mean=$(field mean_score_per_ball "$work/report$n.json")
+  ci=$(field score_ci95_half_width "$work/report$n.json")
   ball_s=$(field mean_ball_time_s "$work/report$n.json")
-  cut=$(field cut_balls "$work/report$n.json")
+  cut=$(field balls_cut_at_time_limit "$work/report$n.json")
   rows+=("$label|$mean|$ci|$ball_s|$cut")
   n=$((n + 1))
   elapsed=$(($(date +%s) - start))
@@ -86,7 +86,7 @@ if $json; then
   sep=""
   for r in "${rows[@]}"; do
     IFS='|' read -r label mean ci ball_s cut <<<"$r"
-    printf '%s{"case": "%s", "mean_score": %s, "score_ci95": %s, "mean_ball_time_s": %s, "cut_balls": %s}' \
+    printf '%s{"case": "%s", "mean_score_per_ball": %s, "score_ci95_half_width": %s, "mean_ball_time_s": %s, "balls_cut_at_time_limit": %s}' \
       "$sep" "$label" "$mean" "$ci" "$ball_s" "$cut"
     sep=", "
   done

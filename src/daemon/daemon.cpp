@@ -16,6 +16,7 @@
 #include "pinball/daemon/can_link_check.h"
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/controller_file.h"
+#include "pinball/core/data_path.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/core/clock.h"
 #include "pinball/daemon/doorbell.h"
@@ -35,6 +36,7 @@
 #include "driver_worker.h"
 #include "frame_handoff.h"
 #include "handoffs.h"
+#include "live_status.h"
 #include "sim_worker.h"
 #include "virtual_board_runner.h"
 
@@ -183,15 +185,6 @@ struct Daemon::Impl {
     }
   }
 };
-
-// A relative path that does not exist from the working directory is looked up
-// in the source tree the daemon was built from, so that the defaults
-// (boards/mit1993.board, controllers/best.json) work from any directory.
-std::string find_data_file(const std::string& path) {
-  if (path.empty() || path.front() == '/' || std::filesystem::exists(path)) return path;
-  const std::string in_tree = std::string(PINBALL_DATA_DIR) + "/" + path;
-  return std::filesystem::exists(in_tree) ? in_tree : path;
-}
 
 void Daemon::Impl::build() {
   sim_mode = config.mode == "sim";
@@ -571,11 +564,14 @@ DaemonReport Daemon::run() {
       });
     });
   }
+  LiveStatus live = LiveStatus::for_stderr(d.sim_mode ? d.config.sim.balls : 0, d.lockstep);
   while (!d.h.stop.load(std::memory_order_acquire) && !d.h.controller_done.load(std::memory_order_acquire)) {
     d.h.main_bell.wait(0.1);
     d.report_faults();
     if (d.stats_requested.exchange(false)) std::fputs(report_to_text(d.report()).c_str(), stderr);
+    live.tick([&d] { return d.report(); });
   }
+  live.finish();
   d.h.stop.store(true, std::memory_order_release);
   for (Doorbell* b : {&d.h.camera_bell, &d.h.controller_bell, &d.h.driver_bell, &d.h.sim_bell}) b->ring();
   if (world.joinable()) world.join();
@@ -649,10 +645,10 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["clock"] = r.mode == "sim" ? (r.lockstep ? "lockstep" : "realtime") : "steady";
   if (r.mode == "sim") j["world"] = {{"board", r.world_board}, {"stepper", r.world}};
   j["balls"] = r.balls;
-  j["mean_score"] = r.mean_score;
-  j["score_ci95"] = r.score_ci95;
+  j["mean_score_per_ball"] = r.mean_score;
+  j["score_ci95_half_width"] = r.score_ci95;
   j["mean_ball_time_s"] = r.mean_ball_time_s;
-  j["cut_balls"] = r.cut_balls;
+  j["balls_cut_at_time_limit"] = r.cut_balls;
   nlohmann::json scores = nlohmann::json::array();
   for (const simlab::SimBallResult& b : r.results) scores.push_back(b.score);
   j["ball_scores"] = scores;
