@@ -332,26 +332,6 @@ TEST_F(Cli, TrackRejectsABadObservationFileNamingTheLine) {
 
 }  // namespace
 
-namespace {
-
-// Runs `pinball args` from `cwd` (not the source tree), stdout and stderr apart.
-CommandResult run_from(const fs::path& cwd, const std::string& args) {
-  const fs::path err = cwd / "stderr.txt";
-  const std::string cmd = "cd " + cwd.string() + " && " PINBALL_EXE " " + args + " 2>" + err.string();
-  CommandResult r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0) r.out.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.err = slurp(err);
-  return r;
-}
-
-}  // namespace
-
 TEST_F(Cli, HelpShowsEveryDefault) {
   const CommandResult sim = run("sim --help");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
@@ -369,16 +349,16 @@ TEST_F(Cli, HelpShowsEveryDefault) {
 
 TEST_F(Cli, FindsTheShippedBoardsAndControllersFromAnyFolder) {
   ASSERT_FALSE(fs::exists(dir_ / "boards"));
-  const CommandResult r = run_from(dir_, "sim boards/mit1993.board --controller controllers/best.json --balls 1 "
+  const CommandResult r = run_in(dir_, "sim boards/mit1993.board --controller controllers/best.json --balls 1 "
                                          "--max-ball-time 2 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(fs::path(j.at("board").get<std::string>()), fs::path(PINBALL_SOURCE_DIR) / "boards/mit1993.board");
   EXPECT_EQ(fs::path(j.at("controller").get<std::string>()), fs::path(PINBALL_SOURCE_DIR) / "controllers/best.json");
   // bench's default --board too.
-  EXPECT_EQ(run_from(dir_, "bench ceiling --balls 1 --max-ball-time 2 --threads 1 --json").exit_code, 0);
+  EXPECT_EQ(run_in(dir_, "bench ceiling --balls 1 --max-ball-time 2 --threads 1 --json").exit_code, 0);
   // A board found nowhere is still refused, naming what was typed.
-  const CommandResult missing = run_from(dir_, "sim boards/no_such.board");
+  const CommandResult missing = run_in(dir_, "sim boards/no_such.board");
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("boards/no_such.board"), std::string::npos) << missing.err;
 }

@@ -43,9 +43,12 @@ class CommandTest : public ::testing::Test {
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
   /// Runs `pinball args` in the source directory.
-  CommandResult run(const std::string& args) {
+  CommandResult run(const std::string& args) { return run_in(PINBALL_SOURCE_DIR, args); }
+
+  /// Runs `pinball args` with `cwd` as the working directory.
+  CommandResult run_in(const std::filesystem::path& cwd, const std::string& args) {
     const std::filesystem::path err = dir_ / "stderr.txt";
-    const std::string cmd = std::string("cd " PINBALL_SOURCE_DIR " && " PINBALL_EXE " ") + args + " 2>" + err.string();
+    const std::string cmd = "cd " + cwd.string() + " && " PINBALL_EXE " " + args + " 2>" + err.string();
     CommandResult r;
     FILE* pipe = ::popen(cmd.c_str(), "r");
     if (!pipe) return r;

@@ -17,17 +17,25 @@ template <class S>
 class VTrapTest : public ::testing::Test {};
 TYPED_TEST_SUITE(VTrapTest, Steppers, StepperNames);
 
+// An empty table holding a V of two walls from `apex`, each `half_rad` off
+// the vertical, reaching 0.3 m past the height where the V is one ball wide.
+table::Board v_board(const Vec2& apex, double half_rad, double dt_s) {
+  const double wedge_h = kBallR / std::sin(half_rad);
+  table::Board b = empty_board(1.0, wedge_h + 0.5, 1.11, dt_s);
+  const double len = wedge_h + 0.3;
+  add_wall(b, apex, apex + len * Vec2{-std::sin(half_rad), std::cos(half_rad)}, 0.5);
+  add_wall(b, apex, apex + len * Vec2{std::sin(half_rad), std::cos(half_rad)}, 0.5);
+  return b;
+}
+
 TYPED_TEST(VTrapTest, BallWedgedInANarrowVNeitherSpeedsUpNorGainsEnergy) {
   using Traits = StepperTraits<TypeParam>;
   constexpr double kDt_s = 1e-3;
   for (const double opening_deg : {1.2, 0.6, 3.0}) {
     const double half = 0.5 * opening_deg * std::numbers::pi / 180.0;
     const double wedge_h = kBallR / std::sin(half);  // where the V is one ball wide, above the apex
-    table::Board b = empty_board(1.0, wedge_h + 0.5, 1.11, kDt_s);
     const Vec2 apex{0.5, 0.05};
-    const double len = wedge_h + 0.3;
-    add_wall(b, apex, apex + len * Vec2{-std::sin(half), std::cos(half)}, 0.5);
-    add_wall(b, apex, apex + len * Vec2{std::sin(half), std::cos(half)}, 0.5);
+    const table::Board b = v_board(apex, half, kDt_s);
     const auto stepper = Traits::make(b, kDt_s);
     // At rest, 0.1 mm above the wedge point: the walls are 1 µm (at 1.2°) either side.
     GameState s = state_with_ball(b, apex + Vec2{0.0, wedge_h + 1e-4}, Vec2::Zero());
@@ -65,11 +73,8 @@ TYPED_TEST(VTrapTest, BallDroppedIntoANarrowVComesToRest) {
   constexpr double kDt_s = 1e-3;
   const double half = 0.5 * 1.2 * std::numbers::pi / 180.0;
   const double wedge_h = kBallR / std::sin(half);
-  table::Board b = empty_board(1.0, wedge_h + 0.5, 1.11, kDt_s);
   const Vec2 apex{0.5, 0.05};
-  const double len = wedge_h + 0.3;
-  add_wall(b, apex, apex + len * Vec2{-std::sin(half), std::cos(half)}, 0.5);
-  add_wall(b, apex, apex + len * Vec2{std::sin(half), std::cos(half)}, 0.5);
+  const table::Board b = v_board(apex, half, kDt_s);
   const auto stepper = Traits::make(b, kDt_s);
   // Dropped 0.2 m above the wedge point, a little off the centre line: it
   // arrives at about 0.67 m/s and rattles down between the walls.
