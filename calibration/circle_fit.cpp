@@ -7,22 +7,18 @@
 
 #include <Eigen/Dense>
 
+#include "pinball/core/statistics.h"
+
 namespace pinball::calibration {
 namespace {
-
-double median_of(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 // Keeps the residuals within trim_mad robust sigmas (1.4826·MAD) of their
 // median. Returns how many are kept, or -1 when nothing changed (or all agree).
 int trim(const std::vector<double>& r, double trim_mad, std::vector<char>& keep) {
-  const double med = median_of(r);
+  const double med = median(r);
   std::vector<double> dev;
   for (const double x : r) dev.push_back(std::abs(x - med));
-  const double sigma = 1.4826 * median_of(dev);
+  const double sigma = 1.4826 * median(dev);
   if (!(sigma > 0.0)) return -1;
   bool changed = false;
   int kept = 0;

@@ -10,6 +10,8 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/core/statistics.h"
+
 namespace pinball::calibration {
 namespace {
 
@@ -29,18 +31,6 @@ Vec2 nearest(std::span<const Vec2> points, const Vec2& target, double tolerance_
                              " mm of " + what);
   }
   return *best;
-}
-
-double median_of(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
-double quantile(std::vector<double> v, double q) {
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
 }
 
 // Bilinear sample of an 8-bit image; 0 outside.
@@ -222,7 +212,7 @@ bool TipTracker::fit_centre_line(cv::Point2d& c, cv::Point2d& d, double half_len
   c += offset * n;
   d = d + slope * n;
   d *= 1.0 / cv::norm(d);
-  width_px = median_of(widths);
+  width_px = median(widths);
   return true;
 }
 
@@ -312,7 +302,7 @@ FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const table::Flip
     track.meet = meet_lines(track.blades_board, options.circle);
     std::vector<double> r;
     for (const Vec2& t : track.tips_board) r.push_back((t - track.meet.point).norm());
-    const double length = median_of(r);
+    const double length = median(r);
     double ss = 0.0;
     for (const double x : r) ss += (x - length) * (x - length);
     track.circle.centre = track.meet.point;
@@ -340,8 +330,8 @@ FlipperCalibration flipper_from_sweep_track(SweepTrack& track, const table::Flip
   if (down.empty() || up.empty() || !(hi > lo)) {
     throw std::runtime_error("flipper sweep: '" + nominal.name + "' turned less than twice the stop band");
   }
-  c.theta_min_rad = median_of(down);
-  c.theta_max_rad = median_of(up);
+  c.theta_min_rad = median(down);
+  c.theta_max_rad = median(up);
   table::Flipper f = nominal;
   f.pivot = c.pivot_m;
   f.length_m = c.length_m;

@@ -7,6 +7,8 @@
 
 #include <Eigen/Dense>
 
+#include "pinball/core/statistics.h"
+
 namespace pinball::calibration {
 namespace {
 
@@ -36,13 +38,6 @@ Quadratic fit_quadratic(std::span<const track::Observation> obs, std::size_t fir
 double eval(const Quadratic& q, double t) {
   const double tau = t - q.t0;
   return q.c(0) + tau * (q.c(1) + tau * q.c(2));
-}
-
-double median_of(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  if (v.size() % 2 == 1) return *mid;
-  return 0.5 * (*mid + *std::max_element(v.begin(), mid));
 }
 
 }  // namespace
@@ -163,10 +158,10 @@ GravityCalibration calibrate_gravity(std::span<const GravityRoll> rolls, const G
   }
   // Outliers by median/MAD, from 3 rolls on; the robust σ never falls below
   // what the rolls' own fits allow (identical rolls must not reject each other).
-  const double med = median_of(a);
+  const double med = median(a);
   std::vector<double> dev;
   for (const double x : a) dev.push_back(std::abs(x - med));
-  const double sigma = std::max(1.4826 * median_of(dev), 2.0 * median_of(se));
+  const double sigma = std::max(1.4826 * median(dev), 2.0 * median(se));
   GravityEstimate& e = out.estimate;
   e.confidence = o.confidence;
   double sum = 0.0;

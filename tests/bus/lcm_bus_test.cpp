@@ -11,6 +11,7 @@
 #include <vector>
 #include <thread>
 
+#include "common/temp_path.h"
 #include "pinball/bus/channels.h"
 
 namespace pinball::bus {
@@ -71,9 +72,6 @@ void publish_projections(LcmBus& bus, int n) {
   }
 }
 
-std::string temp_path(const std::string& name) {
-  return ::testing::TempDir() + "/lcm_bus_" + std::to_string(getpid()) + "_" + name;
-}
 
 TEST(LcmBus, FileUrlsThatWriteAreFoundAndOthersLeftToLiblcm) {
   const auto w = lcm_log_target("file:///tmp/game.lcmlog?mode=w");
@@ -91,7 +89,7 @@ TEST(LcmBus, FileUrlsThatWriteAreFoundAndOthersLeftToLiblcm) {
 }
 
 TEST(LcmBus, AFileLogHoldsEveryMessageInOrderForLiblcm) {
-  const std::string path = temp_path("all.lcmlog");
+  const std::string path = pinball::testing::temp_path("lcm_bus", "all.lcmlog");
   {
     LcmBus bus("file://" + path + "?mode=w");
     bus.start([](lcm::LCM&) {}, 1.0);
@@ -121,7 +119,7 @@ TEST(LcmBus, AFileLogHoldsEveryMessageInOrderForLiblcm) {
 // written earliest utime first, each stamped utime + the run's anchor
 // (never the moment the bus thread wrote it).
 TEST(LcmBus, AFileLogIsInUtimeOrderStampedUtimePlusTheAnchor) {
-  const std::string path = temp_path("clock.lcmlog");
+  const std::string path = pinball::testing::temp_path("lcm_bus", "clock.lcmlog");
   constexpr std::int64_t kAnchorUs = 1'700'000'000'000'000;
   {
     LcmBus bus("file://" + path + "?mode=w");

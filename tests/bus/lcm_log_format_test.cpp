@@ -9,12 +9,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/temp_path.h"
+
 namespace pinball::bus {
 namespace {
-
-std::string temp_path(const std::string& name) {
-  return ::testing::TempDir() + "/lcm_log_format_" + std::to_string(getpid()) + "_" + name;
-}
 
 void write_file(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
@@ -29,7 +27,7 @@ std::string two_events() {
 }
 
 TEST(LcmLogFormat, LiblcmReadsWhatIsWrittenHere) {
-  const std::string path = temp_path("good.lcmlog");
+  const std::string path = pinball::testing::temp_path("lcm_log_format", "good.lcmlog");
   write_file(path, two_events());
   lcm::LogFile in(path, "r");
   ASSERT_TRUE(in.good());
@@ -92,7 +90,7 @@ TEST(LcmLogFormat, TheCheckNamesTheOffsetOfEachDamage) {
       {"bad sync mid-file", bad_sync, end, "sync word 0x00A1DA01"},
   };
   for (const Case& k : cases) {
-    const std::string path = temp_path("bad.lcmlog");
+    const std::string path = pinball::testing::temp_path("lcm_log_format", "bad.lcmlog");
     write_file(path, k.bytes);
     const LcmLogCheck c = check_lcm_log(path);
     EXPECT_FALSE(c.ok) << k.name;

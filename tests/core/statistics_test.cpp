@@ -55,5 +55,13 @@ TEST(RunningStats, TheIntervalOfTwoBallsUsesStudentsT) {
   EXPECT_GT(s.ci95_half_width() / (1.96 * 1000.0), 6.4);  // the normal approximation is 6.5x too narrow
 }
 
+TEST(Statistics, TheMedianIsTheMiddleOrTheMeanOfTheTwoMiddleValues) {
+  EXPECT_EQ(median({}), 0.0);
+  EXPECT_EQ(median({3.0}), 3.0);
+  EXPECT_EQ(median({5.0, 1.0, 3.0}), 3.0);
+  EXPECT_EQ(median({4.0, 1.0, 3.0, 2.0}), 2.5);
+  EXPECT_EQ(median({1.0, 1.0, 7.0, 100.0}), 4.0);
+}
+
 }  // namespace
 }  // namespace pinball

@@ -25,6 +25,10 @@ double quantile(std::vector<T> values, double q) {
   return static_cast<double>(values[static_cast<std::size_t>(k)]);
 }
 
+/// The median of `values`: the middle value, or the mean of the two middle
+/// values for an even count (0 for none). Takes its own copy.
+double median(std::vector<double> values);
+
 /// Two-sided 95 % critical value of Student's t with `dof` degrees of freedom:
 /// 12.71 for 1, 2.23 for 10, 1.96 in the limit. Infinite for dof < 1.
 double student_t95(std::int64_t dof);
