@@ -17,6 +17,7 @@
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/core/data_path.h"
+#include "pinball/core/format.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/core/clock.h"
 #include "pinball/daemon/doorbell.h"
@@ -707,8 +708,8 @@ std::string report_to_text(const DaemonReport& r) {
   std::ostringstream o;
   o << std::fixed << std::setprecision(1);
   if (r.mode == "sim") {
-    o << "balls " << r.balls << "  mean score per ball " << r.mean_score << " ± " << r.score_ci95
-      << " (95 %)  mean ball time " << std::setprecision(2) << r.mean_ball_time_s << " s";
+    o << "balls " << r.balls << "  mean score per ball " << format_mean_ci(r.mean_score, r.score_ci95)
+      << " (95 %)  mean ball time " << format_number(r.mean_ball_time_s) << " s";
     if (r.cut_balls > 0) o << "  cut " << r.cut_balls;
     o << "\n";
   }
