@@ -1,0 +1,142 @@
+#ifndef PINBALL_FIRMWARE_CORE_BOARD_H
+#define PINBALL_FIRMWARE_CORE_BOARD_H
+/* The solenoid driver board's firmware rules (PROTOCOL.md, "Firmware rules",
+ * 1..13), implemented once in portable C11. The same code runs on the STM32
+ * board (firmware/stm32f446/), in the simulator and in every host test
+ * (VirtualDriverBoard wraps it).
+ *
+ * Fixed-size state, no heap, no floating point, deterministic: the caller
+ * owns a pbfw_board, hands it frames and the time in microseconds, and the
+ * board drives its coils through one callback (the HAL's output stage) and
+ * queues its replies in an outbox the caller drains onto the bus.
+ *
+ * Time is a signed 64-bit count of microseconds from any origin that never
+ * goes backwards (an earlier time is taken as the last one). It does not wrap
+ * in practice (292 000 years), so deadlines compare with a plain `<=`. */
+
+#include "pinball/firmware/core/wire.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef int64_t pbfw_time_us;
+
+/* Outgoing frames the board can queue between two drains. */
+#define PBFW_OUTBOX_SIZE 32u
+
+/* The output stage: called for every change of a coil's drive, at the exact
+ * time the rule says it happens (which may be earlier than the call's `now`
+ * when the caller was late: rule 13). duty_pct is 100 in a pulse, the hold
+ * duty in a hold, 0 when off. Must not call back into the board. */
+typedef void (*pbfw_set_coil_fn)(void* context, unsigned driver, pbfw_coil_state state, uint8_t duty_pct,
+                                 pbfw_time_us at_us);
+
+typedef struct pbfw_board_options {
+  uint8_t board_id;           /* 0..15: the id's low nibble */
+  uint8_t driver_count;       /* drivers fitted, 1..8 */
+  pbfw_time_us status_period_us; /* Status period (rule 12: 10 000) */
+  uint8_t fw_major, fw_minor; /* reported in HelloAck */
+  pbfw_set_coil_fn set_coil;  /* the output stage; may be NULL in tests that only read the state */
+  void* set_coil_context;
+} pbfw_board_options;
+
+/* What the board counted since pbfw_board_init (each wraps at 2^32). */
+typedef struct pbfw_board_counters {
+  uint32_t frames;                 /* frames offered */
+  uint32_t bad_frames;             /* failed to decode */
+  uint32_t bad_checksum;           /* of which CRC mismatches */
+  uint32_t version_mismatch;       /* of which wrong protocol version */
+  uint32_t foreign;                /* another board's, or a board->host kind */
+  uint32_t hellos;                 /* sessions started */
+  uint32_t fires_accepted;         /* Fires that energised a coil */
+  uint32_t refused_not_configured; /* commands before Hello / Configure */
+  uint32_t refused_not_armed;      /* Fire while the watchdog was not alive */
+  uint32_t refused_recycle;        /* Fire within the recycle time */
+  uint32_t refused_busy;           /* Fire on a driver already on */
+  uint32_t refused_locked;         /* Fire on a driver locked by its hold cap */
+  uint32_t stale;                  /* Fire / Heartbeat whose seq was not newer */
+  uint32_t pulse_clamps;           /* pulses shortened to the cap */
+  uint32_t hold_cap_trips;         /* holds ended by the cap */
+  uint32_t watchdog_trips;         /* all-off because heartbeats stopped */
+  uint32_t tx_dropped;             /* replies lost to a full outbox */
+} pbfw_board_counters;
+
+/* One driver's state. */
+typedef struct pbfw_driver {
+  pbfw_driver_config config;
+  bool configured;        /* configured in this session */
+  bool hold_after_pulse;  /* the Fire asked for mode 1 */
+  bool locked;            /* hold cap tripped: refuses Fire until Release */
+  bool has_seq;           /* last_seq is meaningful */
+  bool eos;               /* end-of-stroke switch closed */
+  bool has_been_on;       /* off_since_us is meaningful (recycle time) */
+  uint8_t state;          /* pbfw_coil_state */
+  uint8_t duty_pct;       /* 100 in a pulse, the hold duty in a hold */
+  uint16_t last_seq;      /* the driver's sequence reference (rule 9) */
+  pbfw_time_us since_us;     /* when the current state began */
+  pbfw_time_us pulse_end_us; /* when the pulse ends */
+  pbfw_time_us hold_end_us;  /* when the hold cap ends the hold */
+  pbfw_time_us off_since_us; /* when the driver last went off */
+} pbfw_driver;
+
+/* The whole board. Treat as opaque: read it through the functions below. */
+typedef struct pbfw_board {
+  pbfw_board_options options;
+  pbfw_driver drivers[PBFW_MAX_DRIVERS];
+  bool started;     /* time has been set once */
+  bool session;     /* a valid Hello arrived */
+  bool armed;       /* heartbeats arrive in time */
+  bool has_hb_seq;  /* hb_seq is meaningful */
+  bool has_seq;     /* last_seq is meaningful */
+  uint8_t fault_bits;
+  uint16_t hb_seq;      /* newest Heartbeat seq */
+  uint16_t last_seq;    /* newest seq accepted in the session */
+  uint16_t fault_count; /* faults reported since Hello */
+  pbfw_time_us watchdog_us;
+  pbfw_time_us last_heartbeat_us;
+  pbfw_time_us now_us;
+  pbfw_time_us next_status_us;
+  pbfw_frame outbox[PBFW_OUTBOX_SIZE];
+  uint8_t out_head, out_count;
+  pbfw_board_counters counters;
+} pbfw_board;
+
+/* Why pbfw_board_init refused its options. */
+typedef enum pbfw_init_error {
+  PBFW_INIT_OK = 0,
+  PBFW_INIT_BAD_BOARD_ID,     /* board_id > 15 */
+  PBFW_INIT_BAD_DRIVER_COUNT, /* driver_count outside 1..8 */
+  PBFW_INIT_BAD_STATUS_PERIOD /* status_period_us <= 0 */
+} pbfw_init_error;
+
+/* Every driver off and unconfigured, out of session. Calls no callback: the
+ * output stage is off at reset by the hardware's design (rule 1). */
+pbfw_init_error pbfw_board_init(pbfw_board* board, const pbfw_board_options* options);
+
+/* Handles one received frame at `now_us` (runs the timers up to now first). */
+void pbfw_board_on_frame(pbfw_board* board, const pbfw_frame* frame, pbfw_time_us now_us);
+
+/* Runs every timer that expired up to `now_us`, each at its own deadline and
+ * earliest first (pulse end, hold cap, watchdog), then the Status period. */
+void pbfw_board_advance(pbfw_board* board, pbfw_time_us now_us);
+
+/* The earliest time at which pbfw_board_advance has something to do (a pulse
+ * or hold ending, the watchdog, the next Status): a main loop may sleep until
+ * then or until a frame arrives. */
+pbfw_time_us pbfw_board_next_deadline(const pbfw_board* board);
+
+/* Takes the oldest queued reply (Status, Fault, HelloAck); false when none. */
+bool pbfw_board_pop_tx(pbfw_board* board, pbfw_frame* out);
+
+/* Sets driver d's end-of-stroke switch (reported in Status). */
+void pbfw_board_set_end_of_stroke(pbfw_board* board, unsigned d, bool closed);
+
+/* The Status the board would send now. */
+pbfw_status pbfw_board_status(const pbfw_board* board);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PINBALL_FIRMWARE_CORE_BOARD_H */
