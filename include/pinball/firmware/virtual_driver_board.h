@@ -1,6 +1,7 @@
 #pragma once
-// The reference solenoid driver board: the firmware rules of PROTOCOL.md
-// implemented once, exactly. A plain class with explicit time: the caller
+// The reference solenoid driver board: a thin C++ face on the firmware core
+// (include/pinball/firmware/core/board.h, portable C11), the same code the
+// STM32 board runs. A plain class with explicit time: the caller
 // hands it frames and the current time (the simulator's virtual clock, a
 // test's, or the daemon's steady clock) and reads its coil outputs. It never
 // allocates after construction and never throws on bad input; it counts.
@@ -11,6 +12,7 @@
 #include "pinball/firmware/can_transport.h"
 #include "pinball/firmware/codec.h"
 #include "pinball/firmware/coil_output.h"
+#include "pinball/firmware/core/board.h"
 
 namespace pinball::firmware {
 
@@ -54,6 +56,9 @@ class VirtualDriverBoard {
   void on_frame(const CanFrame& frame, double now_s);
   /// Runs the output timers up to `now_s`: pulse end, hold cap, watchdog, status.
   /// Time never goes backwards: an earlier now_s is treated as the last one.
+  /// The core counts whole nanoseconds: a change made by the call itself is
+  /// stamped with `now_s` exactly, one at a timer's deadline with that
+  /// nanosecond (never later than `now_s`).
   void advance(double now_s);
 
   /// Receives every frame waiting on `link`, advances to `now_s`, sends the
@@ -65,15 +70,15 @@ class VirtualDriverBoard {
   int flush(CanTransport& link);
 
   /// Driver `d`'s output now.
-  const CoilOutput& coil(int d) const { return drivers_[static_cast<std::size_t>(d)].out; }
+  const CoilOutput& coil(int d) const { return outputs_[static_cast<std::size_t>(d)]; }
   /// True when driver `d` has a configuration in this session.
-  bool configured(int d) const { return drivers_[static_cast<std::size_t>(d)].configured; }
+  bool configured(int d) const { return core_.drivers[d].configured; }
   /// Driver `d`'s configuration (meaningful when configured).
-  const DriverConfig& config(int d) const { return drivers_[static_cast<std::size_t>(d)].config; }
+  const DriverConfig& config(int d) const { return configs_[static_cast<std::size_t>(d)]; }
   /// True while heartbeats arrive in time.
-  bool armed() const { return armed_; }
+  bool armed() const { return core_.armed; }
   /// True after a valid Hello.
-  bool in_session() const { return session_; }
+  bool in_session() const { return core_.session; }
   /// Sets driver `d`'s end-of-stroke switch (the simulator: flipper at its up stop).
   void set_end_of_stroke(int d, bool closed);
   /// The Status the board would send now.
@@ -91,52 +96,23 @@ class VirtualDriverBoard {
   static constexpr int kOutboxSize = 32;
 
  private:
-  struct Driver {
-    DriverConfig config;
-    bool configured = false;
-    CoilOutput out;
-    double pulse_end_s = 0.0;  // when the pulse ends (state kPulse)
-    double hold_end_s = 0.0;   // when the hold cap ends the hold (state kHold)
-    bool hold_after_pulse = false;
-    double off_since_s = -1e300;  // for the recycle time
-    bool locked = false;          // hold cap tripped: refuses Fire until Release
-    bool has_seq = false;
-    std::uint16_t last_seq = 0;
-    bool eos = false;
-  };
-
-  void handle(const Message& m, double now_s);
-  void on_hello(const Hello& m, double now_s);
-  void on_configure(const Configure& m, double now_s);
-  void on_fire(const Fire& m, double now_s);
-  void on_release(int d, std::uint16_t seq, double now_s);
-  void on_heartbeat(const Heartbeat& m, double now_s);
-  void set_output(int d, CoilState state, double duty, double t_s);
-  void all_off(double t_s);
-  void note_seq(std::uint16_t seq);
-  void fault(FaultCode code, std::uint8_t driver, std::uint16_t detail, std::uint8_t bit);
-  void push_tx(const Payload& p);
+  static void on_core_coil(void* self, unsigned driver, pbfw_coil_state state, std::uint8_t duty_pct,
+                           pbfw_time_ns at_ns);
+  // Converts the caller's time to the core's nanoseconds and remembers both,
+  // so that a change "now" carries the caller's exact time.
+  pbfw_time_ns enter(double now_s);
+  // Copies what the core changed into the C++ views (counters, configs).
+  void sync();
 
   VirtualDriverBoardOptions options_;
-  std::array<Driver, kMaxDrivers> drivers_{};
-  bool session_ = false;
-  bool armed_ = false;
-  double watchdog_s_ = kDefaultWatchdogMs * 1e-3;
-  double last_heartbeat_s_ = 0.0;
-  bool has_hb_seq_ = false;
-  std::uint16_t hb_seq_ = 0;
-  bool has_seq_ = false;
-  std::uint16_t last_seq_ = 0;
-  std::uint8_t fault_bits_ = 0;
-  std::uint16_t fault_count_ = 0;
-  double now_s_ = 0.0;
+  pbfw_board core_{};
+  double now_s_ = 0.0;          // board time of the last call (s), never backwards
+  pbfw_time_ns now_us_ = 0;     // the same on the core's clock
   bool started_ = false;
-  double next_status_s_ = 0.0;
+  std::array<CoilOutput, kMaxDrivers> outputs_{};
+  std::array<DriverConfig, kMaxDrivers> configs_{};
   std::array<CoilListener*, kMaxListeners> listeners_{};
   int listener_count_ = 0;
-  std::array<CanFrame, kOutboxSize> outbox_{};
-  int out_head_ = 0;
-  int out_count_ = 0;
   BoardCounters counters_;
 };
 

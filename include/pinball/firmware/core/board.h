@@ -6,13 +6,15 @@
  * (VirtualDriverBoard wraps it).
  *
  * Fixed-size state, no heap, no floating point, deterministic: the caller
- * owns a pbfw_board, hands it frames and the time in microseconds, and the
+ * owns a pbfw_board, hands it frames and the time in nanoseconds, and the
  * board drives its coils through one callback (the HAL's output stage) and
  * queues its replies in an outbox the caller drains onto the bus.
  *
- * Time is a signed 64-bit count of microseconds from any origin that never
+ * Time is a signed 64-bit count of nanoseconds from any origin that never
  * goes backwards (an earlier time is taken as the last one). It does not wrap
- * in practice (292 000 years), so deadlines compare with a plain `<=`. */
+ * in practice (292 years), so deadlines compare with a plain `<=`. The board's
+ * 1 MHz timer multiplies by 1000; nanoseconds let the simulator's clock (double
+ * seconds) pass through without moving a coil's edge by a measurable amount. */
 
 #include "pinball/firmware/core/wire.h"
 
@@ -20,7 +22,7 @@
 extern "C" {
 #endif
 
-typedef int64_t pbfw_time_us;
+typedef int64_t pbfw_time_ns;
 
 /* Outgoing frames the board can queue between two drains. */
 #define PBFW_OUTBOX_SIZE 32u
@@ -30,36 +32,36 @@ typedef int64_t pbfw_time_us;
  * when the caller was late: rule 13). duty_pct is 100 in a pulse, the hold
  * duty in a hold, 0 when off. Must not call back into the board. */
 typedef void (*pbfw_set_coil_fn)(void* context, unsigned driver, pbfw_coil_state state, uint8_t duty_pct,
-                                 pbfw_time_us at_us);
+                                 pbfw_time_ns at_ns);
 
 typedef struct pbfw_board_options {
   uint8_t board_id;           /* 0..15: the id's low nibble */
   uint8_t driver_count;       /* drivers fitted, 1..8 */
-  pbfw_time_us status_period_us; /* Status period (rule 12: 10 000) */
+  pbfw_time_ns status_period_ns; /* Status period (rule 12: 10 ms = 10 000 000) */
   uint8_t fw_major, fw_minor; /* reported in HelloAck */
   pbfw_set_coil_fn set_coil;  /* the output stage; may be NULL in tests that only read the state */
   void* set_coil_context;
 } pbfw_board_options;
 
-/* What the board counted since pbfw_board_init (each wraps at 2^32). */
+/* What the board counted since pbfw_board_init (64-bit: they never wrap). */
 typedef struct pbfw_board_counters {
-  uint32_t frames;                 /* frames offered */
-  uint32_t bad_frames;             /* failed to decode */
-  uint32_t bad_checksum;           /* of which CRC mismatches */
-  uint32_t version_mismatch;       /* of which wrong protocol version */
-  uint32_t foreign;                /* another board's, or a board->host kind */
-  uint32_t hellos;                 /* sessions started */
-  uint32_t fires_accepted;         /* Fires that energised a coil */
-  uint32_t refused_not_configured; /* commands before Hello / Configure */
-  uint32_t refused_not_armed;      /* Fire while the watchdog was not alive */
-  uint32_t refused_recycle;        /* Fire within the recycle time */
-  uint32_t refused_busy;           /* Fire on a driver already on */
-  uint32_t refused_locked;         /* Fire on a driver locked by its hold cap */
-  uint32_t stale;                  /* Fire / Heartbeat whose seq was not newer */
-  uint32_t pulse_clamps;           /* pulses shortened to the cap */
-  uint32_t hold_cap_trips;         /* holds ended by the cap */
-  uint32_t watchdog_trips;         /* all-off because heartbeats stopped */
-  uint32_t tx_dropped;             /* replies lost to a full outbox */
+  uint64_t frames;                 /* frames offered */
+  uint64_t bad_frames;             /* failed to decode */
+  uint64_t bad_checksum;           /* of which CRC mismatches */
+  uint64_t version_mismatch;       /* of which wrong protocol version */
+  uint64_t foreign;                /* another board's, or a board->host kind */
+  uint64_t hellos;                 /* sessions started */
+  uint64_t fires_accepted;         /* Fires that energised a coil */
+  uint64_t refused_not_configured; /* commands before Hello / Configure */
+  uint64_t refused_not_armed;      /* Fire while the watchdog was not alive */
+  uint64_t refused_recycle;        /* Fire within the recycle time */
+  uint64_t refused_busy;           /* Fire on a driver already on */
+  uint64_t refused_locked;         /* Fire on a driver locked by its hold cap */
+  uint64_t stale;                  /* Fire / Heartbeat whose seq was not newer */
+  uint64_t pulse_clamps;           /* pulses shortened to the cap */
+  uint64_t hold_cap_trips;         /* holds ended by the cap */
+  uint64_t watchdog_trips;         /* all-off because heartbeats stopped */
+  uint64_t tx_dropped;             /* replies lost to a full outbox */
 } pbfw_board_counters;
 
 /* One driver's state. */
@@ -70,14 +72,14 @@ typedef struct pbfw_driver {
   bool locked;            /* hold cap tripped: refuses Fire until Release */
   bool has_seq;           /* last_seq is meaningful */
   bool eos;               /* end-of-stroke switch closed */
-  bool has_been_on;       /* off_since_us is meaningful (recycle time) */
+  bool has_been_on;       /* off_since_ns is meaningful (recycle time) */
   uint8_t state;          /* pbfw_coil_state */
   uint8_t duty_pct;       /* 100 in a pulse, the hold duty in a hold */
   uint16_t last_seq;      /* the driver's sequence reference (rule 9) */
-  pbfw_time_us since_us;     /* when the current state began */
-  pbfw_time_us pulse_end_us; /* when the pulse ends */
-  pbfw_time_us hold_end_us;  /* when the hold cap ends the hold */
-  pbfw_time_us off_since_us; /* when the driver last went off */
+  pbfw_time_ns since_ns;     /* when the current state began */
+  pbfw_time_ns pulse_end_ns; /* when the pulse ends */
+  pbfw_time_ns hold_end_ns;  /* when the hold cap ends the hold */
+  pbfw_time_ns off_since_ns; /* when the driver last went off */
 } pbfw_driver;
 
 /* The whole board. Treat as opaque: read it through the functions below. */
@@ -93,10 +95,10 @@ typedef struct pbfw_board {
   uint16_t hb_seq;      /* newest Heartbeat seq */
   uint16_t last_seq;    /* newest seq accepted in the session */
   uint16_t fault_count; /* faults reported since Hello */
-  pbfw_time_us watchdog_us;
-  pbfw_time_us last_heartbeat_us;
-  pbfw_time_us now_us;
-  pbfw_time_us next_status_us;
+  pbfw_time_ns watchdog_ns;
+  pbfw_time_ns last_heartbeat_ns;
+  pbfw_time_ns now_ns;
+  pbfw_time_ns next_status_ns;
   pbfw_frame outbox[PBFW_OUTBOX_SIZE];
   uint8_t out_head, out_count;
   pbfw_board_counters counters;
@@ -107,24 +109,24 @@ typedef enum pbfw_init_error {
   PBFW_INIT_OK = 0,
   PBFW_INIT_BAD_BOARD_ID,     /* board_id > 15 */
   PBFW_INIT_BAD_DRIVER_COUNT, /* driver_count outside 1..8 */
-  PBFW_INIT_BAD_STATUS_PERIOD /* status_period_us <= 0 */
+  PBFW_INIT_BAD_STATUS_PERIOD /* status_period_ns <= 0 */
 } pbfw_init_error;
 
 /* Every driver off and unconfigured, out of session. Calls no callback: the
  * output stage is off at reset by the hardware's design (rule 1). */
 pbfw_init_error pbfw_board_init(pbfw_board* board, const pbfw_board_options* options);
 
-/* Handles one received frame at `now_us` (runs the timers up to now first). */
-void pbfw_board_on_frame(pbfw_board* board, const pbfw_frame* frame, pbfw_time_us now_us);
+/* Handles one received frame at `now_ns` (runs the timers up to now first). */
+void pbfw_board_on_frame(pbfw_board* board, const pbfw_frame* frame, pbfw_time_ns now_ns);
 
-/* Runs every timer that expired up to `now_us`, each at its own deadline and
+/* Runs every timer that expired up to `now_ns`, each at its own deadline and
  * earliest first (pulse end, hold cap, watchdog), then the Status period. */
-void pbfw_board_advance(pbfw_board* board, pbfw_time_us now_us);
+void pbfw_board_advance(pbfw_board* board, pbfw_time_ns now_ns);
 
 /* The earliest time at which pbfw_board_advance has something to do (a pulse
  * or hold ending, the watchdog, the next Status): a main loop may sleep until
  * then or until a frame arrives. */
-pbfw_time_us pbfw_board_next_deadline(const pbfw_board* board);
+pbfw_time_ns pbfw_board_next_deadline(const pbfw_board* board);
 
 /* Takes the oldest queued reply (Status, Fault, HelloAck); false when none. */
 bool pbfw_board_pop_tx(pbfw_board* board, pbfw_frame* out);
