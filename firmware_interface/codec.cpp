@@ -4,20 +4,17 @@
 
 namespace pinball::firmware {
 
-// The C core and protocol.h state the same protocol; they must agree.
-static_assert(kProtocolVersion == PBFW_PROTOCOL_VERSION);
-static_assert(kMaxFrameBytes == PBFW_MAX_FRAME_BYTES && kMaxDrivers == PBFW_MAX_DRIVERS && kMaxBoards == PBFW_MAX_BOARDS);
-static_assert(kBitrate_bps == PBFW_BITRATE_BPS && kIdBase == PBFW_ID_BASE && kIdMask == PBFW_ID_MASK);
-static_assert(kAbsMaxPulseMs == PBFW_ABS_MAX_PULSE_MS && kAbsMaxHoldDutyPct == PBFW_ABS_MAX_HOLD_DUTY_PCT &&
-              kAbsMaxHoldMs == PBFW_ABS_MAX_HOLD_MS);
-static_assert(kMinWatchdogMs == PBFW_MIN_WATCHDOG_MS && kMaxWatchdogMs == PBFW_MAX_WATCHDOG_MS &&
-              kDefaultWatchdogMs == PBFW_DEFAULT_WATCHDOG_MS);
-static_assert(kBoardDriver == PBFW_BOARD_DRIVER && kSeqReferenceLag == PBFW_SEQ_REFERENCE_LAG &&
-              kMaxFaultCode == PBFW_MAX_FAULT_CODE);
+// The enums are C++'s names for the core's numbers.
 static_assert(static_cast<int>(DecodeError::kWrongVersion) == PBFW_DECODE_WRONG_VERSION &&
-              static_cast<int>(DecodeError::kBadChecksum) == PBFW_DECODE_BAD_CHECKSUM);
-static_assert(static_cast<int>(MessageKind::kHelloAck) == PBFW_HELLO_ACK && static_cast<int>(MessageKind::kFire) == PBFW_FIRE);
-static_assert(sizeof(ConfigureWire) == 8 && sizeof(FireWire) == 6 && sizeof(StatusWire) == 8);
+              static_cast<int>(DecodeError::kBadChecksum) == PBFW_DECODE_BAD_CHECKSUM &&
+              static_cast<int>(DecodeError::kErrorFrame) == PBFW_DECODE_ERROR_FRAME);
+static_assert(static_cast<int>(MessageKind::kReleaseAll) == PBFW_RELEASE_ALL &&
+              static_cast<int>(MessageKind::kFire) == PBFW_FIRE && static_cast<int>(MessageKind::kHelloAck) == PBFW_HELLO_ACK);
+static_assert(static_cast<int>(FaultCode::kWatchdogExpired) == PBFW_FAULT_WATCHDOG_EXPIRED &&
+              static_cast<int>(FaultCode::kLocked) == PBFW_FAULT_LOCKED);
+static_assert(kFaultBitWatchdog == PBFW_FAULT_BIT_WATCHDOG && kFaultBitArmed == PBFW_FAULT_BIT_ARMED &&
+              kFaultBitRefused == PBFW_FAULT_BIT_REFUSED);
+static_assert(static_cast<int>(CoilState::kHold) == PBFW_COIL_HOLD && static_cast<int>(FireMode::kPulseHold) == PBFW_PULSE_HOLD);
 
 std::uint8_t frame_crc(std::uint32_t id, std::span<const std::uint8_t> bytes) {
   return pbfw_crc8(id, bytes.data(), static_cast<unsigned>(bytes.size()));

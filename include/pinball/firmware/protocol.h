@@ -1,14 +1,13 @@
 #pragma once
-// The CAN protocol between the host and the solenoid driver boards: frame ids,
-// message kinds, limits and the packed wire structs, shared by the host
-// (DriverBus) and the reference board (VirtualDriverBoard). PROTOCOL.md is the
-// prose version of this file; the two change together.
-//
-// Byte order on the wire: every multi-byte field is little-endian and stored as
-// bytes (Le16), so the structs mean the same on every host. The last byte of
-// every frame is a CRC-8 over the 11-bit id and the bytes before it.
+// The CAN protocol between the host and the solenoid driver boards, for C++:
+// frame ids, message kinds and limits, each taken from the firmware core's C
+// header (core/wire.h), whose wire.c lays out and checks every frame. The
+// host (DriverBus) and the boards (VirtualDriverBoard, the STM32 firmware)
+// share those numbers. PROTOCOL.md is the prose version; they change together.
 
 #include <cstdint>
+
+#include "pinball/firmware/core/wire.h"
 
 namespace pinball::firmware {
 
@@ -16,22 +15,22 @@ namespace pinball::firmware {
 /// 2: Fault codes 8 (stale) and 9 (locked); a driver's sequence reference
 /// follows the session's newest (rule 9); only Release/ReleaseAll unlock a
 /// hold-capped driver (rule 6).
-inline constexpr std::uint8_t kProtocolVersion = 2;
+inline constexpr std::uint8_t kProtocolVersion = PBFW_PROTOCOL_VERSION;
 
 /// Classic CAN 2.0: at most 8 data bytes.
-inline constexpr int kMaxFrameBytes = 8;
+inline constexpr int kMaxFrameBytes = PBFW_MAX_FRAME_BYTES;
 /// Drivers (coils) on one board.
-inline constexpr int kMaxDrivers = 8;
+inline constexpr int kMaxDrivers = PBFW_MAX_DRIVERS;
 /// Boards on one bus (the low nibble of the id).
-inline constexpr int kMaxBoards = 16;
+inline constexpr int kMaxBoards = PBFW_MAX_BOARDS;
 
 /// The bus's bit rate (bit/s): every board and host on it runs at this one.
-inline constexpr std::uint32_t kBitrate_bps = 500'000;
+inline constexpr std::uint32_t kBitrate_bps = PBFW_BITRATE_BPS;
 
 /// 11-bit id layout: 0b001 KKKK BBBB (K = message kind, B = board).
-inline constexpr std::uint32_t kIdBase = 0x100;
+inline constexpr std::uint32_t kIdBase = PBFW_ID_BASE;
 /// Mask selecting the fixed bits of our ids (for receive filters).
-inline constexpr std::uint32_t kIdMask = 0x700;
+inline constexpr std::uint32_t kIdMask = PBFW_ID_MASK;
 
 /// Message kinds (the id's middle nibble). Lower ids win bus arbitration, so
 /// the commands that switch coils off come first.
@@ -55,14 +54,14 @@ constexpr std::uint32_t make_id(MessageKind kind, std::uint8_t board) {
 // ---- limits (the firmware enforces the absolute ones whatever it is told) ----
 
 /// Absolute cap on a full-power pulse (ms).
-inline constexpr std::uint8_t kAbsMaxPulseMs = 100;
+inline constexpr std::uint8_t kAbsMaxPulseMs = PBFW_ABS_MAX_PULSE_MS;
 /// Absolute cap on the hold PWM duty (percent of full power).
-inline constexpr std::uint8_t kAbsMaxHoldDutyPct = 50;
+inline constexpr std::uint8_t kAbsMaxHoldDutyPct = PBFW_ABS_MAX_HOLD_DUTY_PCT;
 /// Absolute cap on one continuous hold (ms).
-inline constexpr std::uint16_t kAbsMaxHoldMs = 10'000;
+inline constexpr std::uint16_t kAbsMaxHoldMs = PBFW_ABS_MAX_HOLD_MS;
 /// Shortest and longest heartbeat watchdog timeout a Hello may ask for (ms).
-inline constexpr std::uint16_t kMinWatchdogMs = 10;
-inline constexpr std::uint16_t kMaxWatchdogMs = 1'000;
+inline constexpr std::uint16_t kMinWatchdogMs = PBFW_MIN_WATCHDOG_MS;
+inline constexpr std::uint16_t kMaxWatchdogMs = PBFW_MAX_WATCHDOG_MS;
 
 /// Defaults for a flipper coil (MPF-like: ~30 ms pulse, ~25 % hold).
 inline constexpr std::uint8_t kDefaultPulseMs = 30;
@@ -70,7 +69,7 @@ inline constexpr std::uint8_t kDefaultMaxPulseMs = 40;
 inline constexpr std::uint8_t kDefaultHoldDutyPct = 25;
 inline constexpr std::uint16_t kDefaultMaxHoldMs = 5'000;
 inline constexpr std::uint8_t kDefaultRecycleMs = 10;
-inline constexpr std::uint16_t kDefaultWatchdogMs = 100;
+inline constexpr std::uint16_t kDefaultWatchdogMs = PBFW_DEFAULT_WATCHDOG_MS;
 
 /// Coil state of one driver as reported in Status (2 bits per driver).
 enum class CoilState : std::uint8_t {
@@ -98,7 +97,7 @@ enum class FaultCode : std::uint8_t {
   kLocked = 9,           ///< a Fire on a driver locked by its hold cap (detail: 0)
 };
 /// Largest valid FaultCode value.
-inline constexpr std::uint8_t kMaxFaultCode = 9;
+inline constexpr std::uint8_t kMaxFaultCode = PBFW_MAX_FAULT_CODE;
 
 /// Bits of Status::faults: what happened since the previous Status.
 enum FaultBits : std::uint8_t {
@@ -111,116 +110,15 @@ enum FaultBits : std::uint8_t {
   kFaultBitArmed = 1u << 7,     ///< not a fault: the watchdog is alive right now
 };
 
-// ---- wire structs ----
-
-/// A little-endian 16-bit field stored as two bytes.
-struct [[gnu::packed]] Le16 {
-  std::uint8_t lo = 0;  ///< bits 0..7
-  std::uint8_t hi = 0;  ///< bits 8..15
-  /// The value.
-  constexpr std::uint16_t get() const { return static_cast<std::uint16_t>(lo | (hi << 8)); }
-  /// The field holding `v`.
-  static constexpr Le16 of(std::uint16_t v) {
-    return Le16{static_cast<std::uint8_t>(v & 0xFF), static_cast<std::uint8_t>(v >> 8)};
-  }
-};
-static_assert(sizeof(Le16) == 2);
-
-/// Hello (host -> board), 4 bytes.
-struct [[gnu::packed]] HelloWire {
-  std::uint8_t version;  ///< kProtocolVersion
-  Le16 watchdog_ms;      ///< heartbeat timeout (ms), kMinWatchdogMs..kMaxWatchdogMs
-  std::uint8_t crc;      ///< CRC-8
-};
-static_assert(sizeof(HelloWire) == 4);
-
-/// HelloAck (board -> host), 5 bytes.
-struct [[gnu::packed]] HelloAckWire {
-  std::uint8_t version;       ///< the board's protocol version
-  std::uint8_t driver_count;  ///< drivers fitted, 1..kMaxDrivers
-  std::uint8_t fw_major;      ///< firmware version, major
-  std::uint8_t fw_minor;      ///< firmware version, minor
-  std::uint8_t crc;           ///< CRC-8
-};
-static_assert(sizeof(HelloAckWire) == 5);
-
-/// Configure one driver (host -> board), 8 bytes.
-struct [[gnu::packed]] ConfigureWire {
-  std::uint8_t driver;         ///< 0..kMaxDrivers-1
-  std::uint8_t pulse_ms;       ///< default pulse (ms), 1..max_pulse_ms
-  std::uint8_t hold_duty_pct;  ///< hold PWM duty (%), 0..kAbsMaxHoldDutyPct; 0 = no hold
-  std::uint8_t max_pulse_ms;   ///< per-driver pulse cap (ms), 1..kAbsMaxPulseMs
-  std::uint8_t recycle_ms;     ///< minimum off time before the next Fire (ms)
-  Le16 max_hold_ms;            ///< per-driver hold cap (ms), 1..kAbsMaxHoldMs
-  std::uint8_t crc;            ///< CRC-8
-};
-static_assert(sizeof(ConfigureWire) == 8);
-
-/// Fire: pulse then optionally hold (host -> board), 6 bytes.
-struct [[gnu::packed]] FireWire {
-  std::uint8_t driver;    ///< 0..kMaxDrivers-1
-  std::uint8_t mode;      ///< FireMode
-  std::uint8_t pulse_ms;  ///< pulse override (ms), 0 = configured, <= kAbsMaxPulseMs
-  Le16 seq;               ///< command sequence number
-  std::uint8_t crc;       ///< CRC-8
-};
-static_assert(sizeof(FireWire) == 6);
-
-/// Release one driver (host -> board), 4 bytes.
-struct [[gnu::packed]] ReleaseWire {
-  std::uint8_t driver;  ///< 0..kMaxDrivers-1
-  Le16 seq;             ///< command sequence number
-  std::uint8_t crc;     ///< CRC-8
-};
-static_assert(sizeof(ReleaseWire) == 4);
-
-/// Release every driver (host -> board), 3 bytes.
-struct [[gnu::packed]] ReleaseAllWire {
-  Le16 seq;           ///< command sequence number
-  std::uint8_t crc;   ///< CRC-8
-};
-static_assert(sizeof(ReleaseAllWire) == 3);
-
-/// Heartbeat (host -> board), 4 bytes.
-struct [[gnu::packed]] HeartbeatWire {
-  std::uint8_t version;  ///< kProtocolVersion
-  Le16 seq;              ///< command sequence number
-  std::uint8_t crc;      ///< CRC-8
-};
-static_assert(sizeof(HeartbeatWire) == 4);
-
-/// Status (board -> host), 8 bytes.
-struct [[gnu::packed]] StatusWire {
-  Le16 coil_states;            ///< 2 bits per driver (driver d at bits 2d..2d+1), CoilState
-  std::uint8_t end_of_stroke;  ///< bit d: driver d's end-of-stroke switch closed
-  std::uint8_t configured;     ///< bit d: driver d configured
-  std::uint8_t faults;         ///< FaultBits
-  Le16 last_seq;               ///< newest command sequence number accepted
-  std::uint8_t crc;            ///< CRC-8
-};
-static_assert(sizeof(StatusWire) == 8);
-
-/// Fault (board -> host), 7 bytes.
-struct [[gnu::packed]] FaultWire {
-  std::uint8_t code;    ///< FaultCode
-  std::uint8_t driver;  ///< driver concerned, 0xFF = the board
-  Le16 detail;          ///< code-specific (see PROTOCOL.md)
-  Le16 count;           ///< faults reported since Hello (wraps)
-  std::uint8_t crc;     ///< CRC-8
-};
-static_assert(sizeof(FaultWire) == 7);
-
 /// Driver value meaning "the whole board" in Fault frames.
-inline constexpr std::uint8_t kBoardDriver = 0xFF;
+inline constexpr std::uint8_t kBoardDriver = PBFW_BOARD_DRIVER;
 
 /// True when sequence number `a` is newer than `b` (serial-number arithmetic, RFC 1982).
-constexpr bool seq_newer(std::uint16_t a, std::uint16_t b) {
-  return static_cast<std::int16_t>(static_cast<std::uint16_t>(a - b)) > 0;
-}
+inline bool seq_newer(std::uint16_t a, std::uint16_t b) { return pbfw_seq_newer(a, b); }
 
 /// How far a driver's sequence reference may trail the newest sequence
 /// number of the session (rule 9): half of serial arithmetic's window, so
 /// that heartbeats alone can never make a later command look old.
-inline constexpr std::uint16_t kSeqReferenceLag = 1u << 14;
+inline constexpr std::uint16_t kSeqReferenceLag = PBFW_SEQ_REFERENCE_LAG;
 
 }  // namespace pinball::firmware
