@@ -15,6 +15,8 @@
  * sleep: the core's deadlines are met by polling the clock, so a pulse ends
  * at most one iteration after its deadline. */
 
+#include <stddef.h>
+
 #include "hal.h"
 #include "registers.h"
 #include "startup.h"
@@ -40,6 +42,11 @@ typedef struct board_state {
   uint32_t loops;            /* main loop iterations (wraps) */
   uint32_t max_loop_ns;      /* longest iteration since boot */
 } board_state;
+
+/* tools/qemu-boot-test.sh reads these three over QEMU's monitor. */
+_Static_assert(offsetof(board_state, output_clamps) == 24, "qemu-boot-test.sh reads output_clamps at 24");
+_Static_assert(offsetof(board_state, loops) == 28, "qemu-boot-test.sh reads loops at 28");
+_Static_assert(offsetof(board_state, max_loop_ns) == 32, "qemu-boot-test.sh reads max_loop_ns at 32");
 
 board_state g_board_state;
 static pbfw_board board;
