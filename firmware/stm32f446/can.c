@@ -123,7 +123,9 @@ bool can_init(const clock_tree* clock) {
    * retransmission, FIFO overwritten (newest kept) on overrun; frozen while
    * a debugger halts the core (DBF, the reset value). */
   CAN1->MCR = CAN_MCR_INRQ | CAN_MCR_ABOM | CAN_MCR_TXFP | CAN_MCR_DBF;
-  CAN1->BTR = bit_timing(clock->apb1_hz);
+  const uint32_t btr = bit_timing(clock->apb1_hz);
+  if (btr == 0u) return false; /* no exact 500 kbit/s: stay off the bus rather than disturb it */
+  CAN1->BTR = btr;
 
   /* Filter bank 0 (RM0390 30.7.4): 32-bit scale, mask mode, FIFO 0.
    * STID in [31:21]; IDE and RTR in the mask too, so only standard data
