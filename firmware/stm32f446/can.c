@@ -1,9 +1,10 @@
-/* bxCAN1 (RM0390 30) on PA11 (CAN1_RX) and PA12 (CAN1_TX), alternate
- * function 9 (datasheet DS10693, Table 11), to a 3.3 V transceiver (the lab's
- * board: e.g. a TJA1051T/3 or SN65HVD230 on Nucleo CN10-14 / CN10-12).
+/* bxCAN1 (RM0390, bxCAN chapter) on PA11 (CAN1_RX) and PA12 (CAN1_TX),
+ * alternate function 9 (datasheet DS10693, alternate function table), to a
+ * 3.3 V transceiver (the lab's board: e.g. a TJA1051T/3 or SN65HVD230 on
+ * Nucleo CN10-14 / CN10-12).
  *
- * Bit timing (RM0390 30.7.7): bit = 1 + BS1 + BS2 time quanta, tq = BRP /
- * PCLK1, sample point after 1 + BS1.
+ * Bit timing (RM0390, bxCAN "Bit timing"): bit = 1 + BS1 + BS2 time
+ * quanta, tq = BRP / PCLK1, sample point after 1 + BS1.
  *   PCLK1 45 MHz (HSE/PLL): BRP 5  -> tq 111 ns, 18 tq = 1 + 15 + 2,
  *                           sample point 16/18 = 88.9 %, SJW 2 tq.
  *   PCLK1 16 MHz (HSI):     BRP 2  -> tq 125 ns, 16 tq = 1 + 13 + 2,
@@ -40,8 +41,10 @@
 #define CAN_BITRATE_BPS PBFW_BITRATE_BPS
 #define RX_RING_SIZE 16u /* powers of two: the indices wrap by masking */
 #define TX_QUEUE_SIZE 16u
-#define MODE_CHANGE_TIMEOUT_NS 2000000 /* 2 ms: enter init: one frame (< 0.3 ms); leave: 11 recessive bits */
-#define RX0_PRIORITY 1u  /* NVIC: 0 highest; nothing else is enabled */
+/* Entering init waits for the frame on the bus (< 0.3 ms), leaving it for 11
+ * recessive bits: 2 ms is ample, and under the IWDG's shortest 6.8 ms. */
+#define MODE_CHANGE_TIMEOUT_NS 2000000
+#define RX0_PRIORITY 1u /* NVIC: 0 highest; nothing else is enabled */
 #define SCE_PRIORITY 2u
 
 _Static_assert((RX_RING_SIZE & (RX_RING_SIZE - 1u)) == 0u, "RX_RING_SIZE is a power of two");
@@ -113,7 +116,8 @@ bool can_init(const clock_tree* clock) {
   RCC->APB1RSTR &= ~RCC_APB1_CAN1;
 
   bool acknowledged = true;
-  /* Out of sleep (the reset state), into initialisation (RM0390 30.4.1). */
+  /* Out of sleep (the reset state), into initialisation (RM0390, bxCAN
+   * "Initialization mode"). */
   CAN1->MCR = (CAN1->MCR & ~CAN_MCR_SLEEP) | CAN_MCR_INRQ;
   if (!wait_for(&CAN1->MSR, CAN_MSR_INAK | CAN_MSR_SLAK, CAN_MSR_INAK, MODE_CHANGE_TIMEOUT_NS)) {
     ++counters.init_timeouts;
@@ -127,8 +131,8 @@ bool can_init(const clock_tree* clock) {
   if (btr == 0u) return false; /* no exact 500 kbit/s: stay off the bus rather than disturb it */
   CAN1->BTR = btr;
 
-  /* Filter bank 0 (RM0390 30.7.4): 32-bit scale, mask mode, FIFO 0.
-   * STID in [31:21]; IDE and RTR in the mask too, so only standard data
+  /* Filter bank 0 (RM0390, bxCAN "Identifier filtering"): 32-bit scale,
+   * mask mode, FIFO 0. STID in [31:21]; IDE and RTR in the mask too, so only standard data
    * frames pass. */
   CAN1->FMR |= CAN_FMR_FINIT;
   CAN1->FA1R &= ~1u;
@@ -140,8 +144,7 @@ bool can_init(const clock_tree* clock) {
   CAN1->FA1R |= 1u;
   CAN1->FMR &= ~CAN_FMR_FINIT;
 
-  CAN1->IER = CAN_IER_FMPIE0 | CAN_IER_FOVIE0 | CAN_IER_ERRIE | CAN_IER_LECIE | CAN_IER_BOFIE |
-              CAN_IER_EPVIE;
+  CAN1->IER = CAN_IER_FMPIE0 | CAN_IER_FOVIE0 | CAN_IER_ERRIE | CAN_IER_LECIE | CAN_IER_BOFIE | CAN_IER_EPVIE;
   CAN1->ESR = CAN_ESR_LEC_SOFTWARE;
   nvic_set_priority(IRQ_CAN1_RX0, RX0_PRIORITY);
   nvic_set_priority(IRQ_CAN1_SCE, SCE_PRIORITY);
@@ -173,7 +176,7 @@ static void write_le32(uint8_t* b, uint32_t v) {
  * frame that arrives meanwhile raises the interrupt again. */
 void CAN1_RX0_IRQHandler(void) {
   if (CAN1->RF0R & CAN_RF0R_FOVR0) {
-    ++counters.rx_overruns; /* ISR-only writer */
+    ++counters.rx_overruns;      /* ISR-only writer */
     CAN1->RF0R = CAN_RF0R_FOVR0; /* rc_w1; RFOM0 written 0: no release */
   }
   for (unsigned n = 0; n < 3u && (CAN1->RF0R & CAN_RF0R_FMP0_MASK) != 0u; ++n) {
@@ -251,7 +254,7 @@ void can_poll_tx(void) {
   for (unsigned n = 0; n < 3u && tx_count != 0u; ++n) {
     const uint32_t tsr = CAN1->TSR;
     if ((tsr & (CAN_TSR_TME(0u) | CAN_TSR_TME(1u) | CAN_TSR_TME(2u))) == 0u) break;
-    /* CODE: the number of an empty mailbox when any is (RM0390 30.9.2, CAN_TSR). */
+    /* CODE: the number of an empty mailbox when any is (RM0390, CAN_TSR). */
     can_tx_mailbox* box = &CAN1->TX[(tsr >> CAN_TSR_CODE_SHIFT) & 0x3u];
     const pbfw_frame* f = &tx_queue[tx_first];
     box->TDTR = f->len > PBFW_MAX_FRAME_BYTES ? PBFW_MAX_FRAME_BYTES : f->len;

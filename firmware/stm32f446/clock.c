@@ -3,17 +3,19 @@
  * MCU reset on.
  *
  * The Nucleo-F446RE feeds OSC_IN with the ST-LINK's 8 MHz MCO output (user
- * manual UM1724 6.7.1, "MCO from ST-LINK", the default solder-bridge set-up):
- * an external clock, not a crystal, hence HSE bypass (RM0390 6.2.1).
+ * manual UM1724, OSC clock "MCO from ST-LINK", the default solder bridges):
+ * an external clock, not a crystal, hence HSE bypass (RM0390, RCC "HSE
+ * clock").
  *
- * PLL (RM0390 6.2.3, 6.3.2): f_in = 8 MHz / M(4) = 2 MHz (the manual
- * recommends 2 MHz to limit jitter), VCO = 2 MHz * N(180) = 360 MHz (within
+ * PLL (RM0390, RCC "PLL" and RCC_PLLCFGR): f_in = 8 MHz / M(4) = 2 MHz (the
+ * manual recommends 2 MHz to limit jitter), VCO = 2 MHz * N(180) = 360 MHz (within
  * 100..432), SYSCLK = VCO / P(2) = 180 MHz. PLLQ = 8 (45 MHz) and PLLR = 2
  * feed only USB/SDIO and I2S/SAI, which are unused.
  *
- * 180 MHz needs voltage scale 1 with over-drive (RM0390 5.1.4) and 5 flash
- * wait states at 2.7..3.6 V (RM0390 3.4.1, Table 5). APB1 may run at most
- * 45 MHz and APB2 90 MHz (RM0390 6.2): /4 and /2.
+ * 180 MHz needs voltage scale 1 with over-drive (RM0390, PWR, over-drive)
+ * and 5 flash wait states at 2.7..3.6 V (RM0390, the flash wait-state
+ * table). APB1 may run at most 45 MHz and APB2 90 MHz (RM0390, RCC
+ * "Clocks"): /4 and /2.
  *
  * Every wait on a ready flag is bounded (CLOCK_WAIT_LOOPS). On a timeout the
  * tree goes back to the HSI and clock_tree says which step failed. QEMU does
@@ -55,7 +57,7 @@ static clock_tree fall_back_to_hsi(clock_step failed) {
   RCC->CFGR = RCC_CFGR_SW_HSI; /* all prescalers /1 */
   (void)wait_for(&RCC->CFGR, RCC_CFGR_SWS_MASK, RCC_CFGR_SWS_HSI);
   RCC->CR &= ~(RCC_CR_PLLON | RCC_CR_CSSON | RCC_CR_HSEON);
-  RCC->CR &= ~RCC_CR_HSEBYP; /* writable only with HSEON clear (RM0390 6.3.1) */
+  RCC->CR &= ~RCC_CR_HSEBYP; /* writable only with HSEON clear (RM0390, RCC_CR) */
   PWR->CR &= ~(PWR_CR_ODSWEN | PWR_CR_ODEN);
   /* 0 wait states are enough at 16 MHz; lowered after the frequency. */
   FLASH->ACR = FLASH_ACR_PRFTEN | FLASH_ACR_ICEN | FLASH_ACR_DCEN;
@@ -72,13 +74,13 @@ static clock_tree fall_back_to_hsi(clock_step failed) {
 clock_tree clock_init(void) {
   /* The power controller's clock, to select scale 1 and over-drive. The
    * read back makes the enable take effect before PWR is accessed
-   * (RM0390 6.3.13: a delay after enabling a peripheral clock). */
+   * (RM0390, RCC: a delay after enabling a peripheral clock). */
   RCC->APB1ENR |= RCC_APB1_PWR;
   (void)RCC->APB1ENR;
   /* VOS is written while the PLL is off, and takes effect when it starts. */
   PWR->CR = (PWR->CR & ~(0x3u << PWR_CR_VOS_SHIFT)) | PWR_CR_VOS_SCALE1;
 
-  /* HSE bypass: HSEBYP before HSEON (RM0390 6.3.1). */
+  /* HSE bypass: HSEBYP before HSEON (RM0390, RCC_CR). */
   RCC->CR |= RCC_CR_HSEBYP;
   RCC->CR |= RCC_CR_HSEON;
   if (!wait_for(&RCC->CR, RCC_CR_HSERDY, RCC_CR_HSERDY)) return fall_back_to_hsi(CLOCK_STEP_HSE_READY);
@@ -88,17 +90,19 @@ clock_tree clock_init(void) {
                  (PLL_Q << RCC_PLLCFGR_PLLQ_SHIFT) | (PLL_R << RCC_PLLCFGR_PLLR_SHIFT);
   RCC->CR |= RCC_CR_PLLON;
 
-  /* Over-drive, in the order RM0390 5.1.4 gives: with the PLL on, ODEN and
-   * wait ODRDY, then ODSWEN and wait ODSWRDY; then the PLL's lock. */
+  /* Over-drive, in the order RM0390 (PWR, over-drive) gives: with the PLL
+   * on, ODEN and wait ODRDY, then ODSWEN and wait ODSWRDY; then the PLL's
+   * lock. */
   PWR->CR |= PWR_CR_ODEN;
   if (!wait_for(&PWR->CSR, PWR_CSR_ODRDY, PWR_CSR_ODRDY)) return fall_back_to_hsi(CLOCK_STEP_OVERDRIVE_READY);
   PWR->CR |= PWR_CR_ODSWEN;
-  if (!wait_for(&PWR->CSR, PWR_CSR_ODSWRDY, PWR_CSR_ODSWRDY)) return fall_back_to_hsi(CLOCK_STEP_OVERDRIVE_SWITCH);
+  if (!wait_for(&PWR->CSR, PWR_CSR_ODSWRDY, PWR_CSR_ODSWRDY))
+    return fall_back_to_hsi(CLOCK_STEP_OVERDRIVE_SWITCH);
   if (!wait_for(&RCC->CR, RCC_CR_PLLRDY, RCC_CR_PLLRDY)) return fall_back_to_hsi(CLOCK_STEP_PLL_READY);
 
   /* Wait states before the frequency goes up, checked by reading back
-   * (RM0390 3.4.1); prefetch, instruction and data caches (the ART
-   * accelerator, RM0390 3.4.2) hide most of them. */
+   * (RM0390, flash read latency); prefetch, instruction and data caches
+   * (the ART accelerator, RM0390) hide most of them. */
   FLASH->ACR = FLASH_WAIT_STATES_180MHZ | FLASH_ACR_PRFTEN | FLASH_ACR_ICEN | FLASH_ACR_DCEN;
   if ((FLASH->ACR & FLASH_ACR_LATENCY_MASK) != FLASH_WAIT_STATES_180MHZ)
     return fall_back_to_hsi(CLOCK_STEP_FLASH_LATENCY);
@@ -110,9 +114,9 @@ clock_tree clock_init(void) {
   if (!wait_for(&RCC->CFGR, RCC_CFGR_SWS_MASK, RCC_CFGR_SWS_PLLP)) return fall_back_to_hsi(CLOCK_STEP_SWITCH);
 
   /* Clock security system: if the MCO clock stops, the hardware switches to
-   * HSI and raises the NMI (RM0390 6.2.7), whose handler switches the coils
-   * off and lets the IWDG reset the MCU, which then boots on this code's
-   * HSI fallback. */
+   * HSI and raises the NMI (RM0390, RCC "Clock security system"), whose
+   * handler switches the coils off and lets the IWDG reset the MCU, which
+   * then boots on this code's HSI fallback. */
   RCC->CR |= RCC_CR_CSSON;
 
   clock_tree tree = {

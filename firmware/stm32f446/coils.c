@@ -11,24 +11,25 @@
  *     6    | PB8 | TIM4_CH3 AF2  | CN10-3 (Arduino D15)
  *     7    | PB9 | TIM4_CH4 AF2  | CN10-5 (Arduino D14)
  *
- * (alternate functions: datasheet DS10693, Table 11; header pins: UM1724.)
+ * (alternate functions: datasheet DS10693, alternate function table; header
+ * pins: user manual UM1724, the Nucleo-64 morpho and Arduino connectors.)
  *
  * PWM at 20 kHz with 1 % steps: each timer counts at 2 MHz (PSC) through
  * ARR = 99, so CCR is the duty in percent, exactly, on either clock tree.
  * 20 kHz is above hearing, so a held coil does not whine; a solenoid's L/R
  * time constant (milliseconds) is far longer than the 50 us period, so the
  * current ripple is small; and the switching loss of a logic-level MOSFET
- * with a gate driver is still small at that rate. PWM mode 1 (RM0390
- * 17.3.9): the output is high while CNT < CCR, so CCR = 0 is low all the
+ * with a gate driver is still small at that rate. PWM mode 1 (RM0390,
+ * "PWM mode"): the output is high while CNT < CCR, so CCR = 0 is low all the
  * time and CCR = 100 > ARR is high all the time (a pulse).
  *
  * CCR preload is off (OCxPE = 0): a new duty, and above all 0, takes effect
  * at once rather than at the next period; the price is at most one
  * shortened or stretched period on a change, which a coil cannot notice.
  *
- * Off at reset: after any reset these pins are floating inputs
- * (RM0390 7.3.1) until coils_safe runs, and they float again while the MCU is
- * held in reset, so the board needs an external pull-down on every gate
+ * Off at reset: after any reset these pins are floating inputs (RM0390,
+ * GPIO functional description) until coils_safe runs, and they float again
+ * while the MCU is held in reset, so the board needs an external pull-down on every gate
  * (10 kOhm gate to source at the MOSFET or gate driver input): that resistor,
  * not the firmware, keeps the coils off while the MCU is in reset. The
  * firmware then drives the pins low (coils_safe) before anything else, and
@@ -49,7 +50,7 @@ static unsigned coil_channel(unsigned d) { return d & 3u; } /* 0..3 = CH1..CH4 *
 #define COIL_PINS_MASK (0xFu << 6)
 /* The 2-bit fields of pins 6..9 in MODER, PUPDR, OSPEEDR, and a value in all four. */
 #define PINS_FIELD2_MASK (0xFFu << 12)
-#define PINS_FIELD2(v) (((v) * 0x55u) << 12)
+#define PINS_FIELD2(v) (((v)*0x55u) << 12)
 
 /* Drives PC6..9 and PB6..9 low as plain push-pull outputs: the output
  * register first, so no pin ever drives high on the way. */
@@ -75,11 +76,12 @@ static void start_timer(tim_regs* timer, uint32_t apb1_bit, uint32_t timer_hz) {
   timer->PSC = timer_hz / PWM_COUNTER_HZ - 1u; /* 44 at 90 MHz, 7 at 16 MHz */
   timer->ARR = PWM_PERIOD_COUNTS - 1u;
   for (unsigned ch = 0; ch < 4u; ++ch) timer->CCR[ch] = 0u;
-  const uint32_t pwm1_both = (TIM_CCMR_OCM_PWM1 << TIM_CCMR_OCM_SHIFT(0u)) | (TIM_CCMR_OCM_PWM1 << TIM_CCMR_OCM_SHIFT(1u));
+  const uint32_t pwm1_both =
+      (TIM_CCMR_OCM_PWM1 << TIM_CCMR_OCM_SHIFT(0u)) | (TIM_CCMR_OCM_PWM1 << TIM_CCMR_OCM_SHIFT(1u));
   timer->CCMR1 = pwm1_both; /* CH1, CH2: PWM mode 1, no preload, outputs */
   timer->CCMR2 = pwm1_both; /* CH3, CH4 */
   timer->CCER = TIM_CCER_CCE(0u) | TIM_CCER_CCE(1u) | TIM_CCER_CCE(2u) | TIM_CCER_CCE(3u); /* active high */
-  timer->EGR = TIM_EGR_UG; /* load PSC now (RM0390 17.3.2) */
+  timer->EGR = TIM_EGR_UG; /* load PSC now: it is buffered (RM0390, time-base unit) */
   timer->CR1 = TIM_CR1_ARPE | TIM_CR1_CEN;
 }
 

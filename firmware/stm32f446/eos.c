@@ -5,7 +5,7 @@
  *   pin    | PC0 | PC1 | PC2 | PC3 | PC4 | PC5 | PC10 | PC11
  *
  * (PC6..PC9 are coil outputs, coils.c.) Each switch closes to ground; the
- * internal pull-up (RM0390 7.3.1, about 40 kOhm) holds an open switch high,
+ * internal pull-up (30..50 kOhm, datasheet DS10693, I/O static characteristics) holds an open switch high,
  * so a missing switch reads open. The reading is raw, not debounced: Status
  * reports it every 10 ms and the host judges it. */
 

@@ -36,7 +36,8 @@ typedef struct clock_tree {
   clock_step failed_step; /* why source is CLOCK_HSI_16MHZ, when it is */
   uint32_t sysclk_hz;     /* core and AHB clock, Hz */
   uint32_t apb1_hz;       /* PCLK1 (bxCAN), Hz */
-  uint32_t apb1_timer_hz; /* TIM2..TIM5 kernel clock, Hz: PCLK1 x2 when APB1 is divided (RM0390 6.2) */
+  uint32_t
+      apb1_timer_hz; /* TIM2..TIM5 kernel clock, Hz: PCLK1 x2 when APB1 is divided (RM0390, RCC "Clocks") */
 } clock_tree;
 
 /* Brings the core to 180 MHz from the 8 MHz HSE bypass, or leaves it on the

@@ -10,8 +10,9 @@
  *   5. the IWDG: from here a stalled loop resets the MCU within 19 ms;
  *   6. CAN, and the core (out of session, every driver off).
  *
- * The loop (one iteration: tens of microseconds, docs/results.md): frames
- * in, timers, end-of-stroke switches, frames out, IWDG refresh. It does not
+ * The loop (one iteration: a few microseconds idle, under 1 ms with 16
+ * frames to handle; docs/results.md): frames in, timers, end-of-stroke
+ * switches, frames out, IWDG refresh. It does not
  * sleep: the core's deadlines are met by polling the clock, so a pulse ends
  * at most one iteration after its deadline. */
 
@@ -34,13 +35,13 @@
 /* The platform's own health, which the protocol has no field for: read it
  * with a debugger (symbol g_board_state) on the bench. */
 typedef struct board_state {
-  clock_tree clock;          /* the clock tree in force */
-  uint32_t reset_causes;     /* RCC_CSR reset flags at this boot */
-  bool can_acknowledged;     /* bxCAN followed its mode changes at init */
-  uint8_t board_id;          /* straps or PINBALL_BOARD_ID */
-  uint32_t output_clamps;    /* coil commands the output stage had to limit (0 expected) */
-  uint32_t loops;            /* main loop iterations (wraps) */
-  uint32_t max_loop_ns;      /* longest iteration since boot */
+  clock_tree clock;       /* the clock tree in force */
+  uint32_t reset_causes;  /* RCC_CSR reset flags at this boot */
+  bool can_acknowledged;  /* bxCAN followed its mode changes at init */
+  uint8_t board_id;       /* straps or PINBALL_BOARD_ID */
+  uint32_t output_clamps; /* coil commands the output stage had to limit (0 expected) */
+  uint32_t loops;         /* main loop iterations (wraps) */
+  uint32_t max_loop_ns;   /* longest iteration since boot */
 } board_state;
 
 /* tools/qemu-boot-test.sh reads these three over QEMU's monitor. */
@@ -54,7 +55,8 @@ static pbfw_board board;
 /* The core's output stage (coils_apply). The change is applied now: at_ns
  * is when the rule says it happened, earlier than now only when the loop was
  * late, and the hardware cannot go back. */
-static void set_coil(void* context, unsigned driver, pbfw_coil_state state, uint8_t duty_pct, pbfw_time_ns at_ns) {
+static void set_coil(void* context, unsigned driver, pbfw_coil_state state, uint8_t duty_pct,
+                     pbfw_time_ns at_ns) {
   (void)context;
   (void)at_ns;
   if (!coils_apply(driver, state, duty_pct)) ++g_board_state.output_clamps;

@@ -1,7 +1,7 @@
 #ifndef PINBALL_FIRMWARE_STM32F446_REGISTERS_H
 #define PINBALL_FIRMWARE_STM32F446_REGISTERS_H
 /* The STM32F446 registers this firmware touches, and only those, written
- * from the reference manual RM0390 (Rev 6) and the Cortex-M4 generic user
+ * from the reference manual RM0390 and the Cortex-M4 generic user
  * guide (ARM DUI 0553). No vendor header is copied: each block is a struct
  * of volatile 32-bit words laid out as the manual's register map, its
  * offsets checked at compile time, and each bit we use is named after the
@@ -9,7 +9,7 @@
  *
  * Every access goes through a volatile lvalue, so the compiler neither
  * drops, merges nor reorders register accesses (C11 5.1.2.3p6). The
- * addresses come from RM0390 section 2.2.2, Table 1 (memory map). */
+ * addresses come from RM0390's memory map (Memory and bus architecture). */
 
 #include <stddef.h>
 #include <stdint.h>
@@ -18,27 +18,27 @@ typedef volatile uint32_t reg32;
 
 #define REG_CHECK(type, field, offset) _Static_assert(offsetof(type, field) == (offset), #type "." #field)
 
-/* ---- RCC: reset and clock control (RM0390 6.3, map 6.3.28) ---- */
+/* ---- RCC: reset and clock control (RM0390, RCC registers) ---- */
 typedef struct rcc_regs {
-  reg32 CR;          /* 0x00 6.3.1 */
-  reg32 PLLCFGR;     /* 0x04 6.3.2 */
-  reg32 CFGR;        /* 0x08 6.3.3 */
-  reg32 CIR;         /* 0x0C 6.3.4 */
-  reg32 AHB1RSTR;    /* 0x10 */
-  reg32 AHB2RSTR;    /* 0x14 */
-  reg32 AHB3RSTR;    /* 0x18 */
-  reg32 reserved0;   /* 0x1C */
-  reg32 APB1RSTR;    /* 0x20 6.3.8 */
-  reg32 APB2RSTR;    /* 0x24 */
-  reg32 reserved1[2];
-  reg32 AHB1ENR;     /* 0x30 6.3.10 */
-  reg32 AHB2ENR;     /* 0x34 */
-  reg32 AHB3ENR;     /* 0x38 */
-  reg32 reserved2;
-  reg32 APB1ENR;     /* 0x40 6.3.13 */
-  reg32 APB2ENR;     /* 0x44 */
-  reg32 reserved3[11];
-  reg32 CSR;         /* 0x74 6.3.21 */
+  reg32 CR;            /* 0x00 */
+  reg32 PLLCFGR;       /* 0x04 */
+  reg32 CFGR;          /* 0x08 */
+  reg32 CIR;           /* 0x0C */
+  reg32 AHB1RSTR;      /* 0x10 */
+  reg32 AHB2RSTR;      /* 0x14 */
+  reg32 AHB3RSTR;      /* 0x18 */
+  reg32 reserved0;     /* 0x1C */
+  reg32 APB1RSTR;      /* 0x20 */
+  reg32 APB2RSTR;      /* 0x24 */
+  reg32 reserved1[2];  /* 0x28 */
+  reg32 AHB1ENR;       /* 0x30 */
+  reg32 AHB2ENR;       /* 0x34 */
+  reg32 AHB3ENR;       /* 0x38 */
+  reg32 reserved2;     /* 0x3C */
+  reg32 APB1ENR;       /* 0x40 */
+  reg32 APB2ENR;       /* 0x44 */
+  reg32 reserved3[11]; /* 0x48 */
+  reg32 CSR;           /* 0x74 */
 } rcc_regs;
 REG_CHECK(rcc_regs, AHB1ENR, 0x30);
 REG_CHECK(rcc_regs, APB1ENR, 0x40);
@@ -96,10 +96,10 @@ REG_CHECK(rcc_regs, CSR, 0x74);
 #define RCC_CSR_WWDGRSTF (1u << 30)
 #define RCC_CSR_LPWRRSTF (1u << 31)
 
-/* ---- PWR: power controller (RM0390 5.4) ---- */
+/* ---- PWR: power controller (RM0390, PWR registers) ---- */
 typedef struct pwr_regs {
-  reg32 CR;  /* 0x00 5.4.1 */
-  reg32 CSR; /* 0x04 5.4.2 */
+  reg32 CR;  /* 0x00 */
+  reg32 CSR; /* 0x04 */
 } pwr_regs;
 #define PWR ((pwr_regs*)0x40007000u)
 
@@ -111,9 +111,9 @@ typedef struct pwr_regs {
 #define PWR_CSR_ODRDY (1u << 16)
 #define PWR_CSR_ODSWRDY (1u << 17)
 
-/* ---- FLASH interface (RM0390 3.8) ---- */
+/* ---- FLASH interface (RM0390, flash interface registers) ---- */
 typedef struct flash_regs {
-  reg32 ACR; /* 0x00 3.8.1 */
+  reg32 ACR; /* 0x00 */
 } flash_regs;
 #define FLASH ((flash_regs*)0x40023C00u)
 
@@ -122,17 +122,17 @@ typedef struct flash_regs {
 #define FLASH_ACR_ICEN (1u << 9)
 #define FLASH_ACR_DCEN (1u << 10)
 
-/* ---- GPIO (RM0390 7.4, map 7.4.11) ---- */
+/* ---- GPIO (RM0390, GPIO registers) ---- */
 typedef struct gpio_regs {
-  reg32 MODER;   /* 0x00 7.4.1: 2 bits a pin, 00 input 01 output 10 AF 11 analog */
-  reg32 OTYPER;  /* 0x04 7.4.2: 0 push-pull */
-  reg32 OSPEEDR; /* 0x08 7.4.3 */
-  reg32 PUPDR;   /* 0x0C 7.4.4: 00 none 01 pull-up 10 pull-down */
-  reg32 IDR;     /* 0x10 7.4.5 */
-  reg32 ODR;     /* 0x14 7.4.6 */
-  reg32 BSRR;    /* 0x18 7.4.7: low half sets, high half resets, atomically */
-  reg32 LCKR;    /* 0x1C 7.4.8 */
-  reg32 AFR[2];  /* 0x20, 0x24 7.4.9-10: 4 bits a pin */
+  reg32 MODER;   /* 0x00: 2 bits a pin, 00 input 01 output 10 AF 11 analog */
+  reg32 OTYPER;  /* 0x04: 0 push-pull */
+  reg32 OSPEEDR; /* 0x08 */
+  reg32 PUPDR;   /* 0x0C: 00 none 01 pull-up 10 pull-down */
+  reg32 IDR;     /* 0x10 */
+  reg32 ODR;     /* 0x14 */
+  reg32 BSRR;    /* 0x18: low half sets, high half resets, atomically */
+  reg32 LCKR;    /* 0x1C */
+  reg32 AFR[2];  /* 0x20, 0x24: 4 bits a pin */
 } gpio_regs;
 REG_CHECK(gpio_regs, BSRR, 0x18);
 REG_CHECK(gpio_regs, AFR, 0x20);
@@ -148,26 +148,26 @@ REG_CHECK(gpio_regs, AFR, 0x20);
 #define GPIO_PULL_DOWN 0x2u
 #define GPIO_SPEED_MEDIUM 0x1u
 #define GPIO_SPEED_HIGH 0x2u
-#define GPIO_AF2_TIM3_4_5 2u /* datasheet DS10693 Table 11 */
+#define GPIO_AF2_TIM3_4_5 2u /* datasheet DS10693, alternate function table */
 #define GPIO_AF9_CAN1 9u
 
-/* ---- TIM2..TIM5: general-purpose timers (RM0390 17.4, map 17.4.21).
+/* ---- TIM2..TIM5: general-purpose timers (RM0390, TIM2 to TIM5 registers).
  * TIM2 and TIM5 count 32 bits, TIM3 and TIM4 16 bits. ---- */
 typedef struct tim_regs {
-  reg32 CR1;   /* 0x00 17.4.1 */
+  reg32 CR1;   /* 0x00 */
   reg32 CR2;   /* 0x04 */
   reg32 SMCR;  /* 0x08 */
   reg32 DIER;  /* 0x0C */
   reg32 SR;    /* 0x10 */
-  reg32 EGR;   /* 0x14 17.4.6 */
-  reg32 CCMR1; /* 0x18 17.4.7 */
-  reg32 CCMR2; /* 0x1C 17.4.8 */
-  reg32 CCER;  /* 0x20 17.4.9 */
-  reg32 CNT;   /* 0x24 17.4.10 */
-  reg32 PSC;   /* 0x28 17.4.11 */
-  reg32 ARR;   /* 0x2C 17.4.12 */
+  reg32 EGR;   /* 0x14 */
+  reg32 CCMR1; /* 0x18 */
+  reg32 CCMR2; /* 0x1C */
+  reg32 CCER;  /* 0x20 */
+  reg32 CNT;   /* 0x24 */
+  reg32 PSC;   /* 0x28 */
+  reg32 ARR;   /* 0x2C */
   reg32 reserved0;
-  reg32 CCR[4]; /* 0x34..0x40 17.4.14-17 */
+  reg32 CCR[4]; /* 0x34..0x40 */
 } tim_regs;
 REG_CHECK(tim_regs, CNT, 0x24);
 REG_CHECK(tim_regs, CCR, 0x34);
@@ -181,19 +181,19 @@ REG_CHECK(tim_regs, CCR, 0x34);
 #define TIM_EGR_UG (1u << 0)
 #define TIM_SR_UIF (1u << 0)
 /* CCMRx output compare: channel 2k+1 in bits [7:0], channel 2k+2 in [15:8]. */
-#define TIM_CCMR_OCM_PWM1 0x6u /* OCxM = 110: active while CNT < CCRx */
-#define TIM_CCMR_OCM_FORCE_INACTIVE 0x4u /* OCxM = 100 */
-#define TIM_CCMR_OCM_SHIFT(ch) (((ch) & 1u) ? 12u : 4u) /* ch 0..3 */
-#define TIM_CCMR_OCPE(ch) (((ch) & 1u) ? (1u << 11) : (1u << 3))
-#define TIM_CCER_CCE(ch) (1u << (4u * (ch)))   /* CCxE */
+#define TIM_CCMR_OCM_PWM1 0x6u                        /* OCxM = 110: active while CNT < CCRx */
+#define TIM_CCMR_OCM_FORCE_INACTIVE 0x4u              /* OCxM = 100 */
+#define TIM_CCMR_OCM_SHIFT(ch) (((ch)&1u) ? 12u : 4u) /* ch 0..3 */
+#define TIM_CCMR_OCPE(ch) (((ch)&1u) ? (1u << 11) : (1u << 3))
+#define TIM_CCER_CCE(ch) (1u << (4u * (ch)))      /* CCxE */
 #define TIM_CCER_CCP(ch) (1u << (4u * (ch) + 1u)) /* CCxP: 0 active high */
 
-/* ---- IWDG: independent watchdog (RM0390 19.4) ---- */
+/* ---- IWDG: independent watchdog (RM0390, IWDG registers) ---- */
 typedef struct iwdg_regs {
-  reg32 KR;  /* 0x00 19.4.1 */
-  reg32 PR;  /* 0x04 19.4.2: [2:0] 0 = /4 .. 6 = /256 */
-  reg32 RLR; /* 0x08 19.4.3: [11:0] */
-  reg32 SR;  /* 0x0C 19.4.4 */
+  reg32 KR;  /* 0x00 */
+  reg32 PR;  /* 0x04: [2:0] 0 = /4 .. 6 = /256 */
+  reg32 RLR; /* 0x08: [11:0] */
+  reg32 SR;  /* 0x0C */
 } iwdg_regs;
 #define IWDG ((iwdg_regs*)0x40003000u)
 
@@ -203,9 +203,9 @@ typedef struct iwdg_regs {
 #define IWDG_SR_PVU (1u << 0)
 #define IWDG_SR_RVU (1u << 1)
 
-/* ---- bxCAN1 (RM0390 30.9, map 30.9.5) ---- */
+/* ---- bxCAN1 (RM0390, bxCAN registers) ---- */
 typedef struct can_tx_mailbox {
-  reg32 TIR;  /* 30.9.3: STID [31:21], IDE 2, RTR 1, TXRQ 0 */
+  reg32 TIR;  /* STID [31:21], IDE 2, RTR 1, TXRQ 0 */
   reg32 TDTR; /* DLC [3:0] */
   reg32 TDLR; /* data bytes 0..3, byte 0 in [7:0] */
   reg32 TDHR; /* data bytes 4..7 */
@@ -217,7 +217,7 @@ typedef struct can_rx_fifo {
   reg32 RDHR;
 } can_rx_fifo;
 typedef struct can_regs {
-  reg32 MCR;  /* 0x000 30.9.2 */
+  reg32 MCR;  /* 0x000 */
   reg32 MSR;  /* 0x004 */
   reg32 TSR;  /* 0x008 */
   reg32 RF0R; /* 0x00C */
@@ -229,14 +229,14 @@ typedef struct can_regs {
   can_tx_mailbox TX[3]; /* 0x180 */
   can_rx_fifo RX[2];    /* 0x1B0 */
   reg32 reserved1[12];
-  reg32 FMR;   /* 0x200 30.9.4 */
-  reg32 FM1R;  /* 0x204 */
-  reg32 reserved2;
-  reg32 FS1R;  /* 0x20C */
+  reg32 FMR;       /* 0x200 */
+  reg32 FM1R;      /* 0x204 */
+  reg32 reserved2; /* 0x3C */
+  reg32 FS1R;      /* 0x20C */
   reg32 reserved3;
   reg32 FFA1R; /* 0x214 */
   reg32 reserved4;
-  reg32 FA1R;  /* 0x21C */
+  reg32 FA1R; /* 0x21C */
   reg32 reserved5[8];
   reg32 FR[28][2]; /* 0x240: bank i's FR1, FR2 */
 } can_regs;
@@ -279,10 +279,10 @@ REG_CHECK(can_regs, FR, 0x240);
 #define CAN_ESR_LEC_SHIFT 4u
 #define CAN_ESR_LEC_MASK (0x7u << 4)
 #define CAN_ESR_LEC_SOFTWARE (0x7u << 4) /* "set by software": no new error since */
-#define CAN_BTR_BRP_SHIFT 0u  /* [9:0]  prescaler - 1 */
-#define CAN_BTR_TS1_SHIFT 16u /* [19:16] tBS1 - 1 */
-#define CAN_BTR_TS2_SHIFT 20u /* [22:20] tBS2 - 1 */
-#define CAN_BTR_SJW_SHIFT 24u /* [25:24] tSJW - 1 */
+#define CAN_BTR_BRP_SHIFT 0u             /* [9:0]  prescaler - 1 */
+#define CAN_BTR_TS1_SHIFT 16u            /* [19:16] tBS1 - 1 */
+#define CAN_BTR_TS2_SHIFT 20u            /* [22:20] tBS2 - 1 */
+#define CAN_BTR_SJW_SHIFT 24u            /* [25:24] tSJW - 1 */
 #define CAN_ID_STID_SHIFT 21u
 #define CAN_ID_IDE (1u << 2)
 #define CAN_ID_RTR (1u << 1)
@@ -293,10 +293,10 @@ REG_CHECK(can_regs, FR, 0x240);
 typedef struct scb_regs {
   reg32 CPUID; /* 0xE000ED00 */
   reg32 ICSR;
-  reg32 VTOR;  /* 0xE000ED08 */
+  reg32 VTOR; /* 0xE000ED08 */
   reg32 AIRCR;
   reg32 SCR;
-  reg32 CCR;   /* 0xE000ED14 */
+  reg32 CCR; /* 0xE000ED14 */
   reg32 SHPR[3];
   reg32 SHCSR; /* 0xE000ED24 */
   reg32 CFSR;  /* 0xE000ED28 */
@@ -313,14 +313,14 @@ REG_CHECK(scb_regs, CFSR, 0x28);
 #define SCB_SHCSR_USGFAULTENA (1u << 18)
 
 typedef struct nvic_regs {
-  reg32 ISER[8];  /* 0xE000E100 */
+  reg32 ISER[8]; /* 0xE000E100 */
   reg32 reserved0[24];
-  reg32 ICER[8];  /* 0xE000E180 */
+  reg32 ICER[8]; /* 0xE000E180 */
   reg32 reserved1[24];
-  reg32 ISPR[8];  /* 0xE000E200 */
+  reg32 ISPR[8]; /* 0xE000E200 */
   reg32 reserved2[24];
-  reg32 ICPR[8];  /* 0xE000E280 */
-  reg32 reserved3[88]; /* IABR at 0x200 is not used */
+  reg32 ICPR[8];             /* 0xE000E280 */
+  reg32 reserved3[88];       /* IABR at 0x200 is not used */
   volatile uint8_t IPR[240]; /* 0xE000E400: 8 bits a line, the STM32 implements the top 4 */
 } nvic_regs;
 REG_CHECK(nvic_regs, ICER, 0x80);
@@ -328,21 +328,23 @@ REG_CHECK(nvic_regs, IPR, 0x300);
 #define NVIC ((nvic_regs*)0xE000E100u)
 
 typedef struct systick_regs {
-  reg32 CSR;   /* 0xE000E010 */
+  reg32 CSR; /* 0xE000E010 */
   reg32 RVR;
   reg32 CVR;
   reg32 CALIB;
 } systick_regs;
 #define SYSTICK ((systick_regs*)0xE000E010u)
 
-/* STM32F446 interrupt lines (RM0390 10.2, Table 38). */
+/* STM32F446 interrupt lines (RM0390, Interrupts and events: vector table). */
 #define IRQ_CAN1_RX0 20u
 #define IRQ_CAN1_SCE 22u
 #define IRQ_COUNT 97u
 
 static inline void nvic_enable(unsigned irq) { NVIC->ISER[irq >> 5] = 1u << (irq & 31u); }
 static inline void nvic_disable(unsigned irq) { NVIC->ICER[irq >> 5] = 1u << (irq & 31u); }
-static inline void nvic_set_priority(unsigned irq, uint8_t priority) { NVIC->IPR[irq] = (uint8_t)(priority << 4); }
+static inline void nvic_set_priority(unsigned irq, uint8_t priority) {
+  NVIC->IPR[irq] = (uint8_t)(priority << 4);
+}
 
 /* Interrupts masked / unmasked (PRIMASK), with the compiler barrier that keeps
  * memory accesses on their side of it. */

@@ -88,7 +88,8 @@ static unsigned event_count;
 static uint32_t output_clamps;
 
 /* The output stage as main.c wires it, and a log of every call. */
-static void set_coil_logged(void* context, unsigned d, pbfw_coil_state state, uint8_t duty_pct, pbfw_time_ns at_ns) {
+static void set_coil_logged(void* context, unsigned d, pbfw_coil_state state, uint8_t duty_pct,
+                            pbfw_time_ns at_ns) {
   (void)context;
   if (!coils_apply(d, state, duty_pct)) ++output_clamps;
   if (event_count < MAX_EVENTS) {
@@ -98,7 +99,8 @@ static void set_coil_logged(void* context, unsigned d, pbfw_coil_state state, ui
 }
 
 /* The output stage exactly as main.c wires it (no log): for the counts. */
-static void set_coil_plain(void* context, unsigned d, pbfw_coil_state state, uint8_t duty_pct, pbfw_time_ns at_ns) {
+static void set_coil_plain(void* context, unsigned d, pbfw_coil_state state, uint8_t duty_pct,
+                           pbfw_time_ns at_ns) {
   (void)context;
   (void)at_ns;
   if (!coils_apply(d, state, duty_pct)) ++output_clamps;
@@ -161,8 +163,8 @@ static pbfw_frame hello_frame(uint8_t version, uint16_t watchdog_ms) {
   return encode(m);
 }
 
-static pbfw_frame configure_frame(uint8_t d, uint8_t pulse_ms, uint8_t hold_pct, uint8_t max_pulse_ms, uint8_t recycle_ms,
-                                  uint16_t max_hold_ms) {
+static pbfw_frame configure_frame(uint8_t d, uint8_t pulse_ms, uint8_t hold_pct, uint8_t max_pulse_ms,
+                                  uint8_t recycle_ms, uint16_t max_hold_ms) {
   pbfw_message m = {.kind = PBFW_CONFIGURE};
   m.u.configure.driver = d;
   m.u.configure.config.pulse_ms = pulse_ms;
@@ -268,8 +270,9 @@ static void check_outputs(const char* what) {
   for (unsigned d = 0; d < COIL_COUNT; ++d) {
     const uint8_t hw = coils_duty(d);
     const unsigned core_state = (s.coil_states >> (2u * d)) & 3u;
-    const uint8_t core_duty =
-        core_state == PBFW_COIL_PULSE ? 100u : core_state == PBFW_COIL_HOLD ? board.drivers[d].duty_pct : 0u;
+    const uint8_t core_duty = core_state == PBFW_COIL_PULSE  ? 100u
+                              : core_state == PBFW_COIL_HOLD ? board.drivers[d].duty_pct
+                                                             : 0u;
     if (hw == expected_duty[d] && hw == core_duty) continue;
     text_line l;
     line_start(&l);
@@ -405,7 +408,8 @@ static void rules(void) {
 
   step("a late main loop: the pulse still ends at its own deadline (rule 13)");
   advance_to(t5 + 70 * MS); /* the pulse (20 ms) ended at t5 + 50 ms */
-  check(has_event(5, PBFW_COIL_OFF, 0, t5 + 50 * MS), "set_coil(5, off) stamped at the deadline, not at the late call");
+  check(has_event(5, PBFW_COIL_OFF, 0, t5 + 50 * MS),
+        "set_coil(5, off) stamped at the deadline, not at the late call");
   expected_duty[5] = 0u;
   check_outputs("driver 5 at 0 %");
 
@@ -425,12 +429,14 @@ static void rules(void) {
 
   step("heartbeats stop: every coil off at the watchdog deadline (rule 4)");
   advance_to(t5 + 130 * MS); /* late again */
-  check(has_event(0, PBFW_COIL_OFF, 0, t5 + 100 * MS), "set_coil(0, off) at exactly 100 ms after the last Heartbeat");
+  check(has_event(0, PBFW_COIL_OFF, 0, t5 + 100 * MS),
+        "set_coil(0, off) at exactly 100 ms after the last Heartbeat");
   check_fault("Fault 1 watchdog", PBFW_FAULT_WATCHDOG_EXPIRED, 100);
   expected_duty[0] = 0u;
   check_outputs("every output at 0 %");
   st = last_reply(PBFW_STATUS);
-  check(st != NULL && (st->u.status.faults & PBFW_FAULT_BIT_WATCHDOG) && !(st->u.status.faults & PBFW_FAULT_BIT_ARMED),
+  check(st != NULL && (st->u.status.faults & PBFW_FAULT_BIT_WATCHDOG) &&
+            !(st->u.status.faults & PBFW_FAULT_BIT_ARMED),
         "Status: watchdog bit set, armed bit clear");
 
   step("Fire after the watchdog expired is refused (rule 3)");
@@ -770,7 +776,8 @@ int main(void) {
   text_line l;
   line_start(&l);
   line_text(&l, "clock: ");
-  line_text(&l, clock.source == CLOCK_HSE_PLL_180MHZ ? "HSE/PLL 180 MHz" : "HSI 16 MHz fallback, failed step ");
+  line_text(&l,
+            clock.source == CLOCK_HSE_PLL_180MHZ ? "HSE/PLL 180 MHz" : "HSI 16 MHz fallback, failed step ");
   if (clock.source != CLOCK_HSE_PLL_180MHZ) line_u32(&l, (uint32_t)clock.failed_step);
   line_write(&l);
 

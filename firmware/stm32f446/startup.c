@@ -2,10 +2,11 @@
  * Reset_Handler (C runtime set-up, then main) and the one handler every
  * unexpected exception or interrupt lands in.
  *
- * The vector table layout is the Cortex-M4's 16 system entries (ARM DUI 0553,
- * 2.3.4) followed by the STM32F446's 97 interrupt lines (RM0390 10.2,
- * Table 38). Only the lines this firmware enables have their own handler; a
- * strong definition elsewhere (can.c) replaces the weak alias below.
+ * The vector table layout is the Cortex-M4's 16 system entries (ARM DUI
+ * 0553, "Vector table") followed by the STM32F446's 97 interrupt lines
+ * (RM0390, Interrupts and events: the vector table). Only the lines this
+ * firmware enables have their own handler; a strong definition elsewhere
+ * (can.c) replaces the weak alias below.
  *
  * No floating point is used (-mfloat-abi=soft), so the FPU stays off and
  * exception entry never stacks its registers. */
@@ -28,7 +29,8 @@ int main(void);
  * reset state is every coil off too (coils.c). Started here if main had not
  * started it yet: a fault before iwdg_start still ends in a reset, at the
  * IWDG's reset timeout (4096 / (32 kHz / 4) = 512 ms nominal). Writing the
- * start key to a running IWDG changes nothing (RM0390 19.3.2). */
+ * start key to a running IWDG changes nothing (RM0390, IWDG functional
+ * description). */
 void Default_Handler(void) {
   coils_emergency_off();
   IWDG->KR = IWDG_KR_START;
@@ -60,8 +62,9 @@ typedef void (*vector)(void);
 #define D10 D4, D4, D2
 
 /* Placed at 0x08000000 by the linker script (.isr_vector), the address the
- * MCU boots from with BOOT0 low (RM0390 2.4), aliased at 0. Every line has a
- * handler, so a stray interrupt lands in Default_Handler, not at address 0. */
+ * MCU boots from with BOOT0 low (RM0390, boot configuration), aliased at 0.
+ * Every line has a handler, so a stray interrupt lands in Default_Handler,
+ * not at address 0. */
 __attribute__((section(".isr_vector"), used)) const vector vector_table[] = {
     (vector)(uintptr_t)_estack,
     Reset_Handler,

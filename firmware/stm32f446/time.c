@@ -1,5 +1,5 @@
-/* The monotonic clock: TIM2, a 32-bit general-purpose timer (RM0390 17.1),
- * counting up at 1 MHz from reset to 0xFFFFFFFF and around, extended in
+/* The monotonic clock: TIM2, a 32-bit general-purpose timer (RM0390, TIM2
+ * to TIM5), counting up at 1 MHz from reset to 0xFFFFFFFF and around, extended in
  * software to 64 bits and handed to the core in its unit, nanoseconds.
  *
  * No interrupt: the count wraps every 2^32 us (71.6 min), and time_ns adds
@@ -24,11 +24,12 @@ void time_init(const clock_tree* clock) {
   RCC->APB1RSTR &= ~RCC_APB1_TIM2;
 
   /* 90 MHz / 90 or 16 MHz / 16: PSC holds the divider minus one
-   * (RM0390 17.4.11); both trees give an exact 1 MHz. */
+   * (RM0390, TIMx_PSC); both trees give an exact 1 MHz. */
   TIM2->PSC = clock->apb1_timer_hz / TIME_TICK_HZ - 1u;
   TIM2->ARR = 0xFFFFFFFFu;
-  /* PSC is preloaded: the update event generated here loads it now instead of
-   * at the first overflow (RM0390 17.3.2), and zeroes the counter. */
+  /* PSC is buffered (RM0390, time-base unit): the update event generated
+   * here loads it now instead of at the first overflow, and zeroes the
+   * counter. */
   TIM2->EGR = TIM_EGR_UG;
   TIM2->SR = 0u;
   TIM2->CR1 = TIM_CR1_CEN;
