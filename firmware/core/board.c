@@ -46,9 +46,14 @@ static void push_tx(pbfw_board* b, const pbfw_message* m) {
   ++b->out_count;
 }
 
-bool pbfw_board_pop_tx(pbfw_board* b, pbfw_frame* out) {
+bool pbfw_board_peek_tx(const pbfw_board* b, pbfw_frame* out) {
   if (b->out_count == 0) return false;
   *out = b->outbox[b->out_head];
+  return true;
+}
+
+bool pbfw_board_pop_tx(pbfw_board* b, pbfw_frame* out) {
+  if (!pbfw_board_peek_tx(b, out)) return false;
   b->out_head = (uint8_t)((b->out_head + 1u) % PBFW_OUTBOX_SIZE);
   --b->out_count;
   return true;

@@ -128,6 +128,9 @@ void pbfw_board_advance(pbfw_board* board, pbfw_time_ns now_ns);
  * then or until a frame arrives. */
 pbfw_time_ns pbfw_board_next_deadline(const pbfw_board* board);
 
+/* Copies the oldest queued reply without taking it; false when none. */
+bool pbfw_board_peek_tx(const pbfw_board* board, pbfw_frame* out);
+
 /* Takes the oldest queued reply (Status, Fault, HelloAck); false when none. */
 bool pbfw_board_pop_tx(pbfw_board* board, pbfw_frame* out);
 
