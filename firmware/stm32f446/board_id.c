@@ -8,7 +8,7 @@
  * A build may fix the id instead (cmake -DPINBALL_BOARD_ID=n), for a board
  * without straps; the straps are then not read. */
 
-#include "hal.h"
+#include "drivers.h"
 #include "registers.h"
 
 #ifdef PINBALL_BOARD_ID

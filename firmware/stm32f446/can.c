@@ -22,25 +22,23 @@
  * ring at once; the main loop drains the ring. A frame the hardware FIFO or
  * the ring could not keep is counted.
  *
- * Transmit: the core's replies go into a 16-frame software queue and from
- * there into the three TX mailboxes, transmitted in the order requested
- * (TXFP). When the queue is full the oldest frame is dropped and counted:
- * Status is periodic and the newest one matters most. Automatic
- * retransmission stays on (NART = 0), and bus-off is left automatically
- * after 128 x 11 recessive bits (ABOM), the host's restart-ms covering its
- * side.
+ * Transmit: straight into one of the three TX mailboxes, sent in the order
+ * requested (TXFP). When all three are busy can_send says so and the core
+ * keeps the frame in its outbox for the next pass (pbfw_board_service), so
+ * no reply is lost to a busy transmitter. Automatic retransmission stays on
+ * (NART = 0), and bus-off is left automatically after 128 x 11 recessive
+ * bits (ABOM), the host's restart-ms covering its side.
  *
  * Errors: the error interrupt counts error frames (each new last-error
  * code), error-passive and bus-off entries. bxCAN does not hand error frames
  * to software as frames, so they are counted here, not passed to the core
  * (whose Fault 4 is for frames it decoded). */
 
-#include "hal.h"
+#include "drivers.h"
 #include "registers.h"
 
 #define CAN_BITRATE_BPS PBFW_BITRATE_BPS
 #define RX_RING_SIZE 16u /* powers of two: the indices wrap by masking */
-#define TX_QUEUE_SIZE 16u
 /* Entering init waits for the frame on the bus (< 0.3 ms), leaving it for 11
  * recessive bits: 2 ms is ample, and under the IWDG's shortest 6.8 ms. */
 #define MODE_CHANGE_TIMEOUT_NS 2000000
@@ -48,18 +46,12 @@
 #define SCE_PRIORITY 2u
 
 _Static_assert((RX_RING_SIZE & (RX_RING_SIZE - 1u)) == 0u, "RX_RING_SIZE is a power of two");
-_Static_assert((TX_QUEUE_SIZE & (TX_QUEUE_SIZE - 1u)) == 0u, "TX_QUEUE_SIZE is a power of two");
 
 /* Receive ring: the RX0 interrupt writes frames and publishes rx_head; the
  * main loop reads them and publishes rx_tail. One writer per index. */
 static pbfw_frame rx_ring[RX_RING_SIZE];
 static volatile uint32_t rx_head;
 static volatile uint32_t rx_tail;
-
-/* Transmit queue: main loop only. */
-static pbfw_frame tx_queue[TX_QUEUE_SIZE];
-static uint32_t tx_first;
-static uint32_t tx_count;
 
 /* Counters: each written by one context only (noted), read with
  * interrupts masked for a consistent copy. */
@@ -224,7 +216,7 @@ void CAN1_SCE_IRQHandler(void) {
     mask |= CAN_IER_EPVIE;
   }
   if (mask != 0u) {
-    CAN1->IER &= ~mask; /* the IER is only written here and, with this source masked, in can_poll_tx */
+    CAN1->IER &= ~mask; /* also written by can_poll, with interrupts masked */
     masked_error_sources |= mask;
   }
   CAN1->MSR = CAN_MSR_ERRI; /* rc_w1 */
@@ -240,47 +232,34 @@ bool can_receive(pbfw_frame* out) {
   return true;
 }
 
-void can_send(const pbfw_frame* frame) {
-  if (tx_count == TX_QUEUE_SIZE) {
-    tx_first = (tx_first + 1u) & (TX_QUEUE_SIZE - 1u);
-    --tx_count;
-    ++counters.tx_dropped; /* main-loop-only writer */
-  }
-  tx_queue[(tx_first + tx_count) & (TX_QUEUE_SIZE - 1u)] = *frame;
-  ++tx_count;
+bool can_send(const pbfw_frame* f) {
+  const uint32_t tsr = CAN1->TSR;
+  if ((tsr & (CAN_TSR_TME(0u) | CAN_TSR_TME(1u) | CAN_TSR_TME(2u))) == 0u) return false;
+  /* CODE: the number of an empty mailbox when any is (RM0390, CAN_TSR). */
+  can_tx_mailbox* box = &CAN1->TX[(tsr >> CAN_TSR_CODE_SHIFT) & 0x3u];
+  box->TDTR = f->len > PBFW_MAX_FRAME_BYTES ? PBFW_MAX_FRAME_BYTES : f->len;
+  box->TDLR = read_le32(&f->data[0]);
+  box->TDHR = read_le32(&f->data[4]);
+  /* Id last, with the request: a standard data frame (IDE = RTR = 0). */
+  box->TIR = ((f->id & 0x7FFu) << CAN_ID_STID_SHIFT) | CAN_TIR_TXRQ;
+  ++counters.tx_frames; /* main-loop-only writer */
+  return true;
 }
 
-void can_poll_tx(void) {
-  for (unsigned n = 0; n < 3u && tx_count != 0u; ++n) {
-    const uint32_t tsr = CAN1->TSR;
-    if ((tsr & (CAN_TSR_TME(0u) | CAN_TSR_TME(1u) | CAN_TSR_TME(2u))) == 0u) break;
-    /* CODE: the number of an empty mailbox when any is (RM0390, CAN_TSR). */
-    can_tx_mailbox* box = &CAN1->TX[(tsr >> CAN_TSR_CODE_SHIFT) & 0x3u];
-    const pbfw_frame* f = &tx_queue[tx_first];
-    box->TDTR = f->len > PBFW_MAX_FRAME_BYTES ? PBFW_MAX_FRAME_BYTES : f->len;
-    box->TDLR = read_le32(&f->data[0]);
-    box->TDHR = read_le32(&f->data[4]);
-    /* Id last, with the request: a standard data frame (IDE = RTR = 0). */
-    box->TIR = ((f->id & 0x7FFu) << CAN_ID_STID_SHIFT) | CAN_TIR_TXRQ;
-    tx_first = (tx_first + 1u) & (TX_QUEUE_SIZE - 1u);
-    --tx_count;
-    ++counters.tx_frames;
-  }
-
+void can_poll(void) {
   /* An error source masked by the interrupt comes back once its condition
    * has cleared (bus-off left, error active again). */
   const uint32_t masked = masked_error_sources;
-  if (masked != 0u) {
-    const uint32_t esr = CAN1->ESR;
-    uint32_t unmask = 0u;
-    if ((masked & CAN_IER_BOFIE) && !(esr & CAN_ESR_BOFF)) unmask |= CAN_IER_BOFIE;
-    if ((masked & CAN_IER_EPVIE) && !(esr & CAN_ESR_EPVF)) unmask |= CAN_IER_EPVIE;
-    if (unmask != 0u) {
-      irq_disable(); /* read-modify-write shared with the error interrupt */
-      masked_error_sources &= ~unmask;
-      CAN1->IER |= unmask;
-      irq_enable();
-    }
+  if (masked == 0u) return;
+  const uint32_t esr = CAN1->ESR;
+  uint32_t unmask = 0u;
+  if ((masked & CAN_IER_BOFIE) && !(esr & CAN_ESR_BOFF)) unmask |= CAN_IER_BOFIE;
+  if ((masked & CAN_IER_EPVIE) && !(esr & CAN_ESR_EPVF)) unmask |= CAN_IER_EPVIE;
+  if (unmask != 0u) {
+    irq_disable(); /* read-modify-write shared with the error interrupt */
+    masked_error_sources &= ~unmask;
+    CAN1->IER |= unmask;
+    irq_enable();
   }
 }
 
@@ -291,7 +270,6 @@ can_counters can_get_counters(void) {
   copy.rx_overruns = counters.rx_overruns;
   copy.rx_ring_full = counters.rx_ring_full;
   copy.tx_frames = counters.tx_frames;
-  copy.tx_dropped = counters.tx_dropped;
   copy.bus_errors = counters.bus_errors;
   copy.bus_off = counters.bus_off;
   copy.error_passive = counters.error_passive;

@@ -21,7 +21,7 @@
  * tree goes back to the HSI and clock_tree says which step failed. QEMU does
  * not model the RCC (reads 0), so there the image runs on this fallback. */
 
-#include "hal.h"
+#include "drivers.h"
 #include "registers.h"
 
 /* Each iteration reads one peripheral register (at least 2 AHB/APB cycles)

@@ -35,7 +35,7 @@
  * firmware then drives the pins low (coils_safe) before anything else, and
  * hands them to the timers only once every channel is at 0 %. */
 
-#include "hal.h"
+#include "drivers.h"
 #include "registers.h"
 
 #define PWM_COUNTER_HZ 2000000u

@@ -9,7 +9,7 @@
  * so a missing switch reads open. The reading is raw, not debounced: Status
  * reports it every 10 ms and the host judges it. */
 
-#include "hal.h"
+#include "drivers.h"
 #include "registers.h"
 
 #define EOS_PINS_LOW 0x003Fu  /* PC0..PC5: drivers 0..5 */

@@ -21,7 +21,7 @@
  * DBG_IWDG_STOP is left clear): a halted board resets within 19 ms with its
  * coils off, rather than holding a coil on under a breakpoint. */
 
-#include "hal.h"
+#include "drivers.h"
 #include "registers.h"
 
 #define IWDG_PRESCALER_DIV4 0u

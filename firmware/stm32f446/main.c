@@ -10,15 +10,17 @@
  *   5. the IWDG: from here a stalled loop resets the MCU within 19 ms;
  *   6. CAN, and the core (out of session, every driver off).
  *
- * The loop (one iteration: a few microseconds idle, under 1 ms with 16
- * frames to handle; docs/results.md): frames in, timers, end-of-stroke
- * switches, frames out, IWDG refresh. It does not
- * sleep: the core's deadlines are met by polling the clock, so a pulse ends
- * at most one iteration after its deadline. */
+ * The loop is the core's own pass (pbfw_board_service, firmware/core/
+ * service.c) over this board's drivers, then the IWDG refresh: one
+ * iteration takes a few microseconds idle, under 1 ms with 16 frames to
+ * handle (docs/results.md). It does not sleep: the core's deadlines are met
+ * by polling the clock, so a pulse ends at most one iteration after its
+ * deadline. */
 
 #include <stddef.h>
 
-#include "hal.h"
+#include "drivers.h"
+#include "pinball/firmware/core/hal.h"
 #include "registers.h"
 #include "startup.h"
 
@@ -30,7 +32,7 @@
 #endif
 
 #define STATUS_PERIOD_NS 10000000 /* rule 12: 10 ms */
-#define RX_FRAMES_PER_ITERATION 16u
+#define RX_FRAMES_PER_PASS 16u /* the RX ring's size (can.c) */
 
 /* The platform's own health, which the protocol has no field for: read it
  * with a debugger (symbol g_board_state) on the bench. */
@@ -60,6 +62,24 @@ static void set_coil(void* context, unsigned driver, pbfw_coil_state state, uint
   (void)context;
   (void)at_ns;
   if (!coils_apply(driver, state, duty_pct)) ++g_board_state.output_clamps;
+}
+
+/* The HAL's functions: the drivers as the core's loop calls them. */
+static pbfw_time_ns hal_now_ns(void* context) {
+  (void)context;
+  return time_ns();
+}
+static bool hal_receive(void* context, pbfw_frame* frame) {
+  (void)context;
+  return can_receive(frame);
+}
+static bool hal_send(void* context, const pbfw_frame* frame) {
+  (void)context;
+  return can_send(frame);
+}
+static bool hal_end_of_stroke(void* context, unsigned driver) {
+  (void)context;
+  return (eos_read() >> driver) & 1u;
 }
 
 /* Counts the boot in the reset record; a power-on or brown-out reset (or a
@@ -101,28 +121,22 @@ int main(void) {
   };
   if (pbfw_board_init(&board, &options) != PBFW_INIT_OK) Default_Handler(); /* constant options: never */
 
-  uint8_t eos_reported = 0u; /* the core starts with every switch open */
+  /* The core's hardware seam (pinball/firmware/core/hal.h) on this board. */
+  const pbfw_hal hal = {
+      .context = NULL,
+      .now_ns = hal_now_ns,
+      .receive = hal_receive,
+      .send = hal_send,
+      .end_of_stroke = hal_end_of_stroke,
+  };
   pbfw_time_ns loop_start = time_ns();
   for (;;) {
-    pbfw_frame frame;
-    /* Bounded, so a flooded bus cannot hold off the IWDG refresh; each
-     * on_frame runs the timers first (rule 13) anyway. */
-    for (unsigned n = 0; n < RX_FRAMES_PER_ITERATION && can_receive(&frame); ++n) {
-      pbfw_board_on_frame(&board, &frame, time_ns());
-    }
-    pbfw_board_advance(&board, time_ns());
-
-    const uint8_t eos = eos_read();
-    const uint8_t changed = (uint8_t)(eos ^ eos_reported);
-    if (changed != 0u) {
-      for (unsigned d = 0; d < COIL_COUNT; ++d) {
-        if ((changed >> d) & 1u) pbfw_board_set_end_of_stroke(&board, d, (eos >> d) & 1u);
-      }
-      eos_reported = eos;
-    }
-
-    while (pbfw_board_pop_tx(&board, &frame)) can_send(&frame);
-    can_poll_tx();
+    /* One pass of the core's loop: the clock once, at most
+     * RX_FRAMES_PER_PASS frames (so a flooded bus cannot hold off the
+     * timers or the IWDG refresh), the switches, the timers, then replies
+     * into the TX mailboxes while one is free. */
+    (void)pbfw_board_service(&board, &hal, RX_FRAMES_PER_PASS);
+    can_poll();
 
     /* The core has been serviced: only now does the IWDG hear from us. */
     iwdg_refresh();

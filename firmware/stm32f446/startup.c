@@ -13,7 +13,7 @@
 
 #include <stdint.h>
 
-#include "hal.h"
+#include "drivers.h"
 #include "registers.h"
 #include "startup.h"
 

@@ -8,7 +8,7 @@
  * IWDG resets the MCU if the loop stops for IWDG_TIMEOUT_MS, so the gap is
  * never near the limit. */
 
-#include "hal.h"
+#include "drivers.h"
 #include "registers.h"
 
 #define TIME_TICK_HZ 1000000u

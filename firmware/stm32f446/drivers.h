@@ -1,10 +1,11 @@
-#ifndef PINBALL_FIRMWARE_STM32F446_HAL_H
-#define PINBALL_FIRMWARE_STM32F446_HAL_H
-/* The driver board's hardware layer on the STM32F446: one small function set
- * per peripheral, each in its own file (clock.c, time.c, coils.c, eos.c,
- * board_id.c, can.c, iwdg.c). main.c only wires them to the portable core
- * (firmware/core/board.c): time in, frames in, coil outputs and frames out.
- * Nothing here allocates, and every wait on hardware is bounded. */
+#ifndef PINBALL_FIRMWARE_STM32F446_DRIVERS_H
+#define PINBALL_FIRMWARE_STM32F446_DRIVERS_H
+/* The driver board's drivers on the STM32F446: one small function set per
+ * peripheral, each in its own file (clock.c, time.c, coils.c, eos.c,
+ * board_id.c, can.c, iwdg.c). main.c only wires them to the portable core:
+ * the output stage (set_coil) and the core's HAL (pinball/firmware/core/
+ * hal.h: clock, CAN receive and send, switches). Nothing here allocates,
+ * and every wait on hardware is bounded. */
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -120,7 +121,6 @@ typedef struct can_counters {
   uint32_t rx_overruns;   /* frames lost: hardware FIFO 0 overrun */
   uint32_t rx_ring_full;  /* frames lost: software ring full */
   uint32_t tx_frames;     /* frames handed to a mailbox */
-  uint32_t tx_dropped;    /* frames dropped from a full software queue (oldest first) */
   uint32_t bus_errors;    /* error frames seen (LEC changes) */
   uint32_t bus_off;       /* bus-off entries (left by ABOM) */
   uint32_t error_passive; /* error-passive entries */
@@ -136,13 +136,15 @@ bool can_init(const clock_tree* clock);
 /* Takes the oldest received frame; false when none. Main loop only. */
 bool can_receive(pbfw_frame* out);
 
-/* Queues a frame for transmission (drops the oldest queued when full). */
-void can_send(const pbfw_frame* frame);
+/* Puts a frame into a free TX mailbox; false when all three are busy (the
+ * caller keeps it and offers it again). Main loop only. */
+bool can_send(const pbfw_frame* frame);
 
-/* Moves queued frames into free TX mailboxes, in order. */
-void can_poll_tx(void);
+/* Once a main-loop pass: lets an error interrupt that fired on bus-off or
+ * error passive fire again once the condition has cleared. */
+void can_poll(void);
 
 /* A copy of the counters. */
 can_counters can_get_counters(void);
 
-#endif /* PINBALL_FIRMWARE_STM32F446_HAL_H */
+#endif /* PINBALL_FIRMWARE_STM32F446_DRIVERS_H */
