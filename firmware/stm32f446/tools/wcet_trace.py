@@ -50,7 +50,7 @@ FLASH_WAIT_STATES = 5
 PIPELINE_REFILL = 3
 PERIPHERAL_ACCESS = 8
 # Functions whose loads and stores reach peripheral registers on the hot path.
-PERIPHERAL_FUNCTIONS = {"coils_set_duty", "coils_apply", "coils_duty", "time_raw_count", "time_ns"}
+PERIPHERAL_FUNCTIONS = {"coils_set_duty", "coils_apply", "coils_duty", "time_raw_count", "time_ns", "eos_read"}
 
 # The mnemonics that cost more than one cycle, longest first so that a
 # prefix match finds "ldrd" before "ldr"; a condition suffix (ldrne, popeq)
@@ -200,6 +200,11 @@ def run(args):
             if not t:
                 continue
             pc = int(t.group(1), 16)
+            # Under -icount an instruction that touches a device register is
+            # executed again in a block of its own, and logged twice; no
+            # instruction but a branch to itself follows itself.
+            if previous is not None and pc == previous[0] and not previous[1][1].startswith(("b", "cb")):
+                continue
             if previous is not None and current is not None:
                 ppc, pentry = previous
                 taken = pc != ppc + pentry[0]
