@@ -36,7 +36,7 @@ Two figures per window:
 
 Usage: wcet_trace.py --elf build/.../pinball_driver_board_selftest.elf
                      [--qemu qemu-system-arm] [--objdump arm-none-eabi-objdump]
-                     [--nm arm-none-eabi-nm] [--mhz 180] [--json]
+                     [--nm arm-none-eabi-nm] [--mhz 180] [--json] [--profile WINDOW]
 """
 
 import argparse
@@ -121,6 +121,7 @@ def symbol(nm, elf, name):
 
 class Window:
     def __init__(self):
+        self.functions = {}  # name -> instructions executed in it
         self.instructions = 0
         self.core = 0
         self.lines = 0
@@ -210,6 +211,8 @@ def run(args):
                 taken = pc != ppc + pentry[0]
                 c, load, access = price(pentry, taken)
                 current.instructions += 1
+                fname = function_of(functions, ppc)
+                current.functions[fname] = current.functions.get(fname, 0) + 1
                 current.core += c
                 current.loads += 1 if load else 0
                 current.taken += 1 if taken else 0
@@ -248,6 +251,7 @@ def run(args):
             "cold_bound_cycles": d.cold(),
             "core_us": round(d.core / args.mhz, 2),
             "cold_bound_us": round(d.cold() / args.mhz, 2),
+            "by_function": dict(sorted(w.functions.items(), key=lambda kv: -kv[1])),
         })
     return rows
 
@@ -260,8 +264,16 @@ def main():
     p.add_argument("--nm", default="arm-none-eabi-nm")
     p.add_argument("--mhz", type=float, default=180.0)
     p.add_argument("--json", action="store_true")
+    p.add_argument("--profile", metavar="WINDOW", help="also list the instructions WINDOW spent in each function")
     args = p.parse_args()
     rows = run(args)
+    if args.profile:
+        for r in rows:
+            if r["window"] == args.profile:
+                print(f"instructions by function in {args.profile} (harness included):")
+                for name, n in r["by_function"].items():
+                    print(f"{n:8d}  {name}")
+        print()
     if args.json:
         print(json.dumps(rows, indent=1))
         return
