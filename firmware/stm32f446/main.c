@@ -117,7 +117,7 @@ int main(void) {
       .fw_major = PINBALL_FW_MAJOR,
       .fw_minor = PINBALL_FW_MINOR,
       .set_coil = set_coil,
-      .set_coil_context = 0,
+      .set_coil_context = NULL,
   };
   if (pbfw_board_init(&board, &options) != PBFW_INIT_OK) Default_Handler(); /* constant options: never */
 
