@@ -26,7 +26,7 @@ while [ $# -gt 0 ]; do
     --json) json=1 ;;
     --max-flash) max_flash="$2"; shift ;;
     --max-ram) max_ram="$2"; shift ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
     -*) echo "build-firmware: unknown option $1" >&2; exit 2 ;;
     *) dir="$1" ;;
   esac
