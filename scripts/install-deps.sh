@@ -15,6 +15,9 @@ packages=(
   nlohmann-json3-dev libcli11-dev
   can-utils libsocketcan-dev
   python3-minimal   # runs the test of the generated Python LCM bindings
+  # The driver board's firmware (firmware/stm32f446/): the Arm cross compiler
+  # and newlib for the image, QEMU to boot it (ctest label firmware).
+  gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
 )
 
 missing=()
