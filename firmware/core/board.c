@@ -15,6 +15,7 @@ pbfw_init_error pbfw_board_init(pbfw_board* b, const pbfw_board_options* options
   const pbfw_board zero = {0};
   *b = zero;
   b->options = *options;
+  b->watchdog_ms = PBFW_DEFAULT_WATCHDOG_MS;
   b->watchdog_ns = (pbfw_time_ns)PBFW_DEFAULT_WATCHDOG_MS * NS_PER_MS;
   return PBFW_INIT_OK;
 }
@@ -162,7 +163,7 @@ void pbfw_board_advance(pbfw_board* b, pbfw_time_ns now) {
       b->armed = false;
       ++b->counters.watchdog_trips;
       all_off(b, t);
-      fault(b, PBFW_FAULT_WATCHDOG_EXPIRED, PBFW_BOARD_DRIVER, (uint16_t)(b->watchdog_ns / NS_PER_MS),
+      fault(b, PBFW_FAULT_WATCHDOG_EXPIRED, PBFW_BOARD_DRIVER, b->watchdog_ms,
             PBFW_FAULT_BIT_WATCHDOG);
       continue;
     }
@@ -212,6 +213,7 @@ static void on_hello(pbfw_board* b, const pbfw_hello* m, pbfw_time_ns now) {
   }
   b->session = true;
   b->armed = false;
+  b->watchdog_ms = m->watchdog_ms;
   b->watchdog_ns = (pbfw_time_ns)m->watchdog_ms * NS_PER_MS;
   b->has_hb_seq = false;
   b->has_seq = false;

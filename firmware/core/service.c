@@ -12,9 +12,8 @@ unsigned pbfw_board_service(pbfw_board* board, const pbfw_hal* hal, unsigned max
     ++handled;
   }
   if (hal->end_of_stroke != NULL) {
-    for (unsigned d = 0; d < board->options.driver_count; ++d) {
-      pbfw_board_set_end_of_stroke(board, d, hal->end_of_stroke(hal->context, d));
-    }
+    const uint8_t closed = hal->end_of_stroke(hal->context);
+    for (unsigned d = 0; d < board->options.driver_count; ++d) pbfw_board_set_end_of_stroke(board, d, (closed >> d) & 1u);
   }
   pbfw_board_advance(board, now);
   while (pbfw_board_peek_tx(board, &frame) && hal->send(hal->context, &frame)) pbfw_board_pop_tx(board, &frame);

@@ -77,9 +77,9 @@ static bool hal_send(void* context, const pbfw_frame* frame) {
   (void)context;
   return can_send(frame);
 }
-static bool hal_end_of_stroke(void* context, unsigned driver) {
+static uint8_t hal_end_of_stroke(void* context) {
   (void)context;
-  return (eos_read() >> driver) & 1u;
+  return eos_read();
 }
 
 /* Counts the boot in the reset record; a power-on or brown-out reset (or a

@@ -554,10 +554,9 @@ static bool live_send(void* context, const pbfw_frame* f) {
   return true;
 }
 
-static bool live_end_of_stroke(void* context, unsigned d) {
+static uint8_t live_end_of_stroke(void* context) {
   (void)context;
-  (void)d;
-  return false;
+  return 0u;
 }
 
 static const pbfw_hal live_hal = {
@@ -657,9 +656,9 @@ static bool measure_send(void* context, const pbfw_frame* f) {
   (void)f;
   return true;
 }
-static bool measure_end_of_stroke(void* context, unsigned d) {
+static uint8_t measure_end_of_stroke(void* context) {
   (void)context;
-  return (eos_read() >> d) & 1u;
+  return eos_read();
 }
 static const pbfw_hal measure_hal = {
     .context = NULL,

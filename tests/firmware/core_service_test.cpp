@@ -43,7 +43,11 @@ struct ScriptedHal {
       s->tx.push_back(*f);
       return true;
     };
-    h.end_of_stroke = [](void* c, unsigned d) { return static_cast<ScriptedHal*>(c)->eos[d]; };
+    h.end_of_stroke = [](void* c) {
+      std::uint8_t closed = 0;
+      for (unsigned d = 0; d < PBFW_MAX_DRIVERS; ++d) closed |= static_cast<std::uint8_t>(static_cast<ScriptedHal*>(c)->eos[d] << d);
+      return closed;
+    };
     return h;
   }
   void queue(pbfw_message m) {

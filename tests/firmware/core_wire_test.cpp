@@ -144,6 +144,33 @@ TEST(CoreWire, RejectsWithTheReasonANamedCheckGives) {
   EXPECT_EQ(pbfw_decode(&f, nullptr, &reason), PBFW_DECODE_ERROR_FRAME);
 }
 
+// The CRC as PROTOCOL.md defines it, bit by bit.
+std::uint8_t crc8_by_definition(std::uint32_t id, const std::uint8_t* bytes, unsigned n) {
+  std::uint8_t crc = 0xFF;
+  auto feed = [&crc](std::uint8_t b) {
+    crc ^= b;
+    for (int i = 0; i < 8; ++i) crc = (crc & 0x80) ? static_cast<std::uint8_t>((crc << 1) ^ 0x2F) : static_cast<std::uint8_t>(crc << 1);
+  };
+  feed(static_cast<std::uint8_t>(id & 0xFF));
+  feed(static_cast<std::uint8_t>((id >> 8) & 0x07));
+  for (unsigned i = 0; i < n; ++i) feed(bytes[i]);
+  return static_cast<std::uint8_t>(crc ^ 0xFF);
+}
+
+TEST(CoreWire, TheCrcTableIsTheBitwiseDefinition) {
+  std::uint8_t bytes[7];
+  std::uint32_t x = 12345;
+  for (int trial = 0; trial < 20000; ++trial) {
+    for (auto& b : bytes) {
+      x = x * 1664525u + 1013904223u;  // any bytes will do; a fixed LCG keeps the test repeatable
+      b = static_cast<std::uint8_t>(x >> 24);
+    }
+    const std::uint32_t id = (x >> 8) & 0x7FF;
+    const unsigned n = x % 8;
+    ASSERT_EQ(pbfw_crc8(id, bytes, n), crc8_by_definition(id, bytes, n)) << "trial " << trial;
+  }
+}
+
 TEST(CoreWire, ConfigurationLimitsAreTheAbsoluteOnes) {
   pbfw_driver_config c{30, 25, 40, 5000, 10};
   EXPECT_EQ(pbfw_validate_config(&c), nullptr);

@@ -95,6 +95,7 @@ typedef struct pbfw_board {
   uint16_t hb_seq;      /* newest Heartbeat seq */
   uint16_t last_seq;    /* newest seq accepted in the session */
   uint16_t fault_count; /* faults reported since Hello */
+  uint16_t watchdog_ms; /* the session's heartbeat timeout, as Hello gave it */
   pbfw_time_ns watchdog_ns;
   pbfw_time_ns last_heartbeat_ns;
   pbfw_time_ns now_ns;

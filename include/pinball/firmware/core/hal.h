@@ -23,9 +23,9 @@ typedef struct pbfw_hal {
   /* Hands a frame to the transmitter; false when it has no room now (the
    * frame stays queued on the board and is offered again next pass). */
   bool (*send)(void* context, const pbfw_frame* frame);
-  /* True when driver d's end-of-stroke switch is closed; NULL when the board
-   * has no switches. */
-  bool (*end_of_stroke)(void* context, unsigned driver);
+  /* The end-of-stroke switches, bit d closed for driver d, read at once (one
+   * consistent sample, one port read); NULL when the board has none. */
+  uint8_t (*end_of_stroke)(void* context);
 } pbfw_hal;
 
 /* One pass of the main loop, bounded so a flood of frames cannot starve the
