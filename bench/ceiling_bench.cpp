@@ -11,6 +11,7 @@
 #include "pinball/control/spastic_controller.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
+#include "pinball/learn/team.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/simlab/oracle_policy.h"
@@ -96,19 +97,27 @@ CeilingPlayerReport run_player(const sim::World& world, const sim::ThesisStepper
   std::vector<CeilingBall> balls(n);
   std::atomic<int> done{0};
   std::mutex progress_mutex;
-  const int every = std::max(1, options.balls / 10);
   const auto start = std::chrono::steady_clock::now();
-  learn::parallel_for(n, options.threads, [&](std::size_t i) {
+  // Across the job (MPI ranks x threads); progress counts this rank's share.
+  const int share = std::max(1, options.balls / learn::team_size());
+  const int every = std::max(1, share / 10);
+  const std::vector<learn::Blob> blobs = learn::distributed_map(n, options.threads, [&](std::size_t i) {
     const std::unique_ptr<sim::World> ball_world = world.fork();
-    balls[i] = play_ceiling_bench_ball(*ball_world, model, options, kind, ball_seed(options.seed, i));
+    const CeilingBall ball = play_ceiling_bench_ball(*ball_world, model, options, kind, ball_seed(options.seed, i));
     const int d = ++done;
-    if (progress && (d % every == 0 || d == options.balls)) {
+    if (progress && (d % every == 0 || d == share)) {
       const std::lock_guard<std::mutex> lock(progress_mutex);
       // "ceiling: 40/200 balls (20 %), 12 s elapsed, ETA 48 s"
-      progress(format_progress(player_name(kind), d, options.balls, "balls",
+      progress(format_progress(player_name(kind), d, share, "balls",
                                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
     }
+    return learn::BlobWriter().put(ball).take();
   });
+  for (std::size_t i = 0; i < n; ++i) {
+    learn::BlobReader r(blobs[i]);
+    balls[i] = r.get<CeilingBall>();
+    r.expect_end();
+  }
   CeilingPlayerReport r;
   r.name = player_name(kind);
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

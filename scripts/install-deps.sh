@@ -18,6 +18,8 @@ packages=(
   # The driver board's firmware (firmware/stm32f446/): the Arm cross compiler
   # and newlib for the image, QEMU to boot it (ctest label firmware).
   gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
+  # Learning and evaluation across processes and machines (mpirun -n N pinball ...).
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

@@ -9,6 +9,7 @@
 #include "pinball/simlab/simulated_player.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
+#include "pinball/learn/team.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
 
@@ -203,6 +204,25 @@ DemonstrationBall record_demonstration(sim::World& world, const sim::ThesisStepp
   return ball;
 }
 
+Blob to_blob(const DemonstrationBall& b) {
+  BlobWriter w;
+  w.put_vector(b.shots).put(b.score).put(b.duration_s).put(b.cut).put(b.teacher_fires).put(b.unmatched_fires);
+  return w.take();
+}
+
+DemonstrationBall demonstration_ball_from_blob(const Blob& blob) {
+  BlobReader r(blob);
+  DemonstrationBall b;
+  b.shots = r.get_vector<control::ShotExample>();
+  b.score = r.get<double>();
+  b.duration_s = r.get<double>();
+  b.cut = r.get<bool>();
+  b.teacher_fires = r.get<int>();
+  b.unmatched_fires = r.get<int>();
+  r.expect_end();
+  return b;
+}
+
 Demonstrations record_demonstrations(const table::Board& board, const DemonstrationConfig& config, int balls,
                                      std::uint64_t seed, int threads,
                                      const std::function<void(const std::string&)>& progress,
@@ -218,18 +238,24 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
   std::vector<DemonstrationBall> played(n);
   std::atomic<int> done{0};
   std::mutex progress_mutex;
-  const int every = std::max(1, balls / 10);
   const auto start = std::chrono::steady_clock::now();
-  parallel_for(n, threads, [&](std::size_t i) {
+  // Across the job: each rank plays its share (progress counts this rank's balls).
+  const int share = std::max<int>(1, balls / team_size());
+  const int every = std::max(1, share / 10);
+  const std::vector<Blob> blobs = distributed_map(n, threads, [&](std::size_t i) {
     const std::unique_ptr<sim::World> ball_world = world_prototype->fork();
-    played[i] = learner != nullptr ? record_correction(*ball_world, model, config, learner, ball_seed(seed, i))
-                                   : record_demonstration(*ball_world, model, config, ball_seed(seed, i));
+    const DemonstrationBall ball = learner != nullptr
+                                       ? record_correction(*ball_world, model, config, learner, ball_seed(seed, i))
+                                       : record_demonstration(*ball_world, model, config, ball_seed(seed, i));
     const int d = ++done;
-    if (progress && (d % every == 0 || d == balls)) {
+    if (progress && (d % every == 0 || d == share)) {
       const std::lock_guard<std::mutex> lock(progress_mutex);
-      progress(std::string(learner != nullptr ? "learner, teacher judging: " : "teacher: ") + std::to_string(d) + "/" + std::to_string(balls) + " balls");
+      progress(std::string(learner != nullptr ? "learner, teacher judging: " : "teacher: ") + std::to_string(d) + "/" +
+               std::to_string(share) + " balls" + (team_size() > 1 ? " (this rank's share)" : ""));
     }
+    return to_blob(ball);
   });
+  for (std::size_t i = 0; i < n; ++i) played[i] = demonstration_ball_from_blob(blobs[i]);
   Demonstrations out;
   out.balls = balls;
   double score = 0.0;

@@ -16,6 +16,7 @@
 
 #include "pinball/control/imitation_controller.h"
 #include "pinball/firmware/flipper_actuation.h"
+#include "pinball/learn/blob.h"
 #include "pinball/learn/lookahead_player.h"
 #include "pinball/learn/search.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -43,6 +44,10 @@ struct DemonstrationBall {
   int unmatched_fires = 0;   ///< of them, fired where no example could be recorded (no hittable
                              ///< projection in that frame; a learner firing outside the teacher's zone)
 };
+
+/// A demonstration ball as bytes and back (for the MPI ranks and the checkpoint).
+Blob to_blob(const DemonstrationBall& ball);
+DemonstrationBall demonstration_ball_from_blob(const Blob& blob);
 
 /// Plays ball `ball_seed` in `world` with the teacher, which plans on
 /// `model` (its board is the belief the tracker watches with), and records its shots.

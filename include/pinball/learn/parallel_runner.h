@@ -8,6 +8,7 @@
 #include <functional>
 #include <vector>
 
+#include "pinball/learn/blob.h"
 #include "pinball/learn/evaluator.h"
 
 namespace pinball::learn {
@@ -24,9 +25,21 @@ struct BallTask {
 /// threads have joined.
 void parallel_for(std::size_t count, int threads, const std::function<void(std::size_t)>& task);
 
-/// Plays every task (std::thread, `threads` >= 1; 1 plays on the calling
-/// thread) and returns the outcomes in task order. An exception in a task is
-/// rethrown after all threads have joined.
+/// Runs task(i) for every i in [0, count) across the job: the items dealt to
+/// the MPI ranks in small chunks (team.h), each rank's on `threads` threads;
+/// or, when the run's checkpoint already holds this batch, none at all
+/// (checkpoint.h). Returns every result in item order, on every rank, and
+/// records the batch in the checkpoint. A task's exception is rethrown in a
+/// job of one; with several ranks it ends the whole job (team_abort), since
+/// the other ranks would wait for this one forever.
+std::vector<Blob> distributed_map(std::size_t count, int threads, const std::function<Blob(std::size_t)>& task);
+
+/// Plays every task across the job (distributed_map) and returns the
+/// outcomes in task order.
 std::vector<BallOutcome> play_balls(const BallObjective& objective, const std::vector<BallTask>& tasks, int threads);
+
+/// A ball's outcome as bytes and back.
+Blob to_blob(const BallOutcome& outcome);
+BallOutcome ball_outcome_from_blob(const Blob& blob);
 
 }  // namespace pinball::learn
