@@ -115,6 +115,8 @@ struct LearnArgs {
   simlab::WorldSpec world;              ///< the world (default: the model of `board` on the thesis stepper)
   bool json = false;                    ///< one JSON object on stdout
   bool progress = false;                ///< percent and ETA on stderr even when it is not a terminal
+  std::string checkpoint;               ///< record every batch here (resumable); empty: none
+  bool resume = false;                  ///< continue the run recorded in `checkpoint`
 };
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& args);
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err);

@@ -4,6 +4,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <memory>
 #include <array>
 #include <atomic>
@@ -28,12 +31,14 @@
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/progress.h"
 #include "pinball/core/running_stats.h"
+#include "pinball/learn/checkpoint.h"
 #include "pinball/learn/cross_entropy.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/launcher_search.h"
 #include "pinball/learn/learning_curve.h"
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/learn/relay_race.h"
+#include "pinball/learn/team.h"
 #include "pinball/learn/tournament.h"
 #include "pinball/table/board_loader.h"
 
@@ -87,6 +92,11 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   add_camera_model_options(*cmd, a.camera);
   add_world_options(*cmd, a.world);
   add_progress_flag(*cmd, a.progress);
+  cmd->add_option("--checkpoint", a.checkpoint,
+                  "record every batch of balls in this file as the run goes, so that a run cut short resumes "
+                  "(--resume) with the result of an uninterrupted one");
+  cmd->add_flag("--resume", a.resume, "continue the run recorded in --checkpoint (the same command and seed)")
+      ->needs("--checkpoint");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -136,11 +146,12 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
     }
     out = learn::play_balls(ev, tasks, a.threads);
   } else {  // a controller that is no action function (a baseline, the imitation table): one ball per task
-    out.resize(static_cast<std::size_t>(balls));
-    learn::parallel_for(static_cast<std::size_t>(balls), a.threads, [&](std::size_t i) {
-      const std::unique_ptr<control::FlipperController> c = make_controller();
-      out[i] = ev.play_with(*c, a.pull, ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i));
-    });
+    const std::vector<learn::Blob> blobs =
+        learn::distributed_map(static_cast<std::size_t>(balls), a.threads, [&](std::size_t i) {
+          const std::unique_ptr<control::FlipperController> c = make_controller();
+          return learn::to_blob(ev.play_with(*c, a.pull, ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i)));
+        });
+    for (const learn::Blob& b : blobs) out.push_back(learn::ball_outcome_from_blob(b));
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   RunningStats score, duration_s, flips;
@@ -160,6 +171,63 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
   e.balls_per_s = wall > 0.0 ? balls / wall : 0.0;
   return e;
 }
+
+// FNV-1a of a file's bytes ("missing" when it cannot be read), so that a
+// checkpoint is not resumed against an edited board.
+std::string file_digest(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "missing";
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::istreambuf_iterator<char> it(in), end; it != end; ++it) h = (h ^ static_cast<unsigned char>(*it)) * 1099511628211ull;
+  std::ostringstream s;
+  s << std::hex << h;
+  return s.str();
+}
+
+// What makes two runs the same run: every option that changes a result, and
+// the bytes of every file read. Not --threads, the ranks, --out/--curve/--plot,
+// --json or --progress: results do not depend on them.
+std::string run_fingerprint(const LearnArgs& a) {
+  const nlohmann::json j = {
+      {"method", a.method}, {"board", a.board}, {"board_fnv1a", file_digest(a.board)},
+      {"world_board", a.world.board_path},
+      {"world_board_fnv1a", a.world.board_path.empty() ? "" : file_digest(a.world.board_path)},
+      {"stepper", std::string(sim::stepper_kind_name(a.world.stepper))}, {"world_dt_s", a.world.dt_s},
+      {"controller", a.controller}, {"controller_fnv1a", a.controller.empty() ? "" : file_digest(a.controller)},
+      {"budget_balls", a.budget_balls}, {"seed", a.seed}, {"eval_balls", a.eval_balls},
+      {"partitions", a.partitions}, {"partition_h", a.partition_by_h}, {"rolling", a.rolling},
+      {"randomise_launch", a.randomise_launch}, {"pull", a.pull}, {"balls_per_controller", a.balls_per_controller},
+      {"population", a.population}, {"rounds", a.rounds}, {"max_ball_time_s", a.max_ball_time_s},
+      {"loss_penalty", a.loss_penalty}, {"actuation_delay_s", a.actuation_delay_s},
+      {"gravity_scale", a.gravity_scale},
+      {"camera", {{"fps", a.camera.fps}, {"m_per_px", a.camera.m_per_px}, {"noise_px", a.camera.noise_px},
+                  {"latency_s", a.camera.latency_s}, {"drop_probability", a.camera.drop_probability}}}};
+  return "pinball learn " + j.dump();
+}
+
+// The job's figures for the report: ranks, and what gathering cost.
+nlohmann::json team_report() {
+  const learn::TeamCounters c = learn::team_counters();
+  const learn::CheckpointStatus k = learn::checkpoint_status();
+  nlohmann::json j = {{"ranks", learn::team_size()},
+                      {"mpi_wait_s", c.wait_s},
+                      {"mpi_comm_s", c.comm_s},
+                      {"mpi_bytes_received", c.bytes},
+                      {"mpi_batches", c.batches}};
+  if (k.open) {
+    j["checkpoint"] = {{"batches_in_file", k.batches_in_file}, {"replayed", k.replayed}, {"recorded", k.recorded},
+                       {"dropped_bytes", k.dropped_bytes}};
+  }
+  return j;
+}
+
+// Closes the checkpoint however the run ends.
+struct CheckpointScope {
+  explicit CheckpointScope(const learn::CheckpointOptions& o) { learn::open_checkpoint(o); }
+  ~CheckpointScope() { learn::close_checkpoint(); }
+  CheckpointScope(const CheckpointScope&) = delete;
+  CheckpointScope& operator=(const CheckpointScope&) = delete;
+};
 
 }  // namespace
 
@@ -229,6 +297,9 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     learn::PinballEvaluator ev;
     const LearnArgs& la;
   } objective(board, ec, *world, a);
+  const CheckpointScope checkpoint(learn::CheckpointOptions{a.checkpoint, a.resume, run_fingerprint(a)});
+  // Every rank runs the whole command; rank 0 alone writes files.
+  const bool writer = learn::team_root();
 
   nlohmann::json j = {{"board", a.board},
                       {"world_board", a.world.board_path.empty() ? a.board : a.world.board_path},
@@ -252,7 +323,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
       control::ControllerSpec s = spec;
       s.note = "cycle found by pinball learn --method " + a.method + " --seed " + std::to_string(a.seed) +
                ": ball alive at the time limit with score " + std::to_string(o.score);
-      control::save_controller(s, cycle_path);
+      if (writer) control::save_controller(s, cycle_path);
       err << "learn: cycle controller saved to " << cycle_path << "\n";
     };
     learn::SearchResult r;
@@ -274,9 +345,11 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                        std::to_string(a.budget_balls) + " --seed " + std::to_string(a.seed) + " --partitions " +
                        std::to_string(a.partitions) + "; estimated mean " + std::to_string(r.best_mean) + " over " +
                        std::to_string(r.best_balls) + " balls";
-    control::save_controller(result_spec, a.out);
-    if (!a.curve.empty()) learn::write_curve_csv(r, a.curve);
-    if (!a.plot.empty()) learn::plot_curve_png(r, a.plot);
+    if (writer) {
+      control::save_controller(result_spec, a.out);
+      if (!a.curve.empty()) learn::write_curve_csv(r, a.curve);
+      if (!a.plot.empty()) learn::plot_curve_png(r, a.plot);
+    }
     eval_spec = &result_spec;
     nlohmann::json counters = nlohmann::json::object();
     for (const auto& [name, v] : r.counters) counters[name] = v;
@@ -315,13 +388,13 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
           s.shot_table = std::make_shared<const control::ShotTable>(table);
           s.note = "cycle found by pinball learn --method imitate --seed " + std::to_string(a.seed) +
                    ": ball alive at the time limit with score " + std::to_string(score);
-          control::save_controller(s, cycle_path);
+          if (writer) control::save_controller(s, cycle_path);
           err << "learn: cycle controller saved to " << cycle_path << "\n";
         },
         world.world.get());
     const learn::SearchResult curve = learn::imitation_curve(im);
-    if (!a.curve.empty()) learn::write_curve_csv(curve, a.curve);
-    if (!a.plot.empty()) learn::plot_curve_png(curve, a.plot);
+    if (writer && !a.curve.empty()) learn::write_curve_csv(curve, a.curve);
+    if (writer && !a.plot.empty()) learn::plot_curve_png(curve, a.plot);
     j["cycle_found"] = curve.cycle_found;
     j["balls_used"] = curve.balls_used;
     result_spec = objective.prototype();
@@ -339,7 +412,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                        " --rounds " + std::to_string(a.rounds) + " --seed " + std::to_string(a.seed) + ": " +
                        std::to_string(im.table->examples().size()) +
                        " shots of a looking-ahead teacher on the true state";
-    control::save_controller(result_spec, a.out);
+    if (writer) control::save_controller(result_spec, a.out);
     eval_spec = &result_spec;
     j["out"] = a.out;
   }
@@ -355,10 +428,13 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     j["evaluation"]["actuation_delay_s"] = a.actuation_delay_s;
     j["evaluation"]["gravity_scale"] = a.gravity_scale;
   }
+  j["team"] = team_report();
   if (a.json) {
     out << j.dump(2) << "\n";
   } else {
-    out << "learn " << a.method << " on " << a.board << " (seed " << a.seed << ", " << a.threads << " threads)\n";
+    out << "learn " << a.method << " on " << a.board << " (seed " << a.seed << ", " << a.threads << " threads";
+    if (learn::team_size() > 1) out << " on each of " << learn::team_size() << " MPI ranks";
+    out << ")\n";
     if (!a.world.board_path.empty() || a.world.stepper != sim::StepperKind::kThesis) {
       out << "world            " << j["world_board"].get<std::string>() << " on the " << j["stepper"].get<std::string>()
           << " stepper\n";
@@ -380,6 +456,16 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
       }
       out << "cycle found      " << (j["cycle_found"].get<bool>() ? "yes" : "no") << "\n"
           << "controller       " << a.out << "\n";
+    }
+    const auto& team = j["team"];
+    if (learn::team_size() > 1) {
+      out << "MPI ranks        " << team["ranks"] << ", results gathered in " << team["mpi_batches"] << " batches: "
+          << num(team["mpi_comm_s"]) << " s moving them, " << num(team["mpi_wait_s"]) << " s waiting for the slowest rank\n";
+    }
+    if (team.contains("checkpoint")) {
+      const auto& k = team["checkpoint"];
+      out << "checkpoint       " << a.checkpoint << ": " << k["replayed"] << " batches taken from it, " << k["recorded"]
+          << " played and added\n";
     }
     if (j.contains("evaluation")) {
       const auto& e = j["evaluation"];

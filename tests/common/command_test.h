@@ -47,8 +47,13 @@ class CommandTest : public ::testing::Test {
 
   /// Runs `pinball args` with `cwd` as the working directory.
   CommandResult run_in(const std::filesystem::path& cwd, const std::string& args) {
+    return run_shell("cd " + cwd.string() + " && " PINBALL_EXE " " + args);
+  }
+
+  /// Runs a shell command line (e.g. `mpirun ... PINBALL_EXE ...`), its stderr captured too.
+  CommandResult run_shell(const std::string& command_line) {
     const std::filesystem::path err = dir_ / "stderr.txt";
-    const std::string cmd = "cd " + cwd.string() + " && " PINBALL_EXE " " + args + " 2>" + err.string();
+    const std::string cmd = "{ " + command_line + " ; } 2>" + err.string();
     CommandResult r;
     FILE* pipe = ::popen(cmd.c_str(), "r");
     if (!pipe) return r;
