@@ -4,8 +4,6 @@
 
 #include <stddef.h>
 
-#define NS_PER_MS 1000000
-
 static pbfw_driver* driver_at(pbfw_board* b, unsigned d) { return &b->drivers[d]; }
 
 pbfw_init_error pbfw_board_init(pbfw_board* b, const pbfw_board_options* options) {
@@ -16,7 +14,7 @@ pbfw_init_error pbfw_board_init(pbfw_board* b, const pbfw_board_options* options
   *b = zero;
   b->options = *options;
   b->watchdog_ms = PBFW_DEFAULT_WATCHDOG_MS;
-  b->watchdog_ns = (pbfw_time_ns)PBFW_DEFAULT_WATCHDOG_MS * NS_PER_MS;
+  b->watchdog_ns = (pbfw_time_ns)PBFW_DEFAULT_WATCHDOG_MS * PBFW_NS_PER_MS;
   return PBFW_INIT_OK;
 }
 
@@ -118,7 +116,7 @@ static void expire_driver(pbfw_board* b, unsigned d, pbfw_time_ns t) {
   if (drv->state == PBFW_COIL_PULSE) {
     const uint8_t duty = min_u8(drv->config.hold_duty_pct, PBFW_ABS_MAX_HOLD_DUTY_PCT); /* rule 6: never above 50 % */
     if (drv->hold_after_pulse && duty > 0) {
-      drv->hold_end_ns = t + (pbfw_time_ns)min_u16(drv->config.max_hold_ms, PBFW_ABS_MAX_HOLD_MS) * NS_PER_MS;
+      drv->hold_end_ns = t + (pbfw_time_ns)min_u16(drv->config.max_hold_ms, PBFW_ABS_MAX_HOLD_MS) * PBFW_NS_PER_MS;
       set_output(b, d, PBFW_COIL_HOLD, duty, t);
     } else {
       set_output(b, d, PBFW_COIL_OFF, 0, t);
@@ -214,7 +212,7 @@ static void on_hello(pbfw_board* b, const pbfw_hello* m, pbfw_time_ns now) {
   b->session = true;
   b->armed = false;
   b->watchdog_ms = m->watchdog_ms;
-  b->watchdog_ns = (pbfw_time_ns)m->watchdog_ms * NS_PER_MS;
+  b->watchdog_ns = (pbfw_time_ns)m->watchdog_ms * PBFW_NS_PER_MS;
   b->has_hb_seq = false;
   b->has_seq = false;
   b->last_seq = 0;
@@ -271,7 +269,7 @@ static void on_fire(pbfw_board* b, const pbfw_fire* m, pbfw_time_ns now) {
     ++b->counters.refused_busy;
     return;
   }
-  if (drv->has_been_on && now < drv->off_since_ns + (pbfw_time_ns)drv->config.recycle_ms * NS_PER_MS) { /* rule 8 */
+  if (drv->has_been_on && now < drv->off_since_ns + (pbfw_time_ns)drv->config.recycle_ms * PBFW_NS_PER_MS) { /* rule 8 */
     ++b->counters.refused_recycle;
     return;
   }
@@ -285,7 +283,7 @@ static void on_fire(pbfw_board* b, const pbfw_fire* m, pbfw_time_ns now) {
   }
   ++b->counters.fires_accepted;
   drv->hold_after_pulse = m->mode == PBFW_PULSE_HOLD;
-  drv->pulse_end_ns = now + (pbfw_time_ns)pulse * NS_PER_MS;
+  drv->pulse_end_ns = now + (pbfw_time_ns)pulse * PBFW_NS_PER_MS;
   set_output(b, m->driver, PBFW_COIL_PULSE, 100, now);
 }
 

@@ -24,7 +24,7 @@ TEST(ControllerFile, RoundTripKeepsEveryValue) {
   s.randomise_launch = true;
   s.launch_pull_min = 0.6;
   s.note = "test";
-  const std::string path = testing::TempDir() + "/controller_roundtrip.json";
+  const std::string path = ::testing::TempDir() + "/controller_roundtrip.json";
   save_controller(s, path);
   const ControllerSpec r = load_controller(path);
   EXPECT_EQ(r.action_function.config().angle_borders_rad, c.angle_borders_rad);

@@ -16,7 +16,7 @@
 
 namespace {
 
-constexpr pbfw_time_ns kMs = 1'000'000;
+constexpr pbfw_time_ns kMs = PBFW_NS_PER_MS;
 
 struct CoilEvent {
   unsigned driver;

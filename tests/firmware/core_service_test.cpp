@@ -11,8 +11,6 @@
 
 namespace {
 
-constexpr pbfw_time_ns kMs = 1'000'000;
-
 struct ScriptedHal {
   pbfw_time_ns now = 0;
   std::deque<pbfw_frame> rx;
@@ -61,7 +59,7 @@ pbfw_board make_board() {
   pbfw_board b;
   pbfw_board_options o{};
   o.driver_count = 4;
-  o.status_period_ns = 10 * kMs;
+  o.status_period_ns = 10 * PBFW_NS_PER_MS;
   EXPECT_EQ(pbfw_board_init(&b, &o), PBFW_INIT_OK);
   return b;
 }
@@ -76,12 +74,12 @@ TEST(CoreService, HandlesAtMostTheGivenFramesPerPassAllAtOneTime) {
     s.queue(m);
   }
   const pbfw_hal h = s.hal();
-  s.now = 5 * kMs;
+  s.now = 5 * PBFW_NS_PER_MS;
   EXPECT_EQ(pbfw_board_service(&b, &h, 4), 4u);
   EXPECT_EQ(s.rx.size(), 6u);
-  EXPECT_EQ(b.now_ns, 5 * kMs);
+  EXPECT_EQ(b.now_ns, 5 * PBFW_NS_PER_MS);
   EXPECT_EQ(b.last_seq, 4);
-  s.now = 6 * kMs;
+  s.now = 6 * PBFW_NS_PER_MS;
   EXPECT_EQ(pbfw_board_service(&b, &h, 100), 6u);
   EXPECT_EQ(b.last_seq, 10);
 }

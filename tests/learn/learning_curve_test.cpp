@@ -15,8 +15,8 @@ TEST(LearningCurve, WritesCsvAndPng) {
   SearchResult r;
   r.method = "toy";
   for (int g = 1; g <= 5; ++g) r.curve.push_back({g, static_cast<std::uint64_t>(10 * g), 1.0 * g, 2.0 * g, 2.0 * g, 0.1 * g});
-  const std::string csv = testing::TempDir() + "/curve.csv";
-  const std::string png = testing::TempDir() + "/curve.png";
+  const std::string csv = ::testing::TempDir() + "/curve.csv";
+  const std::string png = ::testing::TempDir() + "/curve.png";
   write_curve_csv(r, csv);
   plot_curve_png(r, png);
   std::ifstream f(csv);

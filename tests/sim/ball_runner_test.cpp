@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/ball_radius.h"
+
 #include <cmath>
 
 #include "test_boards.h"
@@ -12,7 +14,7 @@ namespace {
 
 using namespace pinball::sim::testing;
 
-constexpr double kR = 0.0135;
+using pinball::testing::kR;
 
 auto none_policy = [](GameState&) {};
 auto no_observer = [](const GameState&, const StepEvents&) {};

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/ball_radius.h"
+
 #include <cmath>
 #include <numbers>
 
@@ -14,7 +16,7 @@ using testing::add_flipper;
 using testing::add_line;
 using testing::empty_board;
 
-constexpr double kR = 0.0135;
+using pinball::testing::kR;
 
 table::Shape floor_line() { return table::make_line_shape({0.0, 0.0}, {1.0, 0.0}); }
 

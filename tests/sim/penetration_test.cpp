@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/ball_radius.h"
+
 #include <cmath>
 #include <vector>
 
@@ -16,7 +18,7 @@ using testing::add_line;
 using testing::add_point;
 using testing::empty_board;
 
-constexpr double kR = 0.0135;
+using pinball::testing::kR;
 
 TEST(ShapePenetration, LineFrontFaceOnly) {
   table::Board b = empty_board();

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/ball_radius.h"
+
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -23,7 +25,7 @@ namespace {
 
 using namespace pinball::sim::testing;
 
-constexpr double kR = 0.0135;
+using pinball::testing::kR;
 constexpr double kMaxDepth = kDefaultMaxDepth_m;
 
 TEST(StiffCases, FastBallAgainstThinWall) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/ball_radius.h"
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -17,7 +19,7 @@ namespace {
 
 using namespace pinball::sim::testing;
 
-constexpr double kR = 0.0135;
+using pinball::testing::kR;
 
 TEST(ThesisStepper, FreeFlightIsSemiImplicitEuler) {
   const double g = 1.11;

@@ -11,7 +11,7 @@
 namespace pinball::track {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+
 
 FlipperEllipse mit1993_ellipse() {
   static const FlipperEllipse e =
@@ -29,7 +29,7 @@ LaunchEvent at(LaunchDetector& d, const Vec2& p) { return d.update(p, false, 0.0
 
 TEST(FlipperEllipse, Mit1993ByHand) {
   const FlipperEllipse e = mit1993_ellipse();
-  const double s = std::sin(25.0 * kPi / 180.0);
+  const double s = std::sin(25.0 * std::numbers::pi / 180.0);
   EXPECT_NEAR(e.centre.x(), 0.255, 1e-12);
   EXPECT_NEAR(e.centre.y(), 0.160 - 0.5 * 0.076 * s, 1e-12);  // midway between pivots and tips
   EXPECT_NEAR(e.a_m, 0.09 + 0.076, 1e-12);                      // a flipper length past each pivot
@@ -41,7 +41,7 @@ TEST(FlipperEllipse, Mit1993ByHand) {
 TEST(LaunchDetector, EnteringNeedsTheInnerEllipse) {
   const FlipperEllipse e = mit1993_ellipse();
   LaunchDetector d(e);  // inner 0.85, outer 1.15
-  for (const double phi : {kPi / 2.0, 0.3, kPi}) {
+  for (const double phi : {std::numbers::pi / 2.0, 0.3, std::numbers::pi}) {
     d.reset();
     EXPECT_FALSE(at(d, on_ellipse(e, 1.0, phi)).entered);
     EXPECT_FALSE(at(d, on_ellipse(e, 0.86, phi)).entered);  // between inner and the ellipse: not yet
@@ -60,28 +60,28 @@ TEST(LaunchDetector, LeavingNeedsTheOuterEllipse) {
   at(d, e.centre);
   ASSERT_TRUE(d.inside());
   for (const double s : {0.9, 1.0, 1.1, 1.14}) {
-    const LaunchEvent ev = at(d, on_ellipse(e, s, kPi / 2.0));
+    const LaunchEvent ev = at(d, on_ellipse(e, s, std::numbers::pi / 2.0));
     EXPECT_FALSE(ev.launched || ev.lost) << s;
     EXPECT_TRUE(d.inside()) << s;
   }
-  const LaunchEvent out = at(d, on_ellipse(e, 1.16, kPi / 2.0));
+  const LaunchEvent out = at(d, on_ellipse(e, 1.16, std::numbers::pi / 2.0));
   EXPECT_TRUE(out.launched);
   EXPECT_FALSE(out.lost);
   EXPECT_FALSE(d.inside());
   // Outside now: going further out is no second launch.
-  EXPECT_FALSE(at(d, on_ellipse(e, 2.0, kPi / 2.0)).launched);
+  EXPECT_FALSE(at(d, on_ellipse(e, 2.0, std::numbers::pi / 2.0)).launched);
 }
 
 TEST(LaunchDetector, LeavingUpwardIsALaunchDownwardALoss) {
   const FlipperEllipse e = mit1993_ellipse();
-  for (const double phi : {kPi / 2.0, 0.2, kPi - 0.2, 1e-3}) {  // up, up-right, up-left, sideways a hair up
+  for (const double phi : {std::numbers::pi / 2.0, 0.2, std::numbers::pi - 0.2, 1e-3}) {  // up, up-right, up-left, sideways a hair up
     LaunchDetector d(e);
     at(d, e.centre);
     const LaunchEvent ev = at(d, on_ellipse(e, 1.3, phi));
     EXPECT_TRUE(ev.launched) << phi;
     EXPECT_FALSE(ev.lost) << phi;
   }
-  for (const double phi : {-kPi / 2.0, -0.2, -kPi + 0.2}) {  // through the drain gap or past a pivot
+  for (const double phi : {-std::numbers::pi / 2.0, -0.2, -std::numbers::pi + 0.2}) {  // through the drain gap or past a pivot
     LaunchDetector d(e);
     at(d, e.centre);
     const LaunchEvent ev = at(d, on_ellipse(e, 1.3, phi));
@@ -90,7 +90,7 @@ TEST(LaunchDetector, LeavingUpwardIsALaunchDownwardALoss) {
   }
   // Passing by outside the ellipse is nothing.
   LaunchDetector d(e);
-  for (double phi = 0.0; phi < 2.0 * kPi; phi += 0.1) {
+  for (double phi = 0.0; phi < 2.0 * std::numbers::pi; phi += 0.1) {
     const LaunchEvent ev = at(d, on_ellipse(e, 0.9, phi));
     EXPECT_FALSE(ev.launched || ev.lost || ev.entered) << phi;
   }
@@ -101,7 +101,7 @@ TEST(LaunchDetector, LeavingUpwardIsALaunchDownwardALoss) {
 int jitter_events(const FlipperEllipse& e, const LaunchDetectorConfig& config, double noise_m, bool start_inside) {
   Rng rng(77);
   int events = 0;
-  for (const double phi : {kPi / 2.0, 0.0, kPi, 0.4, -0.4, -kPi / 2.0}) {
+  for (const double phi : {std::numbers::pi / 2.0, 0.0, std::numbers::pi, 0.4, -0.4, -std::numbers::pi / 2.0}) {
     LaunchDetector d(e, config);
     if (start_inside) at(d, e.centre);
     const Vec2 rest = on_ellipse(e, 1.0, phi);
@@ -167,7 +167,7 @@ TEST(LaunchDetector, ReversalNeedsEnoughFallingUpdatesAndTheEllipse) {
     EXPECT_TRUE(d.update(inside, true, 0.6, false).launched);
   }
   {
-    const Vec2 far = on_ellipse(e, 3.0, kPi / 2.0);  // a bounce high on the table is no flip
+    const Vec2 far = on_ellipse(e, 3.0, std::numbers::pi / 2.0);  // a bounce high on the table is no flip
     LaunchDetector d(e);
     for (int i = 0; i < 5; ++i) d.update(far, true, -0.5, false);
     EXPECT_FALSE(d.update(far, true, 0.6, false).launched);
@@ -206,7 +206,7 @@ TEST(LaunchDetector, ResetForgetsTheBall) {
   for (int i = 0; i < 3; ++i) d.update(e.centre, true, -0.5, false);
   d.reset();
   EXPECT_FALSE(d.inside());
-  const LaunchEvent out = at(d, on_ellipse(e, 1.5, kPi / 2.0));
+  const LaunchEvent out = at(d, on_ellipse(e, 1.5, std::numbers::pi / 2.0));
   EXPECT_FALSE(out.launched || out.lost);
   at(d, e.centre);
   EXPECT_FALSE(d.update(e.centre, true, 0.6, false).launched);  // the falling count went too

@@ -24,6 +24,9 @@ extern "C" {
 
 typedef int64_t pbfw_time_ns;
 
+/* Nanoseconds per millisecond: the protocol speaks in ms, the core in ns. */
+#define PBFW_NS_PER_MS ((pbfw_time_ns)1000000)
+
 /* Outgoing frames the board can queue between two drains. */
 #define PBFW_OUTBOX_SIZE 32u
 
