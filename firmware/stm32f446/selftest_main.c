@@ -124,7 +124,8 @@ static void drain(pbfw_board* b) {
   }
 }
 
-static void init_board(pbfw_board* b, pbfw_set_coil_fn set_coil) {
+/* The board's options, as main.c gives them, with the output stage `set_coil`. */
+static pbfw_board_options board_options(pbfw_set_coil_fn set_coil) {
   const pbfw_board_options options = {
       .board_id = BOARD_ID,
       .driver_count = COIL_COUNT,
@@ -134,6 +135,11 @@ static void init_board(pbfw_board* b, pbfw_set_coil_fn set_coil) {
       .set_coil = set_coil,
       .set_coil_context = NULL,
   };
+  return options;
+}
+
+static void init_board(pbfw_board* b, pbfw_set_coil_fn set_coil) {
+  const pbfw_board_options options = board_options(set_coil);
   const pbfw_init_error e = pbfw_board_init(b, &options);
   check_eq("pbfw_board_init accepts the board's options", PBFW_INIT_OK, e);
 }
@@ -697,15 +703,7 @@ static void print_count(const char* name, uint32_t instructions) {
 
 /* A session with every driver configured and the watchdog armed, at t. */
 static void session(pbfw_board* b, pbfw_time_ns t, uint16_t max_hold_ms) {
-  const pbfw_board_options options = {
-      .board_id = BOARD_ID,
-      .driver_count = COIL_COUNT,
-      .status_period_ns = 10 * MS,
-      .fw_major = 1,
-      .fw_minor = 0,
-      .set_coil = set_coil_plain,
-      .set_coil_context = NULL,
-  };
+  const pbfw_board_options options = board_options(set_coil_plain);
   (void)pbfw_board_init(b, &options);
   pbfw_board_advance(b, t);
   const pbfw_frame h = hello_frame(PBFW_PROTOCOL_VERSION, 100);
