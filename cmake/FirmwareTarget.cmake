@@ -1,4 +1,4 @@
-# The driver board's firmware for its MCU (firmware/stm32f446/, its own
+# The driver board's firmware for its MCU (firmware_interface/stm32f446/, its own
 # cross-compiled CMake project) as two ctest tests, label `firmware`:
 #
 #   firmware_target_build      scripts/build-firmware.sh into
@@ -43,7 +43,7 @@ if(NOT PINBALL_QEMU_SYSTEM_ARM)
   return()
 endif()
 add_test(NAME firmware_target_qemu_boot
-         COMMAND "${PROJECT_SOURCE_DIR}/firmware/stm32f446/tools/qemu-boot-test.sh" "${_pinball_firmware_dir}")
+         COMMAND "${PROJECT_SOURCE_DIR}/firmware_interface/stm32f446/tools/qemu-boot-test.sh" "${_pinball_firmware_dir}")
 set_tests_properties(firmware_target_qemu_boot PROPERTIES
   LABELS firmware TIMEOUT 60 FIXTURES_REQUIRED pinball_firmware_image
   ENVIRONMENT "QEMU=${PINBALL_QEMU_SYSTEM_ARM}")

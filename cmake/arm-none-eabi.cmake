@@ -1,9 +1,9 @@
-# Cross toolchain for the driver board's firmware (firmware/stm32f446/): the
+# Cross toolchain for the driver board's firmware (firmware_interface/stm32f446/): the
 # GNU Arm Embedded toolchain as Debian packages it (gcc-arm-none-eabi,
 # libnewlib-arm-none-eabi). Bare metal: no OS, no C runtime start-up files
 # (startup.c is ours), newlib-nano only for memcpy/memset.
 #
-#   cmake -S firmware/stm32f446 -B build/firmware-stm32f446 \
+#   cmake -S firmware_interface/stm32f446 -B build/firmware-stm32f446 \
 #         -DCMAKE_TOOLCHAIN_FILE=cmake/arm-none-eabi.cmake
 set(CMAKE_SYSTEM_NAME Generic)
 set(CMAKE_SYSTEM_PROCESSOR arm)

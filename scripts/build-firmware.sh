@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds the driver board's firmware (firmware/stm32f446/, its own CMake
+# Builds the driver board's firmware (firmware_interface/stm32f446/, its own CMake
 # project) with the Arm cross compiler and prints its size: the board image
 # and the QEMU self-test image, from the same start-up code and core.
 #
@@ -43,6 +43,12 @@ for tool in arm-none-eabi-gcc arm-none-eabi-size "$cmake"; do
   fi
 done
 
+src="$root/firmware_interface/stm32f446"
+# A build folder configured from another source folder (the firmware moved,
+# or another checkout) cannot be reused: start it again.
+if [ -f "$dir/CMakeCache.txt" ] && ! grep -qx "CMAKE_HOME_DIRECTORY:INTERNAL=$src" "$dir/CMakeCache.txt"; then
+  rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
+fi
 generator=()
 if [ ! -f "$dir/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 options=(-DCMAKE_TOOLCHAIN_FILE="$root/cmake/arm-none-eabi.cmake")
@@ -51,7 +57,7 @@ if [ -n "${FIRMWARE_OPT:-}" ]; then options+=(-DPINBALL_FW_OPT="$FIRMWARE_OPT");
 # In --json mode stdout carries the JSON object alone.
 if [ "$json" = 1 ]; then exec 3>&1 1>&2; else exec 3>&1; fi
 
-"$cmake" -S "$root/firmware/stm32f446" -B "$dir" "${generator[@]}" "${options[@]}" >/dev/null
+"$cmake" -S "$src" -B "$dir" "${generator[@]}" "${options[@]}" >/dev/null
 "$cmake" --build "$dir" --parallel "${FIRMWARE_JOBS:-1}" >/dev/null
 
 # flash_bytes, ram_bytes of an image, from its section table (size -A):

@@ -15,7 +15,7 @@ packages=(
   nlohmann-json3-dev libcli11-dev
   can-utils libsocketcan-dev
   python3-minimal   # runs the test of the generated Python LCM bindings
-  # The driver board's firmware (firmware/stm32f446/): the Arm cross compiler
+  # The driver board's firmware (firmware_interface/stm32f446/): the Arm cross compiler
   # and newlib for the image, QEMU to boot it (ctest label firmware).
   gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
   # Learning and evaluation across processes and machines (mpirun -n N pinball ...).

@@ -1,4 +1,4 @@
-// The C core's board rules (firmware/core/board.c) through its C API, on the
+// The C core's board rules (firmware_interface/core/board.c) through its C API, on the
 // integer nanosecond clock the STM32 board uses: exact deadlines, and the
 // safety properties under random, mutated and replayed frame streams checked
 // by an observer that knows nothing of the core's state.

@@ -1,4 +1,4 @@
-// One pass of the board's main loop (firmware/core/service.c) over a scripted
+// One pass of the board's main loop (firmware_interface/core/service.c) over a scripted
 // HAL: bounded work per pass, replies held back (never lost) while the
 // transmitter is full, the switches reported.
 

@@ -1,4 +1,4 @@
-// The C core's wire format (firmware/core/wire.c), tested through its C API:
+// The C core's wire format (firmware_interface/core/wire.c), tested through its C API:
 // the layout PROTOCOL.md gives, every kind both ways, and every single-bit
 // error caught.
 

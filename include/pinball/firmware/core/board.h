@@ -2,7 +2,7 @@
 #define PINBALL_FIRMWARE_CORE_BOARD_H
 /* The solenoid driver board's firmware rules (PROTOCOL.md, "Firmware rules",
  * 1..13), implemented once in portable C11. The same code runs on the STM32
- * board (firmware/stm32f446/), in the simulator and in every host test
+ * board (firmware_interface/stm32f446/), in the simulator and in every host test
  * (VirtualDriverBoard wraps it).
  *
  * Fixed-size state, no heap, no floating point, deterministic: the caller

@@ -5,7 +5,7 @@
  * board's `set_coil` callback, called from inside the rules at the exact time
  * a rule acts; the rest is here: a monotonic clock, the CAN controller's
  * receive and transmit, the end-of-stroke switches. The STM32 board
- * (firmware/stm32f446/) implements it on registers, the core's tests on a
+ * (firmware_interface/stm32f446/) implements it on registers, the core's tests on a
  * scripted bus. */
 
 #include "pinball/firmware/core/board.h"

@@ -1,5 +1,5 @@
 /* The QEMU self-test image: the board's start-up code, clock, timer and PWM
- * drivers and the real core (firmware/core/), driven through a scripted
+ * drivers and the real core (firmware_interface/core/), driven through a scripted
  * session instead of CAN (QEMU models no bxCAN). It checks the coil outputs
  * the hardware would produce, read back from TIM3/TIM4's compare registers,
  * against PROTOCOL.md's rules, then measures the instructions the frame

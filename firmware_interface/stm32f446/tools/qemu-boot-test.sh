@@ -9,7 +9,7 @@
 #      loop and stay there (read back over QEMU's monitor), not sit in the
 #      fault handler.
 #
-# Usage: firmware/stm32f446/tools/qemu-boot-test.sh BUILD_DIR
+# Usage: firmware_interface/stm32f446/tools/qemu-boot-test.sh BUILD_DIR
 # Both runs use -icount shift=0: virtual time is the instruction count, so
 # every figure the self-test prints is the same on every machine.
 set -euo pipefail

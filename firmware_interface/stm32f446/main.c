@@ -1,5 +1,5 @@
 /* The driver board: PROTOCOL.md's firmware rules (the portable core,
- * firmware/core/board.c) wired to the STM32F446's CAN, timers and pins.
+ * firmware_interface/core/board.c) wired to the STM32F446's CAN, timers and pins.
  *
  * Start-up order, safest first:
  *   1. coils off: the gate pins driven low (they float until then; the
@@ -10,7 +10,7 @@
  *   5. the IWDG: from here a stalled loop resets the MCU within 19 ms;
  *   6. CAN, and the core (out of session, every driver off).
  *
- * The loop is the core's own pass (pbfw_board_service, firmware/core/
+ * The loop is the core's own pass (pbfw_board_service, firmware_interface/core/
  * service.c) over this board's drivers, then the IWDG refresh: one
  * iteration takes a few microseconds idle, under 1 ms with 16 frames to
  * handle (docs/results.md). It does not sleep: the core's deadlines are met
