@@ -55,7 +55,8 @@ VirtualDriverBoard::VirtualDriverBoard(VirtualDriverBoardOptions options) : opti
   core.set_coil = &VirtualDriverBoard::on_core_coil;
   core.set_coil_context = this;
   if (pbfw_board_init(&core_, &core) != PBFW_INIT_OK) throw std::invalid_argument("VirtualDriverBoard: options refused by the core");
-  sync();
+  sync_counters();
+  sync_configs();
 }
 
 void VirtualDriverBoard::add_listener(CoilListener* listener) {
@@ -91,20 +92,22 @@ void VirtualDriverBoard::on_core_coil(void* self, unsigned driver, pbfw_coil_sta
   }
 }
 
-void VirtualDriverBoard::sync() {
-  counters_ = from_core(core_.counters);
+void VirtualDriverBoard::sync_counters() { counters_ = from_core(core_.counters); }
+
+void VirtualDriverBoard::sync_configs() {
   for (int d = 0; d < kMaxDrivers; ++d) configs_[static_cast<std::size_t>(d)] = from_core(core_.drivers[d].config);
 }
 
 void VirtualDriverBoard::advance(double now_s) {
   pbfw_board_advance(&core_, enter(now_s));
-  sync();
+  sync_counters();  // timers change no configuration
 }
 
 void VirtualDriverBoard::on_frame(const CanFrame& frame, double now_s) {
   const pbfw_frame f = to_core(frame);
   pbfw_board_on_frame(&core_, &f, enter(now_s));
-  sync();
+  sync_counters();
+  sync_configs();
 }
 
 bool VirtualDriverBoard::pop_tx(CanFrame& frame) {

@@ -41,8 +41,9 @@ void line_text(text_line* line, const char* text) {
   while (*text != '\0') put(line, *text++);
 }
 
-void line_u32(text_line* line, uint32_t value) {
-  char digits[10];
+/* The digits of `value`, most significant first. */
+static void put_decimal(text_line* line, uint64_t value) {
+  char digits[20];
   unsigned n = 0u;
   do {
     digits[n++] = (char)('0' + value % 10u);
@@ -51,19 +52,15 @@ void line_u32(text_line* line, uint32_t value) {
   while (n > 0u) put(line, digits[--n]);
 }
 
+void line_u32(text_line* line, uint32_t value) { put_decimal(line, value); }
+
 void line_i64(text_line* line, int64_t value) {
   uint64_t magnitude = (uint64_t)value;
   if (value < 0) {
     put(line, '-');
     magnitude = 0u - magnitude;
   }
-  char digits[20];
-  unsigned n = 0u;
-  do {
-    digits[n++] = (char)('0' + magnitude % 10u);
-    magnitude /= 10u;
-  } while (magnitude != 0u);
-  while (n > 0u) put(line, digits[--n]);
+  put_decimal(line, magnitude);
 }
 
 void line_hex(text_line* line, uint32_t value, unsigned digits) {

@@ -69,31 +69,30 @@ TEST(Checkpoint, ACutOffLastRecordIsDroppedAndTheFileCutBack) {
   EXPECT_EQ(std::filesystem::file_size(path), whole);
 }
 
+// The error open_checkpoint gives for `options` ("" when it opened).
+std::string refusal(const CheckpointOptions& options) {
+  try {
+    open_checkpoint(options);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  close_checkpoint();
+  return "";
+}
+
 TEST(Checkpoint, RefusesWhatWouldLoseOrMixRuns) {
   const std::string path = testing::temp_path("checkpoint", "refuse.ckpt");
   std::filesystem::remove(path);
   const Closer closer;
-  try {
-    open_checkpoint({path, true, "run C"});
-    FAIL() << "resumed a file that does not exist";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("no such file"), std::string::npos) << e.what();
-  }
+  const std::string missing = refusal({path, true, "run C"});
+  EXPECT_NE(missing.find("no such file"), std::string::npos) << "resumed a file that does not exist: " << missing;
   open_checkpoint({path, false, "run C"});
   checkpoint_record(batch(3, 2));
   close_checkpoint();
-  try {
-    open_checkpoint({path, false, "run C"});
-    FAIL() << "started a new checkpoint over an old one";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("already exists"), std::string::npos) << e.what();
-  }
-  try {
-    open_checkpoint({path, true, "run D"});
-    FAIL() << "resumed another run's file";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("another run"), std::string::npos) << e.what();
-  }
+  const std::string over = refusal({path, false, "run C"});
+  EXPECT_NE(over.find("already exists"), std::string::npos) << "started a new checkpoint over an old one: " << over;
+  const std::string other = refusal({path, true, "run D"});
+  EXPECT_NE(other.find("another run"), std::string::npos) << "resumed another run's file: " << other;
   open_checkpoint({path, true, "run C"});
   std::vector<Blob> got;
   EXPECT_THROW(checkpoint_replay(3, got), std::runtime_error) << "a batch of another size is another run";

@@ -101,8 +101,9 @@ class VirtualDriverBoard {
   // Converts the caller's time to the core's nanoseconds and remembers both,
   // so that a change "now" carries the caller's exact time.
   pbfw_time_ns enter(double now_s);
-  // Copies what the core changed into the C++ views (counters, configs).
-  void sync();
+  // Copy what the core changed into the C++ views.
+  void sync_counters();
+  void sync_configs();
 
   VirtualDriverBoardOptions options_;
   pbfw_board core_{};
