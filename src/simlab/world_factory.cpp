@@ -1,14 +1,50 @@
 #include "pinball/simlab/world_factory.h"
 
+#include <stdexcept>
+
 #include "pinball/table/board_loader.h"
+#ifdef PINBALL_HAVE_TWIN
+#include "pinball/simlab/twin_world.h"
+#endif
 
 namespace pinball::simlab {
+
+WorldKind parse_world_kind(std::string_view name) {
+  if (name == "model") return WorldKind::kModel;
+  if (name == "twin") return WorldKind::kTwin;
+  throw std::invalid_argument("unknown world '" + std::string(name) + "' (expected model or twin)");
+}
+
+std::string_view world_kind_name(WorldKind kind) { return kind == WorldKind::kTwin ? "twin" : "model"; }
+
+std::string_view world_name(const WorldSpec& spec) {
+  return spec.kind == WorldKind::kTwin ? "twin" : sim::stepper_kind_name(spec.stepper);
+}
+
+bool twin_available() {
+#ifdef PINBALL_HAVE_TWIN
+  return true;
+#else
+  return false;
+#endif
+}
 
 OwnedWorld make_world(const WorldSpec& spec, const table::Board& belief) {
   OwnedWorld out;
   out.board = std::make_unique<const table::Board>(spec.board_path.empty() ? belief
                                                                            : table::load_board(spec.board_path));
   sim::check_same_flippers(*out.board, belief);
+  if (spec.kind == WorldKind::kTwin) {
+#ifdef PINBALL_HAVE_TWIN
+    out.world = make_twin_world(*out.board, load_twin_params(spec.twin_params_path.empty() ? default_twin_params_path()
+                                                                                             : spec.twin_params_path),
+                                spec.dt_s);
+    return out;
+#else
+    throw std::invalid_argument("this build has no MuJoCo twin: install libmujoco-dev and configure with "
+                                "-DPINBALL_TWIN=ON (docs/worlds.md)");
+#endif
+  }
   sim::ModelWorldOptions options;
   options.stepper = spec.stepper;
   options.dt_s = spec.dt_s;

@@ -9,6 +9,7 @@
 // so any world can stand in for the table while the tracker and the controller
 // keep their own belief of it.
 
+#include <cstdint>
 #include <memory>
 #include <string_view>
 
@@ -22,6 +23,17 @@ namespace pinball::sim {
 enum class StepperKind : std::uint8_t {
   kThesis,  ///< fixed-step semi-implicit Euler (thesis Ch. 3)
   kEvent,   ///< exact event-driven stepper
+};
+
+/// Trouble a world met while playing, counted and reported, never silent
+/// (the twin's MuJoCo warnings; the model worlds have none). A world and all
+/// its forks share one set of counters, so the world a command built reports
+/// every ball its forks played.
+struct WorldWarnings {
+  std::uint64_t penetration = 0;  ///< contacts deeper than the world's limit (a ball pushed into an obstacle)
+  std::uint64_t instability = 0;  ///< bad positions, velocities or accelerations the engine reset
+  std::uint64_t overflow = 0;     ///< contact or constraint buffers full
+  std::uint64_t total() const { return penetration + instability + overflow; }
 };
 
 /// The thing that plays a table. One object per game in progress (a world may
@@ -46,6 +58,8 @@ class World {
   virtual std::unique_ptr<World> fork() const = 0;
   /// Short name for reports and errors: "thesis", "event", "twin".
   virtual std::string_view name() const = 0;
+  /// Warnings of this world and all its forks so far (thread-safe).
+  virtual WorldWarnings warnings() const { return {}; }
 };
 
 /// Parses "thesis" or "event"; throws std::invalid_argument naming the value otherwise.

@@ -6,7 +6,9 @@
 // world is not its model is one option away.
 
 #include <memory>
+#include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "pinball/sim/model_world.h"
 #include "pinball/sim/world.h"
@@ -14,12 +16,29 @@
 
 namespace pinball::simlab {
 
+/// Which kind of world plays the table.
+enum class WorldKind : std::uint8_t {
+  kModel,  ///< the thesis model on a stepper (sim::make_model_world)
+  kTwin,   ///< the MuJoCo lab twin (twin_world.h): not written as our model
+};
+
 /// Which world to play.
 struct WorldSpec {
+  WorldKind kind = WorldKind::kModel;            ///< model or twin
   std::string board_path;                        ///< the world's own board file; empty: the belief's board
-  sim::StepperKind stepper = sim::StepperKind::kThesis;  ///< the model world's integrator
-  double dt_s = 0.0;                             ///< step or step horizon (s); 0: the board's
+  sim::StepperKind stepper = sim::StepperKind::kThesis;  ///< the model world's integrator (model only)
+  double dt_s = 0.0;                             ///< step or step horizon (s); 0: the board's (model) or the twin's
+  std::string twin_params_path;                  ///< the twin's physical parameters; empty: the shipped config/twin.yaml
 };
+
+/// Parses "model" or "twin"; throws std::invalid_argument naming the value otherwise.
+WorldKind parse_world_kind(std::string_view name);
+/// "model" or "twin".
+std::string_view world_kind_name(WorldKind kind);
+/// What a report calls the world of `spec`: "thesis", "event" or "twin".
+std::string_view world_name(const WorldSpec& spec);
+/// True when this build has the MuJoCo twin (configured with PINBALL_TWIN and libmujoco-dev).
+bool twin_available();
 
 /// A world with the board it plays (the world borrows it, so they travel together).
 struct OwnedWorld {
@@ -33,6 +52,9 @@ struct OwnedWorld {
 /// Builds the world of `spec` for a controller that believes `belief`: loads
 /// spec.board_path (table::BoardError on a bad file) or copies the belief, and
 /// checks that world and belief wire the same flippers (std::invalid_argument).
+/// The twin loads its parameter file (TwinParamsError naming file:key) and
+/// refuses a board it cannot represent (std::invalid_argument); in a build
+/// without it, kTwin throws std::invalid_argument saying so.
 OwnedWorld make_world(const WorldSpec& spec, const table::Board& belief);
 
 }  // namespace pinball::simlab
