@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "event_context.h"
-#include "game_rules.h"
+#include "pinball/sim/game_rules.h"
 #include "pinball/sim/collision.h"
 
 namespace pinball::sim::event {

@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "event_context.h"
-#include "game_rules.h"
+#include "pinball/sim/game_rules.h"
 
 namespace pinball::sim {
 namespace {

@@ -1,4 +1,4 @@
-#include "game_rules.h"
+#include "pinball/sim/game_rules.h"
 
 #include <algorithm>
 #include <cmath>
@@ -34,6 +34,12 @@ void hit_obstacle(const table::Board& board, GameState& state, std::int32_t inde
   Vec2& v = state.ball.velocity_mps;
   v = reflect(v, normal, o.rho);
   v += o.action.kick_mps * normal;
+  score_obstacle_hit(board, state, index, events, clear_m);
+}
+
+void score_obstacle_hit(const table::Board& board, GameState& state, std::int32_t index, StepEvents& events,
+                        double clear_m) {
+  const table::Obstacle& o = board.obstacles[index];
   events.flags |= StepEvents::kHitObstacle;
   events.obstacle = index;
   state.score += o.action.score;
@@ -104,6 +110,13 @@ bool on_sensor(const table::Sensor& sensor, const Vec2& p, double r) {
   if (sensor.kind == table::SensorKind::kHole) return (p - shape.p0).norm() <= shape.radius_m;
   if (shape.kind == table::ShapeKind::kLine) return distance_point_segment(p, shape.p0, shape.p1) <= r;
   return (p - shape.p0).norm() <= r + shape.radius_m;
+}
+
+bool swept_onto_sensor(const table::Sensor& sensor, const Vec2& from, const Vec2& to, double r) {
+  const table::Shape& shape = sensor.shape;
+  if (sensor.kind == table::SensorKind::kHole) return distance_point_segment(shape.p0, from, to) <= shape.radius_m;
+  if (shape.kind == table::ShapeKind::kLine) return distance_segment_segment(from, to, shape.p0, shape.p1) <= r;
+  return distance_point_segment(shape.p0, from, to) <= r + shape.radius_m;
 }
 
 void update_contacts(const table::Board& board, GameState& state, std::span<const std::int32_t> candidates, double touch_m,

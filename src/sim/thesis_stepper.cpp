@@ -5,7 +5,7 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "game_rules.h"
+#include "pinball/sim/game_rules.h"
 #include "pinball/sim/collision.h"
 #include "pinball/sim/penetration.h"
 
@@ -266,18 +266,8 @@ void ThesisStepper::update_sensors(GameState& state, const Vec2& from, StepEvent
   for (const std::int32_t i : candidates) {
     const table::Sensor& sensor = board_.sensors[i];
     const Vec2& to = state.ball.position_m;
-    // Swept over the whole move so that a fast ball cannot skip a sensor.
-    bool touched = false;
     const bool inside = rules::on_sensor(sensor, to, r);
-    const table::Shape& shape = sensor.shape;
-    if (sensor.kind == table::SensorKind::kHole) {
-      touched = distance_point_segment(shape.p0, from, to) <= shape.radius_m;
-    } else if (shape.kind == table::ShapeKind::kLine) {
-      touched = distance_segment_segment(from, to, shape.p0, shape.p1) <= r;
-    } else {
-      touched = distance_point_segment(shape.p0, from, to) <= r + shape.radius_m;
-    }
-    const bool entered = touched && !state.sensor_inside[i];
+    const bool entered = rules::swept_onto_sensor(sensor, from, to, r) && !state.sensor_inside[i];
     state.sensor_inside[i] = inside ? 1 : 0;
     if (!entered) continue;
     rules::fire_sensor(board_, state, i, events);

@@ -8,6 +8,8 @@ namespace pinball {
 
 /// A point or vector in the board plane (m, m/s, ...; the name says which).
 using Vec2 = Eigen::Vector2d;
+/// A point or vector in 3-D board coordinates, z out of the playfield (the twin's ball).
+using Vec3 = Eigen::Vector3d;
 
 /// z component of the 3-D cross product of two plane vectors.
 inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }

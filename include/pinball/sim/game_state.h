@@ -16,6 +16,7 @@ namespace pinball::sim {
 struct BallState {
   Vec2 position_m = Vec2::Zero();     ///< centre (m)
   Vec2 velocity_mps = Vec2::Zero();   ///< velocity (m/s)
+  double height_m = 0.0;              ///< lowest point above the playfield (m): 0 on it; the twin's ball hops
 };
 
 /// One flipper's moving parts and its solenoid command.

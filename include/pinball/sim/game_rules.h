@@ -1,7 +1,7 @@
 #pragma once
 // What a hit or a sensor entry does to the game (thesis 3.3.2, 3.4): shared by
-// every stepper so that steppers differ only in how they integrate. Internal
-// to pinball_sim.
+// every world (the thesis and event steppers, the MuJoCo twin) so that worlds
+// differ only in their physics, never in their scoring.
 
 #include <cstdint>
 #include <span>
@@ -10,7 +10,7 @@
 #include "pinball/core/geometry.h"
 #include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
-#include "pinball/sim/thesis_stepper.h"
+#include "pinball/sim/step_events.h"
 
 namespace pinball::sim::rules {
 
@@ -21,9 +21,14 @@ void lose_ball(const table::Board& board, GameState& state, StepEvents& events);
 /// from the ball (a flag never rises into the ball).
 void raise_flags(const table::Board& board, GameState& state, double clear_m);
 
+/// What striking obstacle `index` does to the game, its physics aside: the
+/// score, the bank flag falling (and the bank's bonus), the ball eaten.
+/// clear_m as for raise_flags. The twin calls this; its contacts are its own.
+void score_obstacle_hit(const table::Board& board, GameState& state, std::int32_t index, StepEvents& events,
+                        double clear_m);
+
 /// The ball strikes obstacle `index` with contact normal `normal`: reflection
-/// with ρ, the kick, the score, the bank flag falling (and the bank's bonus),
-/// the ball eaten. clear_m as for raise_flags.
+/// with ρ, the kick, then score_obstacle_hit. clear_m as for raise_flags.
 void hit_obstacle(const table::Board& board, GameState& state, std::int32_t index, const Vec2& normal,
                   StepEvents& events, double clear_m);
 
@@ -42,6 +47,10 @@ double take_command(const table::Flipper& f, FlipperState& fs, std::uint64_t& fl
 /// True while a ball of radius r at p is on the sensor (touching it; for a
 /// hole, its centre inside).
 bool on_sensor(const table::Sensor& sensor, const Vec2& p, double r);
+
+/// True when a ball of radius r moving straight from `from` to `to` touched
+/// the sensor on the way: swept, so that a fast ball cannot skip one.
+bool swept_onto_sensor(const table::Sensor& sensor, const Vec2& from, const Vec2& to, double r);
 
 /// The flippers' contact sensors (ball within touch_m of the segment) and the
 /// contact scores (rate·dt for each listed obstacle within touch_m) at the
