@@ -63,8 +63,8 @@ nlohmann::json to_json(const CeilingReport& r) {
 std::string to_text(const CeilingReport& r) {
   std::ostringstream out;
   const CeilingBenchOptions& o = r.options;
-  out << "ceiling reference on " << r.board << " (world: " << r.world_board << " on the " << r.world
-      << " stepper): " << o.balls << " balls per player (seed " << o.seed
+  out << "ceiling reference on " << r.board << " (world: " << r.world_board << ", "
+      << (r.world == "twin" ? std::string("the MuJoCo twin") : "the " + r.world + " stepper") << "): " << o.balls << " balls per player (seed " << o.seed
       << "), cut at " << format_number(o.max_ball_time_s) << " s, actuation delay "
       << format_number(o.actuation_delay_s * 1e3) << " ms\n"
       << "the ceiling player CHEATS (true state, lookahead with the true simulator): a reference, not a "

@@ -192,10 +192,14 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
   const simlab::OwnedWorld world = simlab::make_world(a.world, board);
   const bench::CeilingReport report = bench::run_ceiling_bench(
       board, options, [&](const std::string& line) { err << "bench ceiling: " << line << "\n"; }, world.world.get());
+  const nlohmann::json world_json = world_report(a.world, a.board, *world.world);
   if (a.json) {
-    out << bench::to_json(report).dump(2) << "\n";
+    nlohmann::json j = bench::to_json(report);
+    j.update(world_json);
+    out << j.dump(2) << "\n";
   } else {
     out << bench::to_text(report);
+    if (a.world.kind == simlab::WorldKind::kTwin) out << world_text_line(world_json);
   }
   return 0;
 }

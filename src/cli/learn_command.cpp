@@ -193,6 +193,10 @@ std::string run_fingerprint(const LearnArgs& a) {
       {"world_board", a.world.board_path},
       {"world_board_fnv1a", a.world.board_path.empty() ? "" : file_digest(a.world.board_path)},
       {"stepper", std::string(sim::stepper_kind_name(a.world.stepper))}, {"world_dt_s", a.world.dt_s},
+      {"world", std::string(simlab::world_kind_name(a.world.kind))},
+      {"twin_params_fnv1a", a.world.kind != simlab::WorldKind::kTwin ? ""
+                            : file_digest(a.world.twin_params_path.empty() ? simlab::default_twin_params_path()
+                                                                           : a.world.twin_params_path)},
       {"controller", a.controller}, {"controller_fnv1a", a.controller.empty() ? "" : file_digest(a.controller)},
       {"budget_balls", a.budget_balls}, {"seed", a.seed}, {"eval_balls", a.eval_balls},
       {"partitions", a.partitions}, {"partition_h", a.partition_by_h}, {"rolling", a.rolling},
@@ -302,8 +306,6 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   const bool writer = learn::team_root();
 
   nlohmann::json j = {{"board", a.board},
-                      {"world_board", a.world.board_path.empty() ? a.board : a.world.board_path},
-                      {"stepper", std::string(sim::stepper_kind_name(a.world.stepper))},
                       {"method", a.method},
                       {"seed", a.seed},
                       {"threads", a.threads}};
@@ -429,16 +431,14 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     j["evaluation"]["gravity_scale"] = a.gravity_scale;
   }
   j["team"] = team_report();
+  j.update(world_report(a.world, a.board, *world.world));
   if (a.json) {
     out << j.dump(2) << "\n";
   } else {
     out << "learn " << a.method << " on " << a.board << " (seed " << a.seed << ", " << a.threads << " threads";
     if (learn::team_size() > 1) out << " on each of " << learn::team_size() << " MPI ranks";
     out << ")\n";
-    if (!a.world.board_path.empty() || a.world.stepper != sim::StepperKind::kThesis) {
-      out << "world            " << j["world_board"].get<std::string>() << " on the " << j["stepper"].get<std::string>()
-          << " stepper\n";
-    }
+    if (!a.world.board_path.empty() || j["world"] != "thesis") out << world_text_line(j);
     auto num = [](const nlohmann::json& x, int digits = 3) { return format_number(x.get<double>(), digits); };
     if (search) {
       out << "balls used       " << j["balls_used"] << " of " << a.budget_balls << " in " << j["generations"]

@@ -188,8 +188,6 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"board", a.board},
         {"policy", policy},
         {"controller", a.controller},
-        {"stepper", std::string(sim::stepper_kind_name(a.world.stepper))},
-        {"world_board", a.world.board_path.empty() ? a.board : a.world.board_path},
         {"seed", a.seed},
         {"dt_s", dt_s},
         {"balls", a.balls},
@@ -216,11 +214,12 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"events", events},
         {"events_per_s", events_per_s},
     };
+    j.update(world_report(a.world, a.board, *world.world));
     out << j.dump(2) << "\n";
   } else {
-    if (!a.world.board_path.empty()) out << "world board      " << a.world.board_path << "\n";
+    out << world_text_line(world_report(a.world, a.board, *world.world));
     out << "board            " << a.board << " (policy " << policy << ", actuation " << a.actuation
-        << ", stepper " << sim::stepper_kind_name(a.world.stepper) << ", dt "
+        << ", world " << world.world->name() << ", dt "
         << format_number(dt_s) << " s, seed " << a.seed << ")\n"
         << "balls            " << a.balls << " (" << cut << " cut at " << format_number(a.max_ball_time_s) << " s, "
         << left_table << " left the table)\n"

@@ -38,4 +38,32 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
       ->default_str("");  // 0: the board's
 }
 
+nlohmann::json world_report(const simlab::WorldSpec& spec, const std::string& belief_board, const sim::World& world) {
+  const sim::WorldWarnings w = world.warnings();
+  nlohmann::json j = {{"world", std::string(world.name())},
+                      {"world_board", spec.board_path.empty() ? belief_board : spec.board_path},
+                      {"stepper", std::string(sim::stepper_kind_name(spec.stepper))},
+                      {"world_warnings",
+                       {{"penetration", w.penetration}, {"instability", w.instability}, {"overflow", w.overflow}}}};
+  if (spec.kind == simlab::WorldKind::kTwin) {
+    j["twin_params"] = spec.twin_params_path.empty() ? std::string("config/twin.yaml") : spec.twin_params_path;
+  }
+  return j;
+}
+
+std::string world_text_line(const nlohmann::json& report) {
+  const std::string world = report["world"].get<std::string>();
+  const std::string board = report["world_board"].get<std::string>();
+  if (world == "twin") {
+    const nlohmann::json& w = report["world_warnings"];
+    const std::uint64_t warnings =
+        w["penetration"].get<std::uint64_t>() + w["instability"].get<std::uint64_t>() + w["overflow"].get<std::uint64_t>();
+    return "world            MuJoCo twin of " + board + " (" + report["twin_params"].get<std::string>() + "), " +
+           std::to_string(warnings) + " warnings (" + std::to_string(w["penetration"].get<std::uint64_t>()) +
+           " deep contacts, " + std::to_string(w["instability"].get<std::uint64_t>()) + " instabilities, " +
+           std::to_string(w["overflow"].get<std::uint64_t>()) + " overflows)\n";
+  }
+  return "world            " + board + " on the " + world + " stepper\n";
+}
+
 }  // namespace pinball::cli

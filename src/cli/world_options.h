@@ -4,12 +4,25 @@
 // belief (the BOARD argument or --board), and defaults to it.
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <string>
 
 #include "pinball/simlab/world_factory.h"
 
 namespace pinball::cli {
 
-/// Adds --world-board, --stepper and --dt, writing into `world`.
+/// Adds --world, --twin-params, --world-board, --stepper and --dt, writing into `world`.
 void add_world_options(CLI::App& cmd, simlab::WorldSpec& world);
+
+/// What a report says of the world it played: `world` (thesis, event or
+/// twin), `world_board`, `stepper`, `twin_params` (twin only) and
+/// `world_warnings` (penetration, instability, overflow: the twin's MuJoCo
+/// warnings, counted over every ball its forks played).
+nlohmann::json world_report(const simlab::WorldSpec& spec, const std::string& belief_board, const sim::World& world);
+
+/// The report as one text line ("world            twin of B (P), 0 warnings"),
+/// empty for the belief's own board on the thesis stepper.
+std::string world_text_line(const nlohmann::json& report);
 
 }  // namespace pinball::cli

@@ -194,6 +194,7 @@ void Daemon::Impl::build() {
   cpus = plan_cpus(config.threads.chain_cpu);
   config.sim.board = find_data_file(config.sim.board);
   if (!config.sim.world_board.empty()) config.sim.world_board = find_data_file(config.sim.world_board);
+  if (!config.sim.twin_params.empty()) config.sim.twin_params = find_data_file(config.sim.twin_params);
   config.board = find_data_file(config.board);
   config.controller = find_data_file(config.controller);
   lockstep = plays_world && !config.sim.realtime;
@@ -256,6 +257,8 @@ void Daemon::Impl::build() {
     wo.max_ball_time_s = config.sim.max_ball_time_s;
     wo.launcher_pull = spec.launcher_pull;
     simlab::WorldSpec ws;
+    ws.kind = config.sim.world;
+    ws.twin_params_path = config.sim.twin_params;
     ws.board_path = config.sim.world_board;
     ws.stepper = config.sim.stepper;
     world_model = simlab::make_world(ws, board);
@@ -434,6 +437,7 @@ DaemonReport Daemon::Impl::report() const {
   if (world) {
     r.world_board = world_model->board().source;
     r.world = std::string(world_model->name());
+    r.world_warnings = world_model->warnings();
     r.results = world->results();
     // The virtual board belongs to the simulator thread: its counters are read once that thread is done.
     if (threads_joined.load(std::memory_order_acquire)) r.board = world->driver_board().counters();
@@ -644,7 +648,15 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   nlohmann::json j;
   j["mode"] = r.mode;
   j["clock"] = r.mode == "sim" ? (r.lockstep ? "lockstep" : "realtime") : "steady";
-  if (r.mode == "sim") j["world"] = {{"board", r.world_board}, {"stepper", r.world}};
+  if (r.mode == "sim") {
+    // "stepper" names the world (thesis, event or twin), as before the twin.
+    j["world"] = {{"board", r.world_board},
+                  {"stepper", r.world},
+                  {"warnings",
+                   {{"penetration", r.world_warnings.penetration},
+                    {"instability", r.world_warnings.instability},
+                    {"overflow", r.world_warnings.overflow}}}};
+  }
   j["balls"] = r.balls;
   j["mean_score_per_ball"] = r.mean_score;
   j["score_ci95_half_width"] = r.score_ci95;
@@ -712,6 +724,11 @@ std::string report_to_text(const DaemonReport& r) {
       << " (95 %)  mean ball time " << format_number(r.mean_ball_time_s) << " s";
     if (r.cut_balls > 0) o << "  cut " << r.cut_balls;
     o << "\n";
+    if (r.world != "thesis") {
+      o << "world " << r.world << " on " << r.world_board << "  warnings " << r.world_warnings.total() << " ("
+        << r.world_warnings.penetration << " deep contacts, " << r.world_warnings.instability << " instabilities, "
+        << r.world_warnings.overflow << " overflows)\n";
+    }
   }
   o << std::setprecision(1);
   o << "frames " << r.frames << " (dropped " << r.frames_dropped << ")  ball seen " << r.detections

@@ -163,6 +163,7 @@ std::vector<PathField> path_fields(DaemonConfig& c) {
   return {
       {"sim.board", &c.sim.board, use(sim, PathUse::kRead)},
       {"sim.world_board", &c.sim.world_board, use(world, PathUse::kRead)},
+      {"sim.twin_params", &c.sim.twin_params, use(world && c.sim.world == simlab::WorldKind::kTwin, PathUse::kRead)},
       {"board", &c.board, use(!sim, PathUse::kRead)},
       {"calibration", &c.calibration, PathUse::kRead},
       {"controller", &c.controller, PathUse::kRead},

@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
       "failed; 2 bad argument; "
       "3 ran, but a recording is incomplete (the --can-log file dropped frames, or LCM refused messages, e.g. a "
       "file:// log on a full disk): the report says what was lost.");
-  std::string config_path, sim_board, world_board, stepper, controller, lcm_url, can_log;
+  std::string config_path, sim_board, world_board, world_kind, twin_params, stepper, controller, lcm_url, can_log;
   int balls = -1;
   long long seed = -1;
   bool realtime = false, json = false, threads = false;
@@ -66,7 +66,14 @@ int main(int argc, char** argv) {
                  "simulation: the board the table really is (default: the --sim board, which stays the belief of "
                  "the tracker and the controller); same flippers required")
       ->check(CLI::ExistingFile);
-  app.add_option("--stepper", stepper, "simulation: the world's integrator, thesis or event")
+  app.add_option("--world", world_kind,
+                 "simulation: which world plays the table, model (the thesis model on --stepper) or twin (the MuJoCo "
+                 "lab twin, docs/worlds.md)")
+      ->check(CLI::IsMember({"model", "twin"}))
+      ->default_str(std::string(pinball::simlab::world_kind_name(defaults.sim.world)));
+  app.add_option("--twin-params", twin_params, "simulation: the twin's parameter file (default: config/twin.yaml)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--stepper", stepper, "simulation: the model world's integrator, thesis or event")
       ->check(CLI::IsMember({"thesis", "event"}))
       ->default_str(std::string(pinball::sim::stepper_kind_name(defaults.sim.stepper)));
   app.add_option("--controller", controller, "controller file")
@@ -111,6 +118,8 @@ int main(int argc, char** argv) {
     }
     if (!world_board.empty()) config.sim.world_board = world_board;
     if (!stepper.empty()) config.sim.stepper = pinball::sim::parse_stepper_kind(stepper);
+    if (!world_kind.empty()) config.sim.world = pinball::simlab::parse_world_kind(world_kind);
+    if (!twin_params.empty()) config.sim.twin_params = twin_params;
     if (!controller.empty()) config.controller = controller;
     if (balls >= 0) config.sim.balls = balls;
     if (seed >= 0) config.sim.seed = static_cast<std::uint64_t>(seed);

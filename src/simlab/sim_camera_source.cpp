@@ -78,6 +78,7 @@ SimCameraSource::SimCameraSource(const table::Board& board, const SimCameraConfi
   check_input(c.width_px >= 32 && c.height_px >= 32 && c.width_px <= 8192 && c.height_px <= 8192, "sim camera",
           "width_px and height_px must be in [32, 8192]");
   check_input(std::isfinite(c.fps) && c.fps > 0.0, "sim camera", "fps must be > 0");
+  check_input(std::isfinite(c.lens_height_m) && c.lens_height_m > 0.1, "sim camera", "lens_height_m must be > 0.1 m");
   check_input(std::isfinite(c.exposure_s) && c.exposure_s >= 0.0 && c.exposure_s <= 1.0 / c.fps, "sim camera",
           "exposure_s must be in [0, 1/fps]");
   check_input(std::isfinite(c.first_exposure_s), "sim camera", "first_exposure_s must be finite");
@@ -263,7 +264,12 @@ void SimCameraSource::observe(const sim::GameState& state) {
   for (std::size_t i = 0; i < flipper_theta_.size() && i < state.flippers.size(); ++i) {
     flipper_theta_[i] = state.flippers[i].theta_rad;
   }
-  observe_ball(state.time_s, state.ball.position_m, state.ball_in_play);
+  // A ball that hops is nearer the lens: seen from above the playfield's
+  // centre it moves out along the line from the centre and grows.
+  const double lens_above_ball = config_.lens_height_m - board_.ball.radius_m;
+  ball_scale_ = lens_above_ball / std::max(lens_above_ball - state.ball.height_m, 0.05 * lens_above_ball);
+  const Vec2 centre(0.5 * board_.width_m, 0.5 * board_.height_m);
+  observe_ball(state.time_s, centre + ball_scale_ * (state.ball.position_m - centre), state.ball_in_play);
 }
 
 void SimCameraSource::draw_flippers(cv::Mat& image) const {
@@ -482,7 +488,7 @@ void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, 
 }
 
 void SimCameraSource::draw_ball(std::span<const Vec2> path_board, int path_total, cv::Mat& image) {
-  const double r_m = board_.ball.radius_m;
+  const double r_m = board_.ball.radius_m * ball_scale_;
   // Image-space box around every path position.
   double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300, r_px = 0.0;
   for (const Vec2& p : path_board) {

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "pinball/core/data_path.h"
 #include "pinball/table/board_loader.h"
 #ifdef PINBALL_HAVE_TWIN
 #include "pinball/simlab/twin_world.h"
@@ -20,6 +21,8 @@ std::string_view world_kind_name(WorldKind kind) { return kind == WorldKind::kTw
 std::string_view world_name(const WorldSpec& spec) {
   return spec.kind == WorldKind::kTwin ? "twin" : sim::stepper_kind_name(spec.stepper);
 }
+
+std::string default_twin_params_path() { return find_data_file("config/twin.yaml"); }
 
 bool twin_available() {
 #ifdef PINBALL_HAVE_TWIN

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/sim/game_state.h"
 #include "pinball/table/board_loader.h"
 #include "common/thesis_board.h"
 
@@ -55,6 +56,33 @@ TEST(SimCameraSource, DeliversFramesAtItsRateStampedAtMidExposure) {
   for (std::size_t i = 0; i < stamps.size(); ++i) EXPECT_NEAR(stamps[i], 0.001 + 0.005 * i, 1e-12);
   EXPECT_EQ(camera.counters().frames, 20u);
   EXPECT_EQ(camera.counters().dropped, 0u);
+}
+
+TEST(SimCameraSource, AHoppingBallLooksFartherFromTheCentreAndLarger) {
+  // The twin's ball hops: the lens (0.9 m above the playfield's centre) sees
+  // it along the line from the centre, 30 mm nearer: out by (H − r)/(H − r − h).
+  const table::Board& board = thesis_board();
+  auto seen = [&](double height_m) {
+    SimCameraConfig c;
+    SimCameraSource camera(board, c);
+    sim::GameState state = sim::make_game_state(board, 1);
+    state.ball_in_play = true;
+    state.ball.position_m = {0.1, 0.2};
+    state.ball.height_m = height_m;
+    vision::Frame frame;
+    for (int step = 1; step <= 20; ++step) {
+      state.time_s = step * 0.0005;
+      camera.observe(state);
+      if (camera.read(frame)) break;
+    }
+    return camera.truth();
+  };
+  const FrameTruth flat = seen(0.0), hop = seen(0.03);
+  const Vec2 centre(0.5 * board.width_m, 0.5 * board.height_m);
+  const double k = (0.9 - board.ball.radius_m) / (0.9 - board.ball.radius_m - 0.03);
+  EXPECT_NEAR((flat.p_board_mid - Vec2(0.1, 0.2)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((hop.p_board_mid - (centre + k * (Vec2(0.1, 0.2) - centre))).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(hop.radius_px / flat.radius_px, k, 0.02);
 }
 
 TEST(SimCameraSource, MotionBlurSpreadsTheBallAlongItsPath) {

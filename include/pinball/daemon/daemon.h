@@ -49,7 +49,8 @@ struct DaemonReport {
   std::string mode;                          ///< sim or lab
   bool lockstep = false;                     ///< sim with the virtual clock
   std::string world_board;                   ///< sim: the board the world plays
-  std::string world;                         ///< sim: the world that played it (thesis, event)
+  std::string world;                         ///< sim: the world that played it (thesis, event, twin)
+  sim::WorldWarnings world_warnings;         ///< sim: the world's warnings (the twin's MuJoCo warnings)
   int balls = 0;                             ///< balls played (sim)
   double mean_score = 0.0;                   ///< mean score per ball (sim)
   double score_ci95 = 0.0;                   ///< half-width of its 95 % interval (sim)

@@ -25,6 +25,7 @@
 #include "pinball/firmware/messages.h"
 #include "pinball/firmware/protocol.h"
 #include "pinball/sim/world.h"
+#include "pinball/simlab/world_factory.h"
 
 namespace pinball::daemon {
 
@@ -121,7 +122,9 @@ struct ThreadSettings {
 struct SimSettings {
   std::string board = "boards/mit1993.board";  ///< board file: the belief, and the world unless world_board is set
   std::string world_board;                     ///< the world's own board file (empty: `board`); same flippers
-  sim::StepperKind stepper = sim::StepperKind::kThesis;  ///< the world's integrator (YAML: thesis | event)
+  simlab::WorldKind world = simlab::WorldKind::kModel;  ///< which world plays it (YAML: model | twin)
+  sim::StepperKind stepper = sim::StepperKind::kThesis;  ///< the model world's integrator (YAML: thesis | event)
+  std::string twin_params;                     ///< the twin's parameter file (empty: the shipped config/twin.yaml)
   int balls = 10;                              ///< balls to play
   std::uint64_t seed = 1;                      ///< launch noise seed (ball i uses ball_seed(seed, i))
   bool realtime = false;                       ///< pace to the wall clock (default: lockstep, as fast as possible)
@@ -132,7 +135,9 @@ struct SimSettings {
   void Serialize(Archive* a) {
     a->Visit(PINBALL_NVP(board));
     a->Visit(PINBALL_NVP(world_board));
+    a->Visit(PINBALL_NVP(world));
     a->Visit(PINBALL_NVP(stepper));
+    a->Visit(PINBALL_NVP(twin_params));
     a->Visit(PINBALL_NVP(balls));
     a->Visit(PINBALL_NVP(seed));
     a->Visit(PINBALL_NVP(realtime));
@@ -196,6 +201,13 @@ std::vector<std::string> daemon_config_path_keys();
 void validate_daemon_config(const DaemonConfig& config, const std::string& source_name);
 
 }  // namespace pinball::daemon
+
+/// The world as the file spells it: model | twin.
+template <>
+struct pinball::EnumText<pinball::simlab::WorldKind> {
+  static std::string name(simlab::WorldKind kind) { return std::string(simlab::world_kind_name(kind)); }
+  static simlab::WorldKind parse(const std::string& text) { return simlab::parse_world_kind(text); }
+};
 
 /// The stepper as the file spells it: thesis | event.
 template <>

@@ -48,6 +48,8 @@ struct SimCameraConfig {
   double exposure_s = 0.002;        ///< shutter open time (s): motion blur spans the ball's travel over it
   double first_exposure_s = 0.0;    ///< simulated time the first exposure starts (s)
   vision::CameraView view;                  ///< where the camera sits (perspective)
+  double lens_height_m = 0.9;       ///< the lens above the playfield, over its centre (m): a hopping ball
+                                    ///< (the twin's) looks farther out from the centre and larger
   int supersample = 2;              ///< the static scene is drawn at this multiple of the image scale, then warped
   double floor_gain = 0.6;          ///< playfield drawing brightness: gray = gain · drawing + offset
   double floor_offset = 20.0;       ///< see floor_gain (gray levels)
@@ -167,6 +169,7 @@ class SimCameraSource final : public vision::FrameSource {
   void advance_effects();
   void compose(std::span<const Vec2> path_board, int path_total, double t_mid_s, vision::Frame& out);
   void draw_ball(std::span<const Vec2> path_board, int path_total, cv::Mat& image);
+  double ball_scale_ = 1.0;  // apparent size of the ball now (1 on the playfield; > 1 while it hops)
   bool sample_at(double t_s, Vec2& p, bool& in_play) const;
 
   const table::Board& board_;

@@ -116,9 +116,6 @@ struct TwinParams {
   }
 };
 
-/// The shipped parameter file: config/twin.yaml, found as shipped data.
-std::string default_twin_params_path();
-
 /// Loads and checks a parameter file. Throws KeyError ("file:key: message")
 /// for a missing, unknown, duplicate or mistyped key, a wrong unit, an empty
 /// source or a value out of its range (the range is in the message), and for

@@ -37,6 +37,8 @@ WorldKind parse_world_kind(std::string_view name);
 std::string_view world_kind_name(WorldKind kind);
 /// What a report calls the world of `spec`: "thesis", "event" or "twin".
 std::string_view world_name(const WorldSpec& spec);
+/// The shipped twin parameter file, config/twin.yaml, found as shipped data (data_path.h).
+std::string default_twin_params_path();
 /// True when this build has the MuJoCo twin (configured with PINBALL_TWIN and libmujoco-dev).
 bool twin_available();
 

@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "pinball/core/check.h"
-#include "pinball/core/data_path.h"
 #include "pinball/core/format.h"
 #include "pinball/core/yaml_read_archive.h"
 
@@ -88,8 +87,6 @@ RangeViolation find_violation(const TwinParams& p) {
 }
 
 }  // namespace
-
-std::string default_twin_params_path() { return find_data_file("config/twin.yaml"); }
 
 void check_twin_params(const TwinParams& params) { check_input(find_violation(params), "twin parameters"); }
 
