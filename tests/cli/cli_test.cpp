@@ -10,6 +10,8 @@
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "pinball/simlab/world_factory.h"
 #include <nlohmann/json.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -77,6 +79,40 @@ TEST_F(Cli, LearnAndBenchCeilingTakeTheWorldApartFromTheBelief) {
   const auto c = nlohmann::json::parse(ceiling.out);
   EXPECT_EQ(c.at("world"), "event");
   EXPECT_EQ(c.at("world_board"), world.string());
+}
+
+TEST_F(Cli, SimLearnAndBenchCeilingPlayTheTwin) {
+  if (!pinball::simlab::twin_available()) GTEST_SKIP() << "this build has no MuJoCo twin";
+  const CommandResult sim = run("sim boards/mit1993.board --world twin --policy spastic --balls 2 --seed 3 --json");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  const auto s = nlohmann::json::parse(sim.out);
+  EXPECT_EQ(s.at("world"), "twin");
+  EXPECT_EQ(s.at("twin_params"), "config/twin.yaml");
+  EXPECT_EQ(s.at("world_warnings").at("instability"), 0);
+  EXPECT_EQ(s.at("balls_left_table"), 0);
+  const CommandResult again = run("sim boards/mit1993.board --world twin --policy spastic --balls 2 --seed 3 --json");
+  EXPECT_EQ(nlohmann::json::parse(again.out).at("state_hash"), s.at("state_hash")) << "the same seed, the same game";
+  const CommandResult learn = run("learn boards/mit1993.board --method evaluate --controller controllers/best.json "
+                                  "--world twin --eval-balls 4 --max-ball-time 10 --seed 5 --threads 2 --json");
+  ASSERT_EQ(learn.exit_code, 0) << learn.err;
+  EXPECT_EQ(nlohmann::json::parse(learn.out).at("world"), "twin");
+  const CommandResult ceiling = run("bench ceiling --balls 2 --max-ball-time 3 --threads 1 --json --world twin");
+  ASSERT_EQ(ceiling.exit_code, 0) << ceiling.err;
+  EXPECT_EQ(nlohmann::json::parse(ceiling.out).at("world"), "twin");
+}
+
+TEST_F(Cli, ABadTwinParameterFileIsRefusedNamingFileAndKey) {
+  if (!pinball::simlab::twin_available()) GTEST_SKIP() << "this build has no MuJoCo twin";
+  std::ifstream in(PINBALL_SOURCE_DIR "/config/twin.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = text.find("\nball_mass_kg:");
+  ASSERT_NE(at, std::string::npos);
+  const fs::path params = dir_ / "twin.yaml";
+  std::ofstream(params) << text.substr(0, at) << "\nball_mass_kg: {value: 80.9, unit: g, source: scale}\n"
+                        << text.substr(text.find('\n', at + 1));
+  const CommandResult r = run("sim boards/mit1993.board --world twin --balls 1 --twin-params " + params.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("twin.yaml:ball_mass_kg: must be given in kg, not 'g'"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, AWorldWithOtherFlippersIsRefusedNamingBothBoards) {

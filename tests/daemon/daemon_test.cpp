@@ -110,6 +110,23 @@ TEST(Daemon, TheWorldIsConfiguredApartFromTheBelief) {
   EXPECT_EQ(report_to_json(other).at("world").at("board"), world_board);
 }
 
+TEST(Daemon, PlaysTheTwinThroughPixelsAndCanFrames) {
+  if (!simlab::twin_available()) GTEST_SKIP() << "this build has no MuJoCo twin";
+  DaemonConfig c = sim_config(2, 5);
+  c.sim.world = simlab::WorldKind::kTwin;
+  DaemonReport r;
+  {
+    Daemon d(c);
+    r = d.run();
+  }
+  EXPECT_EQ(r.world, "twin");
+  ASSERT_EQ(r.balls, 2);
+  EXPECT_GT(r.detections, 0u) << "the camera saw the twin's ball";
+  EXPECT_EQ(r.world_warnings.instability, 0u);
+  EXPECT_EQ(report_to_json(r).at("world").at("stepper"), "twin");
+  EXPECT_TRUE(r.coils_off_at_exit);
+}
+
 // Where the threads run and who writes the CAN frame change the timing, never the game.
 TEST(Daemon, PinningDoesNotChangeTheGame) {
   DaemonConfig pinned = sim_config(2, 5);

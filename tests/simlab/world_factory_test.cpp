@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/thesis_board.h"
+#include "pinball/sim/game_state.h"
 #include "pinball/table/board_loader.h"
 
 namespace pinball::simlab {
@@ -49,6 +50,32 @@ TEST(WorldFactory, TheWorldMayBeAnotherBoardOnAnotherStepper) {
   EXPECT_EQ(w->name(), "event");
   EXPECT_EQ(w->dt_s(), 0.001);
   std::remove(path.c_str());
+}
+
+TEST(WorldFactory, TheTwinIsAWorldOfItsOwnWithTheShippedParameters) {
+  WorldSpec spec;
+  spec.kind = WorldKind::kTwin;
+  if (!twin_available()) {
+    EXPECT_THROW(make_world(spec, thesis_board()), std::invalid_argument) << "says it is not built";
+    GTEST_SKIP() << "this build has no MuJoCo twin";
+  }
+  const OwnedWorld w = make_world(spec, thesis_board());
+  EXPECT_EQ(w->name(), "twin");
+  EXPECT_EQ(world_name(spec), "twin");
+  EXPECT_EQ(w->dt_s(), 0.0005);
+  sim::GameState state = sim::make_game_state(*w.board, 3);
+  w->launch(state, 0.95);
+  for (int i = 0; i < 400; ++i) w->step(state);
+  EXPECT_TRUE(state.ball_in_play);
+  EXPECT_GT(state.ball.position_m.y(), 0.3) << "the launch sent it up the chute";
+  EXPECT_EQ(w->warnings().total(), 0u);
+}
+
+TEST(WorldFactory, WorldKindsAreSpelledModelAndTwin) {
+  EXPECT_EQ(parse_world_kind("twin"), WorldKind::kTwin);
+  EXPECT_EQ(parse_world_kind("model"), WorldKind::kModel);
+  EXPECT_EQ(world_kind_name(WorldKind::kTwin), "twin");
+  EXPECT_THROW(parse_world_kind("mujoco"), std::invalid_argument);
 }
 
 TEST(WorldFactory, AWorldWithOtherFlippersIsRefused) {
