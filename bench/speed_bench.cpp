@@ -8,6 +8,7 @@
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/simlab/oracle_policy.h"
+#include "pinball/simlab/world_factory.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/thesis_stepper.h"
 
@@ -107,12 +108,10 @@ SpeedRun measure(const std::string& name, const table::Board& board, bool use_gr
   return run;
 }
 
-// Event stepper: the same play, timed the same way.
-EventSpeedRun measure_event(const std::string& name, const table::Board& board, const SpeedBenchOptions& options,
-                            const std::function<void(const std::string&)>& progress) {
-  sim::ModelWorldOptions wo;
-  wo.stepper = sim::StepperKind::kEvent;
-  const std::unique_ptr<sim::World> world = sim::make_model_world(board, wo);
+// A world (the event stepper, the twin): the same play, timed the same way.
+EventSpeedRun measure_world(const std::string& name, sim::World& world, std::uint64_t steps,
+                            const SpeedBenchOptions& options, const std::function<void(const std::string&)>& progress) {
+  const table::Board& board = world.board();
   sim::BallLimits limits;
   limits.max_ball_time_s = 60.0;
   std::vector<double> times;
@@ -122,8 +121,8 @@ EventSpeedRun measure_event(const std::string& name, const table::Board& board, 
   for (int i = 0; i < std::max(1, options.repeats); ++i) {
     sim::GameState state = sim::make_game_state(board, options.seed);
     const auto start = std::chrono::steady_clock::now();
-    while (state.steps < options.steps) {
-      sim::play_ball(*world, state, limits, [&](sim::GameState& s) { simlab::oracle_spastic_policy(board, s); },
+    while (state.steps < steps) {
+      sim::play_ball(world, state, limits, [&](sim::GameState& s) { simlab::oracle_spastic_policy(board, s); },
                      [&](const sim::GameState&, const sim::StepEvents&) {});
     }
     times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -150,7 +149,7 @@ EventSpeedRun measure_event(const std::string& name, const table::Board& board, 
 SpeedReport run_speed_bench(const table::Board& board, const SpeedBenchOptions& options,
                             const std::function<void(const std::string&)>& report_line) {
   // Six timed configurations: each line says how far the bench is and its ETA.
-  const auto progress = staged_progress(report_line, "speed", 6, "runs");
+  const auto progress = staged_progress(report_line, "speed", 7, "runs");
   SpeedReport report;
   report.board = board.source;
   report.dt_s = board.dt_s;
@@ -166,12 +165,26 @@ SpeedReport run_speed_bench(const table::Board& board, const SpeedBenchOptions& 
   report.crowded_cost_ratio = (grid_crowded.median_s / static_cast<double>(grid_crowded.steps)) /
                               (grid.median_s / static_cast<double>(grid.steps));
   report.grid_matches_linear = grid.final_hash == linear.final_hash && grid.steps == linear.steps;
-  report.event_runs.push_back(measure_event("event", board, options, progress));
-  report.event_runs.push_back(measure_event("event_crowded", crowded, options, progress));
+  sim::ModelWorldOptions event_options;
+  event_options.stepper = sim::StepperKind::kEvent;
+  report.event_runs.push_back(
+      measure_world("event", *sim::make_model_world(board, event_options), options.steps, options, progress));
+  report.event_runs.push_back(
+      measure_world("event_crowded", *sim::make_model_world(crowded, event_options), options.steps, options, progress));
   const EventSpeedRun& event = report.event_runs[0];
   const EventSpeedRun& event_crowded = report.event_runs[1];
   report.event_crowded_cost_ratio =
       (event_crowded.median_s / event_crowded.simulated_s) / (event.median_s / event.simulated_s);
+  report.thesis_sim_s_per_wall_s = static_cast<double>(grid.steps) * board.dt_s / grid.median_s;
+  if (simlab::twin_available()) {
+    simlab::WorldSpec twin;
+    twin.kind = simlab::WorldKind::kTwin;
+    const simlab::OwnedWorld world = simlab::make_world(twin, board);
+    report.event_runs.push_back(measure_world("twin", *world, options.twin_steps, options, progress));
+  } else {
+    report.twin_skipped = "this build has no MuJoCo twin (libmujoco-dev)";
+    progress("twin: skipped, " + report.twin_skipped);
+  }
   return report;
 }
 
@@ -206,7 +219,9 @@ nlohmann::json to_json(const SpeedReport& report) {
           {"crowded_cost_ratio", report.crowded_cost_ratio},
           {"grid_matches_linear", report.grid_matches_linear},
           {"event_runs", event_runs},
-          {"event_crowded_cost_ratio", report.event_crowded_cost_ratio}};
+          {"event_crowded_cost_ratio", report.event_crowded_cost_ratio},
+          {"thesis_sim_s_per_wall_s", report.thesis_sim_s_per_wall_s},
+          {"twin_skipped", report.twin_skipped}};
 }
 
 }  // namespace pinball::bench

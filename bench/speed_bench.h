@@ -3,7 +3,8 @@
 // with the linear scan, on the board and on a copy crowded with ten times its
 // obstacles out of the ball's reach, all measured in one run; and the event
 // stepper's events per second and simulated seconds per wall second on the
-// same two boards.
+// same two boards; and the MuJoCo twin's simulated seconds per wall second on
+// the board (when this build has it), all playing the spastic oracle.
 
 #include <cstdint>
 #include <functional>
@@ -22,6 +23,7 @@ struct SpeedBenchOptions {
   int repeats = 3;                  ///< timed runs per configuration; the median is reported
   std::uint64_t seed = 1;           ///< launch noise seed (same for every configuration)
   int crowd_factor = 10;            ///< the crowded board has this many extra copies of the obstacles
+  std::uint64_t twin_steps = 200'000;  ///< twin steps per timed run (it is ~100x slower than the thesis stepper)
 };
 
 /// One configuration's figures.
@@ -36,10 +38,11 @@ struct SpeedRun {
   std::uint64_t final_hash = 0;     ///< state hash after the run (equal runs, equal hash)
 };
 
-/// One event-stepper configuration's figures (same play as the thesis runs:
-/// spastic oracle policy, the board's dt as the step horizon).
+/// One world's figures (same play as the thesis runs: spastic oracle
+/// policy; the event stepper's step horizon is the board's dt, the twin's
+/// step its own).
 struct EventSpeedRun {
-  std::string name;                 ///< "event" or "event_crowded"
+  std::string name;                 ///< "event", "event_crowded" or "twin"
   std::size_t obstacles = 0;        ///< obstacle shapes on the board
   std::uint64_t steps = 0;          ///< step() calls per timed run
   std::uint64_t events = 0;         ///< events per timed run
@@ -60,6 +63,8 @@ struct SpeedReport {
   bool grid_matches_linear = false;  ///< the two broadphases produced bit-identical runs
   std::vector<EventSpeedRun> event_runs;  ///< event, event_crowded
   double event_crowded_cost_ratio = 0.0;  ///< event stepper wall time per simulated second, crowded over plain (target <= 1.5)
+  double thesis_sim_s_per_wall_s = 0.0;   ///< the thesis stepper (grid): simulated seconds per wall second
+  std::string twin_skipped;               ///< why the twin was not measured (empty when it was: event_runs' "twin")
 };
 
 /// A copy of `board` with `copies` extra copies of every obstacle placed side

@@ -20,6 +20,8 @@ packages=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
   # Learning and evaluation across processes and machines (mpirun -n N pinball ...).
   libopenmpi-dev openmpi-bin
+  # The MuJoCo lab twin (--world twin, ctest label twin, docs/worlds.md).
+  libmujoco-dev
 )
 
 missing=()
