@@ -366,8 +366,6 @@ TEST_F(Cli, TrackRejectsABadObservationFileNamingTheLine) {
   EXPECT_NE(r.err.find(obs.string() + ":3: column 'y'"), std::string::npos) << r.err;
 }
 
-}  // namespace
-
 TEST_F(Cli, HelpShowsEveryDefault) {
   const CommandResult sim = run("sim --help");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
@@ -425,3 +423,5 @@ TEST_F(Cli, TextReportsRoundTheirNumbers) {
   const double half = j.at("score_ci95_half_width").get<double>();
   EXPECT_NE(half * 1e4, std::round(half * 1e4)) << "JSON keeps full precision: " << half;
 }
+
+}  // namespace
