@@ -26,6 +26,9 @@
 #include "pinball/daemon/pipeline.h"
 #include "pinball/daemon/replay.h"
 #include "pinball/table/board_loader.h"
+#ifdef PINBALL_HAVE_TWIN
+#include "pinball/simlab/twin_params.h"
+#endif
 
 namespace pinball {
 namespace {
@@ -63,10 +66,16 @@ void load_lcm_log(const std::string& path) {
   (void)daemon::replay_log(path, config);
 }
 
+#ifdef PINBALL_HAVE_TWIN
+// As `--world twin --twin-params FILE` and pinballd's sim.twin_params read it.
+void load_twin_params(const std::string& path) { (void)simlab::load_twin_params(path); }
+#endif
+
 /// One kind of input file: its directory under tests/bad_input and its loader.
 struct Kind {
   const char* dir;
   void (*load)(const std::string& path);
+  const char* shipped_good = nullptr;  ///< a shipped file (from the source root) that must load too
 };
 
 // Test names and failures show the directory.
@@ -78,6 +87,9 @@ constexpr Kind kKinds[] = {
     {"config", &load_config},
     {"controller", &load_controller},
     {"calibration", &load_calibration},
+#ifdef PINBALL_HAVE_TWIN
+    {"twin", &load_twin_params, "config/twin.yaml"},
+#endif
 };
 
 // ---- running one load ----
@@ -190,7 +202,8 @@ TEST_P(BadInput, EveryFileIsRefusedNamingTheFileAndThePlace) {
 }
 
 TEST_P(BadInput, GoodFilesLoad) {
-  const std::vector<fs::path> files = files_in(kCorpus / "good" / GetParam().dir);
+  std::vector<fs::path> files = files_in(kCorpus / "good" / GetParam().dir);
+  if (GetParam().shipped_good != nullptr) files.push_back(fs::path(PINBALL_SOURCE_DIR) / GetParam().shipped_good);
   ASSERT_FALSE(files.empty()) << "no good " << GetParam().dir << " files";
   for (const fs::path& file : files) {
     const Outcome o = load_with_deadline(GetParam().load, file.string());
