@@ -61,12 +61,7 @@ CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper&
   } else {
     r = sim::play_ball(world, state, limits, [](sim::GameState&) {}, observer);
   }
-  ball.score = r.score;
-  ball.duration_s = r.duration_s;
-  ball.flips = r.flips;
-  ball.cut = r.cut;
-  ball.left_table = r.left_table;
-  ball.drain_x_m = observer.crossing_x_m();
+  static_cast<PlayedBall&>(ball) = played_ball(r, observer);
   return ball;
 }
 

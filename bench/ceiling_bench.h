@@ -70,14 +70,8 @@ CeilingBenchOptions quick_ceiling_bench_options();
 /// controllers do (the 3x target's spastic baseline is kTrackerSpastic).
 enum class CeilingPlayerKind { kCeiling, kSpastic, kNoFlipping, kTrackerSpastic, kController };
 
-/// One ball's outcome.
-struct CeilingBall {
-  double score = 0.0;             ///< points scored
-  double duration_s = 0.0;        ///< simulated time of the ball
-  int flips = 0;                  ///< flipper activations
-  bool cut = false;               ///< alive at the time limit
-  bool left_table = false;        ///< lost by leaving the table's bounds
-  double drain_x_m = 0.0;         ///< where it last went down past the flippers' pivot line (DrainWatch; NaN: never)
+/// One ball's outcome, and the ceiling player's planning.
+struct CeilingBall : PlayedBall {
   int decisions = 0;              ///< ceiling: frames at which candidates were evaluated
   std::uint64_t branch_steps = 0; ///< ceiling: stepper steps simulated in lookahead branches
 };

@@ -15,6 +15,7 @@
 #include <limits>
 #include <string_view>
 
+#include "pinball/sim/ball_runner.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/step_events.h"
 #include "pinball/table/board.h"
@@ -88,5 +89,21 @@ class DrainWatch {
   Vec2 last_;
   double crossing_x_m_ = std::numeric_limits<double>::quiet_NaN();
 };
+
+/// What a bench keeps of one played ball: the ball runner's result and where
+/// the ball was lost (plain bytes, so it crosses threads and MPI ranks as a blob).
+struct PlayedBall {
+  double score = 0.0;        ///< points scored
+  double duration_s = 0.0;   ///< simulated time of the ball
+  int flips = 0;             ///< flipper activations
+  bool cut = false;          ///< alive at the time limit
+  bool left_table = false;   ///< lost by leaving the table's bounds
+  double drain_x_m = 0.0;    ///< where it last went down past the flippers' pivot line (DrainWatch; NaN: never)
+};
+
+/// The ball `r` that `watch` saw.
+inline PlayedBall played_ball(const sim::BallResult& r, const DrainWatch& watch) {
+  return {r.score, r.duration_s, r.flips, r.cut, r.left_table, watch.crossing_x_m()};
+}
 
 }  // namespace pinball::bench
