@@ -33,15 +33,7 @@ CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper&
   limits.max_ball_time_s = options.max_ball_time_s;
   limits.pull = options.pull;
   CeilingBall ball;
-  double last_x = state.ball.position_m.x();
-  auto observer = [&](const sim::GameState& s, const sim::StepEvents& e) {
-    // A lost ball is moved back to the launcher: keep where it was a step before.
-    if (e.has(sim::StepEvents::kBallLost)) {
-      ball.drain_x_m = last_x;
-    } else {
-      last_x = s.ball.position_m.x();
-    }
-  };
+  DrainWatch observer(state, drain_zones(board));
   sim::BallResult r;
   if (kind == CeilingPlayerKind::kCeiling) {
     learn::LookaheadPlayer player(model, options.planner, options.actuation_delay_s);
@@ -69,11 +61,7 @@ CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper&
   } else {
     r = sim::play_ball(world, state, limits, [](sim::GameState&) {}, observer);
   }
-  ball.score = r.score;
-  ball.duration_s = r.duration_s;
-  ball.flips = r.flips;
-  ball.cut = r.cut;
-  ball.left_table = r.left_table;
+  static_cast<PlayedBall&>(ball) = played_ball(r, observer);
   return ball;
 }
 
@@ -118,6 +106,7 @@ CeilingPlayerReport run_player(const sim::World& world, const sim::ThesisStepper
     balls[i] = r.get<CeilingBall>();
     r.expect_end();
   }
+  const DrainZones zones = drain_zones(model.board());
   CeilingPlayerReport r;
   r.name = player_name(kind);
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -133,12 +122,7 @@ CeilingPlayerReport run_player(const sim::World& world, const sim::ThesisStepper
       ++r.cut;
       continue;
     }
-    if (b.left_table) ++r.left_table;
-    if (b.drain_x_m < options.left_outlane_x_m) {
-      ++r.drains_left_outlane;
-    } else {
-      ++r.drains_elsewhere;
-    }
+    r.drains.add(classify_drain(zones, b.drain_x_m), b.left_table);
   }
   if (n > 0) {
     r.decisions_per_ball = decisions / static_cast<double>(n);

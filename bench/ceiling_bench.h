@@ -32,6 +32,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "drain_cause.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/firmware/flipper_actuation.h"
@@ -53,7 +54,6 @@ struct CeilingBenchOptions {
   double actuation_delay_s = firmware::kDefaultActuationDelay_s; ///< command to flipper motion, as in the evaluator
   double pull = -1.0;               ///< launcher pull; negative: the board's
   double spastic_reach_factor = 2.5;///< the spastic baseline's reach (ball radii)
-  double left_outlane_x_m = 0.045;  ///< a drain with x below this went down the left outlane
   learn::LookaheadConfig planner;   ///< the ceiling player's planner
   track::CameraModelConfig camera;  ///< the tracker-side players' camera (the evaluator's)
   /// A controller to play through the camera model and tracker beside the
@@ -70,14 +70,8 @@ CeilingBenchOptions quick_ceiling_bench_options();
 /// controllers do (the 3x target's spastic baseline is kTrackerSpastic).
 enum class CeilingPlayerKind { kCeiling, kSpastic, kNoFlipping, kTrackerSpastic, kController };
 
-/// One ball's outcome.
-struct CeilingBall {
-  double score = 0.0;             ///< points scored
-  double duration_s = 0.0;        ///< simulated time of the ball
-  int flips = 0;                  ///< flipper activations
-  bool cut = false;               ///< alive at the time limit
-  bool left_table = false;        ///< lost by leaving the table's bounds
-  double drain_x_m = 0.0;         ///< ball x just before it was lost (when not cut)
+/// One ball's outcome, and the ceiling player's planning.
+struct CeilingBall : PlayedBall {
   int decisions = 0;              ///< ceiling: frames at which candidates were evaluated
   std::uint64_t branch_steps = 0; ///< ceiling: stepper steps simulated in lookahead branches
 };
@@ -97,9 +91,7 @@ struct CeilingPlayerReport {
   RunningStats duration_s;        ///< per ball
   RunningStats flips;             ///< per ball
   int cut = 0;                    ///< balls cut at the time limit
-  int drains_left_outlane = 0;    ///< lost with x < left_outlane_x_m
-  int drains_elsewhere = 0;       ///< lost anywhere else
-  int left_table = 0;             ///< of the drains, lost by leaving the table's bounds
+  DrainCounts drains;             ///< lost balls by where they went (classify_drain)
   double decisions_per_ball = 0.0;     ///< ceiling: planning frames per ball
   double branch_steps_per_ball = 0.0;  ///< ceiling: lookahead steps per ball
   double wall_s = 0.0;            ///< wall time of this player's balls

@@ -16,9 +16,12 @@ nlohmann::json player_json(const CeilingPlayerReport& r) {
           {"mean_ball_time_s", r.duration_s.mean()},
           {"flips_per_ball", r.flips.mean()},
           {"balls_cut_at_time_limit", r.cut},
-          {"drains_left_outlane", r.drains_left_outlane},
-          {"drains_elsewhere", r.drains_elsewhere},
-          {"drains_left_table", r.left_table},
+          {"drains_left_outlane", r.drains.left_outlane},
+          {"drains_elsewhere", r.drains.total() - r.drains.left_outlane},
+          {"drains_right_outlane", r.drains.right_outlane},
+          {"drains_centre", r.drains.centre},
+          {"drains_other", r.drains.other},
+          {"drains_left_table", r.drains.left_table},
           {"decisions_per_ball", r.decisions_per_ball},
           {"branch_steps_per_ball", r.branch_steps_per_ball},
           {"wall_s", r.wall_s}};
@@ -45,7 +48,6 @@ nlohmann::json to_json(const CeilingReport& r) {
           {"actuation_delay_s", o.actuation_delay_s},
           {"pull", o.pull},
           {"spastic_reach_factor", o.spastic_reach_factor},
-          {"left_outlane_x_m", o.left_outlane_x_m},
           {"planner",
            {{"frame_steps", p.frame_steps},
             {"fire_frames", p.fire_frames},
@@ -75,8 +77,9 @@ std::string to_text(const CeilingReport& r) {
     out << "  " << p->name << ": " << format_mean_ci(p->score.mean(), p->score.ci95_half_width())
         << " per ball (95 %), " << format_number(p->duration_s.mean()) << " s per ball, "
         << format_number(p->flips.mean()) << " flips per ball, " << p->cut << " cut; drains: left outlane "
-        << p->drains_left_outlane << ", elsewhere " << p->drains_elsewhere << "; wall " << format_number(p->wall_s)
-        << " s\n";
+        << p->drains.left_outlane << ", elsewhere " << p->drains.total() - p->drains.left_outlane << " (centre "
+        << p->drains.centre << ", right outlane " << p->drains.right_outlane << ", other " << p->drains.other
+        << "); wall " << format_number(p->wall_s) << " s\n";
   }
   out << "  ceiling planning: " << format_number(r.ceiling.decisions_per_ball) << " decisions, "
       << format_number(r.ceiling.branch_steps_per_ball) << " lookahead steps per ball\n"

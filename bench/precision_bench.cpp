@@ -10,6 +10,7 @@
 #include "pinball/sim/event_stepper.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
+#include "least_squares_line.h"
 #include "staged_progress.h"
 
 namespace pinball::bench {
@@ -384,20 +385,11 @@ double loglog_interpolate(const std::vector<std::pair<double, double>>& xy, doub
 
 LogLogFit loglog_fit(const std::vector<std::pair<double, double>>& xy) {
   if (xy.size() < 2) throw std::invalid_argument("loglog_fit: need two points");
-  double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
-  for (const auto& [x, y] : xy) {
-    const double lx = std::log(x), ly = std::log(y);
-    sx += lx;
-    sy += ly;
-    sxx += lx * lx;
-    sxy += lx * ly;
-  }
-  const double n = static_cast<double>(xy.size());
-  LogLogFit f;
-  const double den = n * sxx - sx * sx;
-  f.slope = den == 0.0 ? 0.0 : (n * sxy - sx * sy) / den;
-  f.intercept = (sy - f.slope * sx) / n;
-  return f;
+  std::vector<std::pair<double, double>> logs;
+  logs.reserve(xy.size());
+  for (const auto& [x, y] : xy) logs.emplace_back(std::log(x), std::log(y));
+  const LineFit line = fit_line(logs);
+  return {line.intercept, line.slope};
 }
 
 PrecisionReport run_precision_bench(const Board& table, const PrecisionBenchOptions& options,

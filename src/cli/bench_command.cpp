@@ -1,6 +1,7 @@
 // `pinball bench KIND`: the measurements behind docs/results.md.
 
 #include <array>
+#include <filesystem>
 #include <fstream>
 #include <ostream>
 #include <stdexcept>
@@ -17,6 +18,7 @@
 #include <optional>
 
 #include "ceiling_bench.h"
+#include "transfer_bench.h"
 #include "pinball/control/controller_file.h"
 #include "detector_bench.h"
 #include "daemon_latency_bench.h"
@@ -29,37 +31,55 @@
 namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
-  CLI::App* cmd =
-      app.add_subcommand("bench",
-                         "run a benchmark (speed, tracker, latency, detector, calibration, precision, ceiling, protocol)");
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "run a benchmark (speed, tracker, latency, detector, calibration, precision, ceiling, transfer, protocol)");
   cmd->add_option("kind", a.which,
-                  "which benchmark: speed, tracker, latency, detector, calibration, precision, ceiling, protocol")
+                  "which benchmark: speed, tracker, latency, detector, calibration, precision, ceiling, transfer "
+                  "(every controller in several worlds and a sweep of world errors, the belief nominal), protocol")
       ->required()
-      ->check(CLI::IsMember({"speed", "tracker", "latency", "detector", "calibration", "precision", "ceiling", "protocol"}));
-  cmd->add_option("--board", a.board, "board file")->transform(data_file());
-  cmd->add_option("--steps", a.steps, "speed: steps per timed run (the MuJoCo twin's runs: a tenth)")->check(CLI::Range(1000, 1'000'000'000));
+      ->check(CLI::IsMember(
+          {"speed", "tracker", "latency", "detector", "calibration", "precision", "ceiling", "transfer", "protocol"}));
+  cmd->add_option("--board", a.board, "board file (ceiling, transfer: the belief)")->transform(data_file());
+  cmd->add_option("--steps", a.steps, "speed: steps per timed run (the MuJoCo twin's runs: a tenth)")
+      ->check(CLI::Range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
       ->check(CLI::Range(10, 1'000'000));
   cmd->add_option("--seed", a.seed,
-                  "tracker, detector, calibration, ceiling: seed for play, camera noise, placements and balls");
+                  "tracker, detector, calibration, ceiling, transfer: seed for play, camera noise, placements and "
+                  "balls");
   cmd->add_flag("--quick", a.quick,
-                "tracker, detector, calibration, latency, precision, ceiling: a short run (fewer approaches, frames, "
-                "roll sets, balls or settings)");
-  cmd->add_option("--balls", a.balls, "ceiling: balls per player (same ball seeds for every player)")
-      ->check(CLI::Range(1, 1'000'000));
-  cmd->add_option("--threads", a.threads, "ceiling: worker threads (results do not depend on it)")
+                "tracker, detector, calibration, latency, precision, ceiling, transfer: a short run (fewer "
+                "approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one value per family)");
+  cmd->add_option("--balls", a.balls,
+                  "ceiling: balls per player; transfer: balls per world and controller (the same ball seeds for "
+                  "every player)")
+      ->check(CLI::Range(1, 1'000'000))
+      ->default_str("ceiling 200, transfer " + std::to_string(bench::TransferBenchOptions{}.balls));
+  cmd->add_option("--twin-balls", a.twin_balls,
+                  "transfer: balls per controller in the MuJoCo twin, the first of the same seeds (it plays about "
+                  "100x slower than the model)")
+      ->check(CLI::Range(1, 1'000'000))
+      ->default_str(std::to_string(bench::TransferBenchOptions{}.twin_balls));
+  cmd->add_option("--threads", a.threads, "ceiling, transfer: worker threads (results do not depend on it)")
       ->check(CLI::Range(1, 256));
-  cmd->add_option("--controller", a.controller,
-                  "ceiling: also play this controller file through the camera model and tracker")
-      ->transform(data_file());
-  cmd->add_option("--max-ball-time", a.max_ball_time_s, "ceiling: seconds after which a ball still alive is cut")
+  cmd->add_option("--controller", a.controllers,
+                  "ceiling: also play this controller file through the camera model and tracker; transfer "
+                  "(repeatable): play these instead of controllers/best.json, imitation.json and cem.json")
+      ->transform(data_file())
+      ->default_str("ceiling none, transfer controllers/best.json imitation.json cem.json");
+  cmd->add_option("--max-ball-time", a.max_ball_time_s,
+                  "ceiling, transfer: seconds after which a ball still alive is cut")
       ->check(CLI::Range(1.0, 3600.0));
   cmd->add_option("--frames", a.frames, "protocol: random and mutated frames per seed")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
   cmd->add_option("--seeds", a.seeds, "protocol: seeds to run, from --seed on")->check(CLI::Range(1, 1000));
-  cmd->add_option("--csv", a.csv, "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here");
-  cmd->add_option("--png", a.png, "precision: write the log-log plot of error against run time here");
+  cmd->add_option("--csv", a.csv,
+                  "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here; transfer: one "
+                  "row per world and controller");
+  cmd->add_option("--png", a.png,
+                  "precision: write the log-log plot of error against run time here; transfer: the score ratio to "
+                  "the spastic flipper against each perturbation");
   add_world_options(*cmd, a.world);
   add_camera_model_options(*cmd, a.camera);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
@@ -178,16 +198,17 @@ int run_precision(const BenchArgs& a, const table::Board& board, std::ostream& o
 
 int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::CeilingBenchOptions options = a.quick ? bench::quick_ceiling_bench_options() : bench::CeilingBenchOptions{};
-  if (!a.quick) options.balls = a.balls;
+  if (!a.quick && a.balls > 0) options.balls = a.balls;
   options.seed = a.seed;
   options.threads = a.threads;
   options.max_ball_time_s = a.max_ball_time_s;
   options.camera = a.camera;
+  if (a.controllers.size() > 1) throw std::invalid_argument("bench ceiling: one --controller at most");
   std::optional<control::ControllerSpec> controller;
-  if (!a.controller.empty()) {
-    controller = control::load_controller(a.controller);
+  if (!a.controllers.empty()) {
+    controller = control::load_controller(a.controllers.front());
     options.controller = &*controller;
-    options.controller_name = a.controller;
+    options.controller_name = a.controllers.front();
   }
   const simlab::OwnedWorld world = simlab::make_world(a.world, board);
   const bench::CeilingReport report = bench::run_ceiling_bench(
@@ -200,6 +221,64 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
   } else {
     out << bench::to_text(report);
     if (a.world.kind == simlab::WorldKind::kTwin) out << world_text_line(world_json);
+  }
+  return 0;
+}
+
+// A file the bench will write when it has finished: its folder must exist
+// now, so that a long run does not end in a write error.
+void check_output_folder(const std::string& path, const char* option) {
+  if (path.empty()) return;
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (!folder.empty() && !std::filesystem::is_directory(folder)) {
+    throw std::invalid_argument(std::string(option) + " " + path + ": no folder " + folder.string());
+  }
+}
+
+int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
+  const simlab::WorldSpec model_world;
+  if (a.world.kind != model_world.kind || !a.world.board_path.empty() || a.world.stepper != model_world.stepper ||
+      a.world.dt_s != model_world.dt_s) {
+    throw std::invalid_argument(
+        "bench transfer: its worlds are its rows (model, event, twin and the sweep); --world, --world-board, "
+        "--stepper and --dt do not apply");
+  }
+  check_output_folder(a.csv, "--csv");
+  check_output_folder(a.png, "--png");
+  bench::TransferBenchOptions options =
+      a.quick ? bench::quick_transfer_bench_options() : bench::TransferBenchOptions{};
+  if (a.balls > 0) options.balls = a.balls;
+  if (a.twin_balls > 0) options.twin_balls = a.twin_balls;
+  options.seed = a.seed;
+  options.threads = a.threads;
+  options.max_ball_time_s = a.max_ball_time_s;
+  options.camera = a.camera;
+  options.twin_params_path = a.world.twin_params_path;
+  std::vector<std::string> files = a.controllers;
+  if (files.empty()) {
+    for (const char* f : {"controllers/best.json", "controllers/imitation.json", "controllers/cem.json"}) {
+      files.push_back(find_data_file(f));
+    }
+  }
+  std::vector<control::ControllerSpec> specs;
+  specs.reserve(files.size());  // the options borrow them
+  for (const std::string& f : files) {
+    specs.push_back(control::load_controller(f));
+    options.controllers.push_back({std::filesystem::path(f).stem().string(), f, &specs.back()});
+  }
+  const bench::TransferReport report = bench::run_transfer_bench(
+      board, options, [&](const std::string& line) { err << "bench transfer: " << line << "\n"; });
+  // The files only now, from a finished run.
+  if (!a.png.empty()) bench::plot_transfer_png(report, a.png);
+  if (!a.csv.empty()) {
+    std::ofstream f(a.csv);
+    f << bench::to_csv(report);
+    if (!f) throw std::runtime_error(a.csv + ": cannot write CSV");
+  }
+  if (a.json) {
+    out << bench::to_json(report).dump(2) << "\n";
+  } else {
+    out << bench::to_text(report);
   }
   return 0;
 }
@@ -253,6 +332,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   if (a.which == "calibration") return run_calibration(a, board, out, err);
   if (a.which == "precision") return run_precision(a, board, out, err);
   if (a.which == "ceiling") return run_ceiling(a, board, out, err);
+  if (a.which == "transfer") return run_transfer(a, board, out, err);
   bench::SpeedBenchOptions options;
   options.steps = a.steps;
   options.twin_steps = std::max<std::uint64_t>(1000, a.steps / 10);

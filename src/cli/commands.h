@@ -64,21 +64,22 @@ int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 
 /// `pinball bench`
 struct BenchArgs {
-  std::string which;                                 ///< speed | tracker | latency | detector | calibration | precision | ceiling | protocol
+  std::string which;                                 ///< speed | tracker | latency | detector | calibration | precision | ceiling | transfer | protocol
   std::string board = "boards/mit1993.board";        ///< board to measure on
   std::uint64_t steps = 2'000'000;                   ///< steps per timed run
   int repeats = 3;                                   ///< timed runs per configuration
   int approaches = 2000;                             ///< tracker: free-flight approaches
   std::uint64_t seed = 1;                            ///< tracker: approach and noise seed
   bool quick = false;                                ///< tracker, detector, precision, ceiling: a short run
-  int balls = 200;                                   ///< ceiling: balls per player
-  int threads = 2;                                   ///< ceiling: worker threads (results do not depend on it)
-  double max_ball_time_s = 60.0;                     ///< ceiling: a ball alive after this is cut
-  std::string controller;                            ///< ceiling: a controller file to play beside the others
-  std::string csv;                                   ///< precision: CSV file to write, or empty
-  std::string png;                                   ///< precision: log-log plot to write, or empty
+  int balls = 0;                                     ///< ceiling: balls per player; transfer: per cell (0: the bench's)
+  int twin_balls = 0;                                ///< transfer: per cell in the twin (0: the bench's)
+  int threads = 2;                                   ///< ceiling, transfer: worker threads (results do not depend on it)
+  double max_ball_time_s = 60.0;                     ///< ceiling, transfer: a ball alive after this is cut
+  std::vector<std::string> controllers;              ///< ceiling: one controller file; transfer: the controllers
+  std::string csv;                                   ///< precision, transfer: CSV file to write, or empty
+  std::string png;                                   ///< precision, transfer: plot to write, or empty
   simlab::WorldSpec world;                           ///< ceiling: the world (default: the model of `board`)
-  track::CameraModelConfig camera;                   ///< ceiling: the tracker-side players' camera
+  track::CameraModelConfig camera;                   ///< ceiling, transfer: the tracker-side players' (nominal) camera
   std::uint64_t frames = 1'000'000;                  ///< protocol: frames per seed
   int seeds = 1;                                     ///< protocol: seeds, from --seed on
   bool json = false;                                 ///< one JSON object on stdout

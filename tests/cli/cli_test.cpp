@@ -22,15 +22,10 @@ namespace {
 namespace fs = std::filesystem;
 
 using pinball::testing::CommandResult;
+using pinball::testing::count_lines;
 using pinball::testing::slurp;
 
 class Cli : public pinball::testing::CommandTest {};
-
-int count_lines(const std::string& s) {
-  int n = 0;
-  for (char c : s) n += c == '\n';
-  return n;
-}
 
 // The thesis table with one line replaced, written into the test's directory.
 fs::path variant_board(const fs::path& dir, const std::string& from, const std::string& to) {

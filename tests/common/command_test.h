@@ -31,6 +31,13 @@ inline std::string slurp(const std::filesystem::path& p) {
   return s.str();
 }
 
+/// Lines in a command's output (its newlines): a one-line error is 1.
+inline int count_lines(const std::string& s) {
+  int n = 0;
+  for (const char c : s) n += c == '\n' ? 1 : 0;
+  return n;
+}
+
 /// A test fixture with run("args") and a temporary directory dir_, removed after the test.
 class CommandTest : public ::testing::Test {
  protected:

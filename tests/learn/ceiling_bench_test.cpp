@@ -68,8 +68,8 @@ TEST(CeilingBench, ReportCountsEveryBallAndPrintsOneJsonObject) {
   ASSERT_TRUE(r.controller.has_value());
   for (const CeilingPlayerReport* p : {&r.ceiling, &r.spastic, &r.no_flipping, &r.tracker_spastic, &*r.controller}) {
     EXPECT_EQ(p->score.count(), 3) << p->name;
-    EXPECT_EQ(p->cut + p->drains_left_outlane + p->drains_elsewhere, 3) << p->name;
-    EXPECT_LE(p->left_table, p->drains_left_outlane + p->drains_elsewhere) << p->name;
+    EXPECT_EQ(p->cut + p->drains.total(), 3) << p->name;
+    EXPECT_LE(p->drains.left_table, p->drains.total()) << p->name;
     EXPECT_LE(p->duration_s.max(), 8.0 + 1e-9) << p->name;
   }
   EXPECT_EQ(r.no_flipping.flips.mean(), 0.0);
@@ -86,7 +86,7 @@ TEST(CeilingBench, ReportCountsEveryBallAndPrintsOneJsonObject) {
   EXPECT_EQ(j.at("controller"), "early.json");
   for (const char* p : {"ceiling", "spastic", "no_flipping", "tracker_spastic", "controller"}) {
     for (const char* k : {"mean_score_per_ball", "score_ci95_half_width", "mean_ball_time_s", "flips_per_ball",
-                          "balls_cut_at_time_limit", "drains_left_outlane", "drains_elsewhere", "wall_s"}) {
+                          "balls_cut_at_time_limit", "drains_left_outlane", "drains_elsewhere", "drains_centre", "wall_s"}) {
       EXPECT_TRUE(j.at("players").at(p).contains(k)) << p << "." << k;
     }
   }

@@ -1,0 +1,219 @@
+#include "transfer_bench.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+
+#include "pinball/control/spastic_controller.h"
+#include "pinball/core/progress.h"
+#include "pinball/core/rng.h"
+#include "pinball/learn/evaluator.h"
+#include "pinball/learn/parallel_runner.h"
+#include "pinball/learn/team.h"
+#include "pinball/sim/model_world.h"
+
+namespace pinball::bench {
+
+TransferBenchOptions quick_transfer_bench_options() {
+  TransferBenchOptions o;
+  o.balls = 5;
+  o.twin_balls = 2;
+  o.sweep = quick_transfer_sweep();
+  return o;
+}
+
+TransferBall play_transfer_ball(sim::World& world, const WorldSettings& settings, const table::Board& belief,
+                                const track::CameraModelConfig& belief_camera, const control::ControllerSpec* spec,
+                                double max_ball_time_s, std::uint64_t ball_seed) {
+  const std::unique_ptr<control::FlipperController> controller =
+      spec != nullptr ? control::make_flipper_controller(*spec) : std::make_unique<control::SpasticController>();
+  sim::GameState state = sim::make_game_state(world.board(), ball_seed);
+  sim::BallLimits limits;
+  limits.max_ball_time_s = max_ball_time_s;
+  limits.pull = spec != nullptr ? spec->launcher_pull : -1.0;  // the spastic flipper: the board's, as learn plays it
+  DrainWatch watch(state, drain_zones(belief));
+  // The tracker believes the nominal camera: its σ is the calibrated one, whatever the real camera does.
+  const sim::BallResult r =
+      learn::play_through_tracker(world, belief, state, settings.camera,
+                                  track::default_tracker_config(belief, belief_camera), *controller,
+                                  settings.actuation_delay_s, limits, ball_seed, watch);
+  TransferBall b;
+  static_cast<PlayedBall&>(b) = played_ball(r, watch);
+  return b;
+}
+
+namespace {
+
+// A world to play, with the board it borrows and its world-side settings.
+struct PlannedWorld {
+  TransferWorld row;
+  WorldSettings settings;
+  simlab::OwnedWorld world;  // empty when skipped
+};
+
+std::string value_text(double v, bool sign) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), sign ? "%+g" : "%g", v);
+  return buf;
+}
+
+// The nominal worlds, then the sweep in order; a value equal to the nominal
+// setting is the `model` world and is not played twice.
+std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const TransferBenchOptions& o) {
+  WorldSettings nominal{belief, o.actuation_delay_s, o.camera};
+  std::vector<PlannedWorld> out;
+  const auto add_factory_world = [&](const std::string& name, const simlab::WorldSpec& spec) {
+    PlannedWorld w{{}, nominal, {}};
+    w.row.name = name;
+    w.row.family = "nominal";
+    w.row.world = std::string(simlab::world_name(spec));
+    w.row.balls = spec.kind == simlab::WorldKind::kTwin ? std::min(o.balls, o.twin_balls) : o.balls;
+    try {
+      w.world = simlab::make_world(spec, belief);
+      w.row.played = true;
+    } catch (const std::exception& e) {
+      // The twin in a build without it, or one that refuses this board: a row that says why, never a stand-in.
+      if (spec.kind != simlab::WorldKind::kTwin) throw;
+      w.row.skipped_reason = e.what();
+    }
+    out.push_back(std::move(w));
+  };
+  add_factory_world("model", simlab::WorldSpec{});
+  simlab::WorldSpec event;
+  event.stepper = sim::StepperKind::kEvent;
+  add_factory_world("event", event);
+  simlab::WorldSpec twin;
+  twin.kind = simlab::WorldKind::kTwin;
+  twin.twin_params_path = o.twin_params_path;
+  add_factory_world("twin", twin);
+  for (const SweepFamily& family : o.sweep) {
+    for (const double v : family.values) {
+      if (std::fabs(v - nominal_value(family.kind, o)) < 1e-9) continue;  // the model world
+      PlannedWorld w{{}, perturb(nominal, family.kind, v), {}};
+      w.row.family = std::string(perturbation_name(family.kind));
+      w.row.name = w.row.family + "=" + value_text(v, is_offset(family.kind));
+      w.row.value = v;
+      w.row.world = "thesis";
+      w.row.balls = o.balls;
+      w.row.played = true;
+      w.world.board = std::make_unique<const table::Board>(w.settings.board);
+      w.world.world = sim::make_model_world(*w.world.board);
+      out.push_back(std::move(w));
+    }
+  }
+  return out;
+}
+
+// Shares one count of balls over every cell for the progress line.
+class ProgressCount {
+ public:
+  ProgressCount(const std::function<void(const std::string&)>& progress, long total)
+      : progress_(progress), total_(std::max(1L, total)), every_(std::max(1L, total / 100)) {}
+  void ball_done(const std::string& world) {
+    const long d = ++done_;
+    if (!progress_ || (d % every_ != 0 && d != total_)) return;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    // "transfer: 4000/116000 balls (3 %), 40 s elapsed, ETA 19 min 10 s; gravity_pct=+10"
+    progress_(format_progress("transfer", static_cast<double>(d), static_cast<double>(total_), "balls",
+                              std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(),
+                              world));
+  }
+
+ private:
+  const std::function<void(const std::string&)>& progress_;
+  long total_;
+  long every_;
+  std::atomic<long> done_{0};
+  std::mutex mutex_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+// Plays every controller's balls in one world, across the job.
+void play_world(PlannedWorld& w, const table::Board& belief, const TransferBenchOptions& o,
+                const std::vector<TransferController>& players, ProgressCount& progress) {
+  const auto balls = static_cast<std::size_t>(w.row.balls);
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<learn::Blob> blobs = learn::distributed_map(players.size() * balls, o.threads, [&](std::size_t i) {
+    const auto ball_start = std::chrono::steady_clock::now();
+    const std::unique_ptr<sim::World> ball_world = w.world->fork();
+    TransferBall b = play_transfer_ball(*ball_world, w.settings, belief, o.camera, players[i / balls].spec,
+                                        o.max_ball_time_s, ball_seed(o.seed, i % balls));
+    b.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - ball_start).count();
+    progress.ball_done(w.row.name);
+    return learn::BlobWriter().put(b).take();
+  });
+  w.row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const DrainZones zones = drain_zones(belief);
+  for (std::size_t c = 0; c < players.size(); ++c) {
+    TransferCell cell;
+    cell.controller = players[c].name;
+    for (std::size_t i = 0; i < balls; ++i) {
+      learn::BlobReader r(blobs[c * balls + i]);
+      const auto b = r.get<TransferBall>();
+      r.expect_end();
+      cell.score.add(b.score);
+      cell.duration_s.add(b.duration_s);
+      cell.flips.add(b.flips);
+      cell.wall_s += b.wall_s;
+      if (b.cut) {
+        ++cell.cut;
+      } else {
+        cell.drains.add(classify_drain(zones, b.drain_x_m), b.left_table);
+      }
+    }
+    w.row.cells.push_back(cell);
+  }
+  const double spastic = w.row.cells.front().score.mean();
+  for (TransferCell& cell : w.row.cells) cell.ratio_to_spastic = spastic != 0.0 ? cell.score.mean() / spastic : 0.0;
+  w.row.world_warnings = w.world->warnings().total();
+}
+
+void check_options(const TransferBenchOptions& o) {
+  if (o.balls < 1) throw std::invalid_argument("transfer bench: balls must be >= 1");
+  if (o.twin_balls < 1) throw std::invalid_argument("transfer bench: twin balls must be >= 1");
+  if (o.threads < 1) throw std::invalid_argument("transfer bench: threads must be >= 1");
+  if (!(o.max_ball_time_s > 0.0)) throw std::invalid_argument("transfer bench: max ball time must be > 0");
+  for (const TransferController& c : o.controllers) {
+    if (c.spec == nullptr) throw std::invalid_argument("transfer bench: controller " + c.name + " has no spec");
+    if (c.name == "spastic") throw std::invalid_argument("transfer bench: 'spastic' names the baseline; rename " + c.file);
+    // A per-ball random pull is the evaluator's (PinballEvaluator::play); this bench plays a fixed pull.
+    if (c.spec->randomise_launch) {
+      throw std::invalid_argument("transfer bench: " + c.file + " draws its launch pull at random; the bench plays "
+                                  "every controller at a fixed pull");
+    }
+    for (const TransferController& d : o.controllers) {
+      if (&c != &d && c.name == d.name) throw std::invalid_argument("transfer bench: two controllers named " + c.name);
+    }
+  }
+}
+
+}  // namespace
+
+TransferReport run_transfer_bench(const table::Board& belief, const TransferBenchOptions& options,
+                                  const std::function<void(const std::string&)>& progress) {
+  check_options(options);
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<TransferController> players{{"spastic", "", nullptr}};
+  players.insert(players.end(), options.controllers.begin(), options.controllers.end());
+  std::vector<PlannedWorld> worlds = plan_worlds(belief, options);
+  long balls = 0;
+  for (const PlannedWorld& w : worlds) balls += w.row.played ? w.row.balls : 0;
+  // Progress counts this rank's share of the job (learn::distributed_map deals balls to the ranks).
+  ProgressCount count(progress, balls * static_cast<long>(players.size()) / learn::team_size());
+  TransferReport report;
+  report.board = belief.source;
+  report.options = options;
+  for (PlannedWorld& w : worlds) {
+    if (w.row.played) play_world(w, belief, options, players, count);
+    report.worlds.push_back(std::move(w.row));
+  }
+  report.sensitivities = transfer_sensitivities(report.worlds, options);
+  report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
+}
+
+}  // namespace pinball::bench

@@ -1,0 +1,205 @@
+#pragma once
+// `pinball bench transfer` (issue 19, items 4 and 5): how much of a learned
+// controller's advantage survives a world that is not the one it was learned
+// in. Every controller (the tracker-side spastic flipper as the baseline, and
+// the controller files) plays the same ball seeds (ball_seed(seed, i)) in
+// each world: the thesis model on both steppers and the MuJoCo twin at the
+// nominal board, then a one-at-a-time sweep of the world on the thesis
+// stepper (flipper pivots, θ_min, flipper μ, wall ρ, g, actuation delay,
+// camera latency and noise) while the belief (what the tracker and the
+// controllers assume: board, g, the camera's noise) stays nominal.
+//
+// Each ball is the fast loop's (learn::play_through_tracker, as the evaluator
+// plays it) with a DrainWatch, so a cell also says where its balls were lost.
+// The sweep's slopes of score against the size of each error say which
+// calibration errors cost most (item 5).
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "drain_cause.h"
+#include "pinball/control/controller_file.h"
+#include "pinball/core/running_stats.h"
+#include "pinball/firmware/flipper_actuation.h"
+#include "pinball/simlab/world_factory.h"
+#include "pinball/table/board.h"
+#include "pinball/track/camera_model.h"
+
+namespace pinball::bench {
+
+/// One thing the sweep changes in the world (the belief keeps the nominal value).
+enum class Perturbation : unsigned char {
+  kPivotY_mm,          ///< both flipper pivots moved up (+) or down (−) the table, along y
+  kThetaMin_deg,       ///< both flippers' rest stop θ_min turned (+ raises the flipper)
+  kFlipperMu_pct,      ///< both flippers' μ scaled by 1 + v/100
+  kWallRho,            ///< v added to ρ of every obstacle with ρ ≤ 1 that eats no ball, clamped to [0, 1]
+  kGravity_pct,        ///< g along the table scaled by 1 + v/100; the tracker keeps the nominal g
+  kActuationDelay_ms,  ///< command to flipper motion (absolute value)
+  kCameraLatency_ms,   ///< exposure to delivery (absolute value)
+  kCameraNoise_px,     ///< the camera's centroid noise (absolute; the tracker keeps the nominal noise)
+};
+
+/// Every perturbation, in report order.
+inline constexpr Perturbation kAllPerturbations[] = {
+    Perturbation::kPivotY_mm,     Perturbation::kThetaMin_deg,       Perturbation::kFlipperMu_pct,
+    Perturbation::kWallRho,       Perturbation::kGravity_pct,        Perturbation::kActuationDelay_ms,
+    Perturbation::kCameraLatency_ms, Perturbation::kCameraNoise_px};
+
+/// The report's name: "pivot_y_mm", "theta_min_deg", "flipper_mu_pct", "wall_rho", "gravity_pct",
+/// "actuation_delay_ms", "camera_latency_ms", "camera_noise_px".
+std::string_view perturbation_name(Perturbation p);
+/// For people and plots: "flipper pivots along y (mm)", ...
+std::string_view perturbation_label(Perturbation p);
+/// True for an offset from the nominal world (the nominal value is 0); false
+/// for an absolute setting (delay, latency, noise).
+bool is_offset(Perturbation p);
+
+/// One family of the sweep: its values, each played in a world of its own.
+struct SweepFamily {
+  Perturbation kind = Perturbation::kPivotY_mm;  ///< what changes
+  std::vector<double> values;                    ///< in the family's unit; the nominal value is the `model` world
+};
+
+/// The issue's sweep: pivots ±1/±3/±5 mm, θ_min ±0.5/±1°, μ ±20 %, ρ ±0.1,
+/// g ±3/5/10 %, delay 0/10/20 ms, latency 0/10 ms, noise 1/2 px (the nominal
+/// 4 ms, 5 ms and 0.3 px are the `model` world).
+std::vector<SweepFamily> default_transfer_sweep();
+/// One value per family, for tests and a first look.
+std::vector<SweepFamily> quick_transfer_sweep();
+
+/// A player: the spastic baseline (spec null) or a controller file.
+struct TransferController {
+  std::string name;                                ///< "spastic", or the file's stem
+  std::string file;                                ///< the file ("" for spastic)
+  const control::ControllerSpec* spec = nullptr;   ///< borrowed; null: the tracker-side spastic flipper
+};
+
+/// What to measure.
+struct TransferBenchOptions {
+  int balls = 2000;                 ///< balls per cell (world x controller), the same seeds in every cell
+  int twin_balls = 200;             ///< balls per cell in the twin (the first of the same seeds): it plays
+                                    ///< about 100x slower than the model (docs/results.md)
+  std::uint64_t seed = 1;           ///< ball i plays ball_seed(seed, i)
+  int threads = 2;                  ///< worker threads; results do not depend on it
+  double max_ball_time_s = 60.0;    ///< a ball alive after this is cut (as in the evaluator)
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< nominal command to flipper motion
+  track::CameraModelConfig camera;  ///< the nominal camera (the tracker's belief in every world)
+  std::vector<SweepFamily> sweep = default_transfer_sweep();  ///< the perturbations
+  /// The players after the spastic baseline, which always plays first (the ratios' denominator).
+  std::vector<TransferController> controllers;
+  std::string twin_params_path;     ///< the twin's parameters ("" : the shipped config/twin.yaml)
+};
+
+/// The value of `p` in the nominal (`model`) world: 0 for an offset, the
+/// options' delay, latency or noise for a setting.
+double nominal_value(Perturbation p, const TransferBenchOptions& options);
+
+/// A short run: 5 balls per cell, quick_transfer_sweep().
+TransferBenchOptions quick_transfer_bench_options();
+
+/// The world a cell plays beside its board: the perturbed table and the
+/// world-side settings (the solenoid's delay, the real camera).
+struct WorldSettings {
+  table::Board board;               ///< the world's table
+  double actuation_delay_s = 0.0;   ///< command to flipper motion (s)
+  track::CameraModelConfig camera;  ///< the camera the world really has
+};
+
+/// `nominal` with perturbation `p` of `value` applied (`value` in p's unit).
+/// Throws std::invalid_argument when the result is no table (a negative g or
+/// delay, μ ≤ 0, a negative noise).
+WorldSettings perturb(const WorldSettings& nominal, Perturbation p, double value);
+
+/// One ball's outcome, and what it cost.
+struct TransferBall : PlayedBall {
+  double wall_s = 0.0;       ///< wall time the ball took on its thread (run_transfer_bench sets it)
+};
+
+/// Plays ball `ball_seed` in `world` (a fork of the cell's world) with the
+/// camera and delay of `settings`; the tracker and `controller` believe
+/// `belief` and the nominal camera `belief_camera`. `spec` null: the spastic flipper.
+TransferBall play_transfer_ball(sim::World& world, const WorldSettings& settings, const table::Board& belief,
+                                const track::CameraModelConfig& belief_camera, const control::ControllerSpec* spec,
+                                double max_ball_time_s, std::uint64_t ball_seed);
+
+/// One controller in one world.
+struct TransferCell {
+  std::string controller;   ///< TransferController::name
+  RunningStats score;       ///< per ball
+  RunningStats duration_s;  ///< per ball
+  RunningStats flips;       ///< per ball
+  int cut = 0;              ///< balls cut at the time limit
+  DrainCounts drains;       ///< lost balls by cause
+  double ratio_to_spastic = 0.0;  ///< mean score / the spastic flipper's in the same world (0 when that is 0)
+  double wall_s = 0.0;      ///< wall time of this cell's balls, summed over their threads (its cost)
+};
+
+/// One world (a row of the table).
+struct TransferWorld {
+  std::string name;           ///< "model", "event", "twin", or "<perturbation>=<value>" ("gravity_pct=+10")
+  std::string family;         ///< "nominal" for model, event and twin; otherwise perturbation_name
+  double value = 0.0;         ///< the perturbation's value (0 for the nominal worlds)
+  std::string world;          ///< what played: thesis, event or twin
+  int balls = 0;              ///< balls per cell in this world
+  bool played = false;        ///< false: skipped (the twin in a build without it)
+  std::string skipped_reason; ///< why, when skipped
+  std::uint64_t world_warnings = 0;  ///< the world's own warnings (the twin's MuJoCo contacts; 0 for the model)
+  double wall_s = 0.0;        ///< elapsed wall time of this world's balls
+  std::vector<TransferCell> cells;   ///< spastic first, then the options' controllers
+};
+
+/// Points per ball a controller loses per unit of one calibration error:
+/// minus the least-squares slope of mean score against |value| over the
+/// family's worlds and the `model` world (|value| = 0).
+struct TransferSensitivity {
+  std::string family;          ///< perturbation_name
+  std::string unit;            ///< "mm", "deg", "%", "1" (ρ)
+  std::string controller;      ///< whose
+  double points_per_ball_lost_per_unit = 0.0;  ///< −slope
+  /// 95 % half-width of that slope, each cell's mean taken as independent
+  /// (student_t95 of the balls): conservative, since the cells share their ball seeds.
+  double ci95_half_width = 0.0;
+  int worlds = 0;              ///< points in the fit
+};
+
+/// The whole measurement.
+struct TransferReport {
+  std::string board;                 ///< the belief's board file
+  TransferBenchOptions options;      ///< what was run (controllers' specs not owned)
+  std::vector<TransferWorld> worlds; ///< model, event, twin, then the sweep in order
+  std::vector<TransferSensitivity> sensitivities;  ///< per offset family and controller
+  double wall_s = 0.0;               ///< the whole run
+};
+
+/// Runs every cell. `belief` is the nominal board. `progress` (may be
+/// empty) gets lines with percent done and an ETA over all cells, from any
+/// thread but never two at once. Throws std::invalid_argument for bad
+/// options (no balls, a non-positive cap, a controller that draws its launch at random).
+TransferReport run_transfer_bench(const table::Board& belief, const TransferBenchOptions& options,
+                                  const std::function<void(const std::string&)>& progress);
+
+/// The sensitivities of a report's worlds (run_transfer_bench fills them).
+std::vector<TransferSensitivity> transfer_sensitivities(const std::vector<TransferWorld>& worlds,
+                                                        const TransferBenchOptions& options);
+
+// The report (transfer_bench_report.cpp).
+
+/// The report as one JSON object.
+nlohmann::json to_json(const TransferReport& report);
+/// The report as text: Markdown tables, numbers rounded.
+std::string to_text(const TransferReport& report);
+/// One row per world x controller, with a header.
+std::string to_csv(const TransferReport& report);
+
+// The figure (transfer_bench_plot.cpp).
+
+/// Ratio to the spastic flipper against each perturbation's value: a panel
+/// per family, a curve per controller. Throws std::runtime_error if it cannot write.
+void plot_transfer_png(const TransferReport& report, const std::string& path);
+
+}  // namespace pinball::bench

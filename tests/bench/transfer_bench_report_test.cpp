@@ -1,0 +1,84 @@
+#include <algorithm>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "transfer_bench.h"
+#include "transfer_report_fixture.h"
+
+namespace pinball::bench {
+namespace {
+
+using pinball::testing::made_report;
+
+TEST(TransferReport, JsonHasTheOptionsEveryCellAndTheSameKeysAsEveryCommand) {
+  const nlohmann::json j = to_json(made_report());
+  EXPECT_EQ(j.at("benchmark"), "transfer");
+  for (const char* k : {"board", "balls", "seed", "threads", "max_ball_time_s", "actuation_delay_s", "camera",
+                        "pivot_axis", "wall_rho_rule", "drains_rule", "ratio_interval", "controllers", "sweep",
+                        "worlds", "sensitivity", "wall_s"}) {
+    EXPECT_TRUE(j.contains(k)) << k;
+  }
+  EXPECT_EQ(j.at("controllers").size(), 2u);
+  EXPECT_EQ(j.at("worlds").size(), 8u);
+  for (const auto& w : j.at("worlds")) {
+    if (!w.at("played").get<bool>()) {
+      EXPECT_EQ(w.at("name"), "twin");
+      EXPECT_FALSE(w.at("skipped_reason").get<std::string>().empty());
+      EXPECT_TRUE(w.at("cells").empty());
+      continue;
+    }
+    for (const char* c : {"spastic", "learned"}) {
+      for (const char* k : {"mean_score_per_ball", "score_ci95_half_width", "balls_cut_at_time_limit", "wall_s",
+                            "ratio_to_spastic", "drains_left_outlane", "drains_right_outlane", "drains_centre",
+                            "drains_other", "drains_left_table"}) {
+        EXPECT_TRUE(w.at("cells").at(c).contains(k)) << w.at("name") << " " << c << " " << k;
+      }
+    }
+    EXPECT_EQ(w.at("cells").at("spastic").at("ratio_to_spastic"), 1.0);
+  }
+  const auto& pivot = j.at("sensitivity").at("pivot_y_mm");
+  EXPECT_EQ(pivot.at("unit"), "mm");
+  EXPECT_NEAR(pivot.at("controllers").at("learned").at("points_per_ball_lost_per_unit").get<double>(), 50.0, 1e-9);
+}
+
+TEST(TransferReport, CsvHasAHeaderAndOneRowPerWorldAndController) {
+  const std::string csv = to_csv(made_report());
+  std::istringstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("world,family,value,stepper,controller,status,balls,mean_score_per_ball,"
+                         "score_ci95_half_width,ratio_to_spastic,balls_cut_at_time_limit,max_ball_time_s",
+                         0),
+            0u)
+      << header;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 8 * 2);
+  const auto columns = [](const std::string& line) {
+    int n = 1;
+    bool quoted = false;
+    for (const char c : line) {
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) ++n;
+    }
+    return n;
+  };
+  for (std::string line; std::getline(in, line);) EXPECT_EQ(columns(line), columns(header)) << line;
+  EXPECT_NE(csv.find("twin,nominal,0,twin,spastic,\"skipped: this build has no MuJoCo twin, not even a \"\"stub\"\"\""),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find("pivot_y_mm=+3,pivot_y_mm,3,thesis,learned,played,4,1850,"), std::string::npos) << csv;
+}
+
+TEST(TransferReport, TextRoundsAndSaysWhatWasSkipped) {
+  const std::string text = to_text(made_report());
+  EXPECT_NE(text.find("| world | spastic | learned |"), std::string::npos) << text;
+  EXPECT_NE(text.find("| model (thesis) | 1000 ± "), std::string::npos) << text;
+  EXPECT_NE(text.find("2x"), std::string::npos) << "learned / spastic in the model world\n" << text;
+  EXPECT_NE(text.find("| twin | skipped: this build has no MuJoCo twin"), std::string::npos) << text;
+  EXPECT_NE(text.find("balls cut at 60 s"), std::string::npos) << "the cap in every output\n" << text;
+  EXPECT_NE(text.find("| pivot_y_mm | mm | 10 ± "), std::string::npos) << text;
+  EXPECT_EQ(text.find("1849.999"), std::string::npos) << "rounded\n" << text;
+}
+
+}  // namespace
+}  // namespace pinball::bench
