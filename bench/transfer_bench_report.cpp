@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "pinball/core/json_write_archive.h"
 #include "pinball/core/format.h"
 #include "pinball/core/progress.h"
 #include "transfer_bench.h"
@@ -103,12 +104,7 @@ nlohmann::json to_json(const TransferReport& r) {
           {"threads", o.threads},
           {"max_ball_time_s", o.max_ball_time_s},
           {"actuation_delay_s", o.actuation_delay_s},
-          {"camera",
-           {{"fps", o.camera.fps},
-            {"m_per_px", o.camera.m_per_px},
-            {"noise_px", o.camera.noise_px},
-            {"latency_s", o.camera.latency_s},
-            {"drop_probability", o.camera.drop_probability}}},
+          {"camera", to_json_value(o.camera)},
           {"pivot_axis", kPivotAxis},
           {"wall_rho_rule", kWallRhoRule},
           {"drains_rule", kDrainRule},

@@ -204,8 +204,7 @@ std::string run_fingerprint(const LearnArgs& a) {
       {"population", a.population}, {"rounds", a.rounds}, {"max_ball_time_s", a.max_ball_time_s},
       {"loss_penalty", a.loss_penalty}, {"actuation_delay_s", a.actuation_delay_s},
       {"gravity_scale", a.gravity_scale},
-      {"camera", {{"fps", a.camera.fps}, {"m_per_px", a.camera.m_per_px}, {"noise_px", a.camera.noise_px},
-                  {"latency_s", a.camera.latency_s}, {"drop_probability", a.camera.drop_probability}}}};
+      {"camera", to_json_value(a.camera)}};
   return "pinball learn " + j.dump();
 }
 

@@ -14,6 +14,7 @@
 #include "camera_options.h"
 #include "data_file.h"
 #include "commands.h"
+#include "pinball/core/json_write_archive.h"
 #include "pinball/core/format.h"
 #include "pinball/core/progress.h"
 #include "pinball/core/running_stats.h"
@@ -192,11 +193,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"dt_s", dt_s},
         {"balls", a.balls},
         {"camera",
-         {{"fps", a.camera.fps},
-          {"m_per_px", a.camera.m_per_px},
-          {"noise_px", a.camera.noise_px},
-          {"latency_s", a.camera.latency_s},
-          {"drop_probability", a.camera.drop_probability}}},
+         to_json_value(a.camera)},
         {"flips", flips},
         {"actuation", a.actuation},
         {"actuation_delay_s", a.actuation_delay_s},

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "pinball/core/geometry.h"
+#include "pinball/core/name_value.h"
 #include "pinball/core/rng.h"
 #include "pinball/track/observation.h"
 
@@ -23,6 +24,16 @@ struct CameraModelConfig {
   /// (up to 5 ms), transfer and driver hand-over; cheaper set-ups add 5-30 ms.
   double latency_s = 0.005;
   double drop_probability = 0.0;  ///< chance a frame is lost
+
+  /// The fields as every report spells them (core/json_write_archive.h).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(fps));
+    a->Visit(PINBALL_NVP(m_per_px));
+    a->Visit(PINBALL_NVP(noise_px));
+    a->Visit(PINBALL_NVP(latency_s));
+    a->Visit(PINBALL_NVP(drop_probability));
+  }
 };
 
 /// Standard deviation (m) of one observed coordinate: quantisation (res²/12)
