@@ -63,7 +63,7 @@ TEST(TransferReport, CsvHasAHeaderAndOneRowPerWorldAndController) {
     return n;
   };
   for (std::string line; std::getline(in, line);) EXPECT_EQ(columns(line), columns(header)) << line;
-  EXPECT_NE(csv.find("twin,nominal,0,twin,spastic,\"skipped: this build has no MuJoCo twin, not even a \"\"stub\"\"\""),
+  EXPECT_NE(csv.find("twin,nominal,0,twin,spastic,\"skipped: this build has no MuJoCo twin, so no \"\"twin\"\" row is played\""),
             std::string::npos)
       << csv;
   EXPECT_NE(csv.find("pivot_y_mm=+3,pivot_y_mm,3,thesis,learned,played,4,1850,"), std::string::npos) << csv;

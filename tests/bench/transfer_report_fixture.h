@@ -52,7 +52,7 @@ inline bench::TransferReport made_report() {
   twin.name = "twin";
   twin.family = "nominal";
   twin.world = "twin";
-  twin.skipped_reason = "this build has no MuJoCo twin, not even a \"stub\"";
+  twin.skipped_reason = "this build has no MuJoCo twin, so no \"twin\" row is played";
   r.worlds.push_back(twin);
   for (const double v : {-3.0, -1.0, 1.0, 3.0}) {
     r.worlds.push_back(world(std::string("pivot_y_mm=") + (v > 0 ? "+" : "") + std::to_string(static_cast<int>(v)),
