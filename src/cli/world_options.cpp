@@ -1,6 +1,8 @@
 #include "world_options.h"
 
 #include "data_file.h"
+#include "pinball/core/json_read_archive.h"
+#include "pinball/core/json_write_archive.h"
 
 #include <map>
 #include <string>
@@ -43,8 +45,7 @@ nlohmann::json world_report(const simlab::WorldSpec& spec, const std::string& be
   nlohmann::json j = {{"world", std::string(world.name())},
                       {"world_board", spec.board_path.empty() ? belief_board : spec.board_path},
                       {"stepper", std::string(sim::stepper_kind_name(spec.stepper))},
-                      {"world_warnings",
-                       {{"penetration", w.penetration}, {"instability", w.instability}, {"overflow", w.overflow}}}};
+                      {"world_warnings", to_json_value(w)}};
   if (spec.kind == simlab::WorldKind::kTwin) {
     j["twin_params"] = spec.twin_params_path.empty() ? std::string("config/twin.yaml") : spec.twin_params_path;
   }
@@ -55,13 +56,10 @@ std::string world_text_line(const nlohmann::json& report) {
   const std::string world = report["world"].get<std::string>();
   const std::string board = report["world_board"].get<std::string>();
   if (world == "twin") {
-    const nlohmann::json& w = report["world_warnings"];
-    const std::uint64_t warnings =
-        w["penetration"].get<std::uint64_t>() + w["instability"].get<std::uint64_t>() + w["overflow"].get<std::uint64_t>();
+    sim::WorldWarnings warnings;
+    JsonReadArchive("world report").read(&report.at("world_warnings"), "world_warnings", &warnings);
     return "world            MuJoCo twin of " + board + " (" + report["twin_params"].get<std::string>() + "), " +
-           std::to_string(warnings) + " warnings (" + std::to_string(w["penetration"].get<std::uint64_t>()) +
-           " deep contacts, " + std::to_string(w["instability"].get<std::uint64_t>()) + " instabilities, " +
-           std::to_string(w["overflow"].get<std::uint64_t>()) + " overflows)\n";
+           describe(warnings) + "\n";
   }
   return "world            " + board + " on the " + world + " stepper\n";
 }

@@ -1,3 +1,4 @@
+#include "pinball/core/json_write_archive.h"
 #include "pinball/daemon/daemon.h"
 
 #include <algorithm>
@@ -652,10 +653,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
     // "stepper" names the world (thesis, event or twin), as before the twin.
     j["world"] = {{"board", r.world_board},
                   {"stepper", r.world},
-                  {"warnings",
-                   {{"penetration", r.world_warnings.penetration},
-                    {"instability", r.world_warnings.instability},
-                    {"overflow", r.world_warnings.overflow}}}};
+                  {"warnings", to_json_value(r.world_warnings)}};
   }
   j["balls"] = r.balls;
   j["mean_score_per_ball"] = r.mean_score;
@@ -725,9 +723,7 @@ std::string report_to_text(const DaemonReport& r) {
     if (r.cut_balls > 0) o << "  cut " << r.cut_balls;
     o << "\n";
     if (r.world != "thesis") {
-      o << "world " << r.world << " on " << r.world_board << "  warnings " << r.world_warnings.total() << " ("
-        << r.world_warnings.penetration << " deep contacts, " << r.world_warnings.instability << " instabilities, "
-        << r.world_warnings.overflow << " overflows)\n";
+      o << "world " << r.world << " on " << r.world_board << "  " << describe(r.world_warnings) << "\n";
     }
   }
   o << std::setprecision(1);

@@ -13,6 +13,11 @@ StepperKind parse_stepper_kind(std::string_view name) {
 
 std::string_view stepper_kind_name(StepperKind kind) { return kind == StepperKind::kEvent ? "event" : "thesis"; }
 
+std::string describe(const WorldWarnings& w) {
+  return std::to_string(w.total()) + " warnings (" + std::to_string(w.penetration) + " deep contacts, " +
+         std::to_string(w.instability) + " instabilities, " + std::to_string(w.overflow) + " overflows)";
+}
+
 void check_same_flippers(const table::Board& world, const table::Board& belief) {
   bool same = world.flippers.size() == belief.flippers.size();
   for (std::size_t i = 0; same && i < world.flippers.size(); ++i) {

@@ -11,8 +11,10 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <string_view>
 
+#include "pinball/core/name_value.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/step_events.h"
 #include "pinball/table/board.h"
@@ -34,7 +36,18 @@ struct WorldWarnings {
   std::uint64_t instability = 0;  ///< bad positions, velocities or accelerations the engine reset
   std::uint64_t overflow = 0;     ///< contact or constraint buffers full
   std::uint64_t total() const { return penetration + instability + overflow; }
+
+  /// The counts as every report spells them (core/json_write_archive.h, json_read_archive.h).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(penetration));
+    a->Visit(PINBALL_NVP(instability));
+    a->Visit(PINBALL_NVP(overflow));
+  }
 };
+
+/// For text reports: "3 warnings (3 deep contacts, 0 instabilities, 0 overflows)".
+std::string describe(const WorldWarnings& warnings);
 
 /// The thing that plays a table. One object per game in progress (a world may
 /// keep state of its own beside the GameState, as the twin does); fork() makes

@@ -157,8 +157,8 @@ TwinModelText twin_model_text(const table::Board& board, const TwinParams& param
           << ' ' << centre.y() << ' ' << 0.5 * h << "\" euler=\"0 0 " << std::atan2(d.y(), d.x()) << "\"";
     } else {
       // A post or a pin: a vertical capsule. Its side is a cylinder's, and
-      // MuJoCo collides a sphere with a capsule exactly (with a cylinder only
-      // through its general convex search, which loses energy at each bounce).
+      // MuJoCo 2.2 collides a sphere with a capsule in closed form (with a
+      // cylinder only through its general convex search).
       const double radius = std::max(s.radius_m, pin);
       out << " type=\"capsule\" size=\"" << radius << "\" fromto=\"" << s.p0.x() << ' ' << s.p0.y() << " 0 "
           << s.p0.x() << ' ' << s.p0.y() << ' ' << h << "\"";
