@@ -41,6 +41,29 @@ void check_calibration(const Calibration& c, const YamlReadArchive& r) {
     if (!(std::abs(cv::determinant(k.image_from_board)) > 0.0)) r.fail("camera.image_from_board", "singular matrix");
     if (k.image_width_px <= 0 || k.image_height_px <= 0) r.fail("camera.image_width_px", "image size must be > 0");
   }
+  if (c.intrinsics) {
+    const vision::CameraIntrinsics& lens = c.intrinsics->lens;
+    if (const RangeViolation v = vision::check_intrinsics(lens)) r.fail("intrinsics.lens." + v.key, v.rule);
+    if (c.camera && (lens.width_px != c.camera->image_width_px || lens.height_px != c.camera->image_height_px)) {
+      r.fail("intrinsics.lens.width_px", "the lens was calibrated on " + std::to_string(lens.width_px) + "x" +
+                                             std::to_string(lens.height_px) + " images but the camera section's are " +
+                                             std::to_string(c.camera->image_width_px) + "x" +
+                                             std::to_string(c.camera->image_height_px));
+    }
+  }
+  if (c.camera_timing) {
+    const CameraTiming& t = *c.camera_timing;
+    if (!std::isfinite(t.latency_s) || t.latency_s < 0.0 || t.latency_s > 1.0) {
+      r.fail("camera_timing.latency_s", "must be in [0, 1] s");
+    }
+    if (!std::isfinite(t.latency_spread_s) || t.latency_spread_s < 0.0) {
+      r.fail("camera_timing.latency_spread_s", "must be >= 0 s");
+    }
+    if (!std::isfinite(t.row_time_s) || t.row_time_s < 0.0 || t.row_time_s > 1e-3) {
+      r.fail("camera_timing.row_time_s", "must be in [0, 0.001] s");
+    }
+    if (t.events_used < 0) r.fail("camera_timing.events_used", "must be >= 0");
+  }
   for (std::size_t i = 0; i < c.flippers.size(); ++i) {
     check_flipper(c.flippers[i], "flippers[" + std::to_string(i) + "]", r);
   }
@@ -90,6 +113,38 @@ std::string calibration_to_yaml(const Calibration& c) {
     e << YAML::Key << "markers_used" << YAML::Value << k.markers_used;
     e << YAML::Key << "reprojection_rms_px" << YAML::Value << k.reprojection_rms_px;
     e << YAML::Key << "reprojection_max_px" << YAML::Value << k.reprojection_max_px;
+    e << YAML::EndMap;
+  }
+  if (c.intrinsics) {
+    const IntrinsicsCalibration& in = *c.intrinsics;
+    const vision::CameraIntrinsics& l = in.lens;
+    e << YAML::Key << "intrinsics" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "lens" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "width_px" << YAML::Value << l.width_px;
+    e << YAML::Key << "height_px" << YAML::Value << l.height_px;
+    e << YAML::Key << "fx_px" << YAML::Value << l.fx_px;
+    e << YAML::Key << "fy_px" << YAML::Value << l.fy_px;
+    e << YAML::Key << "cx_px" << YAML::Value << l.cx_px;
+    e << YAML::Key << "cy_px" << YAML::Value << l.cy_px;
+    e << YAML::Key << "k1" << YAML::Value << l.k1 << YAML::Comment("radial, OpenCV's model");
+    e << YAML::Key << "k2" << YAML::Value << l.k2;
+    e << YAML::Key << "k3" << YAML::Value << l.k3;
+    e << YAML::Key << "p1" << YAML::Value << l.p1 << YAML::Comment("tangential");
+    e << YAML::Key << "p2" << YAML::Value << l.p2;
+    e << YAML::EndMap;
+    e << YAML::Key << "target" << YAML::Value << in.target;
+    e << YAML::Key << "images_used" << YAML::Value << in.images_used;
+    e << YAML::Key << "images_rejected" << YAML::Value << in.images_rejected;
+    e << YAML::Key << "reprojection_rms_px" << YAML::Value << in.reprojection_rms_px;
+    e << YAML::EndMap;
+  }
+  if (c.camera_timing) {
+    const CameraTiming& t = *c.camera_timing;
+    e << YAML::Key << "camera_timing" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "latency_s" << YAML::Value << t.latency_s << YAML::Comment("frame stamp minus row 0's mid-exposure");
+    e << YAML::Key << "latency_spread_s" << YAML::Value << t.latency_spread_s;
+    e << YAML::Key << "row_time_s" << YAML::Value << t.row_time_s << YAML::Comment("rolling shutter; 0: global");
+    e << YAML::Key << "events_used" << YAML::Value << t.events_used << YAML::Comment("0: configured, not measured");
     e << YAML::EndMap;
   }
   if (!c.flippers.empty()) {

@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
   libopencv-calib3d-dev
+  libopencv-contrib-dev   # aruco: ChArUco targets for `pinball calibrate intrinsics`
   liblcm-dev liblcm-bin
   libgtest-dev libgmock-dev googletest
   libbenchmark-dev

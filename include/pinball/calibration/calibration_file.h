@@ -23,6 +23,7 @@
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/track/tracker.h"
 #include "pinball/vision/camera_homography.h"
+#include "pinball/vision/lens_model.h"
 
 namespace pinball::calibration {
 
@@ -52,6 +53,44 @@ struct CameraCalibration {
     a->Visit(PINBALL_NVP(markers_used));
     a->Visit(PINBALL_NVP(reprojection_rms_px));
     a->Visit(PINBALL_NVP(reprojection_max_px));
+  }
+};
+
+/// The intrinsics section: the lens, from images of a printed target
+/// (`pinball calibrate intrinsics`). With it the detector undistorts each
+/// centroid and the homography is fitted on undistorted points.
+struct IntrinsicsCalibration {
+  vision::CameraIntrinsics lens;       ///< camera matrix and distortion coefficients (OpenCV's model)
+  std::string target;                  ///< what was photographed ("chessboard 9x6 inner corners, 25 mm squares")
+  int images_used = 0;                 ///< images in the fit
+  int images_rejected = 0;             ///< images left out (target not found, or a poor fit)
+  double reprojection_rms_px = 0.0;    ///< RMS reprojection error over the used images (px)
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(lens));
+    a->Visit(PINBALL_NVP(target));
+    a->Visit(PINBALL_NVP(images_used));
+    a->Visit(PINBALL_NVP(images_rejected));
+    a->Visit(PINBALL_NVP(reprojection_rms_px));
+  }
+};
+
+/// The camera_timing section: when a frame's pixels were exposed, relative to
+/// the time the host stamps on it. The detector dates an observation
+/// t = frame stamp − latency_s + v · row_time_s (v: the ball's row on the sensor).
+struct CameraTiming {
+  double latency_s = 0.0;         ///< frame stamp minus the middle of row 0's exposure (s)
+  double latency_spread_s = 0.0;  ///< standard deviation of that delay over the measured events (s)
+  double row_time_s = 0.0;        ///< rolling shutter: row v is exposed v · this after row 0 (s); 0: global shutter
+  int events_used = 0;            ///< events behind latency_s (`pinball calibrate latency`); 0: configured, not measured
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(latency_s));
+    a->Visit(PINBALL_NVP(latency_spread_s));
+    a->Visit(PINBALL_NVP(row_time_s));
+    a->Visit(PINBALL_NVP(events_used));
   }
 };
 
@@ -137,6 +176,8 @@ struct Calibration {
   std::string date;                        ///< when written, ISO 8601 UTC; set by write_calibration when empty
   std::string board;                       ///< the board file the machine was described by
   std::optional<CameraCalibration> camera; ///< camera section
+  std::optional<IntrinsicsCalibration> intrinsics;  ///< intrinsics section (lens)
+  std::optional<CameraTiming> camera_timing;        ///< camera_timing section
   std::vector<FlipperCalibration> flippers;///< flippers section (board order)
   std::optional<GravityEstimate> gravity;  ///< gravity section
 
@@ -146,6 +187,8 @@ struct Calibration {
     a->Visit(PINBALL_NVP(date));
     a->Visit(PINBALL_NVP(board));
     a->Visit(PINBALL_NVP(camera));
+    a->Visit(PINBALL_NVP(intrinsics));
+    a->Visit(PINBALL_NVP(camera_timing));
     // The section may be absent (an empty list is not written).
     std::optional<std::vector<FlipperCalibration>> listed;
     if (!flippers.empty()) listed = flippers;
