@@ -41,7 +41,9 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-ErrorSummary summarise(std::vector<double> v) {
+}  // namespace
+
+ErrorSummary summarise_errors(std::vector<double> v) {
   ErrorSummary s;
   s.count = v.size();
   if (v.empty()) return s;
@@ -51,7 +53,6 @@ ErrorSummary summarise(std::vector<double> v) {
   return s;
 }
 
-// Learns the detector's background from ball-free frames with the lamps still and the glare off.
 void learn_background(simlab::SimCameraSource& camera, vision::BallDetector& detector, int frames, double& t_s) {
   camera.set_lamps_blinking(false);
   camera.set_glare(false);
@@ -65,6 +66,8 @@ void learn_background(simlab::SimCameraSource& camera, vision::BallDetector& det
   camera.set_lamps_blinking(true);
   camera.set_glare(true);
 }
+
+namespace {
 
 // Plays the board with the oracle spastic player and hands every delivered
 // frame (with the camera's truth) to `on_frame` until it returns false.
@@ -143,9 +146,9 @@ void measure_accuracy(const table::Board& board, const DetectorBenchOptions& o, 
     }
     return a.unoccluded < static_cast<std::size_t>(o.play_frames);
   });
-  a.error_px = summarise(err_px);
-  a.error_mm = summarise(err_mm);
-  a.naive_error_px = summarise(naive_px);
+  a.error_px = summarise_errors(err_px);
+  a.error_mm = summarise_errors(err_mm);
+  a.naive_error_px = summarise_errors(naive_px);
   a.median_blur_px = quantile(blur_px, 0.5);
   a.p99_blur_px = quantile(blur_px, 0.99);
   a.median_radius_px = quantile(radius_px, 0.5);

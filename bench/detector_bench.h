@@ -62,6 +62,16 @@ struct ErrorSummary {
   double max = 0.0;       ///< 0 when count == 0
 };
 
+/// The summary of a set of errors (bench camera shares it).
+ErrorSummary summarise_errors(std::vector<double> errors);
+
+/// The summary as JSON: count, median, p99, max.
+nlohmann::json to_json(const ErrorSummary& summary);
+
+/// Learns the detector's background from `frames` ball-free frames rendered
+/// from t_s on (advanced), with the lamps still and the glare off.
+void learn_background(simlab::SimCameraSource& camera, vision::BallDetector& detector, int frames, double& t_s);
+
 /// Accuracy on frames from play.
 struct AccuracyFigures {
   std::size_t frames = 0;              ///< frames delivered during play

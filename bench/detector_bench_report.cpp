@@ -5,13 +5,10 @@
 #include <sstream>
 
 namespace pinball::bench {
-namespace {
 
 nlohmann::json to_json(const ErrorSummary& s) {
   return {{"count", s.count}, {"median", s.median}, {"p99", s.p99}, {"max", s.max}};
 }
-
-}  // namespace
 
 nlohmann::json to_json(const DetectorReport& r) {
   const DetectorBenchOptions& o = r.options;

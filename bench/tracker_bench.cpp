@@ -134,23 +134,14 @@ std::size_t distance_bin(double d_m) {
 void record(const track::TrajectoryProjection& p, const TrackerApproach& a, const track::FlipperGeometry& geometry,
             ErrorSamples& e) {
   ++e.observations;
-  if (!p.valid) return;
+  const ProjectionError err = projection_error(p, a, geometry);
+  if (!err.valid) return;
   ++e.valid;
-  const track::TrajectoryProjection& truth = a.truth;
-  double dh = 0.0;
-  if (p.flipper == truth.flipper) {
-    dh = std::abs(p.h - truth.h);
-  } else {
-    // The other arm of the 'V': the way along the V through the apex.
-    ++e.wrong_flipper;
-    dh = (geometry.h_apex[p.flipper] - p.h) + (geometry.h_apex[truth.flipper] - truth.h);
-  }
-  const double dt = p.t_observation_s + p.t_impact_s - truth.t_impact_s;
-  const double dtheta = track::fold_to_half_plane(p.angle_rad - truth.angle_rad);
-  e.dh.push_back(static_cast<float>(std::abs(dh)));
-  e.dt_ms.push_back(static_cast<float>(std::abs(dt) * 1e3));
-  e.ds.push_back(static_cast<float>(std::abs(p.speed_mps - truth.speed_mps)));
-  e.dtheta_deg.push_back(static_cast<float>(std::abs(dtheta) * 180.0 / std::numbers::pi));
+  if (err.wrong_flipper) ++e.wrong_flipper;
+  e.dh.push_back(static_cast<float>(err.abs_dh));
+  e.dt_ms.push_back(static_cast<float>(err.abs_dt_impact_s * 1e3));
+  e.ds.push_back(static_cast<float>(err.abs_ds_mps));
+  e.dtheta_deg.push_back(static_cast<float>(err.abs_dtheta_deg));
 }
 
 // Observations of one approach through a fresh camera, until the true impact.
@@ -166,11 +157,6 @@ void observe(const TrackerApproach& a, const track::CameraModelConfig& camera, s
     cam.expose(t, exact.position_at(t));
     while (cam.deliver(t, o)) out.push_back(o);
   }
-}
-
-double remaining_distance(const TrackerApproach& a, double t_s) {
-  const Vec2 p = track::exact_trajectory(a.p0, a.v0, a.g_mps2, 0.0).position_at(t_s);
-  return (p - a.truth.impact_point).norm();
 }
 
 TrackerSetting run_setting(const table::Board& board, const track::FlipperGeometry& geometry,
@@ -311,6 +297,30 @@ std::string camera_label(const track::CameraModelConfig& c, double g_factor) {
   std::ostringstream s;
   s << c.fps << " fps, " << c.m_per_px * 1e3 << " mm/px, " << c.noise_px << " px, g x" << g_factor;
   return s.str();
+}
+
+ProjectionError projection_error(const track::TrajectoryProjection& p, const TrackerApproach& a,
+                                 const track::FlipperGeometry& geometry) {
+  ProjectionError e;
+  if (!p.valid) return e;
+  e.valid = true;
+  const track::TrajectoryProjection& truth = a.truth;
+  if (p.flipper == truth.flipper) {
+    e.abs_dh = std::abs(p.h - truth.h);
+  } else {
+    // The other arm of the 'V': the way along the V through the apex.
+    e.wrong_flipper = true;
+    e.abs_dh = std::abs((geometry.h_apex[p.flipper] - p.h) + (geometry.h_apex[truth.flipper] - truth.h));
+  }
+  e.abs_dt_impact_s = std::abs(p.t_observation_s + p.t_impact_s - truth.t_impact_s);
+  e.abs_ds_mps = std::abs(p.speed_mps - truth.speed_mps);
+  e.abs_dtheta_deg = std::abs(track::fold_to_half_plane(p.angle_rad - truth.angle_rad)) * 180.0 / std::numbers::pi;
+  return e;
+}
+
+double remaining_distance(const TrackerApproach& a, double t_s) {
+  const Vec2 p = track::exact_trajectory(a.p0, a.v0, a.g_mps2, 0.0).position_at(t_s);
+  return (p - a.truth.impact_point).norm();
 }
 
 std::vector<TrackerApproach> collect_tracker_approaches(const table::Board& board, const TrackerBenchOptions& options,

@@ -85,6 +85,23 @@ struct ApproachCounts {
 std::vector<TrackerApproach> collect_tracker_approaches(const table::Board& board, const TrackerBenchOptions& options,
                                                         ApproachCounts* counts = nullptr);
 
+/// One projection judged against an approach's truth (t = 0 at the approach's start).
+struct ProjectionError {
+  bool valid = false;            ///< the predictor gave a projection
+  bool wrong_flipper = false;    ///< onto the other flipper than the truth
+  double abs_dh = 0.0;           ///< |Δh| in flipper lengths, along the 'V' (through the apex when the flipper is wrong)
+  double abs_dt_impact_s = 0.0;  ///< |predicted − true time of impact| (s)
+  double abs_ds_mps = 0.0;       ///< |Δs_impact| (m/s)
+  double abs_dtheta_deg = 0.0;   ///< |Δθ_impact| (degrees, modulo 180)
+};
+
+/// The error of projection `p` (made at p.t_observation_s) against approach `a`'s truth.
+ProjectionError projection_error(const track::TrajectoryProjection& p, const TrackerApproach& a,
+                                 const track::FlipperGeometry& geometry);
+
+/// Distance (m) from the ball at time t_s of approach `a` to its true impact point.
+double remaining_distance(const TrackerApproach& a, double t_s);
+
 /// Median and 90th percentile of one error over the observations that had a projection.
 struct ErrorStats {
   std::size_t count = 0;  ///< samples

@@ -20,6 +20,7 @@
 #include "ceiling_bench.h"
 #include "transfer_bench.h"
 #include "pinball/control/controller_file.h"
+#include "camera_bench.h"
 #include "detector_bench.h"
 #include "daemon_latency_bench.h"
 #include "latency_bench.h"
@@ -32,13 +33,16 @@ namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   CLI::App* cmd = app.add_subcommand(
-      "bench", "run a benchmark (speed, tracker, latency, detector, calibration, precision, ceiling, transfer, protocol)");
+      "bench",
+      "run a benchmark (speed, tracker, latency, detector, camera, calibration, precision, ceiling, transfer, protocol)");
   cmd->add_option("kind", a.which,
-                  "which benchmark: speed, tracker, latency, detector, calibration, precision, ceiling, transfer "
+                  "which benchmark: speed, tracker, latency, detector, camera (a real camera's faults, uncorrected and "
+                  "corrected), calibration, precision, ceiling, transfer "
                   "(every controller in several worlds and a sweep of world errors, the belief nominal), protocol")
       ->required()
       ->check(CLI::IsMember(
-          {"speed", "tracker", "latency", "detector", "calibration", "precision", "ceiling", "transfer", "protocol"}));
+          {"speed", "tracker", "latency", "detector", "camera", "calibration", "precision", "ceiling", "transfer",
+           "protocol"}));
   cmd->add_option("--board", a.board, "board file (ceiling, transfer: the belief)")->transform(data_file());
   cmd->add_option("--steps", a.steps, "speed: steps per timed run (the MuJoCo twin's runs: a tenth)")
       ->check(CLI::Range(1000, 1'000'000'000));
@@ -46,10 +50,10 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
       ->check(CLI::Range(10, 1'000'000));
   cmd->add_option("--seed", a.seed,
-                  "tracker, detector, calibration, ceiling, transfer: seed for play, camera noise, placements and "
+                  "tracker, detector, camera, calibration, ceiling, transfer: seed for play, camera noise, placements and "
                   "balls");
   cmd->add_flag("--quick", a.quick,
-                "tracker, detector, calibration, latency, precision, ceiling, transfer: a short run (fewer "
+                "tracker, detector, camera, calibration, latency, precision, ceiling, transfer: a short run (fewer "
                 "approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one value per family)");
   cmd->add_option("--balls", a.balls,
                   "ceiling: balls per player; transfer: balls per world and controller (the same ball seeds for "
@@ -108,6 +112,19 @@ int run_detector(const BenchArgs& a, const table::Board& board, std::ostream& ou
   options.seed = a.seed;
   const bench::DetectorReport report = bench::run_detector_bench(
       board, options, [&](const std::string& line) { err << "bench detector: " << line << "\n"; });
+  if (a.json) {
+    out << bench::to_json(report).dump(2) << "\n";
+  } else {
+    out << bench::to_text(report);
+  }
+  return 0;
+}
+
+int run_camera(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
+  bench::CameraBenchOptions options = a.quick ? bench::quick_camera_bench_options() : bench::CameraBenchOptions{};
+  options.seed = a.seed;
+  const bench::CameraReport report =
+      bench::run_camera_bench(board, options, [&](const std::string& line) { err << "bench camera: " << line << "\n"; });
   if (a.json) {
     out << bench::to_json(report).dump(2) << "\n";
   } else {
@@ -329,6 +346,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   const table::Board board = table::load_board(a.board);
   if (a.which == "tracker") return run_tracker(a, board, out, err);
   if (a.which == "detector") return run_detector(a, board, out, err);
+  if (a.which == "camera") return run_camera(a, board, out, err);
   if (a.which == "calibration") return run_calibration(a, board, out, err);
   if (a.which == "precision") return run_precision(a, board, out, err);
   if (a.which == "ceiling") return run_ceiling(a, board, out, err);

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "pinball/core/check.h"
@@ -31,7 +32,9 @@ cv::Matx33d render_from_board(const table::Board& board, const sim::RenderOption
 // An anti-aliased filled convex polygon (image points) as a patch: the patch's
 // place in an image of `size` and its 8-bit values (`value` inside). Empty
 // roi when the polygon is off the image.
-void polygon_patch(const std::vector<cv::Point2d>& uv_px, double value, cv::Size size, cv::Rect& roi, cv::Mat& patch) {
+// `convex`: fillConvexPoly; a convex outline seen through a lens may bend in, so fillPoly.
+void polygon_patch(const std::vector<cv::Point2d>& uv_px, double value, cv::Size size, cv::Rect& roi, cv::Mat& patch,
+                   bool convex) {
   double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
   for (const cv::Point2d& p : uv_px) {
     u0 = std::min(u0, p.x);
@@ -48,12 +51,38 @@ void polygon_patch(const std::vector<cv::Point2d>& uv_px, double value, cv::Size
     fixed.emplace_back(static_cast<int>(std::lround((p.x - box.x) * 16.0)),
                        static_cast<int>(std::lround((p.y - box.y) * 16.0)));
   }
-  cv::fillConvexPoly(patch, fixed, cv::Scalar(value), cv::LINE_AA, 4);
+  if (convex) {
+    cv::fillConvexPoly(patch, fixed, cv::Scalar(value), cv::LINE_AA, 4);
+  } else {
+    const std::vector<std::vector<cv::Point>> polygons{fixed};
+    cv::fillPoly(patch, polygons, cv::Scalar(value), cv::LINE_AA, 4);
+  }
   if (roi.area() == 0) return;
   patch = patch(cv::Rect(roi.x - box.x, roi.y - box.y, roi.width, roi.height)).clone();
 }
 
 }  // namespace
+
+SimCameraRealism SimCameraRealism::typical(int width_px, int height_px) {
+  SimCameraRealism r;
+  r.lens = vision::typical_wide_lens(width_px, height_px);
+  // A CMOS sensor read out row by row in about 4.8 ms (480 rows), inside the 5 ms frame period at 200 fps.
+  r.row_time_s = 4.8e-3 / height_px;
+  // The sensor's own crystal-clocked frame timing: a few microseconds.
+  r.frame_jitter_s = 5e-6;
+  // Row 0's mid-exposure to the host's stamp: the rest of the readout (~4 ms), USB3 transfer of
+  // 300 kB and the driver's hand-over (~2 ms), then the host's wake-up (exponential, mean 1 ms).
+  r.latency_min_s = 0.007;
+  r.latency_jitter_mean_s = 0.001;
+  // Incandescent general illumination on 50 Hz mains: ±8 % at 100 Hz, less than a lamp's own
+  // swing because the room's light is mixed in.
+  r.flicker_hz = 100.0;
+  r.flicker_amplitude = 0.08;
+  // Auto-exposure off, but the sensor warms and the room light changes: 2 % over tens of seconds.
+  r.gain_drift_sigma = 0.02;
+  r.gain_drift_time_s = 30.0;
+  return r;
+}
 
 std::vector<SimPlastic> SimCameraConfig::default_plastics() {
   // Fractions of a 0.51 x 1.07 m table; upper left and right mid, where
@@ -107,9 +136,33 @@ SimCameraSource::SimCameraSource(const table::Board& board, const SimCameraConfi
   check_input(c.marker_radius_m > 0.0 && c.marker_ring_m >= c.marker_radius_m && c.marker_gray >= 0.0 &&
               c.marker_gray <= 255.0 && c.marker_ring_gray >= 0.0 && c.marker_ring_gray <= 255.0, "sim camera",
           "markers need 0 < marker_radius_m <= marker_ring_m and grays in [0, 255]");
+  const SimCameraRealism& r = c.realism;
+  if (r.lens) {
+    check_input(vision::check_intrinsics(*r.lens), "sim camera lens");
+    check_input(r.lens->width_px == c.width_px && r.lens->height_px == c.height_px, "sim camera",
+                "the lens's image size must be the camera's");
+  }
+  check_input(std::isfinite(r.row_time_s) && r.row_time_s >= 0.0 && r.row_time_s * c.height_px <= 1.0 / c.fps,
+              "sim camera", "row_time_s must be >= 0 and read the frame out within one frame period");
+  check_input(std::isfinite(r.frame_jitter_s) && r.frame_jitter_s >= 0.0 && r.frame_jitter_s <= 0.1 / c.fps,
+              "sim camera", "frame_jitter_s must be in [0, a tenth of the frame period]");
+  check_input(std::isfinite(r.latency_min_s) && r.latency_min_s >= 0.0 && r.latency_min_s <= 1.0 &&
+                  std::isfinite(r.latency_jitter_mean_s) && r.latency_jitter_mean_s >= 0.0 &&
+                  r.latency_jitter_mean_s <= 1.0,
+              "sim camera", "latency_min_s and latency_jitter_mean_s must be in [0, 1] s");
+  check_input(std::isfinite(r.flicker_hz) && r.flicker_hz > 0.0 && r.flicker_amplitude >= 0.0 &&
+                  r.flicker_amplitude < 1.0,
+              "sim camera", "flicker_hz must be > 0 and flicker_amplitude in [0, 1)");
+  check_input(std::isfinite(r.gain_drift_sigma) && r.gain_drift_sigma >= 0.0 && r.gain_drift_sigma <= 0.5 &&
+                  std::isfinite(r.gain_drift_time_s) && r.gain_drift_time_s > 0.0,
+              "sim camera", "gain_drift_sigma must be in [0, 0.5] and gain_drift_time_s > 0");
   for (const table::Flipper& f : board.flippers) flipper_theta_.push_back(f.theta_min_rad);
   period_s_ = 1.0 / c.fps;
-  next_exposure_s_ = c.first_exposure_s;
+  // Its own stream: switching realism on leaves the scene, lamps and noise as they were.
+  timing_rng_ = Rng(c.seed ^ 0x5DEECE66DULL);
+  if (r.flicker_amplitude > 0.0) flicker_phase_rad_ = timing_rng_.uniform(0.0, 2.0 * std::numbers::pi);
+  schedule_next_frame(c.first_exposure_s);
+  if (r.lens) build_lens_map();
   build_floor();
   build_lamps();
   build_plastics();
@@ -121,7 +174,54 @@ std::string SimCameraSource::describe() const {
   std::ostringstream s;
   s << "simulated camera " << config_.width_px << "x" << config_.height_px << " at " << config_.fps << " fps, exposure "
     << config_.exposure_s * 1e3 << " ms, seed " << config_.seed;
+  const SimCameraRealism& r = config_.realism;
+  if (r.lens) s << ", lens k1 " << r.lens->k1 << " k2 " << r.lens->k2;
+  if (r.row_time_s > 0.0) s << ", rolling shutter " << r.row_time_s * 1e6 << " us/row";
+  if (r.latency_mean_s() > 0.0) s << ", latency " << r.latency_mean_s() * 1e3 << " ms";
+  if (r.flicker_amplitude > 0.0) s << ", flicker " << r.flicker_amplitude * 100.0 << " % at " << r.flicker_hz << " Hz";
+  if (r.gain_drift_sigma > 0.0) s << ", gain drift " << r.gain_drift_sigma * 100.0 << " %";
   return s.str();
+}
+
+cv::Point2d SimCameraSource::image_from_board(const Vec2& p_board) const {
+  const cv::Point2d ideal = homography_.image_from_board(p_board);
+  return config_.realism.lens ? vision::distort_pixel(*config_.realism.lens, ideal) : ideal;
+}
+
+Vec2 SimCameraSource::board_at_pixel(int u, int v) const {
+  if (ideal_map_.empty()) return homography_.board_from_image(cv::Point2d(u, v));
+  const cv::Vec2f ideal = ideal_map_.at<cv::Vec2f>(v, u);
+  return homography_.board_from_image(cv::Point2d(ideal[0], ideal[1]));
+}
+
+void SimCameraSource::build_lens_map() {
+  const vision::CameraIntrinsics& lens = *config_.realism.lens;
+  std::vector<cv::Point2d> pixels;
+  pixels.reserve(static_cast<std::size_t>(config_.width_px) * static_cast<std::size_t>(config_.height_px));
+  for (int v = 0; v < config_.height_px; ++v) {
+    for (int u = 0; u < config_.width_px; ++u) pixels.emplace_back(u, v);
+  }
+  std::vector<cv::Point2d> ideal;
+  const cv::Matx33d k = vision::camera_matrix(lens);
+  cv::undistortPoints(pixels, ideal, k, vision::distortion_coefficients(lens), cv::noArray(), k,
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-6));
+  ideal_map_.create(config_.height_px, config_.width_px, CV_32FC2);
+  for (int v = 0; v < config_.height_px; ++v) {
+    auto* row = ideal_map_.ptr<cv::Vec2f>(v);
+    for (int u = 0; u < config_.width_px; ++u) {
+      const cv::Point2d& q = ideal[static_cast<std::size_t>(v) * static_cast<std::size_t>(config_.width_px) +
+                                   static_cast<std::size_t>(u)];
+      row[u] = cv::Vec2f(static_cast<float>(q.x), static_cast<float>(q.y));
+    }
+  }
+}
+
+void SimCameraSource::schedule_next_frame(double nominal_start_s) {
+  const SimCameraRealism& r = config_.realism;
+  next_nominal_s_ = nominal_start_s;
+  next_start_s_ = nominal_start_s + (r.frame_jitter_s > 0.0 ? r.frame_jitter_s * timing_rng_.normal() : 0.0);
+  next_latency_s_ = r.latency_min_s;
+  if (r.latency_jitter_mean_s > 0.0) next_latency_s_ -= r.latency_jitter_mean_s * std::log1p(-timing_rng_.uniform01());
 }
 
 void SimCameraSource::build_floor() {
@@ -167,10 +267,24 @@ void SimCameraSource::build_floor() {
   gray.convertTo(gray, CV_8U, config_.floor_gain, config_.floor_offset);
   if (config_.supersample > 1) cv::GaussianBlur(gray, gray, cv::Size(0, 0), 0.45 * config_.supersample);
 
-  const cv::Matx33d image_from_render = homography_.image_from_board_matrix() * r_from_b.inv();
   const double outside = std::clamp(18.0 * config_.floor_gain + config_.floor_offset, 0.0, 255.0);
-  cv::warpPerspective(gray, floor_, cv::Mat(image_from_render), size, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-                      cv::Scalar(outside));
+  if (ideal_map_.empty()) {
+    const cv::Matx33d image_from_render = homography_.image_from_board_matrix() * r_from_b.inv();
+    cv::warpPerspective(gray, floor_, cv::Mat(image_from_render), size, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                        cv::Scalar(outside));
+    return;
+  }
+  // Through the lens: each frame pixel samples the drawing where its ideal pixel's board point lies.
+  cv::Mat map(size, CV_32FC2);
+  for (int v = 0; v < size.height; ++v) {
+    auto* row = map.ptr<cv::Vec2f>(v);
+    for (int u = 0; u < size.width; ++u) {
+      const Vec2 b = board_at_pixel(u, v);
+      const cv::Vec3d q = r_from_b * cv::Vec3d(b.x(), b.y(), 1.0);
+      row[u] = cv::Vec2f(static_cast<float>(q[0] / q[2]), static_cast<float>(q[1] / q[2]));
+    }
+  }
+  cv::remap(gray, floor_, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(outside));
 }
 
 void SimCameraSource::build_lamps() {
@@ -191,9 +305,9 @@ void SimCameraSource::build_lamps() {
                  c - 0.023 * d + 0.0065 * n};
     }
     std::vector<cv::Point2d> uv;
-    for (const Vec2& p : outline) uv.push_back(homography_.image_from_board(p));
+    for (const Vec2& p : outline) uv.push_back(image_from_board(p));
     Patch lamp;
-    polygon_patch(uv, config_.lamp_delta_gray, size, lamp.roi, lamp.values);
+    polygon_patch(uv, config_.lamp_delta_gray, size, lamp.roi, lamp.values, !config_.realism.lens);
     if (lamp.roi.area() == 0) continue;
     // Unlit, an insert is a little brighter than the playfield around it.
     cv::Mat unlit;
@@ -209,10 +323,16 @@ void SimCameraSource::build_plastics() {
   const cv::Size size(config_.width_px, config_.height_px);
   occluder_mask_ = cv::Mat::zeros(size, CV_8U);
   for (const SimPlastic& p : config_.plastics) {
+    // Each edge in pieces, so that a lens bends it.
     std::vector<cv::Point2d> uv;
-    for (const Vec2& q : p.polygon_board) uv.push_back(homography_.image_from_board(q));
+    const std::size_t corners = p.polygon_board.size();
+    for (std::size_t i = 0; i < corners; ++i) {
+      const Vec2& a = p.polygon_board[i];
+      const Vec2& b = p.polygon_board[(i + 1) % corners];
+      for (int k = 0; k < 8; ++k) uv.push_back(image_from_board(a + (k / 8.0) * (b - a)));
+    }
     Patch plastic;
-    polygon_patch(uv, 255.0 * p.opacity, size, plastic.roi, plastic.values);
+    polygon_patch(uv, 255.0 * p.opacity, size, plastic.roi, plastic.values, !config_.realism.lens);
     if (plastic.roi.area() == 0) continue;
     cv::Mat mask = occluder_mask_(plastic.roi);
     cv::Mat covered;
@@ -227,7 +347,7 @@ void SimCameraSource::build_glare() {
   const SimGlare& g = config_.glare;
   if (!g.enabled) return;
   const cv::Size size(config_.width_px, config_.height_px);
-  const cv::Point2d c = homography_.image_from_board(g.centre_board);
+  const cv::Point2d c = image_from_board(g.centre_board);
   const double reach_px = 3.0 * g.sigma_m * homography_.px_per_m_at(g.centre_board) * 1.2;
   const cv::Rect box(cv::Point(static_cast<int>(std::floor(c.x - reach_px)), static_cast<int>(std::floor(c.y - reach_px))),
                      cv::Point(static_cast<int>(std::ceil(c.x + reach_px)) + 1,
@@ -238,7 +358,7 @@ void SimCameraSource::build_glare() {
   for (int v = 0; v < glare_.roi.height; ++v) {
     auto* row = glare_.values.ptr<std::uint8_t>(v);
     for (int u = 0; u < glare_.roi.width; ++u) {
-      const Vec2 q = homography_.board_from_image(cv::Point2d(glare_.roi.x + u, glare_.roi.y + v));
+      const Vec2 q = board_at_pixel(glare_.roi.x + u, glare_.roi.y + v);
       const double r2 = (q - g.centre_board).squaredNorm() / (g.sigma_m * g.sigma_m);
       row[u] = cv::saturate_cast<std::uint8_t>(g.peak_gray * std::exp(-0.5 * r2));
     }
@@ -282,8 +402,8 @@ void SimCameraSource::draw_flippers(cv::Mat& image) const {
   };
   for (std::size_t i = 0; i < flipper_theta_.size(); ++i) {
     const table::Flipper& f = board_.flippers[i];
-    const cv::Point2d a = homography_.image_from_board(f.pivot);
-    const cv::Point2d b = homography_.image_from_board(table::flipper_tip(f, flipper_theta_[i]));
+    const cv::Point2d a = image_from_board(f.pivot);
+    const cv::Point2d b = image_from_board(table::flipper_tip(f, flipper_theta_[i]));
     const int width_px = std::max(1, static_cast<int>(std::lround(config_.flipper_width_m * homography_.px_per_m_at(f.pivot))));
     cv::line(image, fixed(a), fixed(b), cv::Scalar(config_.flipper_gray), width_px, cv::LINE_AA, kShift);
   }
@@ -303,10 +423,10 @@ void SimCameraSource::set_markers(std::span<const Vec2> centres_board) {
       std::vector<cv::Point2d> uv;
       for (int k = 0; k < 64; ++k) {
         const double a = 2.0 * std::numbers::pi * k / 64.0;
-        uv.push_back(homography_.image_from_board(c + radius * Vec2{std::cos(a), std::sin(a)}));
+        uv.push_back(image_from_board(c + radius * Vec2{std::cos(a), std::sin(a)}));
       }
       Patch disc;
-      polygon_patch(uv, 255.0, size, disc.roi, disc.values);
+      polygon_patch(uv, 255.0, size, disc.roi, disc.values, !config_.realism.lens);
       if (disc.roi.area() == 0) continue;
       markers_.push_back(disc);
       marker_gray_.push_back(gray);
@@ -332,7 +452,7 @@ void SimCameraSource::observe_ball(double t_s, const Vec2& p_board, bool in_play
 void SimCameraSource::reset(double t_s) {
   history_size_ = 0;
   history_head_ = 0;
-  next_exposure_s_ = t_s;
+  schedule_next_frame(t_s);
 }
 
 bool SimCameraSource::sample_at(double t_s, Vec2& p, bool& in_play) const {
@@ -370,57 +490,119 @@ bool SimCameraSource::sample_at(double t_s, Vec2& p, bool& in_play) const {
   return true;
 }
 
+std::span<const Vec2> SimCameraSource::BallPaths::row(int v) const {
+  if (rows == 0) return common;
+  if (v < first_row || v >= first_row + rows) return {};
+  const auto k = static_cast<std::size_t>(v - first_row);
+  return {row_paths + k * kMaxPath, static_cast<std::size_t>(row_counts[k])};
+}
+
+double SimCameraSource::ball_row(double start_s, Vec2& p_board) const {
+  // The row whose exposure catches the ball's centre: a fixed point of
+  // v = image row of the ball at that row's mid-exposure (the ball moves far
+  // less than a row per row time, so it converges in a few steps).
+  const SimCameraRealism& r = config_.realism;
+  double v = 0.0;
+  bool in_play = false;
+  for (int it = 0; it < 6; ++it) {
+    sample_at(start_s + v * r.row_time_s + 0.5 * config_.exposure_s, p_board, in_play);
+    v = std::clamp(image_from_board(p_board).y, 0.0, config_.height_px - 1.0);
+    if (r.row_time_s == 0.0) break;
+  }
+  return v;
+}
+
+SimCameraSource::BallPaths SimCameraSource::ball_paths(double start_s) {
+  const double exposure = config_.exposure_s;
+  Vec2 p0, p1;
+  bool in0 = false, in1 = false;
+  sample_at(start_s, p0, in0);
+  sample_at(start_s + exposure, p1, in1);
+  const double blur_px = cv::norm(image_from_board(p1) - image_from_board(p0));
+  const int n = std::clamp(static_cast<int>(std::ceil(blur_px / 0.25)) + 1, 2, static_cast<int>(kMaxPath));
+  BallPaths paths;
+  paths.total = n;
+  // Path samples at the middles of n equal slices of an exposure from t0.
+  const auto fill = [&](double t0, Vec2* out) {
+    int present = 0;
+    for (int k = 0; k < n; ++k) {
+      Vec2 p;
+      bool in_play = false;
+      sample_at(t0 + (k + 0.5) / n * exposure, p, in_play);
+      if (in_play) out[present++] = p;
+    }
+    return present;
+  };
+  const double row_time = config_.realism.row_time_s;
+  if (row_time == 0.0) {
+    paths.common = std::span<const Vec2>(path_.data(), static_cast<std::size_t>(fill(start_s, path_.data())));
+    return paths;
+  }
+  Vec2 p_centre;
+  const double v_centre = ball_row(start_s, p_centre);
+  const double radius_px = board_.ball.radius_m * ball_scale_ * homography_.px_per_m_at(p_centre);
+  const double reach = radius_px + blur_px + 3.0;
+  const int first = std::max(0, static_cast<int>(std::floor(v_centre - reach)));
+  const int last = std::min(config_.height_px - 1, static_cast<int>(std::ceil(v_centre + reach)));
+  paths.first_row = first;
+  paths.rows = std::clamp(last - first + 1, 0, kMaxRows);
+  paths.row_paths = row_path_.data();
+  paths.row_counts = row_count_.data();
+  for (int k = 0; k < paths.rows; ++k) {
+    row_count_[static_cast<std::size_t>(k)] =
+        fill(start_s + (first + k) * row_time, row_path_.data() + static_cast<std::size_t>(k) * kMaxPath);
+  }
+  paths.common = paths.row(static_cast<int>(std::lround(v_centre)));
+  return paths;
+}
+
 bool SimCameraSource::read(vision::Frame& out) {
   if (history_size_ == 0) return false;
   const double newest = history_[(history_head_ + history_size_ - 1) % kHistory].t_s;
   const double oldest = history_[history_head_].t_s;
+  const SimCameraRealism& r = config_.realism;
   while (true) {
-    const double start = next_exposure_s_;
-    const double end = start + config_.exposure_s;
-    if (newest < end) return false;
+    const double start = next_start_s_;
+    const double readout_end = start + (config_.height_px - 1) * r.row_time_s + config_.exposure_s;
+    const double row0_mid = start + 0.5 * config_.exposure_s;
+    const double stamp = row0_mid + next_latency_s_;
+    if (newest < std::max(readout_end, stamp)) return false;
     if (start < oldest && history_size_ == kHistory) {  // its exposure left the history: lost
       ++counters_.dropped;
       ++sequence_;
-      next_exposure_s_ += period_s_;
+      schedule_next_frame(next_nominal_s_ + period_s_);
       continue;
     }
-    // Path samples at the middles of n equal slices of the exposure.
-    Vec2 p0, p1;
-    bool in0 = false, in1 = false;
-    sample_at(start, p0, in0);
-    sample_at(end, p1, in1);
-    const double blur_px = cv::norm(homography_.image_from_board(p1) - homography_.image_from_board(p0));
-    const int n = std::clamp(static_cast<int>(std::ceil(blur_px / 0.25)) + 1, 2, static_cast<int>(kMaxPath));
-    std::size_t present = 0;
-    for (int k = 0; k < n; ++k) {
-      Vec2 p;
-      bool in_play = false;
-      sample_at(start + (k + 0.5) / n * config_.exposure_s, p, in_play);
-      if (in_play) path_[present++] = p;
-    }
-    const double t_mid = start + 0.5 * config_.exposure_s;
-    compose(std::span<const Vec2>(path_.data(), present), n, t_mid, out);
-    Vec2 p_mid;
-    bool in_mid = false;
-    sample_at(t_mid, p_mid, in_mid);
-    truth_.p_board_mid = p_mid;
-    truth_.uv_px_mid = homography_.image_from_board(p_mid);
+    compose(ball_paths(start), start, out);
+    Vec2 p_ball;
+    const double v_ball = ball_row(start, p_ball);
+    truth_.t_row0_exposure_s = row0_mid;
+    truth_.t_ball_exposure_s = row0_mid + v_ball * r.row_time_s;
+    truth_.latency_s = stamp - row0_mid;
+    truth_.p_board_mid = p_ball;
+    truth_.uv_px_mid = image_from_board(p_ball);
+    out.t_s = stamp;
     out.driver_t_s = start;
-    next_exposure_s_ += period_s_;
+    schedule_next_frame(next_nominal_s_ + period_s_);
     return true;
   }
 }
 
 void SimCameraSource::render(std::span<const Vec2> path_board, double t_mid_s, vision::Frame& out) {
-  const std::size_t n = std::min(path_board.size(), kMaxPath);
-  compose(path_board.first(n), static_cast<int>(n), t_mid_s, out);
-  if (n > 0) {
+  BallPaths paths;
+  paths.common = path_board.first(std::min(path_board.size(), kMaxPath));
+  paths.total = std::max(1, static_cast<int>(paths.common.size()));
+  const double start = t_mid_s - 0.5 * config_.exposure_s;
+  compose(paths, start, out);
+  if (!paths.common.empty()) {
     Vec2 mean = Vec2::Zero();
-    for (std::size_t i = 0; i < n; ++i) mean += path_board[i];
-    truth_.p_board_mid = mean / static_cast<double>(n);
-    truth_.uv_px_mid = homography_.image_from_board(truth_.p_board_mid);
+    for (const Vec2& p : paths.common) mean += p;
+    truth_.p_board_mid = mean / static_cast<double>(paths.common.size());
+    truth_.uv_px_mid = image_from_board(truth_.p_board_mid);
   }
-  out.driver_t_s = t_mid_s - 0.5 * config_.exposure_s;
+  truth_.t_row0_exposure_s = truth_.t_ball_exposure_s = t_mid_s;
+  out.t_s = t_mid_s;
+  out.driver_t_s = start;
 }
 
 // Paints `gray` over `image` inside the patch, the patch's values being the opacity (255: opaque).
@@ -447,7 +629,38 @@ void SimCameraSource::advance_effects() {
   }
 }
 
-void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, double t_mid_s, vision::Frame& out) {
+void SimCameraSource::apply_gain(double start_s, cv::Mat& image) {
+  const SimCameraRealism& r = config_.realism;
+  if (r.gain_drift_sigma > 0.0) {  // Ornstein–Uhlenbeck, stepped one frame period
+    const double a = std::exp(-period_s_ / r.gain_drift_time_s);
+    drift_ = a * drift_ + r.gain_drift_sigma * std::sqrt(1.0 - a * a) * timing_rng_.normal();
+  }
+  const double base = 1.0 + drift_;
+  truth_.gain = base;
+  if (r.flicker_amplitude <= 0.0) {
+    if (base != 1.0) image.convertTo(image, -1, base);
+    return;
+  }
+  // The light's brightness averaged over each row's exposure.
+  const double w = 2.0 * std::numbers::pi * r.flicker_hz;
+  const double exposure = config_.exposure_s;
+  const auto row_gain = [&](double t0) {
+    const double mean_cos = exposure > 0.0 ? (std::sin(w * (t0 + exposure) + flicker_phase_rad_) -
+                                              std::sin(w * t0 + flicker_phase_rad_)) / (w * exposure)
+                                           : std::cos(w * t0 + flicker_phase_rad_);
+    return base * (1.0 + r.flicker_amplitude * mean_cos);
+  };
+  if (r.row_time_s == 0.0) {
+    image.convertTo(image, -1, row_gain(start_s));
+    return;
+  }
+  for (int v = 0; v < image.rows; ++v) {
+    cv::Mat row = image.row(v);
+    row.convertTo(row, -1, row_gain(start_s + v * r.row_time_s));
+  }
+}
+
+void SimCameraSource::compose(const BallPaths& paths, double start_s, vision::Frame& out) {
   advance_effects();
   floor_.copyTo(out.gray);  // reuses out.gray's buffer when it already has this size
   cv::Mat& image = out.gray;
@@ -459,9 +672,10 @@ void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, 
     ++truth_.lamps_lit;
   }
   draw_flippers(image);
-  truth_.ball_present = !path_board.empty();
-  truth_.ball_whole_exposure = !path_board.empty() && static_cast<int>(path_board.size()) == path_total;
-  if (!path_board.empty()) draw_ball(path_board, path_total, image);
+  const std::span<const Vec2> centre_path = paths.common;
+  truth_.ball_present = !centre_path.empty();
+  truth_.ball_whole_exposure = !centre_path.empty() && static_cast<int>(centre_path.size()) == paths.total;
+  if (truth_.ball_present) draw_ball(paths, image);
   for (std::size_t i = 0; i < plastics_.size(); ++i) blend(plastics_[i], plastic_gray_[i], image);
   for (std::size_t i = 0; i < markers_.size(); ++i) blend(markers_[i], marker_gray_[i], image);
   truth_.glare_on = glare_ready_ && glare_on_;
@@ -470,11 +684,12 @@ void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, 
     cv::add(target, glare_.values, target);
     if (truth_.ball_present) {
       const double reach = 3.0 * config_.glare.sigma_m + board_.ball.radius_m;
-      for (const Vec2& p : path_board) {
+      for (const Vec2& p : centre_path) {
         if ((p - config_.glare.centre_board).norm() < reach) truth_.in_glare = true;
       }
     }
   }
+  apply_gain(start_s, image);
   if (noise_span_ > 0) {
     const std::size_t offset = static_cast<std::size_t>(rng_.next_u64() % noise_span_);
     const cv::Mat pos(image.rows, image.cols, CV_8U, noise_pos_.data() + offset);
@@ -482,44 +697,51 @@ void SimCameraSource::compose(std::span<const Vec2> path_board, int path_total, 
     cv::add(image, pos, image);
     cv::subtract(image, neg, image);
   }
-  out.t_s = t_mid_s;
   out.sequence = sequence_++;
   ++counters_.frames;
 }
 
-void SimCameraSource::draw_ball(std::span<const Vec2> path_board, int path_total, cv::Mat& image) {
+void SimCameraSource::draw_ball(const BallPaths& paths, cv::Mat& image) {
   const double r_m = board_.ball.radius_m * ball_scale_;
-  // Image-space box around every path position.
-  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300, r_px = 0.0;
-  for (const Vec2& p : path_board) {
-    const cv::Point2d c = homography_.image_from_board(p);
-    const double r = r_m * homography_.px_per_m_at(p);
-    r_px = std::max(r_px, r);
-    u0 = std::min(u0, c.x - r);
-    v0 = std::min(v0, c.y - r);
-    u1 = std::max(u1, c.x + r);
-    v1 = std::max(v1, c.y + r);
+  // Image-space box around every path position of every row.
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  const auto extend = [&](std::span<const Vec2> path) {
+    for (const Vec2& p : path) {
+      const cv::Point2d c = image_from_board(p);
+      const double r = r_m * homography_.px_per_m_at(p);
+      u0 = std::min(u0, c.x - r);
+      v0 = std::min(v0, c.y - r);
+      u1 = std::max(u1, c.x + r);
+      v1 = std::max(v1, c.y + r);
+    }
+  };
+  if (paths.rows == 0) {
+    extend(paths.common);
+  } else {
+    for (int v = paths.first_row; v < paths.first_row + paths.rows; ++v) extend(paths.row(v));
   }
-  truth_.blur_px = cv::norm(homography_.image_from_board(path_board.back()) -
-                            homography_.image_from_board(path_board.front()));
-  const cv::Rect box = cv::Rect(cv::Point(static_cast<int>(std::floor(u0)) - 2, static_cast<int>(std::floor(v0)) - 2),
-                                cv::Point(static_cast<int>(std::ceil(u1)) + 3, static_cast<int>(std::ceil(v1)) + 3)) &
-                       cv::Rect(0, 0, image.cols, image.rows);
-  const Vec2 mid = path_board[path_board.size() / 2];
+  const std::span<const Vec2> centre_path = paths.common;
+  truth_.blur_px = cv::norm(image_from_board(centre_path.back()) - image_from_board(centre_path.front()));
+  cv::Rect box = cv::Rect(cv::Point(static_cast<int>(std::floor(u0)) - 2, static_cast<int>(std::floor(v0)) - 2),
+                          cv::Point(static_cast<int>(std::ceil(u1)) + 3, static_cast<int>(std::ceil(v1)) + 3)) &
+                 cv::Rect(0, 0, image.cols, image.rows);
+  const Vec2 mid = centre_path[centre_path.size() / 2];
   const double scale = homography_.px_per_m_at(mid);  // px per m, for the edge's anti-aliasing width
   truth_.radius_px = r_m * scale;
   const SimCameraConfig& c = config_;
   const Vec2 highlight = c.highlight_offset * r_m;
   const double inv_2s2 = 1.0 / (2.0 * c.highlight_sigma * c.highlight_sigma * r_m * r_m);
   const double rim_gray = c.ball_gray * (1.0 - c.ball_limb_darkening);
-  const double inv_n = 1.0 / path_total;
+  const double inv_n = 1.0 / paths.total;
   double covered = 0.0;
   double hidden = 0.0;
   for (int v = box.y; v < box.y + box.height; ++v) {
+    const std::span<const Vec2> path_board = paths.row(v);
+    if (path_board.empty()) continue;
     auto* row = image.ptr<std::uint8_t>(v);
     const auto* occluded = occluder_mask_.ptr<std::uint8_t>(v);
     for (int u = box.x; u < box.x + box.width; ++u) {
-      const Vec2 q = homography_.board_from_image(cv::Point2d(u, v));
+      const Vec2 q = board_at_pixel(u, v);
       const double under = row[u];
       double acc = 0.0;
       double coverage = 0.0;

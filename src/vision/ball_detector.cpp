@@ -96,6 +96,20 @@ BallDetector::BallDetector(const CameraHomography& homography, cv::Size frame_si
               c.separation_radius_fraction < 1.0, "ball detector",
           "separation_radius_fraction must be in [0, 1)");
   check_input(c.max_separated_elongation >= 1.0, "ball detector", "max_separated_elongation must be >= 1");
+  check_input(std::isfinite(c.latency_s) && c.latency_s >= 0.0 && c.latency_s <= 1.0, "ball detector",
+              "latency_s must be in [0, 1] s");
+  check_input(std::isfinite(c.row_time_s) && c.row_time_s >= 0.0 && c.row_time_s <= 1e-3, "ball detector",
+              "row_time_s must be in [0, 0.001] s");
+  check_input(c.dejitter_frames >= 0 && c.dejitter_frames <= FrameDejitter::kMaxWindow, "ball detector",
+              "dejitter_frames must be in [0, " + std::to_string(FrameDejitter::kMaxWindow) + "]");
+  if (c.lens) {
+    check_input(c.lens->width_px == size_.width && c.lens->height_px == size_.height, "ball detector",
+                "the lens was calibrated on " + std::to_string(c.lens->width_px) + "x" +
+                    std::to_string(c.lens->height_px) + " images but the frames are " + std::to_string(size_.width) +
+                    "x" + std::to_string(size_.height));
+    undistorter_.emplace(*c.lens);
+  }
+  if (c.dejitter_frames > 0) dejitter_.emplace(c.frame_period_s, c.dejitter_frames);
   split_label_ = cv::Mat::zeros(size_, CV_8U);
   split_core_ = cv::Mat::zeros(size_, CV_8U);
   split_run_ = cv::Mat::zeros(size_, CV_16S);
@@ -118,7 +132,15 @@ void BallDetector::set_occluder_mask(const cv::Mat& mask) {
 }
 
 double BallDetector::expected_radius_px(const cv::Point2d& uv_px) const {
-  return config_.ball_radius_m * homography_.px_per_m_at(homography_.board_from_image(uv_px));
+  if (!undistorter_) return config_.ball_radius_m * homography_.px_per_m_at(homography_.board_from_image(uv_px));
+  // Through the lens: the ideal image's scale times the lens's local area magnification there.
+  const cv::Point2d ideal = undistorter_->ideal_from_distorted(uv_px);
+  const CameraIntrinsics& lens = undistorter_->intrinsics();
+  const cv::Point2d d0 = distort_pixel(lens, ideal);
+  const cv::Point2d du = distort_pixel(lens, ideal + cv::Point2d(1.0, 0.0)) - d0;
+  const cv::Point2d dv = distort_pixel(lens, ideal + cv::Point2d(0.0, 1.0)) - d0;
+  const double magnification = std::sqrt(std::abs(du.x * dv.y - du.y * dv.x));
+  return config_.ball_radius_m * homography_.px_per_m_at(homography_.board_from_image(ideal)) * magnification;
 }
 
 void BallDetector::fill_blob(int u, int v, const cv::Rect& region, Blob& blob) {
@@ -275,8 +297,9 @@ bool BallDetector::search(const cv::Rect& region, bool region_is_roi, double t_s
   out.radius_px = best.r_fit;
   out.from_roi = region_is_roi;
   out.separated = best.opened;
-  out.observation.t_s = t_s;
-  out.observation.p_board = homography_.board_from_image(uv);
+  out.uv_ideal_px = undistorter_ ? undistorter_->ideal_from_distorted(uv) : uv;
+  out.observation.t_s = t_s - config_.latency_s + uv.y * config_.row_time_s;
+  out.observation.p_board = homography_.board_from_image(out.uv_ideal_px);
   out.observation.confidence = best.conf;
   return true;
 }
@@ -475,6 +498,8 @@ Detection BallDetector::detect(const Frame& frame, const cv::Point2d* predicted_
     out.miss = DetectionMiss::kBadFrame;
     return out;
   }
+  // Every frame feeds the steady clock, ball or not.
+  const double stamp_s = dejitter_ ? dejitter_->steady_stamp(frame.sequence, frame.t_s) : frame.t_s;
   if (!background_.ready()) {
     out.miss = DetectionMiss::kNoBackground;
     return out;
@@ -504,13 +529,14 @@ Detection BallDetector::detect(const Frame& frame, const cv::Point2d* predicted_
                                   cv::Point(pixel_index(std::ceil(predicted.x + half)) + 1,
                                             pixel_index(std::ceil(predicted.y + half)) + 1)) &
                          image;
-    if (roi.area() > 0) found = search(roi, roi != image, frame.t_s, out);
+    if (roi.area() > 0) found = search(roi, roi != image, stamp_s, out);
   }
   if (!found) {
     ++counters_.full_searches;
-    found = search(image, false, frame.t_s, out);
+    found = search(image, false, stamp_s, out);
   }
   if (found) {
+    out.observation.latency_s = frame.t_s - out.observation.t_s;
     ++counters_.found;
     if (out.from_roi) ++counters_.found_in_roi;
     if (out.separated) ++counters_.found_separated;

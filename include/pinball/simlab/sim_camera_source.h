@@ -6,9 +6,19 @@
 // an optional glare patch, sensor noise, all seen through a perspective
 // homography. The static scene is rendered once at construction; a frame
 // costs one copy, the ball patch and the noise. Deterministic by seed.
+//
+// What makes a real camera differ from that ideal pinhole (SimCameraRealism,
+// each part off by default and switched on alone or all together with
+// SimCameraRealism::typical()): lens distortion (the static scene is remapped
+// once; patches and the ball are drawn through the lens), a rolling shutter
+// (each row of the ball is drawn where the ball was when that row was
+// exposed), exposure-start jitter, a delivery latency (the frame is stamped
+// and handed over when it arrives, as a host clock stamps a real camera's),
+// lamp flicker (per row, integrated over the exposure) and a slow gain drift.
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -21,6 +31,7 @@
 #include "pinball/sim/game_state.h"
 #include "pinball/vision/camera_homography.h"
 #include "pinball/vision/frame_source.h"
+#include "pinball/vision/lens_model.h"
 
 namespace pinball::simlab {
 
@@ -38,6 +49,42 @@ struct SimGlare {
   double sigma_m = 0.03;            ///< Gaussian size on the table (m); the patch spans ±3σ
   double peak_gray = 150.0;         ///< brightness added at the centre (gray levels)
   double toggle_probability = 0.0;  ///< per frame: chance it switches on/off (0: always on)
+};
+
+/// The ways a real camera differs from the ideal one; each is off at its
+/// zero (or empty) value. typical() is a 200 fps 640x480 USB3 machine-vision
+/// camera with a rolling-shutter CMOS sensor and a 4 mm lens under mains lamps
+/// (docs/vision.md, "A real camera", states and justifies each number).
+struct SimCameraRealism {
+  std::optional<vision::CameraIntrinsics> lens;  ///< lens distortion (its size must be the image's); empty: ideal pinhole
+  double row_time_s = 0.0;             ///< rolling shutter: row v starts its exposure v · this after row 0 (s); 0: global
+  double frame_jitter_s = 0.0;         ///< standard deviation of each exposure start about its nominal time (s)
+  double latency_min_s = 0.0;          ///< delivery: the frame is stamped and handed over this long after row 0's
+                                       ///< mid-exposure (s) ...
+  double latency_jitter_mean_s = 0.0;  ///< ... plus an exponential delay of this mean (USB and driver scheduling, s)
+  double flicker_hz = 100.0;           ///< lamp flicker frequency: twice the mains (Hz)
+  double flicker_amplitude = 0.0;      ///< the light's brightness swings by ± this fraction at flicker_hz
+  double gain_drift_sigma = 0.0;       ///< exposure/gain drift: stationary standard deviation of the relative gain
+  double gain_drift_time_s = 30.0;     ///< its correlation time (s)
+
+  /// The typical camera, for images of width_px x height_px.
+  static SimCameraRealism typical(int width_px = 640, int height_px = 480);
+  /// Mean delivery latency (s): latency_min_s + latency_jitter_mean_s.
+  double latency_mean_s() const { return latency_min_s + latency_jitter_mean_s; }
+
+  /// The fields as reports spell them (core/json_write_archive.h).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(lens));
+    a->Visit(PINBALL_NVP(row_time_s));
+    a->Visit(PINBALL_NVP(frame_jitter_s));
+    a->Visit(PINBALL_NVP(latency_min_s));
+    a->Visit(PINBALL_NVP(latency_jitter_mean_s));
+    a->Visit(PINBALL_NVP(flicker_hz));
+    a->Visit(PINBALL_NVP(flicker_amplitude));
+    a->Visit(PINBALL_NVP(gain_drift_sigma));
+    a->Visit(PINBALL_NVP(gain_drift_time_s));
+  }
 };
 
 /// Every setting of the simulated camera.
@@ -73,6 +120,7 @@ struct SimCameraConfig {
   double marker_gray = 245.0;       ///< bright disc brightness (gray levels)
   double marker_ring_gray = 15.0;   ///< dark disc brightness (gray levels)
   std::uint64_t seed = 1;           ///< clutter, lamps, noise
+  SimCameraRealism realism;         ///< lens, rolling shutter, timing, flicker, drift (all off by default)
 
   /// Two plastics on the upper playfield, scaled to a 0.51 x 1.07 m table.
   static std::vector<SimPlastic> default_plastics();
@@ -83,8 +131,12 @@ struct SimCameraConfig {
 struct FrameTruth {
   bool ball_present = false;        ///< the ball was in play during some of the exposure
   bool ball_whole_exposure = false; ///< ... during all of it
-  Vec2 p_board_mid = Vec2::Zero();  ///< ball centre at mid-exposure (m)
-  cv::Point2d uv_px_mid;            ///< the same in the image (px)
+  Vec2 p_board_mid = Vec2::Zero();  ///< ball centre at the true mid-exposure of its row (m)
+  cv::Point2d uv_px_mid;            ///< the same in the image the sensor saw (px, distorted by the lens)
+  double t_ball_exposure_s = 0.0;   ///< that time: the mid-exposure of the ball's row (s, simulated)
+  double t_row0_exposure_s = 0.0;   ///< mid-exposure of row 0 (s, simulated)
+  double latency_s = 0.0;           ///< the frame's stamp minus t_row0_exposure_s (s)
+  double gain = 1.0;                ///< the frame's brightness gain from drift (flicker varies per row)
   double blur_px = 0.0;             ///< distance the ball's image travelled during the exposure (px)
   double radius_px = 0.0;           ///< ball radius in the image at mid-exposure (px)
   double occluded_fraction = 0.0;   ///< fraction of the ball's image under plastic
@@ -104,9 +156,11 @@ class SimCameraSource final : public vision::FrameSource {
   /// The same from a bare ball position: `in_play` false means no ball in view.
   void observe_ball(double t_s, const Vec2& p_board, bool in_play);
 
-  /// Next frame whose exposure has ended by the latest observed time; false
-  /// when none is due. Frames whose exposure is no longer in the history are
-  /// skipped and counted as dropped.
+  /// Next frame that has been read out and delivered by the latest observed
+  /// time; false when none is due. Frames whose exposure is no longer in the
+  /// history are skipped and counted as dropped. The frame's t_s is its
+  /// delivery stamp (row 0's mid-exposure plus the latency; without latency,
+  /// the mid-exposure), driver_t_s its exposure start.
   bool read(vision::Frame& out) override;
 
   /// Renders one frame directly: the ball at `path_board` positions spread
@@ -130,7 +184,7 @@ class SimCameraSource final : public vision::FrameSource {
   /// Freezes (false) or resumes (true) lamp toggling.
   void set_lamps_blinking(bool blinking) { lamps_blinking_ = blinking; }
 
-  /// The camera's homography (board -> image).
+  /// The camera's homography (board -> ideal image: before the lens distorts it).
   const vision::CameraHomography& homography() const { return homography_; }
   /// 255 where a plastic hides the playfield (the detector's occluder mask).
   const cv::Mat& occluder_mask() const { return occluder_mask_; }
@@ -138,6 +192,8 @@ class SimCameraSource final : public vision::FrameSource {
   const cv::Mat& static_scene() const { return floor_; }
   /// The settings.
   const SimCameraConfig& config() const { return config_; }
+  /// Where a board point appears in the frames (px; through the lens when there is one).
+  cv::Point2d image_from_board(const Vec2& p_board) const;
 
   cv::Size frame_size() const override { return {config_.width_px, config_.height_px}; }
   double fps() const override { return config_.fps; }
@@ -154,6 +210,27 @@ class SimCameraSource final : public vision::FrameSource {
     cv::Rect roi;
     cv::Mat values;  // CV_8U: lamp delta, glare delta, or plastic alpha
   };
+  // The ball's positions over the exposure, per image row under a rolling
+  // shutter (rows == 0: one path for every row).
+  struct BallPaths {
+    std::span<const Vec2> common;  // every row's path (global shutter); the ball's centre row's (rolling)
+    int first_row = 0;
+    int rows = 0;                  // rolling shutter: paths of rows first_row .. first_row + rows - 1
+    int total = 1;                 // samples over the whole exposure (fewer present: the ball left play)
+    const Vec2* row_paths = nullptr;  // kMaxPath per row
+    const int* row_counts = nullptr;
+    std::span<const Vec2> row(int v) const;
+  };
+  static constexpr int kMaxRows = 160;
+  // Board point under an integer pixel of the frame (through the lens).
+  Vec2 board_at_pixel(int u, int v) const;
+  // Ball paths for a frame whose row 0 starts its exposure at start_s (fills row_path_ under a rolling shutter).
+  BallPaths ball_paths(double start_s);
+  // The (fractional) row that sees the ball's centre and where the ball was then.
+  double ball_row(double start_s, Vec2& p_board) const;
+  // Draws the row-dependent gain (flicker, drift) of a frame exposed from start_s.
+  void apply_gain(double start_s, cv::Mat& image);
+  void schedule_next_frame(double nominal_start_s);
   void draw_flippers(cv::Mat& image) const;
   // Paints `gray` over `image` inside the patch, its values being the opacity (255: opaque).
   static void blend(const Patch& p, double gray, cv::Mat& image);
@@ -161,14 +238,15 @@ class SimCameraSource final : public vision::FrameSource {
   static constexpr std::size_t kHistory = 2048;
   static constexpr std::size_t kMaxPath = 64;
 
+  void build_lens_map();
   void build_floor();
   void build_lamps();
   void build_plastics();
   void build_glare();
   void build_noise();
   void advance_effects();
-  void compose(std::span<const Vec2> path_board, int path_total, double t_mid_s, vision::Frame& out);
-  void draw_ball(std::span<const Vec2> path_board, int path_total, cv::Mat& image);
+  void compose(const BallPaths& paths, double start_s, vision::Frame& out);
+  void draw_ball(const BallPaths& paths, cv::Mat& image);
   double ball_scale_ = 1.0;  // apparent size of the ball now (1 on the playfield; > 1 while it hops)
   bool sample_at(double t_s, Vec2& p, bool& in_play) const;
 
@@ -176,6 +254,7 @@ class SimCameraSource final : public vision::FrameSource {
   SimCameraConfig config_;
   vision::CameraHomography homography_;
   Rng rng_;
+  Rng timing_rng_{1};  // frame jitter, latency, flicker phase, gain drift
   std::vector<double> flipper_theta_;  // latest angle per board flipper (sized once)
   cv::Mat floor_;          // CV_8U static scene: drawing, clutter, unlit lamps
   cv::Mat occluder_mask_;  // CV_8U
@@ -195,7 +274,14 @@ class SimCameraSource final : public vision::FrameSource {
   std::array<Sample, kHistory> history_{};
   std::size_t history_head_ = 0;         // index of the oldest sample
   std::size_t history_size_ = 0;
-  double next_exposure_s_ = 0.0;
+  double next_nominal_s_ = 0.0;  // the next frame's nominal exposure start (s)
+  double next_start_s_ = 0.0;    // ... with its jitter
+  double next_latency_s_ = 0.0;  // ... and its delivery latency
+  cv::Mat ideal_map_;            // CV_32FC2: per frame pixel, the ideal-image pixel it shows (lens only)
+  double flicker_phase_rad_ = 0.0;
+  double drift_ = 0.0;           // relative gain offset (Ornstein–Uhlenbeck)
+  std::array<Vec2, kMaxRows * kMaxPath> row_path_{};
+  std::array<int, kMaxRows> row_count_{};
   double period_s_ = 0.0;
   std::uint64_t sequence_ = 0;
   std::array<Vec2, kMaxPath> path_{};

@@ -6,7 +6,11 @@
 // flippers are rejected) and it touches neither a known occluder nor the edge
 // of the image. The centre is the sub-pixel centroid of the difference image
 // with saturating weights (shading and the specular highlight do not pull it),
-// mapped to the board through the camera homography. A ball touching a thin
+// undistorted as one point when the lens is known (cv::undistortPoints, never
+// the whole frame) and mapped to the board through the camera homography; the
+// observation is dated at the exposure of the ball's row: the frame's stamp
+// less the camera's latency, plus the row times the row time under a rolling
+// shutter. A ball touching a thin
 // bright object (a flipper, a rail) merges with it into one blob of the wrong
 // shape; when no blob passes, such blobs are opened (eroded then dilated) with
 // a disc smaller than the ball, which removes the thin parts and keeps the
@@ -16,6 +20,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -24,6 +29,8 @@
 #include "pinball/vision/background_model.h"
 #include "pinball/vision/camera_homography.h"
 #include "pinball/vision/frame.h"
+#include "pinball/vision/frame_dejitter.h"
+#include "pinball/vision/lens_model.h"
 
 namespace pinball::vision {
 
@@ -53,6 +60,15 @@ struct BallDetectorConfig {
   double max_separated_elongation = 1.5;    ///< largest elongation of a ball cut loose by the opening (a ball
                                             ///< blurred by about one radius): a longer piece is more likely
                                             ///< a ball with a lump of the object it touches
+  // The camera's corrections (calibration file: intrinsics, camera_timing). Off, the
+  // detector treats the camera as an ideal pinhole with a global shutter stamped at exposure.
+  std::optional<CameraIntrinsics> lens;     ///< undistort the centroid before the homography (its size must be the frame's)
+  double latency_s = 0.0;                   ///< the frame's stamp minus row 0's mid-exposure (s): subtracted
+  double row_time_s = 0.0;                  ///< rolling shutter: the ball's row v was exposed v · this after row 0 (s)
+  int dejitter_frames = 0;                  ///< > 0: date frames by the camera's steady clock, the lower envelope of
+                                            ///< the stamps over this many frames (FrameDejitter); latency_s is then
+                                            ///< the minimum latency. 0: the stamps as they come
+  double frame_period_s = 0.005;            ///< the camera's frame period, for dejittering (s)
 };
 
 /// Why a frame gave no ball.
@@ -71,7 +87,8 @@ enum class DetectionMiss : std::uint8_t {
 struct Detection {
   bool found = false;               ///< true: `observation` holds the ball
   track::Observation observation;   ///< t_s (the frame's), p_board (m), confidence in (0, 1]
-  cv::Point2d uv_px{0.0, 0.0};      ///< sub-pixel centre in the image (px)
+  cv::Point2d uv_px{0.0, 0.0};      ///< sub-pixel centre in the image as the sensor saw it (px)
+  cv::Point2d uv_ideal_px{0.0, 0.0};///< the same undistorted: where an ideal pinhole camera saw it (px)
   double area_px = 0.0;             ///< the accepted blob's area (px)
   double expected_area_px = 0.0;    ///< π·r_px² at that place (px)
   double elongation = 0.0;          ///< major/minor axis ratio
@@ -158,6 +175,8 @@ class BallDetector {
   cv::Point2d weighted_centroid(const Blob& blob, bool opened);
 
   CameraHomography homography_;
+  std::optional<PointUndistorter> undistorter_;  // with a lens
+  std::optional<FrameDejitter> dejitter_;        // with dejitter_frames > 0
   cv::Size size_;
   BallDetectorConfig config_;
   BackgroundModel background_;
