@@ -142,5 +142,128 @@ TEST(SimCameraSource, RejectsBadSettings) {
   EXPECT_THROW(SimCameraSource(thesis_board(), c), std::invalid_argument);
 }
 
+TEST(SimCameraSource, RealismIsOffByDefaultAndTypicalIsAStatedCamera) {
+  const SimCameraRealism off;
+  EXPECT_FALSE(off.lens.has_value());
+  EXPECT_EQ(off.row_time_s, 0.0);
+  EXPECT_EQ(off.latency_mean_s(), 0.0);
+  EXPECT_EQ(off.flicker_amplitude, 0.0);
+  EXPECT_EQ(off.gain_drift_sigma, 0.0);
+  const SimCameraRealism typical = SimCameraRealism::typical();
+  ASSERT_TRUE(typical.lens.has_value());
+  EXPECT_LT(typical.lens->k1, 0.0);                         // barrel
+  EXPECT_NEAR(typical.row_time_s * 480, 4.8e-3, 1e-9);      // read out within a 5 ms frame
+  EXPECT_NEAR(typical.latency_mean_s(), 0.008, 1e-12);
+  EXPECT_EQ(typical.flicker_hz, 100.0);
+  // Switching it on keeps the scene: the same seed draws the same table art.
+  SimCameraConfig plain;
+  plain.noise_sigma = 0.0;
+  SimCameraConfig timed = plain;
+  timed.realism.latency_min_s = 0.004;
+  EXPECT_EQ(cv::norm(SimCameraSource(thesis_board(), plain).static_scene(),
+                     SimCameraSource(thesis_board(), timed).static_scene(), cv::NORM_INF), 0.0);
+}
+
+TEST(SimCameraSource, ALensBendsTheTableTowardsTheImageCentre) {
+  SimCameraConfig c;
+  c.realism.lens = vision::typical_wide_lens();
+  const SimCameraSource camera(thesis_board(), c);
+  const cv::Point2d centre(c.realism.lens->cx_px, c.realism.lens->cy_px);
+  const Vec2 corner{0.0, thesis_board().height_m};
+  const cv::Point2d ideal = camera.homography().image_from_board(corner);
+  const cv::Point2d seen = camera.image_from_board(corner);
+  EXPECT_LT(cv::norm(seen - centre), cv::norm(ideal - centre) - 10.0);
+  // The static scene was drawn through it: the table's edge is where the lens puts it, not the homography.
+  const cv::Mat diff = camera.static_scene() != SimCameraSource(thesis_board(), SimCameraConfig{}).static_scene();
+  EXPECT_GT(cv::countNonZero(diff), 10000);
+}
+
+TEST(SimCameraSource, LatencyDelaysDeliveryAndTheStampSaysWhenTheFrameArrived) {
+  SimCameraConfig c;
+  c.realism.latency_min_s = 0.010;
+  c.realism.latency_jitter_mean_s = 0.002;
+  SimCameraSource camera(thesis_board(), c);
+  vision::Frame frame;
+  double sum_latency = 0.0;
+  int frames = 0;
+  for (int step = 1; step <= 4000; ++step) {  // 2 s at 0.5 ms
+    const double t = step * 0.0005;
+    camera.observe_ball(t, Vec2{0.25, 0.5}, true);
+    while (camera.read(frame)) {
+      const FrameTruth& truth = camera.truth();
+      EXPECT_LE(frame.t_s, t + 1e-12);  // never delivered before it arrived
+      EXPECT_NEAR(frame.t_s - truth.t_row0_exposure_s, truth.latency_s, 1e-12);
+      EXPECT_GE(truth.latency_s, 0.010 - 1e-12);
+      EXPECT_NEAR(frame.driver_t_s, truth.t_row0_exposure_s - 0.5 * c.exposure_s, 1e-12);
+      sum_latency += truth.latency_s;
+      ++frames;
+    }
+  }
+  ASSERT_GT(frames, 380);
+  EXPECT_NEAR(sum_latency / frames, 0.012, 0.0005);
+}
+
+TEST(SimCameraSource, ARollingShutterExposesEachRowLater) {
+  SimCameraConfig c;
+  c.realism.row_time_s = 1e-5;
+  SimCameraSource camera(thesis_board(), c);
+  vision::Frame frame;
+  int frames = 0;
+  for (int step = 1; step <= 400; ++step) {  // a ball crossing the table at 4 m/s
+    const double t = step * 0.0001;
+    camera.observe_ball(t, Vec2{0.1 + 2.0 * t, 0.3 + 3.4 * t}, true);
+    while (camera.read(frame)) {
+      const FrameTruth& truth = camera.truth();
+      // The ball was caught by the row it lies on, that row's time later than row 0.
+      EXPECT_NEAR(truth.t_ball_exposure_s - truth.t_row0_exposure_s, truth.uv_px_mid.y * 1e-5, 2e-7);
+      EXPECT_GT(truth.t_ball_exposure_s - truth.t_row0_exposure_s, 5e-4);
+      ++frames;
+    }
+  }
+  EXPECT_GE(frames, 6);
+}
+
+TEST(SimCameraSource, FlickerBandsTheRowsOfARollingShutterButNotOfAGlobalOne) {
+  // Row by row gain of a flickering frame against the same frame unlit by flicker.
+  const auto row_gain_spread = [](double row_time_s) {
+    SimCameraConfig c;
+    c.noise_sigma = 0.0;
+    c.lamps = 0;
+    c.realism.row_time_s = row_time_s;
+    SimCameraConfig flickering = c;
+    flickering.realism.flicker_amplitude = 0.08;
+    SimCameraSource steady(thesis_board(), c);
+    SimCameraSource lit(thesis_board(), flickering);
+    vision::Frame a, b;
+    steady.render({}, 0.0123, a);
+    lit.render({}, 0.0123, b);
+    double lo = 1e9, hi = -1e9;
+    for (int v = 0; v < a.gray.rows; v += 8) {
+      const double gain = cv::mean(b.gray.row(v))[0] / cv::mean(a.gray.row(v))[0];
+      lo = std::min(lo, gain);
+      hi = std::max(hi, gain);
+    }
+    return hi - lo;
+  };
+  const double rolling = row_gain_spread(1e-5);
+  EXPECT_GT(rolling, 0.03);
+  EXPECT_LT(row_gain_spread(0.0), rolling / 3.0);  // what remains is 8-bit rounding of dark rows
+}
+
+TEST(SimCameraSource, RejectsRealismItCannotRender) {
+  SimCameraConfig c;
+  c.realism.lens = vision::typical_wide_lens(1280, 960);  // not the 640x480 camera's
+  EXPECT_THROW(SimCameraSource(thesis_board(), c), std::invalid_argument);
+  c = SimCameraConfig{};
+  c.realism.row_time_s = 2e-5;  // 9.6 ms readout: longer than a frame at 200 fps
+  EXPECT_THROW(SimCameraSource(thesis_board(), c), std::invalid_argument);
+  c = SimCameraConfig{};
+  c.realism.latency_min_s = -0.001;
+  EXPECT_THROW(SimCameraSource(thesis_board(), c), std::invalid_argument);
+  c = SimCameraConfig{};
+  c.realism.flicker_amplitude = 1.0;
+  EXPECT_THROW(SimCameraSource(thesis_board(), c), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace pinball::simlab

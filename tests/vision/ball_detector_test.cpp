@@ -382,5 +382,68 @@ TEST(BallDetector, RejectsBadSettings) {
   EXPECT_THROW(ok.set_occluder_mask(cv::Mat(10, 10, CV_8U)), std::invalid_argument);
 }
 
+TEST(BallDetector, ALensIsCorrectedByUndistortingTheCentroid) {
+  simlab::SimCameraConfig c;
+  c.realism.lens = typical_wide_lens();
+  BallDetectorConfig corrected;
+  corrected.lens = c.realism.lens;
+  Scene with_lens(c, corrected);
+  Scene without_lens(c);
+  const table::Board& b = thesis_board();
+  double worst_corrected_m = 0.0;
+  double worst_uncorrected_m = 0.0;
+  for (const Vec2& p : {Vec2{0.06, 0.25}, Vec2{b.width_m - 0.06, b.height_m - 0.06}, Vec2{0.25, 0.55}}) {
+    const Detection a = with_lens.shoot(p);
+    const Detection u = without_lens.shoot(p);
+    ASSERT_TRUE(a.found) << p.transpose();
+    worst_corrected_m = std::max(worst_corrected_m, (a.observation.p_board - p).norm());
+    // Uncorrected, a ball far out may also be refused for looking too small.
+    if (u.found) worst_uncorrected_m = std::max(worst_uncorrected_m, (u.observation.p_board - p).norm());
+    // The image centre is the sensor's, the ideal one where the pinhole would have seen it.
+    EXPECT_LT(cv::norm(a.uv_px - with_lens.camera.truth().uv_px_mid), 0.5);
+  }
+  EXPECT_LT(worst_corrected_m, 0.0005);
+  EXPECT_GT(worst_uncorrected_m, 0.005);  // a centimetre and more at the table's corners
+}
+
+TEST(BallDetector, ObservationsAreDatedAtTheBallsRowLessTheLatency) {
+  simlab::SimCameraConfig c;
+  c.realism.row_time_s = 1e-5;
+  c.realism.latency_min_s = 0.009;
+  BallDetectorConfig d;
+  d.row_time_s = 1e-5;
+  d.latency_s = 0.009;
+  Scene s(c, d);
+  s.camera.reset(s.t_s);
+  vision::Frame frame;
+  int found = 0;
+  for (int step = 1; step <= 600; ++step) {
+    const double t = s.t_s + step * 1e-4;
+    s.camera.observe_ball(t, Vec2{0.1 + 2.0 * (t - s.t_s), 0.3 + 3.0 * (t - s.t_s)}, true);
+    while (s.camera.read(frame)) {
+      const Detection det = s.detector.detect(frame);
+      if (!det.found) continue;
+      ++found;
+      EXPECT_NEAR(det.observation.t_s, s.camera.truth().t_ball_exposure_s, 2e-5);
+      EXPECT_NEAR(det.observation.latency_s, frame.t_s - det.observation.t_s, 1e-12);
+      EXPECT_GT(det.observation.latency_s, 0.004);  // 9 ms less the row's few milliseconds
+    }
+  }
+  EXPECT_GE(found, 8);
+}
+
+TEST(BallDetector, RefusesALensOfAnotherImageSize) {
+  simlab::SimCameraSource camera(thesis_board(), simlab::SimCameraConfig{});
+  BallDetectorConfig d;
+  d.lens = typical_wide_lens(1280, 960);
+  EXPECT_THROW(BallDetector(camera.homography(), camera.frame_size(), d), std::invalid_argument);
+  d = BallDetectorConfig{};
+  d.latency_s = -0.001;
+  EXPECT_THROW(BallDetector(camera.homography(), camera.frame_size(), d), std::invalid_argument);
+  d = BallDetectorConfig{};
+  d.dejitter_frames = 1000;
+  EXPECT_THROW(BallDetector(camera.homography(), camera.frame_size(), d), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace pinball::vision

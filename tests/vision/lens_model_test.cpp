@@ -1,0 +1,102 @@
+#include "pinball/vision/lens_model.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+
+namespace pinball::vision {
+namespace {
+
+TEST(LensModel, WithoutDistortionEveryPixelStaysPut) {
+  const CameraIntrinsics lens = without_distortion(typical_wide_lens());
+  EXPECT_FALSE(has_distortion(lens));
+  const PointUndistorter undistorter(lens);
+  for (const cv::Point2d p : {cv::Point2d(0, 0), cv::Point2d(320, 240), cv::Point2d(639, 479)}) {
+    EXPECT_EQ(distort_pixel(lens, p), p);
+    EXPECT_EQ(undistorter.ideal_from_distorted(p), p);
+  }
+}
+
+TEST(LensModel, ClosedFormDistortionIsOpenCvsProjection) {
+  const CameraIntrinsics lens = typical_wide_lens();
+  std::vector<cv::Point3d> rays;
+  for (double x = -0.7; x <= 0.7; x += 0.35) {
+    for (double y = -0.5; y <= 0.5; y += 0.25) rays.emplace_back(x, y, 1.0);
+  }
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera_matrix(lens), distortion_coefficients(lens),
+                    projected);
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const cv::Point2d ideal(lens.fx_px * rays[i].x + lens.cx_px, lens.fy_px * rays[i].y + lens.cy_px);
+    EXPECT_LT(cv::norm(distort_pixel(lens, ideal) - projected[i]), 1e-9) << i;
+  }
+}
+
+TEST(LensModel, TheTypicalWideLensMovesTheCornersByManyPixels) {
+  const CameraIntrinsics lens = typical_wide_lens();
+  const PointUndistorter undistorter(lens);
+  // The sensor's corner shows a point the ideal camera would see far outside it (barrel).
+  const cv::Point2d corner(0.0, 0.0);
+  const double shift = cv::norm(undistorter.ideal_from_distorted(corner) - corner);
+  EXPECT_GT(shift, 30.0);
+  EXPECT_LT(shift, 120.0);
+  // Near the principal point almost nothing moves.
+  const cv::Point2d centre(lens.cx_px + 5.0, lens.cy_px - 5.0);
+  EXPECT_LT(cv::norm(undistorter.ideal_from_distorted(centre) - centre), 0.05);
+}
+
+TEST(LensModel, UndistortionInvertsDistortionEverywhereInTheImage) {
+  const CameraIntrinsics lens = typical_wide_lens();
+  const PointUndistorter undistorter(lens);
+  double worst = 0.0;
+  for (double v = 0.0; v <= 479.0; v += 47.9) {
+    for (double u = 0.0; u <= 639.0; u += 63.9) {
+      const cv::Point2d sensor(u, v);
+      const cv::Point2d back = distort_pixel(lens, undistorter.ideal_from_distorted(sensor));
+      worst = std::max(worst, cv::norm(back - sensor));
+    }
+  }
+  EXPECT_LT(worst, 1e-4);
+}
+
+TEST(LensModel, ScalesWithTheImage) {
+  const CameraIntrinsics small = typical_wide_lens(640, 480);
+  const CameraIntrinsics large = typical_wide_lens(1280, 960);
+  EXPECT_DOUBLE_EQ(large.fx_px, 2.0 * small.fx_px);
+  EXPECT_EQ(large.width_px, 1280);
+  EXPECT_DOUBLE_EQ(large.k1, small.k1);
+}
+
+TEST(LensModel, OpenCvsCoefficientsComeBackAsTheyWent) {
+  const CameraIntrinsics lens = typical_wide_lens();
+  const cv::Vec<double, 5> d = distortion_coefficients(lens);
+  const CameraIntrinsics back = intrinsics_from_opencv(camera_matrix(lens), cv::Mat(d).reshape(1, 1), {640, 480});
+  EXPECT_DOUBLE_EQ(back.k1, lens.k1);
+  EXPECT_DOUBLE_EQ(back.p2, lens.p2);
+  EXPECT_DOUBLE_EQ(back.cx_px, lens.cx_px);
+  EXPECT_EQ(back.height_px, 480);
+  // Eight coefficients whose rational terms are not zero are a model we do not have.
+  cv::Mat eight = cv::Mat::zeros(1, 8, CV_64F);
+  eight.at<double>(0, 5) = 0.1;
+  EXPECT_THROW(intrinsics_from_opencv(camera_matrix(lens), eight, {640, 480}), std::invalid_argument);
+}
+
+TEST(LensModel, OutOfRangeIntrinsicsAreNamed) {
+  CameraIntrinsics lens = typical_wide_lens();
+  EXPECT_FALSE(check_intrinsics(lens));
+  lens.fx_px = 0.0;
+  EXPECT_EQ(check_intrinsics(lens).key, "fx_px");
+  lens = typical_wide_lens();
+  lens.cx_px = 700.0;
+  EXPECT_EQ(check_intrinsics(lens).key, "cx_px");
+  lens = typical_wide_lens();
+  lens.k2 = std::nan("");
+  EXPECT_EQ(check_intrinsics(lens).key, "k2");
+  EXPECT_THROW(PointUndistorter{lens}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pinball::vision
