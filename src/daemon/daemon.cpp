@@ -251,6 +251,7 @@ void Daemon::Impl::build() {
     cc.height_px = config.camera.height_px;
     cc.fps = config.camera.fps;
     cc.seed = config.sim.seed;
+    if (config.sim.camera == "typical") cc.realism = simlab::SimCameraRealism::typical(cc.width_px, cc.height_px);
     simlab::SimWorldOptions wo;
     wo.balls = config.sim.balls;
     wo.seed = config.sim.seed;
@@ -282,6 +283,18 @@ void Daemon::Impl::build() {
     cv::setNumThreads(1);
     vision::BallDetectorConfig dc;
     dc.ball_radius_m = board.ball.radius_m;
+    // The calibration's lens and timing; in the simulation without them, the simulated
+    // camera's true ones stand in (as its homography does).
+    std::optional<vision::CameraIntrinsics> lens = setup.lens;
+    std::optional<calibration::CameraTiming> timing = setup.timing;
+    if (world) {
+      const simlab::SimCameraRealism& r = world->camera().config().realism;
+      if (!lens) lens = r.lens;
+      if (!timing && (r.row_time_s > 0.0 || r.latency_min_s > 0.0)) {
+        timing = calibration::CameraTiming{r.latency_min_s, 0.0, r.row_time_s, 0};
+      }
+    }
+    apply_camera_corrections(lens, timing, config.camera.fps, dc);
     detector = std::make_unique<vision::BallDetector>(*homography, frame_size, dc);
     if (world) detector->set_occluder_mask(world->camera().occluder_mask());
   }

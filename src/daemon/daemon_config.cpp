@@ -87,6 +87,7 @@ void check_sim(const SimSettings& c, const std::string& s) {
   require(c.actuation_delay_s >= 0.0 && c.actuation_delay_s < 0.1, s, "sim.actuation_delay_s",
           "must be in [0, 0.1) s");
   require(positive(c.max_ball_time_s), s, "sim.max_ball_time_s", "must be > 0");
+  require(c.camera == "ideal" || c.camera == "typical", s, "sim.camera", "must be ideal or typical");
 }
 
 void check_threads(const ThreadSettings& c, const std::string& s) {

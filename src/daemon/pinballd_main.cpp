@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
       "failed; 2 bad argument; "
       "3 ran, but a recording is incomplete (the --can-log file dropped frames, or LCM refused messages, e.g. a "
       "file:// log on a full disk): the report says what was lost.");
-  std::string config_path, sim_board, world_board, world_kind, twin_params, stepper, controller, lcm_url, can_log;
+  std::string config_path, sim_board, world_board, world_kind, twin_params, stepper, controller, lcm_url, can_log,
+      sim_camera;
   int balls = -1;
   long long seed = -1;
   bool realtime = false, json = false, threads = false;
@@ -73,6 +74,11 @@ int main(int argc, char** argv) {
       ->default_str(std::string(pinball::simlab::world_kind_name(defaults.sim.world)));
   app.add_option("--twin-params", twin_params, "simulation: the twin's parameter file (default: config/twin.yaml)")
       ->check(CLI::ExistingFile);
+  app.add_option("--sim-camera", sim_camera,
+                 "simulation: the camera, ideal or typical (lens distortion, rolling shutter, 8 ms latency, flicker; "
+                 "docs/vision.md)")
+      ->check(CLI::IsMember({"ideal", "typical"}))
+      ->default_str(defaults.sim.camera);
   app.add_option("--stepper", stepper, "simulation: the model world's integrator, thesis or event")
       ->check(CLI::IsMember({"thesis", "event"}))
       ->default_str(std::string(pinball::sim::stepper_kind_name(defaults.sim.stepper)));
@@ -119,6 +125,7 @@ int main(int argc, char** argv) {
     if (!world_board.empty()) config.sim.world_board = world_board;
     if (!stepper.empty()) config.sim.stepper = pinball::sim::parse_stepper_kind(stepper);
     if (!world_kind.empty()) config.sim.world = pinball::simlab::parse_world_kind(world_kind);
+    if (!sim_camera.empty()) config.sim.camera = sim_camera;
     if (!twin_params.empty()) config.sim.twin_params = twin_params;
     if (!controller.empty()) config.controller = controller;
     if (balls >= 0) config.sim.balls = balls;

@@ -149,14 +149,38 @@ int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, 
 TrackingSetup tracking_setup_for(const DaemonConfig& config, const table::Board& board) {
   track::CameraModelConfig camera_model;
   camera_model.fps = config.camera.fps;
-  TrackingSetup s{track::default_tracker_config(board, camera_model), track::flipper_geometry_from_board(board), {}};
+  TrackingSetup s{track::default_tracker_config(board, camera_model), track::flipper_geometry_from_board(board), {}, {}, {}};
   if (!config.calibration.empty()) {
     const calibration::Calibration c = calibration::read_calibration(config.calibration);
     calibration::check_calibration_matches_board(c, config.calibration, board);  // a misnamed flipper is refused
     calibration::apply_calibration(c, config.calibration, s.tracker, s.geometry);
     if (c.camera) s.homography = calibration::camera_homography(c, config.calibration);
+    if (c.intrinsics) {
+      const vision::CameraIntrinsics& lens = c.intrinsics->lens;
+      if (lens.width_px != config.camera.width_px || lens.height_px != config.camera.height_px) {
+        throw std::runtime_error(config.calibration + ":intrinsics.lens.width_px: the lens was calibrated on " +
+                                 std::to_string(lens.width_px) + "x" + std::to_string(lens.height_px) +
+                                 " images but camera.width_px x camera.height_px is " +
+                                 std::to_string(config.camera.width_px) + "x" +
+                                 std::to_string(config.camera.height_px));
+      }
+      s.lens = lens;
+    }
+    s.timing = c.camera_timing;
   }
   return s;
+}
+
+void apply_camera_corrections(const std::optional<vision::CameraIntrinsics>& lens,
+                              const std::optional<calibration::CameraTiming>& timing, double fps,
+                              vision::BallDetectorConfig& config) {
+  config.lens = lens;
+  if (!timing) return;
+  config.latency_s = timing->latency_s;
+  config.row_time_s = timing->row_time_s;
+  // The latency is measured on the steady clock's dates (pinball calibrate latency), so date frames by it.
+  config.dejitter_frames = 64;
+  config.frame_period_s = 1.0 / fps;
 }
 
 ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const table::Board& board) {

@@ -103,10 +103,12 @@ cv::Point2d PointUndistorter::ideal_from_distorted(const cv::Point2d& distorted_
   cv::Mat src_view(1, 1, CV_64FC2, src.val);
   cv::Mat dst_view(1, 1, CV_64FC2, dst.val);
   // OpenCV's default stops after 5 iterations, which leaves tenths of a pixel
-  // at the corners of a wide lens; iterate to 1e-6 px instead.
-  cv::undistortPoints(src_view, dst_view, k_, d_, cv::noArray(), k_,
+  // at the corners of a wide lens; iterate to 1e-6 px instead. No P: OpenCV
+  // would multiply it in with a temporary matrix (an allocation per call); the
+  // normalised point goes back to pixels through K here.
+  cv::undistortPoints(src_view, dst_view, k_, d_, cv::noArray(), cv::noArray(),
                       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-6));
-  return {dst(0, 0), dst(0, 1)};
+  return {intrinsics_.fx_px * dst(0, 0) + intrinsics_.cx_px, intrinsics_.fy_px * dst(0, 1) + intrinsics_.cy_px};
 }
 
 }  // namespace pinball::vision

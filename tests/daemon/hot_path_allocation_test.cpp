@@ -77,7 +77,7 @@ namespace pinball::daemon {
 namespace {
 
 // Plays 2 balls with `controller` and counts allocations on the per-frame path.
-void expect_no_allocation_per_frame(const std::string& controller) {
+void expect_no_allocation_per_frame(const std::string& controller, const std::string& sim_camera = "ideal") {
   // The counter sees allocations: check that it does before trusting a zero.
   {
     HotPathScope hot;
@@ -95,6 +95,7 @@ void expect_no_allocation_per_frame(const std::string& controller) {
   c.controller = controller;
   c.sim.balls = 2;
   c.sim.seed = 4;
+  c.sim.camera = sim_camera;
   Daemon d(c);
   const DaemonReport r = d.run();
   ASSERT_EQ(r.balls, 2);
@@ -106,6 +107,12 @@ void expect_no_allocation_per_frame(const std::string& controller) {
 TEST(HotPath, CameraAndControllerThreadsAllocateNothingPerFrame) {
   if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
   expect_no_allocation_per_frame(std::string(PINBALL_SOURCE_DIR) + "/controllers/best.json");
+}
+
+TEST(HotPath, CorrectingARealCamerasFaultsAllocatesNothingPerFrame) {
+  if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
+  // The typical camera: the detector undistorts each centroid, dates it by its row and the steady clock.
+  expect_no_allocation_per_frame(std::string(PINBALL_SOURCE_DIR) + "/controllers/best.json", "typical");
 }
 
 TEST(HotPath, TheImitationControllerAllocatesNothingPerFrame) {

@@ -211,5 +211,40 @@ TEST(CameraStage, ForgetsABallOutOfSightAndSaysSo) {
   EXPECT_EQ(stage.counters().track_resets, 1u);
 }
 
+TEST(TrackingSetup, TheCalibrationsLensAndTimingReachTheDetector) {
+  const table::Board board = table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  calibration::Calibration c;
+  c.board = "boards/mit1993.board";
+  c.intrinsics = calibration::IntrinsicsCalibration{vision::typical_wide_lens(), "chessboard", 20, 1, 0.12};
+  c.camera_timing = calibration::CameraTiming{0.0071, 0.0002, 1e-5, 12};
+  const std::string path = ::testing::TempDir() + "/pipeline_lens.yaml";
+  calibration::write_calibration(c, path);
+  DaemonConfig config;
+  config.calibration = path;
+  const TrackingSetup setup = tracking_setup_for(config, board);
+  ASSERT_TRUE(setup.lens.has_value());
+  ASSERT_TRUE(setup.timing.has_value());
+  vision::BallDetectorConfig d;
+  apply_camera_corrections(setup.lens, setup.timing, config.camera.fps, d);
+  ASSERT_TRUE(d.lens.has_value());
+  EXPECT_DOUBLE_EQ(d.lens->k1, vision::typical_wide_lens().k1);
+  EXPECT_DOUBLE_EQ(d.latency_s, 0.0071);
+  EXPECT_DOUBLE_EQ(d.row_time_s, 1e-5);
+  EXPECT_EQ(d.dejitter_frames, 64);  // the latency was measured on the steady clock's dates
+  EXPECT_DOUBLE_EQ(d.frame_period_s, 1.0 / config.camera.fps);
+
+  // A lens calibrated on other images than the camera delivers is refused, naming the file.
+  config.camera.width_px = 1280;
+  config.camera.height_px = 960;
+  try {
+    tracking_setup_for(config, board);
+    FAIL() << "a 640x480 lens on a 1280x960 camera was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ":intrinsics.lens.width_px"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("1280x960"), std::string::npos) << e.what();
+  }
+  std::remove(path.c_str());
+}
+
 }  // namespace
 }  // namespace pinball::daemon

@@ -130,6 +130,10 @@ struct SimSettings {
   bool realtime = false;                       ///< pace to the wall clock (default: lockstep, as fast as possible)
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;            ///< coil on -> flipper moves (s)
   double max_ball_time_s = 60.0;               ///< a ball alive this long is cut (s)
+  /// The simulated camera: ideal (a pinhole, global shutter, stamped at exposure) or typical (lens
+  /// distortion, rolling shutter, 8 ms latency, flicker, drift: simlab::SimCameraRealism::typical();
+  /// the detector corrects it with the camera's true lens and timing unless a calibration file gives them).
+  std::string camera = "ideal";
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -143,6 +147,7 @@ struct SimSettings {
     a->Visit(PINBALL_NVP(realtime));
     a->Visit(PINBALL_NVP(actuation_delay_s));
     a->Visit(PINBALL_NVP(max_ball_time_s));
+    a->Visit(PINBALL_NVP(camera));
   }
 };
 

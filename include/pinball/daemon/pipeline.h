@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "pinball/calibration/calibration_file.h"
 #include "pinball/control/flipper_controller.h"
 #include "pinball/core/single_writer_counter.h"
 #include "pinball/daemon/daemon_config.h"
@@ -184,7 +185,16 @@ struct TrackingSetup {
   track::TrackerConfig tracker;                      ///< g, windows, critical area
   track::FlipperGeometry geometry;                   ///< flipper lines the projections use
   std::optional<vision::CameraHomography> homography;  ///< from the calibration's camera section, if any
+  std::optional<vision::CameraIntrinsics> lens;        ///< from its intrinsics section, if any
+  std::optional<calibration::CameraTiming> timing;     ///< from its camera_timing section, if any
 };
+
+/// The detector's corrections for a camera with this lens and timing (either may be
+/// absent): the lens undistorts the centroid; with a timing the frames are dated by the
+/// camera's steady clock (64 frames) less the latency, plus the ball's row's time.
+void apply_camera_corrections(const std::optional<vision::CameraIntrinsics>& lens,
+                              const std::optional<calibration::CameraTiming>& timing, double fps,
+                              vision::BallDetectorConfig& config);
 /// The setup for `config` on `board` (the table's board file). Throws
 /// std::runtime_error naming the calibration file and key when it is bad or
 /// calibrates a flipper the board lacks.
