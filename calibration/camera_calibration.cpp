@@ -362,9 +362,20 @@ HomographyFit fit_homography(std::span<const DetectedMarker> det, std::span<cons
   return fit;
 }
 
+void undistort_markers(std::vector<DetectedMarker>& markers, const vision::CameraIntrinsics& lens) {
+  const vision::PointUndistorter undistorter(lens);
+  for (DetectedMarker& m : markers) m.uv_px = undistorter.ideal_from_distorted(m.uv_px);
+}
+
 HomographyFit calibrate_camera(const cv::Mat& gray, std::span<const Vec2> layout, const MarkerDetectorConfig& detector,
-                               const HomographyFitConfig& config) {
-  const std::vector<DetectedMarker> det = detect_markers(gray, detector);
+                               const HomographyFitConfig& config, const std::optional<vision::CameraIntrinsics>& lens) {
+  std::vector<DetectedMarker> det = detect_markers(gray, detector);
+  if (lens) {
+    check_input(lens->width_px == gray.cols && lens->height_px == gray.rows, "calibrate camera",
+                "the lens was calibrated on " + std::to_string(lens->width_px) + "x" + std::to_string(lens->height_px) +
+                    " images but this image is " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows));
+    undistort_markers(det, *lens);
+  }
   return fit_homography(det, layout, gray.size(), config);
 }
 

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pinball/core/rng.h"
+#include "pinball/simlab/sim_camera_source.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/vision/camera_homography.h"
 
@@ -112,6 +113,42 @@ TEST(CameraCalibration, DetectsDrawnMarkersWithSubpixelCentres) {
   EXPECT_NEAR(m[0].uv_px.x, centre.x, 0.1);
   EXPECT_NEAR(m[0].uv_px.y, centre.y, 0.1);
   EXPECT_THROW(detect_markers(cv::Mat(10, 10, CV_8UC3)), std::invalid_argument);
+}
+
+TEST(CameraCalibration, ThroughALensTheHomographyIsFittedOnUndistortedMarkers) {
+  const table::Board b = table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  simlab::SimCameraConfig c;
+  c.realism.lens = vision::typical_wide_lens();
+  simlab::SimCameraSource camera(b, c);
+  const std::vector<Vec2> layout = default_marker_layout(b);
+  camera.set_markers(layout);
+  vision::Frame frame;
+  camera.render({}, 0.0, frame);
+  // The board error of a fitted homography against the camera's true (ideal-image) one.
+  const auto worst_error_m = [&](const HomographyFit& fit) {
+    const vision::CameraHomography h(fit.calibration.image_from_board);
+    double worst = 0.0;
+    for (int i = 0; i <= 10; ++i) {
+      for (int k = 0; k <= 20; ++k) {
+        const Vec2 p{b.width_m * i / 10.0, b.height_m * k / 20.0};
+        worst = std::max(worst, (h.board_from_image(camera.homography().image_from_board(p)) - p).norm());
+      }
+    }
+    return worst;
+  };
+  const HomographyFit with_lens = calibrate_camera(frame.gray, layout, {}, {}, c.realism.lens);
+  EXPECT_LT(with_lens.calibration.reprojection_rms_px, 0.3);
+  EXPECT_LT(worst_error_m(with_lens), 0.001);
+  // Without it the homography cannot absorb the distortion: pixels of residual, centimetres off at the edges.
+  HomographyFitConfig loose;
+  loose.ransac_threshold_px = 50.0;
+  loose.match_tolerance_px = 40.0;
+  const HomographyFit without = calibrate_camera(frame.gray, layout, {}, loose);
+  EXPECT_GT(without.calibration.reprojection_rms_px, 1.0);
+  EXPECT_GT(worst_error_m(without), 0.005);
+  // A lens of other images than this one is refused.
+  EXPECT_THROW(calibrate_camera(frame.gray, layout, {}, {}, vision::typical_wide_lens(1280, 960)),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 // camera may look at the table from any side and extra bright blobs do no
 // harm), then cv::findHomography with RANSAC fits all matched markers.
 
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -87,8 +88,16 @@ struct HomographyFit {
 HomographyFit fit_homography(std::span<const DetectedMarker> detections, std::span<const Vec2> layout,
                              cv::Size image_size, const HomographyFitConfig& config = {});
 
-/// detect_markers then fit_homography on one image.
+/// Moves each marker's centre from where the lens put it to where the ideal
+/// pinhole camera sees it, the image the homography maps the board into.
+void undistort_markers(std::vector<DetectedMarker>& markers, const vision::CameraIntrinsics& lens);
+
+/// detect_markers then fit_homography on one image; with a lens (the
+/// calibration's intrinsics), the markers are undistorted first so the
+/// homography is fitted on undistorted points (a homography cannot absorb
+/// distortion). Throws std::invalid_argument for a lens of another image size.
 HomographyFit calibrate_camera(const cv::Mat& gray, std::span<const Vec2> layout,
-                               const MarkerDetectorConfig& detector = {}, const HomographyFitConfig& config = {});
+                               const MarkerDetectorConfig& detector = {}, const HomographyFitConfig& config = {},
+                               const std::optional<vision::CameraIntrinsics>& lens = {});
 
 }  // namespace pinball::calibration
