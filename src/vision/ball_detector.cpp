@@ -297,7 +297,16 @@ bool BallDetector::search(const cv::Rect& region, bool region_is_roi, double t_s
   out.radius_px = best.r_fit;
   out.from_roi = region_is_roi;
   out.separated = best.opened;
-  out.uv_ideal_px = undistorter_ ? undistorter_->ideal_from_distorted(uv) : uv;
+  if (undistorter_) {
+    // The pixels' spread about the centroid (+ 1/12: a pixel's own extent), for the lens's second-order terms.
+    const Blob& b = best.blob;
+    const double mu = b.su / b.area, mv = b.sv / b.area;
+    const cv::Matx22d cov(b.suu / b.area - mu * mu + 1.0 / 12.0, b.suv / b.area - mu * mv, b.suv / b.area - mu * mv,
+                          b.svv / b.area - mv * mv + 1.0 / 12.0);
+    out.uv_ideal_px = undistorter_->ideal_centroid(uv, cov);
+  } else {
+    out.uv_ideal_px = uv;
+  }
   out.observation.t_s = t_s - config_.latency_s + uv.y * config_.row_time_s;
   out.observation.p_board = homography_.board_from_image(out.uv_ideal_px);
   out.observation.confidence = best.conf;

@@ -111,4 +111,36 @@ cv::Point2d PointUndistorter::ideal_from_distorted(const cv::Point2d& distorted_
   return {intrinsics_.fx_px * dst(0, 0) + intrinsics_.cx_px, intrinsics_.fy_px * dst(0, 1) + intrinsics_.cy_px};
 }
 
+cv::Point2d PointUndistorter::ideal_centroid(const cv::Point2d& c, const cv::Matx22d& cov) const {
+  if (!has_distortion(intrinsics_)) return c;
+  // The blob's ideal centroid is Σ U(p) J(p) / Σ J(p) over its pixels p (U: the
+  // undistortion, J = det dU/dp: ideal area per sensor pixel). To second order
+  // about the sensor centroid c (E[p − c] = 0, E[(p − c)(p − c)ᵀ] = Σ):
+  //   U(c) + ½ tr(H_U Σ) + A Σ ∇J / J,   A = dU/dp, H_U its Hessian per component,
+  // all from central differences on a 3x3 grid of step h.
+  constexpr double h = 2.0;
+  cv::Point2d g[3][3];
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 3; ++i) g[j][i] = ideal_from_distorted(c + cv::Point2d((i - 1) * h, (j - 1) * h));
+  }
+  const cv::Point2d u0 = g[1][1];
+  const cv::Point2d du = (g[1][2] - g[1][0]) * (0.5 / h);  // ∂U/∂u
+  const cv::Point2d dv = (g[2][1] - g[0][1]) * (0.5 / h);  // ∂U/∂v
+  const cv::Point2d duu = (g[1][2] - 2.0 * u0 + g[1][0]) * (1.0 / (h * h));
+  const cv::Point2d dvv = (g[2][1] - 2.0 * u0 + g[0][1]) * (1.0 / (h * h));
+  const cv::Point2d duv = (g[2][2] - g[2][0] - g[0][2] + g[0][0]) * (0.25 / (h * h));
+  const double a11 = du.x, a12 = dv.x, a21 = du.y, a22 = dv.y;
+  const double jac = a11 * a22 - a12 * a21;
+  // ∇J from the Hessians: ∂A11/∂u = ∂²U1/∂u², ∂A22/∂u = ∂²U2/∂u∂v, ...
+  const double dj_du = duu.x * a22 + a11 * duv.y - duv.x * a21 - a12 * duu.y;
+  const double dj_dv = duv.x * a22 + a11 * dvv.y - dvv.x * a21 - a12 * duv.y;
+  const double s_uu = cov(0, 0), s_uv = cov(0, 1), s_vv = cov(1, 1);
+  const cv::Point2d curvature = 0.5 * (duu * s_uu + 2.0 * duv * s_uv + dvv * s_vv);
+  // A Σ ∇J / J
+  const double sg_u = (s_uu * dj_du + s_uv * dj_dv) / jac;
+  const double sg_v = (s_uv * dj_du + s_vv * dj_dv) / jac;
+  const cv::Point2d area(a11 * sg_u + a12 * sg_v, a21 * sg_u + a22 * sg_v);
+  return u0 + curvature + area;
+}
+
 }  // namespace pinball::vision

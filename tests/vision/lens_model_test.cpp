@@ -98,5 +98,38 @@ TEST(LensModel, OutOfRangeIntrinsicsAreNamed) {
   EXPECT_THROW(PointUndistorter{lens}, std::invalid_argument);
 }
 
+TEST(LensModel, ABlobsCentroidIsUndistortedToSecondOrder) {
+  // A uniform disc of radius 7 px far out in the ideal image, seen through the
+  // lens: its sensor pixels' centroid, undistorted as a point, misses the
+  // disc's centre by the lens's curvature across it; the second-order terms
+  // recover it.
+  const CameraIntrinsics lens = typical_wide_lens();
+  const PointUndistorter undistorter(lens);
+  const cv::Point2d centre(40.0, 45.0);
+  const double r = 7.0;
+  // Sensor pixels whose ideal point falls in the disc: a fine grid, area-weighted by construction.
+  double n = 0.0;
+  cv::Point2d sum(0.0, 0.0);
+  double suu = 0.0, svv = 0.0, suv = 0.0;
+  const cv::Point2d c0 = distort_pixel(lens, centre);
+  for (double v = c0.y - 12.0; v <= c0.y + 12.0; v += 0.05) {
+    for (double u = c0.x - 12.0; u <= c0.x + 12.0; u += 0.05) {
+      if (cv::norm(undistorter.ideal_from_distorted({u, v}) - centre) > r) continue;
+      n += 1.0;
+      sum += cv::Point2d(u, v);
+      suu += u * u;
+      svv += v * v;
+      suv += u * v;
+    }
+  }
+  const cv::Point2d c = sum * (1.0 / n);
+  const cv::Matx22d cov(suu / n - c.x * c.x, suv / n - c.x * c.y, suv / n - c.x * c.y, svv / n - c.y * c.y);
+  const double first_order = cv::norm(undistorter.ideal_from_distorted(c) - centre);
+  const double second_order = cv::norm(undistorter.ideal_centroid(c, cov) - centre);
+  EXPECT_GT(first_order, 0.01);
+  EXPECT_LT(second_order, 0.3 * first_order);
+  EXPECT_LT(second_order, 0.01);
+}
+
 }  // namespace
 }  // namespace pinball::vision

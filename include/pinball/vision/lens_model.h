@@ -89,6 +89,13 @@ class PointUndistorter {
   /// The ideal (pinhole) pixel of a pixel the sensor saw.
   cv::Point2d ideal_from_distorted(const cv::Point2d& distorted_px) const;
 
+  /// The ideal-image centroid of a small blob (a ball's image) whose centroid
+  /// on the sensor is `distorted_px` and whose pixels spread with covariance
+  /// `covariance_px2` about it: the undistorted centroid plus the second-order
+  /// terms of the lens's curvature across the blob and of its area change
+  /// (about 0.02 px for a 7 px ball at the edge of the typical wide lens).
+  cv::Point2d ideal_centroid(const cv::Point2d& distorted_px, const cv::Matx22d& covariance_px2) const;
+
   /// The intrinsics in use.
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }
 
