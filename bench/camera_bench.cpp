@@ -284,10 +284,10 @@ std::vector<CameraScenario> camera_scenarios(const CameraBenchOptions& o) {
   row_timed.row_time_s = t.row_time_s;
   vision::BallDetectorConfig mean_latency;
   mean_latency.latency_s = t.latency_mean_s();
-  // The steady clock over 64 frames (0.32 s at 200 fps); the latency is then the minimum one.
+  // The steady clock; the latency is then the minimum one.
   vision::BallDetectorConfig steady;
-  steady.dejitter_frames = 64;
-  steady.frame_period_s = 0.005;
+  steady.dejitter_frames = vision::kDefaultDejitterFrames;
+  steady.frame_period_s = 1.0 / simlab::SimCameraConfig{}.fps;
   steady.latency_s = t.latency_min_s;
   vision::BallDetectorConfig all = steady;
   all.lens = t.lens;

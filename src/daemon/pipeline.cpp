@@ -179,7 +179,7 @@ void apply_camera_corrections(const std::optional<vision::CameraIntrinsics>& len
   config.latency_s = timing->latency_s;
   config.row_time_s = timing->row_time_s;
   // The latency is measured on the steady clock's dates (pinball calibrate latency), so date frames by it.
-  config.dejitter_frames = 64;
+  config.dejitter_frames = vision::kDefaultDejitterFrames;
   config.frame_period_s = 1.0 / fps;
 }
 

@@ -230,7 +230,7 @@ TEST(TrackingSetup, TheCalibrationsLensAndTimingReachTheDetector) {
   EXPECT_DOUBLE_EQ(d.lens->k1, vision::typical_wide_lens().k1);
   EXPECT_DOUBLE_EQ(d.latency_s, 0.0071);
   EXPECT_DOUBLE_EQ(d.row_time_s, 1e-5);
-  EXPECT_EQ(d.dejitter_frames, 64);  // the latency was measured on the steady clock's dates
+  EXPECT_EQ(d.dejitter_frames, vision::kDefaultDejitterFrames);  // the latency was measured on the steady clock's dates
   EXPECT_DOUBLE_EQ(d.frame_period_s, 1.0 / config.camera.fps);
 
   // A lens calibrated on other images than the camera delivers is refused, naming the file.

@@ -191,7 +191,7 @@ struct TrackingSetup {
 
 /// The detector's corrections for a camera with this lens and timing (either may be
 /// absent): the lens undistorts the centroid; with a timing the frames are dated by the
-/// camera's steady clock (64 frames) less the latency, plus the ball's row's time.
+/// camera's steady clock (vision::kDefaultDejitterFrames) less the latency, plus the ball's row's time.
 void apply_camera_corrections(const std::optional<vision::CameraIntrinsics>& lens,
                               const std::optional<calibration::CameraTiming>& timing, double fps,
                               vision::BallDetectorConfig& config);
