@@ -7,10 +7,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pinball/core/least_squares_line.h"
 #include "pinball/sim/event_stepper.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
-#include "least_squares_line.h"
 #include "staged_progress.h"
 
 namespace pinball::bench {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <utility>
 
-#include "least_squares_line.h"
+#include "pinball/core/least_squares_line.h"
 #include "pinball/core/statistics.h"
 #include "transfer_bench.h"
 

@@ -1,10 +1,18 @@
-// `pinball calibrate camera|flippers|gravity`: measures the lab machine (or
-// the simulated one with --sim) and writes the calibration file.
+// `pinball calibrate camera|flippers|gravity|latency`: measures the lab
+// machine (or the simulated one with --sim) and writes the calibration file.
 
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <filesystem>
+#include <iomanip>
 #include <memory>
+#include <mutex>
 #include <numbers>
+#include <optional>
 #include <ostream>
+#include <sstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -16,19 +24,28 @@
 #include "pinball/calibration/camera_calibration.h"
 #include "pinball/calibration/flipper_calibration.h"
 #include "pinball/calibration/gravity_calibration.h"
+#include "pinball/calibration/latency_calibration.h"
+#include "pinball/core/clock.h"
+#include "pinball/core/rng.h"
+#include "pinball/firmware/can_link.h"
+#include "pinball/firmware/driver_bus.h"
+#include "pinball/firmware/socketcan_transport.h"
 #include "pinball/simlab/sim_lab.h"
+#include "pinball/simlab/sim_latency_lab.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/track/observation_io.h"
 #include "pinball/vision/capture_source.h"
+#include "pinball/vision/lens_model.h"
 
 namespace pinball::cli {
 
 CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
-  CLI::App* cmd = app.add_subcommand("calibrate", "measure the camera homography, the flippers or gravity");
-  cmd->add_option("kind", a.kind, "what to calibrate: camera, flippers, gravity")
+  CLI::App* cmd =
+      app.add_subcommand("calibrate", "measure the camera homography, the flippers, gravity or the camera's latency");
+  cmd->add_option("kind", a.kind, "what to calibrate: camera, flippers, gravity, latency")
       ->required()
-      ->check(CLI::IsMember({"camera", "flippers", "gravity"}));
+      ->check(CLI::IsMember({"camera", "flippers", "gravity", "latency"}));
   auto* sim = cmd->add_option("--sim", a.sim_board, "generate the inputs from the simulator on this board")
                   ->transform(data_file());
   cmd->add_option("--board", a.board, "the machine's board file (flipper names, sides, rough places)")
@@ -66,6 +83,26 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--sim-theta-offset-deg", a.sim_theta_offset_deg, "--sim: both flipper stops this much higher (degrees)")
       ->check(CLI::Range(-10.0, 10.0))
       ->needs(sim);
+  cmd->add_option("--device", a.device, "latency: the camera, /dev/videoN");
+  cmd->add_option("--can", a.can, "latency: the driver board's SocketCAN interface, e.g. can0");
+  cmd->add_option("--flipper", a.flipper, "latency: the flipper to fire, by the board's name (default: the first)");
+  cmd->add_option("--events", a.events, "latency: times the flipper is fired")->check(CLI::Range(3, 1000));
+  cmd->add_option("--sim-latency-ms", a.sim_latency_ms,
+                  "latency --sim: the simulated camera's minimum latency (ms; default: the typical camera's 7)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->needs(sim);
+  cmd->add_option("--actuation-delay-ms", a.actuation_delay_ms,
+                  "latency: the host's command to the flipper's first motion (ms)")
+      ->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--row-time-us", a.row_time_us,
+                  "latency: rolling shutter row time (us; 0: global shutter; default: the simulated camera's, "
+                  "or the file's camera_timing)")
+      ->check(CLI::Range(0.0, 1000.0));
+  cmd->add_option("--exposure-us", a.exposure_us,
+                  "latency: the camera's fixed exposure time (us), corrected for; 0: not corrected (default: the "
+                  "simulated camera's)")
+      ->check(CLI::Range(0.0, 100000.0));
+  cmd->add_option("--fps", a.fps, "latency: the frame rate asked of the camera")->check(CLI::Range(1.0, 2000.0));
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }
@@ -104,6 +141,7 @@ struct Context {
   std::unique_ptr<simlab::SimLab> lab;
   calibration::Calibration cal;
   nlohmann::json report;
+  std::string text;  // the text report, when a kind has its own (else the file's YAML)
 };
 
 calibration::HomographyFit camera(Context& c) {
@@ -272,13 +310,307 @@ void run_gravity(Context& c) {
   if (!c.a.png.empty()) sim::write_png(calibration::draw_gravity_figure(rolls, g), c.a.png);
 }
 
+// ---- latency: the camera's latency against a flipper fired at a known time ----
+
+// The board's flipper named `name` (the first for an empty name). Throws naming the choices.
+std::size_t flipper_index(const table::Board& board, const std::string& name) {
+  if (board.flippers.empty()) throw std::runtime_error("calibrate latency: the board has no flipper");
+  if (name.empty()) return 0;
+  std::string names;
+  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
+    if (board.flippers[i].name == name) return i;
+    names += (names.empty() ? "" : ", ") + board.flippers[i].name;
+  }
+  throw std::runtime_error("calibrate latency: --flipper " + name + ": not on the board (" + names + ")");
+}
+
+// What one measurement reports, text and JSON.
+void report_latency(Context& c, const calibration::LatencyEstimate& e, const calibration::LatencyOptions& o,
+                    const std::string& flipper, const simlab::SimLatencyRun* truth) {
+  nlohmann::json events = nlohmann::json::array();
+  for (std::size_t i = 0; i < e.events.size(); ++i) {
+    const calibration::LatencyEvent& ev = e.events[i];
+    nlohmann::json j = {{"event", i + 1}, {"command_s", ev.command_t_s}, {"used", ev.used()}};
+    if (ev.used()) {
+      j.update({{"latency_ms", ev.latency_s * 1e3}, {"motion_row_px", ev.motion_row_px}, {"fit_frames", ev.fit_frames},
+                {"fit_rms", ev.fit_rms}, {"stroke_sigmas", ev.stroke_sigmas}});
+    } else {
+      j["why"] = calibration::to_string(ev.rejection);
+    }
+    events.push_back(j);
+  }
+  nlohmann::json j = {{"flipper", flipper},
+                      {"latency_ms", e.latency_s * 1e3},
+                      {"spread_ms", e.spread_s * 1e3},
+                      {"events_used", e.events_used},
+                      {"events_rejected", e.events_rejected},
+                      {"row_time_us", o.row_time_s * 1e6},
+                      {"motion_row_px", e.motion_row_px},
+                      {"exposure_ms", o.exposure_s * 1e3},
+                      {"actuation_delay_ms", o.actuation_delay_s * 1e3},
+                      {"frame_period_ms", o.frame_period_s * 1e3},
+                      {"events", events}};
+  if (truth) {
+    j["truth"] = {{"latency_ms", truth->true_latency_s * 1e3},
+                  {"mean_latency_ms", truth->true_mean_latency_s * 1e3},
+                  {"error_ms", (e.latency_s - truth->true_latency_s) * 1e3}};
+  }
+  c.report["latency"] = j;
+
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(3);
+  s << "event  command (s)  latency (ms)  fit frames  fit rms\n";
+  for (std::size_t i = 0; i < e.events.size(); ++i) {
+    const calibration::LatencyEvent& ev = e.events[i];
+    s << std::setw(5) << i + 1 << "  " << std::setw(11) << ev.command_t_s << "  ";
+    if (ev.used()) {
+      s << std::setw(12) << ev.latency_s * 1e3 << "  " << std::setw(10) << ev.fit_frames << "  " << std::setw(7)
+        << std::setprecision(4) << ev.fit_rms << std::setprecision(3) << "\n";
+    } else {
+      s << "not used: " << calibration::to_string(ev.rejection) << "\n";
+    }
+  }
+  s << "camera latency " << e.latency_s * 1e3 << " ms (median of " << e.events_used << " of " << e.events.size()
+    << " events; standard deviation " << e.spread_s * 1e3 << " ms), flipper " << flipper << ", row time "
+    << o.row_time_s * 1e6 << " us, actuation delay " << o.actuation_delay_s * 1e3 << " ms\n";
+  if (truth) {
+    s << "simulated camera: true minimum latency " << truth->true_latency_s * 1e3 << " ms, error "
+      << std::showpos << (e.latency_s - truth->true_latency_s) * 1e3 << std::noshowpos << " ms\n";
+  }
+  c.text = s.str();
+}
+
+void run_latency_sim(Context& c) {
+  const CalibrateArgs& a = c.a;
+  simlab::SimLatencyOptions o;
+  o.seed = a.seed;
+  o.events = a.events;
+  o.flipper = flipper_index(c.board, a.flipper);
+  o.actuation_delay_s = a.actuation_delay_ms * 1e-3;
+  if (a.sim_latency_ms >= 0.0) o.camera.realism.latency_min_s = a.sim_latency_ms * 1e-3;
+  c.err << "calibrate latency: simulating " << o.events << " fires of " << c.board.flippers[o.flipper].name << "\n";
+  const simlab::SimLatencyRun run = simlab::simulate_latency_run(c.board, o);
+  calibration::LatencyOptions lo = run.timing;
+  if (a.row_time_us >= 0.0) lo.row_time_s = a.row_time_us * 1e-6;
+  if (a.exposure_us >= 0.0) lo.exposure_s = a.exposure_us * 1e-6;
+  const calibration::LatencyEstimate e = calibration::measure_latency(run.recording, run.region, lo);
+  c.cal.camera_timing = e.camera_timing();
+  report_latency(c, e, lo, c.board.flippers[o.flipper].name, &run);
+}
+
+// SIGINT/SIGTERM during the lab run: stop firing, release, report.
+std::atomic<bool> g_latency_interrupted{false};
+extern "C" void on_latency_signal(int) { g_latency_interrupted.store(true); }
+
+// Installs the handlers for its lifetime.
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    g_latency_interrupted.store(false);
+    struct sigaction sa {};
+    sa.sa_handler = on_latency_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~InterruptGuard() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
+
+// Sleeps until steady time t_s (s), in short naps so that an interrupt is seen.
+void sleep_until(double t_s) {
+  while (!g_latency_interrupted.load()) {
+    const double left = t_s - steady_now_s();
+    if (left <= 0.0) return;
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::min(left, 0.01)));
+  }
+}
+
+// Writes what the bus has queued (a Fire or a Release) now and returns the
+// steady time it was written to the socket (s).
+double send_now(firmware::DriverBus& bus) {
+  // The bus thread may hold the socket for a moment: try again until the queue is out.
+  for (int i = 0; i < 1000; ++i) {
+    if (bus.send_queued(steady_now_s())) return steady_now_s();
+    std::this_thread::sleep_for(std::chrono::microseconds(20));
+  }
+  return steady_now_s();  // the bus thread sent it meanwhile, within its period
+}
+
+void run_latency_lab(Context& c) {
+  const CalibrateArgs& a = c.a;
+  if (a.device.empty() || a.can.empty()) {
+    throw std::runtime_error("calibrate latency: give --device /dev/videoN and --can IFACE (or --sim BOARD)");
+  }
+  const std::string from = a.calibration.empty() ? a.out : a.calibration;
+  if (from.empty()) {
+    throw std::runtime_error("calibrate latency: give --calibration FILE with the camera and flippers sections");
+  }
+  // Everything that can be checked before the hardware moves.
+  const calibration::Calibration file = calibration::read_calibration(from);
+  const vision::CameraHomography h = calibration::camera_homography(file, from);
+  calibration::check_calibration_matches_board(file, from, c.board);
+  const std::size_t index = flipper_index(c.board, a.flipper);
+  const std::string& name = c.board.flippers[index].name;
+  table::Flipper flipper = c.board.flippers[index];
+  bool calibrated = false;
+  for (const calibration::FlipperCalibration& f : file.flippers) {
+    if (f.name != name) continue;
+    flipper.pivot = f.pivot_m;
+    flipper.length_m = f.length_m;
+    flipper.theta_min_rad = f.theta_min_rad;
+    flipper.theta_max_rad = f.theta_max_rad;
+    calibrated = true;
+  }
+  if (!calibrated) throw std::runtime_error(from + ":flippers: " + name + " is not calibrated (pinball calibrate flippers)");
+  calibration::LatencyOptions lo;
+  lo.actuation_delay_s = a.actuation_delay_ms * 1e-3;
+  lo.exposure_s = std::max(a.exposure_us, 0.0) * 1e-6;
+  if (a.row_time_us >= 0.0) {
+    lo.row_time_s = a.row_time_us * 1e-6;
+  } else if (file.camera_timing) {
+    lo.row_time_s = file.camera_timing->row_time_s;
+  } else {
+    throw std::runtime_error("calibrate latency: give --row-time-us (the sensor's line time; 0 for a global shutter): " +
+                             from + " has no camera_timing section to take it from");
+  }
+  const cv::Size size(file.camera->image_width_px, file.camera->image_height_px);
+  const std::optional<vision::CameraIntrinsics> lens =
+      file.intrinsics ? std::optional<vision::CameraIntrinsics>(file.intrinsics->lens) : std::nullopt;
+  const calibration::FlipperRegion region = calibration::flipper_region(
+      flipper,
+      [&](const Vec2& p) {
+        const cv::Point2d ideal = h.image_from_board(p);
+        return lens ? vision::distort_pixel(*lens, ideal) : ideal;
+      },
+      size);
+
+  // The hardware: say everything that is missing at once, before opening anything.
+  std::string missing;
+  if (!vision::is_device_source(a.device)) {
+    missing = a.device + ": not a camera device (a video file cannot watch a flipper being fired)";
+  } else if (a.device.rfind("/dev/", 0) == 0 && !std::filesystem::exists(a.device)) {
+    missing = a.device + ": no such camera device";
+  }
+  const firmware::CanLinkVerdict link =
+      firmware::judge_can_link(firmware::read_can_link(a.can), a.can, firmware::kBitrate_bps);
+  if (!link.ok) missing += (missing.empty() ? "" : "; ") + std::string("--can ") + link.message;
+  if (!missing.empty()) throw std::runtime_error("calibrate latency: " + missing + "; nothing was fired or written");
+
+  vision::CaptureConfig cc;
+  cc.source = a.device;
+  cc.width_px = size.width;
+  cc.height_px = size.height;
+  cc.fps = a.fps;
+  vision::CaptureSource camera(cc);
+  if (camera.frame_size() != size) {
+    throw std::runtime_error("calibrate latency: " + a.device + " gives " + std::to_string(camera.frame_size().width) +
+                             "x" + std::to_string(camera.frame_size().height) + " frames, the calibration is for " +
+                             std::to_string(size.width) + "x" + std::to_string(size.height));
+  }
+  firmware::SocketCanOptions so;
+  so.interface = a.can;
+  firmware::SocketCanTransport transport(so);
+  firmware::DriverBusOptions bo;
+  bo.driver_count = static_cast<int>(c.board.flippers.size());
+  firmware::DriverBus bus(transport, bo);  // its destructor stops the thread with every coil off
+  InterruptGuard interrupts;
+  bus.start();  // from here the bus's destructor stops it with every coil off
+  const double answer_by = steady_now_s() + 2.0;
+  while (bus.state() != firmware::BusState::kRunning && steady_now_s() < answer_by && !g_latency_interrupted.load()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (bus.state() != firmware::BusState::kRunning) {
+    throw std::runtime_error("calibrate latency: the driver board did not answer on " + a.can + " within 2 s");
+  }
+
+  // The camera's thread keeps the region of every frame; this one fires.
+  calibration::LatencyRecording recording;
+  std::atomic<bool> stop{false};
+  std::string camera_error;  // written by the reader before it ends, read after the join
+  std::thread reader([&] {
+    try {
+      vision::Frame frame;
+      int failures = 0;
+      while (!stop.load()) {
+        if (camera.read(frame)) {
+          recording.add_frame(region, frame.gray, frame.t_s, frame.sequence);
+          failures = 0;
+        } else if (++failures > 100) {
+          throw std::runtime_error("the camera stopped delivering frames");
+        } else {
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+      }
+    } catch (const std::exception& e) {
+      camera_error = e.what();
+      stop.store(true);
+    }
+  });
+  struct Join {
+    std::thread& t;
+    std::atomic<bool>& stop;
+    ~Join() {
+      stop.store(true);
+      if (t.joinable()) t.join();
+    }
+  } join{reader, stop};
+  // Every coil off first on the way out, whatever happens below (declared
+  // last: released before the camera's thread is joined).
+  struct CoilsOff {
+    firmware::DriverBus& bus;
+    ~CoilsOff() {
+      bus.release_all();
+      bus.send_queued(steady_now_s());
+    }
+  } coils_off{bus};
+  const double period = 1.0 / camera.fps();
+  const double hold_s = 0.1, spacing_s = 0.5;
+  Rng rng(a.seed);
+  std::vector<double> commands;
+  const int driver = static_cast<int>(index);
+  double next = steady_now_s() + (lo.dejitter_frames + 40) * period;  // the frame clock settles first
+  c.err << "calibrate latency: firing " << name << " " << a.events << " times, " << spacing_s << " s apart\n";
+  for (int k = 0; k < a.events && !stop.load() && !g_latency_interrupted.load(); ++k) {
+    sleep_until(next + rng.uniform(0.0, period));  // a random phase against the frames
+    if (g_latency_interrupted.load() || stop.load()) break;
+    if (!bus.fire(driver)) throw std::runtime_error("calibrate latency: the driver bus refused the fire command");
+    commands.push_back(send_now(bus));
+    sleep_until(commands.back() + hold_s);
+    bus.release(driver);
+    send_now(bus);
+    next = commands.back() + spacing_s;
+  }
+  sleep_until(steady_now_s() + 0.3);  // the last event's window
+  stop.store(true);
+  reader.join();
+  if (g_latency_interrupted.load()) throw std::runtime_error("calibrate latency: interrupted; every coil released, nothing written");
+  if (!camera_error.empty()) throw std::runtime_error("calibrate latency: " + a.device + ": " + camera_error);
+  if (bus.counters().coils_dropped > 0 || bus.state() != firmware::BusState::kRunning) {
+    throw std::runtime_error("calibrate latency: the driver board dropped the coils or the session during the run");
+  }
+  recording.command_t_s = commands;
+  lo.frame_period_s = calibration::estimate_frame_period_s(recording, period);
+  const calibration::LatencyEstimate e = calibration::measure_latency(recording, region, lo);
+  c.cal.camera_timing = e.camera_timing();
+  report_latency(c, e, lo, name, nullptr);
+}
+
 }  // namespace
 
 int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) {
   const std::string board_path = a.sim_board.empty() ? a.board : a.sim_board;
   if (board_path.empty()) throw std::runtime_error("calibrate: give --board BOARD (or --sim BOARD)");
-  Context c{a, err, table::load_board(board_path), nullptr, {}, {}};
-  if (!a.sim_board.empty()) {
+  Context c{a, err, table::load_board(board_path), nullptr, {}, {}, {}};
+  if (!a.sim_board.empty() && a.kind != "latency") {
     simlab::SimLabOptions o;
     o.seed = a.seed;
     o.pivot_offset_m = Vec2{a.sim_pivot_offset_mm.at(0), a.sim_pivot_offset_mm.at(1)} * 1e-3;
@@ -297,16 +629,25 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
   if (a.kind == "camera") run_camera(c);
   if (a.kind == "flippers") run_flippers(c);
   if (a.kind == "gravity") run_gravity(c);
+  if (a.kind == "latency") {
+    if (a.sim_board.empty()) {
+      run_latency_lab(c);
+    } else {
+      run_latency_sim(c);
+    }
+  }
   if (!a.out.empty()) {
     calibration::write_calibration(c.cal, a.out);
     err << "calibrate: wrote " << a.out << "\n";
   }
   c.report["kind"] = a.kind;
   c.report["board"] = board_path;
-  c.report["simulated"] = c.lab != nullptr;
+  c.report["simulated"] = !a.sim_board.empty();
   c.report["out"] = a.out;
   if (a.json) {
     out << c.report.dump(2) << "\n";
+  } else if (!c.text.empty()) {
+    out << c.text;
   } else {
     out << calibration::calibration_to_yaml(c.cal);
   }

@@ -122,9 +122,9 @@ struct LearnArgs {
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& args);
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err);
 
-/// `pinball calibrate camera|flippers|gravity`
+/// `pinball calibrate camera|flippers|gravity|latency`
 struct CalibrateArgs {
-  std::string kind;                  ///< camera | flippers | gravity
+  std::string kind;                  ///< camera | flippers | gravity | latency
   std::string sim_board;             ///< --sim BOARD: generate the inputs from the simulator
   std::string board;                 ///< the machine's board file (names, sides, rough places)
   std::string image;                 ///< camera: marker image
@@ -146,6 +146,15 @@ struct CalibrateArgs {
   std::vector<double> sim_pivot_offset_mm{0.0, 0.0};
   double sim_length_offset_mm = 0.0;
   double sim_theta_offset_deg = 0.0;
+  std::string device;                ///< latency: the camera, /dev/videoN
+  std::string can;                   ///< latency: the driver board's SocketCAN interface (can0)
+  std::string flipper;               ///< latency: the flipper fired (board name); empty: the board's first
+  int events = 20;                   ///< latency: times the flipper is fired
+  double sim_latency_ms = -1.0;      ///< latency --sim: the camera's minimum latency (ms); < 0: the typical camera's
+  double actuation_delay_ms = firmware::kDefaultActuationDelay_s * 1e3;  ///< latency: command to first motion (ms)
+  double row_time_us = -1.0;         ///< latency: rolling shutter row time (µs); < 0: the camera's (--sim) or the file's
+  double exposure_us = -1.0;         ///< latency: the camera's exposure time (µs); < 0: the simulated camera's, or 0 in the lab
+  double fps = 200.0;                ///< latency: the frame rate asked of the camera
   bool json = false;                 ///< one JSON object on stdout
 };
 CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& args);

@@ -157,6 +157,7 @@ SimCameraSource::SimCameraSource(const table::Board& board, const SimCameraConfi
                   std::isfinite(r.gain_drift_time_s) && r.gain_drift_time_s > 0.0,
               "sim camera", "gain_drift_sigma must be in [0, 0.5] and gain_drift_time_s > 0");
   for (const table::Flipper& f : board.flippers) flipper_theta_.push_back(f.theta_min_rad);
+  flipper_history_.assign(kHistory * flipper_theta_.size(), 0.0);
   period_s_ = 1.0 / c.fps;
   // Its own stream: switching realism on leaves the scene, lamps and noise as they were.
   timing_rng_ = Rng(c.seed ^ 0x5DEECE66DULL);
@@ -409,6 +410,94 @@ void SimCameraSource::draw_flippers(cv::Mat& image) const {
   }
 }
 
+void SimCameraSource::draw_flippers_exposed(double start_s, cv::Mat& image) {
+  constexpr int kShift = 4;
+  constexpr double kScale = 1 << kShift;
+  constexpr int kCoarse = 17;     // instants that find where the flipper is during the frame
+  constexpr int kMaxInstants = 96;
+  const double row_time = config_.realism.row_time_s;
+  const double exposure = config_.exposure_s;
+  const cv::Rect frame_rect(0, 0, image.cols, image.rows);
+  for (std::size_t i = 0; i < flipper_theta_.size(); ++i) {
+    const table::Flipper& f = board_.flippers[i];
+    const cv::Point2d pivot = image_from_board(f.pivot);
+    const int width_px = std::max(1, static_cast<int>(std::lround(config_.flipper_width_m * homography_.px_per_m_at(f.pivot))));
+    // Coarse pass over the whole frame's exposure: does it move, and which rows can it cover?
+    const double frame_span = (image.rows - 1) * row_time + exposure;
+    double lo_rad = 1e300, hi_rad = -1e300;
+    double u0 = pivot.x, u1 = pivot.x, v0 = pivot.y, v1 = pivot.y;
+    for (int k = 0; k < kCoarse; ++k) {
+      const double theta = flipper_angle_at(i, start_s + frame_span * k / (kCoarse - 1));
+      lo_rad = std::min(lo_rad, theta);
+      hi_rad = std::max(hi_rad, theta);
+      const cv::Point2d tip = image_from_board(table::flipper_tip(f, theta));
+      u0 = std::min(u0, tip.x);
+      u1 = std::max(u1, tip.x);
+      v0 = std::min(v0, tip.y);
+      v1 = std::max(v1, tip.y);
+    }
+    if (hi_rad == lo_rad || frame_span <= 0.0) {  // still during the frame: one sharp drawing
+      const cv::Point2d tip = image_from_board(table::flipper_tip(f, lo_rad));
+      cv::line(image, cv::Point(static_cast<int>(std::lround(pivot.x * kScale)), static_cast<int>(std::lround(pivot.y * kScale))),
+               cv::Point(static_cast<int>(std::lround(tip.x * kScale)), static_cast<int>(std::lround(tip.y * kScale))),
+               cv::Scalar(config_.flipper_gray), width_px, cv::LINE_AA, kShift);
+      continue;
+    }
+    const int reach = width_px + 3;
+    const cv::Rect box = cv::Rect(cv::Point(static_cast<int>(std::floor(u0)) - reach, static_cast<int>(std::floor(v0)) - reach),
+                                  cv::Point(static_cast<int>(std::ceil(u1)) + reach + 1,
+                                            static_cast<int>(std::ceil(v1)) + reach + 1)) &
+                         frame_rect;
+    if (box.area() == 0) continue;
+    // Instants evenly over the exposures of the box's rows, fine enough that
+    // the tip moves about a quarter pixel from one to the next.
+    const double t_first = start_s + box.y * row_time;
+    const double span = (box.height - 1) * row_time + exposure;
+    const double sweep_px = (hi_rad - lo_rad) * f.length_m * homography_.px_per_m_at(f.pivot);
+    const int instants = std::clamp(static_cast<int>(std::ceil(sweep_px / 0.25)) + 2, 2, kMaxInstants);
+    const double step = span / (instants - 1);
+    flipper_instant_.resize(static_cast<std::size_t>(instants));
+    for (int j = 0; j < instants; ++j) flipper_instant_[static_cast<std::size_t>(j)] = flipper_angle_at(i, t_first + j * step);
+    // Row r of the box averages the instants inside its own exposure (the nearest one when it has none).
+    flipper_sum_.create(box.size(), CV_16U);
+    flipper_sum_.setTo(0);
+    flipper_sample_.create(box.size(), CV_8U);
+    flipper_row_count_.assign(static_cast<std::size_t>(box.height), 0);
+    const auto first_instant = [&](int r) {
+      return std::clamp(static_cast<int>(std::ceil((r * row_time) / step - 1e-9)), 0, instants - 1);
+    };
+    const auto last_instant = [&](int r) {
+      const int j = std::clamp(static_cast<int>(std::floor((r * row_time + exposure) / step + 1e-9)), 0, instants - 1);
+      return std::max(j, first_instant(r));
+    };
+    for (int j = 0; j < instants; ++j) {
+      flipper_sample_.setTo(0);
+      const cv::Point2d tip = image_from_board(table::flipper_tip(f, flipper_instant_[static_cast<std::size_t>(j)]));
+      const auto fixed = [&](const cv::Point2d& p) {
+        return cv::Point(static_cast<int>(std::lround((p.x - box.x) * kScale)), static_cast<int>(std::lround((p.y - box.y) * kScale)));
+      };
+      cv::line(flipper_sample_, fixed(pivot), fixed(tip), cv::Scalar(255), width_px, cv::LINE_AA, kShift);
+      for (int r = 0; r < box.height; ++r) {
+        if (j < first_instant(r) || j > last_instant(r)) continue;
+        const auto* from = flipper_sample_.ptr<std::uint8_t>(r);
+        auto* to = flipper_sum_.ptr<std::uint16_t>(r);
+        for (int u = 0; u < box.width; ++u) to[u] = static_cast<std::uint16_t>(to[u] + from[u]);
+        ++flipper_row_count_[static_cast<std::size_t>(r)];
+      }
+    }
+    for (int r = 0; r < box.height; ++r) {
+      const double scale = 1.0 / (255.0 * std::max(flipper_row_count_[static_cast<std::size_t>(r)], 1));
+      const auto* sum = flipper_sum_.ptr<std::uint16_t>(r);
+      auto* row = image.ptr<std::uint8_t>(box.y + r) + box.x;
+      for (int u = 0; u < box.width; ++u) {
+        if (sum[u] == 0) continue;
+        const double a = sum[u] * scale;
+        row[u] = cv::saturate_cast<std::uint8_t>(row[u] + a * (config_.flipper_gray - row[u]));
+      }
+    }
+  }
+}
+
 void SimCameraSource::set_flipper_angles(std::span<const double> theta_rad) {
   for (std::size_t i = 0; i < flipper_theta_.size() && i < theta_rad.size(); ++i) flipper_theta_[i] = theta_rad[i];
 }
@@ -440,13 +529,16 @@ void SimCameraSource::observe_ball(double t_s, const Vec2& p_board, bool in_play
     if (!(t_s > newest.t_s)) return;  // time must increase; a repeated time adds nothing
   }
   const Sample s{t_s, p_board, in_play};
+  std::size_t slot = history_head_;
   if (history_size_ < kHistory) {
-    history_[(history_head_ + history_size_) % kHistory] = s;
+    slot = (history_head_ + history_size_) % kHistory;
     ++history_size_;
   } else {
-    history_[history_head_] = s;
     history_head_ = (history_head_ + 1) % kHistory;
   }
+  history_[slot] = s;
+  std::copy(flipper_theta_.begin(), flipper_theta_.end(),
+            flipper_history_.begin() + static_cast<std::ptrdiff_t>(slot * flipper_theta_.size()));
 }
 
 void SimCameraSource::reset(double t_s) {
@@ -455,20 +547,18 @@ void SimCameraSource::reset(double t_s) {
   schedule_next_frame(t_s);
 }
 
-bool SimCameraSource::sample_at(double t_s, Vec2& p, bool& in_play) const {
-  if (history_size_ == 0) return false;
+void SimCameraSource::bracket(double t_s, std::size_t& lo, std::size_t& hi, double& fraction) const {
   auto at = [&](std::size_t i) -> const Sample& { return history_[(history_head_ + i) % kHistory]; };
+  lo = 0;
+  hi = history_size_ - 1;
+  fraction = 0.0;
   if (t_s <= at(0).t_s) {
-    p = at(0).p;
-    in_play = at(0).in_play;
-    return true;
+    hi = 0;
+    return;
   }
-  std::size_t lo = 0;
-  std::size_t hi = history_size_ - 1;
   if (t_s >= at(hi).t_s) {
-    p = at(hi).p;
-    in_play = at(hi).in_play;
-    return true;
+    lo = hi;
+    return;
   }
   while (hi - lo > 1) {  // at(lo).t < t <= at(hi).t
     const std::size_t mid = (lo + hi) / 2;
@@ -478,16 +568,30 @@ bool SimCameraSource::sample_at(double t_s, Vec2& p, bool& in_play) const {
       hi = mid;
     }
   }
-  const Sample& a = at(lo);
-  const Sample& b = at(hi);
+  fraction = (t_s - at(lo).t_s) / (at(hi).t_s - at(lo).t_s);
+}
+
+bool SimCameraSource::sample_at(double t_s, Vec2& p, bool& in_play) const {
+  if (history_size_ == 0) return false;
+  std::size_t lo = 0, hi = 0;
+  double f = 0.0;
+  bracket(t_s, lo, hi, f);
+  const Sample& a = history_[(history_head_ + lo) % kHistory];
+  const Sample& b = history_[(history_head_ + hi) % kHistory];
   in_play = b.in_play;
-  if (a.in_play && b.in_play) {
-    const double f = (t_s - a.t_s) / (b.t_s - a.t_s);
-    p = a.p + f * (b.p - a.p);
-  } else {
-    p = b.p;
-  }
+  p = lo != hi && a.in_play && b.in_play ? Vec2(a.p + f * (b.p - a.p)) : b.p;
   return true;
+}
+
+double SimCameraSource::flipper_angle_at(std::size_t i, double t_s) const {
+  if (history_size_ == 0) return flipper_theta_[i];
+  std::size_t lo = 0, hi = 0;
+  double f = 0.0;
+  bracket(t_s, lo, hi, f);
+  const std::size_t n = flipper_theta_.size();
+  const double a = flipper_history_[((history_head_ + lo) % kHistory) * n + i];
+  const double b = flipper_history_[((history_head_ + hi) % kHistory) * n + i];
+  return a + f * (b - a);
 }
 
 std::span<const Vec2> SimCameraSource::BallPaths::row(int v) const {
@@ -573,7 +677,7 @@ bool SimCameraSource::read(vision::Frame& out) {
       schedule_next_frame(next_nominal_s_ + period_s_);
       continue;
     }
-    compose(ball_paths(start), start, out);
+    compose(ball_paths(start), start, true, out);
     Vec2 p_ball;
     const double v_ball = ball_row(start, p_ball);
     truth_.t_row0_exposure_s = row0_mid;
@@ -593,7 +697,7 @@ void SimCameraSource::render(std::span<const Vec2> path_board, double t_mid_s, v
   paths.common = path_board.first(std::min(path_board.size(), kMaxPath));
   paths.total = std::max(1, static_cast<int>(paths.common.size()));
   const double start = t_mid_s - 0.5 * config_.exposure_s;
-  compose(paths, start, out);
+  compose(paths, start, false, out);
   if (!paths.common.empty()) {
     Vec2 mean = Vec2::Zero();
     for (const Vec2& p : paths.common) mean += p;
@@ -660,7 +764,7 @@ void SimCameraSource::apply_gain(double start_s, cv::Mat& image) {
   }
 }
 
-void SimCameraSource::compose(const BallPaths& paths, double start_s, vision::Frame& out) {
+void SimCameraSource::compose(const BallPaths& paths, double start_s, bool exposed, vision::Frame& out) {
   advance_effects();
   floor_.copyTo(out.gray);  // reuses out.gray's buffer when it already has this size
   cv::Mat& image = out.gray;
@@ -671,7 +775,11 @@ void SimCameraSource::compose(const BallPaths& paths, double start_s, vision::Fr
     cv::add(target, lamps_[i].values, target);
     ++truth_.lamps_lit;
   }
-  draw_flippers(image);
+  if (exposed) {
+    draw_flippers_exposed(start_s, image);
+  } else {
+    draw_flippers(image);
+  }
   const std::span<const Vec2> centre_path = paths.common;
   truth_.ball_present = !centre_path.empty();
   truth_.ball_whole_exposure = !centre_path.empty() && static_cast<int>(centre_path.size()) == paths.total;

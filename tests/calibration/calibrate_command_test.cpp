@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include "common/command_test.h"
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/table/board_loader.h"
+#include "pinball/vision/camera_homography.h"
 
 namespace {
 
@@ -100,6 +102,103 @@ TEST_F(Calibrate, TheSimulatedMachineIsMountedOffOnlyWhenAsked) {
     EXPECT_NEAR(moved.y(), -0.002, 0.001) << "flipper " << i;
   }
   EXPECT_EQ(run("calibrate flippers --board boards/mit1993.board --sim-length-offset-mm 2").exit_code, 2);  // needs --sim
+}
+
+// The lab's file before the latency is measured: camera and flippers as the
+// board file and the simulated camera's default view have them, and gravity.
+pinball::calibration::Calibration lab_file() {
+  namespace cal = pinball::calibration;
+  const pinball::table::Board board = pinball::table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  cal::Calibration c;
+  c.board = "boards/mit1993.board";
+  cal::CameraCalibration camera;
+  camera.image_from_board = pinball::vision::CameraHomography::default_view(board, {640, 480}).image_from_board_matrix();
+  camera.image_width_px = 640;
+  camera.image_height_px = 480;
+  camera.markers_used = 7;
+  c.camera = camera;
+  for (const pinball::table::Flipper& f : board.flippers) {
+    cal::FlipperCalibration fc;
+    fc.name = f.name;
+    fc.side = f.side;
+    fc.pivot_m = f.pivot;
+    fc.tip_m = pinball::table::flipper_tip(f, f.theta_min_rad);
+    fc.length_m = f.length_m;
+    fc.theta_min_rad = f.theta_min_rad;
+    fc.theta_max_rad = f.theta_max_rad;
+    c.flippers.push_back(fc);
+  }
+  cal::GravityEstimate g;
+  g.g_mps2 = 1.11;
+  g.ci_low_mps2 = 1.10;
+  g.ci_high_mps2 = 1.12;
+  g.rolls_used = 5;
+  c.gravity = g;
+  return c;
+}
+
+// `calibrate latency --sim`: the simulated typical camera's 7 ms are found,
+// the camera_timing section is written and the others are kept.
+TEST_F(Calibrate, LatencyOnTheSimulatedCameraWritesTheTimingAndKeepsTheRest) {
+  const std::string file = (dir_ / "lab.yaml").string();
+  pinball::calibration::write_calibration(lab_file(), file);
+  Result r = run("calibrate latency --sim boards/mit1993.board --events 8 --out " + file + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  const nlohmann::json& l = j.at("latency");
+  EXPECT_EQ(l.at("events").size(), 8u);
+  EXPECT_GE(l.at("events_used").get<int>(), 7);
+  EXPECT_EQ(l.at("truth").at("latency_ms").get<double>(), 7.0);
+  EXPECT_LT(std::abs(l.at("truth").at("error_ms").get<double>()), 0.5);
+  EXPECT_NEAR(l.at("row_time_us").get<double>(), 10.0, 1e-9);
+  EXPECT_EQ(l.at("flipper"), "left_flipper");
+  const pinball::calibration::Calibration c = pinball::calibration::read_calibration(file);
+  ASSERT_TRUE(c.camera_timing);
+  EXPECT_NEAR(c.camera_timing->latency_s, l.at("latency_ms").get<double>() * 1e-3, 1e-12);
+  EXPECT_EQ(c.camera_timing->events_used, l.at("events_used").get<int>());
+  EXPECT_NEAR(c.camera_timing->row_time_s, 1e-5, 1e-12);
+  EXPECT_TRUE(c.camera);
+  EXPECT_TRUE(c.gravity);
+  EXPECT_EQ(c.flippers.size(), 2u);
+
+  // Text: the events, the result and the truth; another latency and flipper.
+  r = run("calibrate latency --sim boards/mit1993.board --events 5 --sim-latency-ms 12 --flipper right_flipper");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, std::regex("camera latency ([0-9.]+) ms"))) << r.out;
+  EXPECT_NEAR(std::stod(m[1]), 12.0, 0.5);
+  EXPECT_NE(r.out.find("true minimum latency 12.000 ms, error "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("flipper right_flipper"), std::string::npos) << r.out;
+  EXPECT_EQ(pinball::testing::count_lines(r.out), 1 + 5 + 2);
+  EXPECT_EQ(run("calibrate latency --sim boards/mit1993.board --events 5 --flipper middle").exit_code, 1);
+}
+
+// The lab path on a machine without the camera or the CAN interface: one
+// line naming both, nothing fired, nothing written.
+TEST_F(Calibrate, LatencyInTheLabWithoutHardwareFailsClearlyAndWritesNothing) {
+  const std::string file = (dir_ / "lab.yaml").string();
+  const std::string out = (dir_ / "out.yaml").string();
+  pinball::calibration::write_calibration(lab_file(), file);
+  Result r = run("calibrate latency --board boards/mit1993.board --calibration " + file +
+                 " --device /dev/video97 --can pinballcan7 --row-time-us 10 --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(pinball::testing::count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("/dev/video97: no such camera device"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pinballcan7"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nothing was fired or written"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // What it needs is asked for before any hardware is touched.
+  r = run("calibrate latency --board boards/mit1993.board --calibration " + file + " --device /dev/video97 --can can0");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--row-time-us"), std::string::npos) << r.err;
+  r = run("calibrate latency --board boards/mit1993.board --calibration " + file);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("give --device"), std::string::npos) << r.err;
+  const std::string before = pinball::testing::slurp(file);
+  r = run("calibrate latency --board boards/mit1993.board --calibration " + file +
+          " --device /dev/video97 --can pinballcan7 --row-time-us 10 --out " + file);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(pinball::testing::slurp(file), before) << "a failed run leaves the file as it was";
 }
 
 }  // namespace

@@ -112,6 +112,50 @@ TEST(SimCameraSource, MotionBlurSpreadsTheBallAlongItsPath) {
   EXPECT_GT(cv::norm(moving.gray, empty.gray, cv::NORM_L1), 0.0);
 }
 
+// A frame is drawn as its rows were exposed, not as the table stands when it
+// is delivered: a flipper raised at t_up shows up only in rows exposed after
+// t_up, and frames delivered 10 ms later still show it down if exposed before.
+TEST(SimCameraSource, AFlipperIsDrawnWhereItWasWhenItsRowsWereExposed) {
+  const table::Board& board = thesis_board();
+  const table::Flipper& f = board.flippers[0];
+  SimCameraConfig c;
+  c.noise_sigma = 0.0;
+  c.exposure_s = 0.001;
+  c.realism.row_time_s = 1e-5;
+  c.realism.latency_min_s = 0.010;
+  SimCameraSource camera(board, c);
+  camera.set_lamps_blinking(false);
+  // A pixel the raised bat covers and the lowered one does not.
+  const cv::Point2d probe = camera.image_from_board(f.pivot + 0.7 * (table::flipper_tip(f, f.theta_max_rad) - f.pivot));
+  const int row = static_cast<int>(std::lround(probe.y));
+  ASSERT_GT(row * c.realism.row_time_s, 0.0015) << "the probe's row must be exposed well after row 0";
+  // Raised 0.5 ms before the probe's row of the frame starting at 45 ms begins its exposure, after row 0 ended.
+  const double t_up = 0.045 + row * c.realism.row_time_s - 0.0005;
+  std::vector<double> theta{f.theta_min_rad, board.flippers[1].theta_min_rad};
+  vision::Frame frame;
+  int before = 0, after = 0;
+  for (int step = 1; step <= 1600; ++step) {
+    const double t = step * 0.0001;
+    theta[0] = t >= t_up ? f.theta_max_rad : f.theta_min_rad;
+    camera.set_flipper_angles(theta);
+    camera.observe_ball(t, Vec2{-1.0, -1.0}, false);
+    while (camera.read(frame)) {
+      const double row_start = frame.driver_t_s + row * c.realism.row_time_s;
+      const int gray = frame.gray.at<std::uint8_t>(cv::Point(probe));
+      if (row_start + c.exposure_s < t_up) {
+        EXPECT_LT(gray, 120) << "exposed before the flipper rose, delivered at " << frame.t_s;
+        ++before;
+      } else if (row_start > t_up) {
+        EXPECT_GT(gray, 170) << "exposed after the flipper rose";
+        ++after;
+      }
+    }
+  }
+  EXPECT_GE(before, 8);
+  EXPECT_GE(after, 10);
+  EXPECT_NEAR(frame.t_s - camera.truth().t_row0_exposure_s, 0.010, 1e-12);
+}
+
 TEST(SimCameraSource, PlasticHidesTheBallAndTheTruthSaysSo) {
   SimCameraConfig c;
   c.noise_sigma = 0.0;

@@ -15,6 +15,10 @@
 // exposed), exposure-start jitter, a delivery latency (the frame is stamped
 // and handed over when it arrives, as a host clock stamps a real camera's),
 // lamp flicker (per row, integrated over the exposure) and a slow gain drift.
+// A frame that read() delivers shows the flippers at the angles they had
+// while it was exposed (each row at its own time under a rolling shutter,
+// blurred over the exposure), so that a flipper fired at a known time is
+// seen late by exactly the camera's latency.
 
 #include <array>
 #include <cstdint>
@@ -179,7 +183,9 @@ class SimCameraSource final : public vision::FrameSource {
   /// Calibration markers (stickers on the table) drawn on top of everything
   /// from the next frame on, centred on these board points; empty: none.
   void set_markers(std::span<const Vec2> centres_board);
-  /// Sets the flippers' angles (rad, board order) as observe() would, without a game state.
+  /// Sets the flippers' angles (rad, board order) as observe() would, without
+  /// a game state: render() draws them, and the next observe_ball() records
+  /// them with its time for the frames read() delivers.
   void set_flipper_angles(std::span<const double> theta_rad);
   /// Freezes (false) or resumes (true) lamp toggling.
   void set_lamps_blinking(bool blinking) { lamps_blinking_ = blinking; }
@@ -231,7 +237,15 @@ class SimCameraSource final : public vision::FrameSource {
   // Draws the row-dependent gain (flicker, drift) of a frame exposed from start_s.
   void apply_gain(double start_s, cv::Mat& image);
   void schedule_next_frame(double nominal_start_s);
+  // Draws the flippers at their current angles (render(), or when nothing is observed).
   void draw_flippers(cv::Mat& image) const;
+  // Draws the flippers as a frame whose row 0 starts its exposure at start_s
+  // saw them: each row at its own time, averaged over the exposure.
+  void draw_flippers_exposed(double start_s, cv::Mat& image);
+  // Flipper `i`'s angle at time t_s from the observed history (rad).
+  double flipper_angle_at(std::size_t i, double t_s) const;
+  // The two history samples around t_s (lo == hi at either end) and t_s's fraction between them.
+  void bracket(double t_s, std::size_t& lo, std::size_t& hi, double& fraction) const;
   // Paints `gray` over `image` inside the patch, its values being the opacity (255: opaque).
   static void blend(const Patch& p, double gray, cv::Mat& image);
 
@@ -245,7 +259,8 @@ class SimCameraSource final : public vision::FrameSource {
   void build_glare();
   void build_noise();
   void advance_effects();
-  void compose(const BallPaths& paths, double start_s, vision::Frame& out);
+  // `exposed`: the flippers as observed over the exposure (read()), else at their current angles (render()).
+  void compose(const BallPaths& paths, double start_s, bool exposed, vision::Frame& out);
   void draw_ball(const BallPaths& paths, cv::Mat& image);
   double ball_scale_ = 1.0;  // apparent size of the ball now (1 on the playfield; > 1 while it hops)
   bool sample_at(double t_s, Vec2& p, bool& in_play) const;
@@ -272,6 +287,11 @@ class SimCameraSource final : public vision::FrameSource {
   std::vector<std::uint8_t> noise_neg_;  // |noise| where noise < 0, else 0
   std::size_t noise_span_ = 0;           // offsets in [0, noise_span_)
   std::array<Sample, kHistory> history_{};
+  std::vector<double> flipper_history_;  // kHistory x flippers: the angles recorded with each sample (rad)
+  cv::Mat flipper_sample_;               // CV_8U scratch: one flipper drawn at one instant (coverage 0..255)
+  cv::Mat flipper_sum_;                  // CV_16U scratch: its coverage summed per row over the row's exposure
+  std::vector<int> flipper_row_count_;   // instants summed per row of that scratch
+  std::vector<double> flipper_instant_;  // the flipper's angle at each instant (rad)
   std::size_t history_head_ = 0;         // index of the oldest sample
   std::size_t history_size_ = 0;
   double next_nominal_s_ = 0.0;  // the next frame's nominal exposure start (s)

@@ -1,12 +1,13 @@
 #pragma once
-// The benches' one straight-line fit: ordinary least squares of y on x, used
-// for the precision bench's power laws (on logs) and the transfer bench's
-// cost of a calibration error (score against the size of the error).
+// The project's one straight-line fit: ordinary least squares of y on x, used
+// for the precision bench's power laws (on logs), the transfer bench's cost
+// of a calibration error (score against the size of the error) and the
+// camera latency calibration (the flipper's motion against the frame stamp).
 
 #include <utility>
 #include <vector>
 
-namespace pinball::bench {
+namespace pinball {
 
 /// y ≈ intercept + slope·x.
 struct LineFit {
@@ -22,4 +23,4 @@ LineFit fit_line(const std::vector<std::pair<double, double>>& xy);
 /// caller can carry each y's uncertainty into the slope's. Same preconditions.
 std::vector<double> slope_weights(const std::vector<std::pair<double, double>>& xy);
 
-}  // namespace pinball::bench
+}  // namespace pinball

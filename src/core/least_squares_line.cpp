@@ -1,8 +1,8 @@
-#include "least_squares_line.h"
+#include "pinball/core/least_squares_line.h"
 
 #include <stdexcept>
 
-namespace pinball::bench {
+namespace pinball {
 
 std::vector<double> slope_weights(const std::vector<std::pair<double, double>>& xy) {
   if (xy.size() < 2) throw std::invalid_argument("fit_line: need two points");
@@ -33,4 +33,4 @@ LineFit fit_line(const std::vector<std::pair<double, double>>& xy) {
   return f;
 }
 
-}  // namespace pinball::bench
+}  // namespace pinball

@@ -1,10 +1,10 @@
-#include "least_squares_line.h"
+#include "pinball/core/least_squares_line.h"
 
 #include <stdexcept>
 
 #include <gtest/gtest.h>
 
-namespace pinball::bench {
+namespace pinball {
 namespace {
 
 TEST(LeastSquaresLine, RecoversALineAndItsWeightsGiveTheSlope) {
@@ -32,4 +32,4 @@ TEST(LeastSquaresLine, NoisyPointsGiveTheBestSlopeAndSameXGivesNone) {
 }
 
 }  // namespace
-}  // namespace pinball::bench
+}  // namespace pinball
