@@ -6,7 +6,9 @@
 #include <numbers>
 #include <sstream>
 
+#include "pinball/calibration/latency_calibration.h"
 #include "pinball/core/rng.h"
+#include "pinball/simlab/sim_latency_lab.h"
 #include "pinball/core/statistics.h"
 #include "pinball/track/tracker.h"
 #include "tracker_bench.h"
@@ -249,6 +251,16 @@ CalibratedLensFigures compare_lens(const vision::CameraIntrinsics& truth, const 
 
 }  // namespace
 
+double measure_simulated_latency_s(const table::Board& board, const simlab::SimCameraRealism& camera, int events,
+                                   std::uint64_t seed) {
+  simlab::SimLatencyOptions o;
+  o.seed = seed;
+  o.events = events;
+  o.camera.realism = camera;
+  const simlab::SimLatencyRun run = simlab::simulate_latency_run(board, o);
+  return calibration::measure_latency(run.recording, run.region, run.timing).latency_s;
+}
+
 CameraBenchOptions quick_camera_bench_options() {
   CameraBenchOptions o;
   o.speeds_mps = {1.0, 5.0};
@@ -292,8 +304,12 @@ std::vector<CameraScenario> camera_scenarios(const CameraBenchOptions& o) {
   vision::BallDetectorConfig all = steady;
   all.lens = t.lens;
   all.row_time_s = t.row_time_s;
+  vision::BallDetectorConfig measured = steady;
+  if (o.measured_latency_s) measured.latency_s = *o.measured_latency_s;
+  // The lab's flow: every correction from its calibration, none from the truth.
   vision::BallDetectorConfig all_calibrated = all;
-  all_calibrated.lens = o.calibrated_lens;
+  if (o.calibrated_lens) all_calibrated.lens = o.calibrated_lens;
+  if (o.measured_latency_s) all_calibrated.latency_s = *o.measured_latency_s;
 
   std::vector<CameraScenario> s;
   s.push_back({"ideal", {}, none, false});
@@ -310,13 +326,14 @@ std::vector<CameraScenario> camera_scenarios(const CameraBenchOptions& o) {
     s.push_back({"latency_uncompensated", timing_only, none, false});
     s.push_back({"latency_mean_subtracted", timing_only, mean_latency, false});
     s.push_back({"latency_compensated", timing_only, steady, true});
+    if (o.measured_latency_s) s.push_back({"latency_compensated_measured", timing_only, measured, true});
   }
   if (t.flicker_amplitude > 0.0 || t.gain_drift_sigma > 0.0) {
     s.push_back({"flicker_and_drift", light_only, none, true});
   }
   s.push_back({"all_uncorrected", t, none, false});
   s.push_back({"all_corrected", t, all, true});
-  if (o.calibrated_lens && t.lens) s.push_back({"all_corrected_calibrated_lens", t, all_calibrated, true});
+  if ((o.calibrated_lens && t.lens) || o.measured_latency_s) s.push_back({"all_calibrated", t, all_calibrated, true});
   return s;
 }
 
@@ -326,6 +343,7 @@ CameraReport run_camera_bench(const table::Board& board, const CameraBenchOption
   CameraReport report;
   report.board = board.source;
   report.options = options;
+  report.true_latency_s = options.camera.latency_min_s;
   const std::vector<CameraScenario> scenarios = camera_scenarios(options);
 
   TrackerBenchOptions to;

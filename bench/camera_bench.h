@@ -44,8 +44,10 @@ struct CameraBenchOptions {
   int background_frames = 32;                       ///< ball-free frames the background is learned from
   int timing_frames = 300;                          ///< cost: frames timed per pass
   simlab::SimCameraRealism camera = simlab::SimCameraRealism::typical();  ///< the faults, as a typical camera has them
-  std::optional<vision::CameraIntrinsics> calibrated_lens;  ///< from `calibrate intrinsics`: adds a scenario
+  std::optional<vision::CameraIntrinsics> calibrated_lens;  ///< from `calibrate intrinsics`: adds scenarios
   std::string calibrated_lens_source;               ///< how it was obtained (for the report)
+  std::optional<double> measured_latency_s;         ///< from `calibrate latency`: adds scenarios
+  std::string measured_latency_source;              ///< how it was obtained (for the report)
 };
 
 /// A short run for tests.
@@ -120,10 +122,16 @@ struct CameraReport {
   CameraBenchOptions options;               ///< what was asked
   std::vector<CameraScenarioResult> scenarios;  ///< in camera_scenarios() order
   CalibratedLensFigures calibrated_lens;    ///< when given
+  double true_latency_s = 0.0;              ///< the camera's minimum latency (what a measurement should find, s)
   CameraCostFigures cost;                   ///< detector frames per second
   bool corrected_within_target = false;     ///< every corrected scenario within the target
   double wall_s = 0.0;                      ///< wall time (s)
 };
+
+/// The latency `pinball calibrate latency --sim` measures on this camera
+/// (`events` fires of the first flipper, seed `seed`), as the lab would.
+double measure_simulated_latency_s(const table::Board& board, const simlab::SimCameraRealism& camera, int events,
+                                   std::uint64_t seed);
 
 /// Runs the measurement; `progress` (may be empty) receives one line per scenario.
 CameraReport run_camera_bench(const table::Board& board, const CameraBenchOptions& options,

@@ -75,6 +75,9 @@ nlohmann::json to_json(const CameraReport& r) {
             {"camera", to_json_value(o.camera)}}},
           {"scenarios", scenarios},
           {"calibrated_lens", lens},
+          {"true_latency_s", r.true_latency_s},
+          {"measured_latency_s", o.measured_latency_s ? nlohmann::json(*o.measured_latency_s) : nlohmann::json()},
+          {"measured_latency_source", o.measured_latency_source},
           {"cost",
            {{"frames", r.cost.frames},
             {"plain_roi_fps", r.cost.plain_roi_fps},
@@ -118,6 +121,10 @@ std::string to_text(const CameraReport& r) {
     s << std::setprecision(3) << "calibrated lens (" << l.source << "): fx " << l.fx_error_percent << " %, fy "
       << l.fy_error_percent << " %, principal point " << l.principal_point_error_px << " px, distortion up to "
       << l.max_distortion_error_px << " px from the true lens\n";
+  }
+  if (r.options.measured_latency_s) {
+    s << std::setprecision(3) << "measured latency (" << r.options.measured_latency_source << "): "
+      << *r.options.measured_latency_s * 1e3 << " ms, true minimum " << r.true_latency_s * 1e3 << " ms\n";
   }
   s << std::setprecision(0) << "detector cost, ROI, one core: " << r.cost.plain_roi_fps << " fps uncorrected, "
     << r.cost.corrected_roi_fps << " fps with every correction (" << r.cost.frames << " frames)\n";

@@ -123,6 +123,11 @@ int run_detector(const BenchArgs& a, const table::Board& board, std::ostream& ou
 int run_camera(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::CameraBenchOptions options = a.quick ? bench::quick_camera_bench_options() : bench::CameraBenchOptions{};
   options.seed = a.seed;
+  // The latency as the lab measures it (`pinball calibrate latency --sim`), not the simulation's truth.
+  const int latency_events = a.quick ? 8 : 20;
+  options.measured_latency_s = bench::measure_simulated_latency_s(board, options.camera, latency_events, a.seed);
+  options.measured_latency_source =
+      "pinball calibrate latency --sim, " + std::to_string(latency_events) + " events, seed " + std::to_string(a.seed);
   const bench::CameraReport report =
       bench::run_camera_bench(board, options, [&](const std::string& line) { err << "bench camera: " << line << "\n"; });
   if (a.json) {

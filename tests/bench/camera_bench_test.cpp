@@ -38,7 +38,11 @@ TEST(CameraBench, EveryFaultIsMeasuredUncorrectedAndCorrectedBesideTheIdealCamer
   EXPECT_EQ(names, expected);
   CameraBenchOptions with_lens = quick_camera_bench_options();
   with_lens.calibrated_lens = vision::typical_wide_lens();
-  EXPECT_EQ(camera_scenarios(with_lens).size(), expected.size() + 2);
+  EXPECT_EQ(camera_scenarios(with_lens).size(), expected.size() + 2);  // the lens alone, and everything calibrated
+  CameraBenchOptions with_latency = quick_camera_bench_options();
+  with_latency.measured_latency_s = 0.007;
+  EXPECT_EQ(camera_scenarios(with_latency).size(), expected.size() + 2);  // the latency alone, and everything
+
 }
 
 TEST(CameraBench, CorrectionsWinBackWhatTheFaultsCostAndTheReportSaysSo) {
