@@ -151,10 +151,11 @@ cv::Mat target_image(const TargetSpec& t, double px_per_m, int margin_px) {
   check_input(check_target(t), "target");
   check_input(std::isfinite(px_per_m) && px_per_m > 0.0, "target image", "px_per_m must be > 0");
   check_input(margin_px >= 0 && margin_px <= 100000, "target image", "margin_px must be in [0, 100000]");
-  const int w = static_cast<int>(std::lround(t.squares_x * t.square_m * px_per_m));
-  const int h = static_cast<int>(std::lround(t.squares_y * t.square_m * px_per_m));
-  check_input(w >= 2 * t.squares_x && h >= 2 * t.squares_y && static_cast<double>(w) * h < 4e8, "target image",
-              "the pattern would be " + std::to_string(w) + "x" + std::to_string(h) + " px: choose another px_per_m");
+  const double w_px = t.squares_x * t.square_m * px_per_m, h_px = t.squares_y * t.square_m * px_per_m;
+  check_input(w_px >= 2.0 * t.squares_x && h_px >= 2.0 * t.squares_y && w_px * h_px < 4e8, "target image",
+              "the pattern would be " + std::to_string(std::lround(std::min(w_px, 1e9))) + "x" +
+                  std::to_string(std::lround(std::min(h_px, 1e9))) + " px: choose another px_per_m");
+  const int w = static_cast<int>(std::lround(w_px)), h = static_cast<int>(std::lround(h_px));
   cv::Mat img;
   if (t.kind == TargetKind::kCharuco) {
     detail::make_charuco_board(t)->draw(cv::Size(w + 2 * margin_px, h + 2 * margin_px), img, margin_px, 1);

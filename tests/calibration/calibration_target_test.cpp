@@ -84,6 +84,7 @@ TEST(CalibrationTarget, ChessboardImageHasItsSquaresAndMargin) {
   }
   EXPECT_THROW((void)target_image(t, 0.0, 10), std::invalid_argument);
   EXPECT_THROW((void)target_image(t, 1000.0, -1), std::invalid_argument);
+  EXPECT_THROW((void)target_image(t, 1e300, 10), std::invalid_argument);  // not a 1e300-pixel image
 }
 
 // The renderer's pattern is OpenCV's drawing of the board: squares, markers,
