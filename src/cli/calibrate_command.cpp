@@ -1,10 +1,13 @@
-// `pinball calibrate camera|flippers|gravity|latency`: measures the lab
-// machine (or the simulated one with --sim) and writes the calibration file.
+// `pinball calibrate camera|intrinsics|flippers|gravity|latency`: measures the
+// lab machine (or the simulated one with --sim) and writes the calibration file.
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <memory>
 #include <mutex>
@@ -13,6 +16,8 @@
 #include <ostream>
 #include <sstream>
 #include <thread>
+
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -24,14 +29,18 @@
 #include "pinball/calibration/camera_calibration.h"
 #include "pinball/calibration/flipper_calibration.h"
 #include "pinball/calibration/gravity_calibration.h"
+#include "pinball/calibration/intrinsics_calibration.h"
 #include "pinball/calibration/latency_calibration.h"
 #include "pinball/core/clock.h"
+#include "pinball/core/format.h"
+#include "pinball/core/json_write_archive.h"
 #include "pinball/core/rng.h"
 #include "pinball/firmware/can_link.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/socketcan_transport.h"
 #include "pinball/simlab/sim_lab.h"
 #include "pinball/simlab/sim_latency_lab.h"
+#include "pinball/simlab/sim_target_view.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/track/observation_io.h"
@@ -41,11 +50,11 @@
 namespace pinball::cli {
 
 CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
-  CLI::App* cmd =
-      app.add_subcommand("calibrate", "measure the camera homography, the flippers, gravity or the camera's latency");
-  cmd->add_option("kind", a.kind, "what to calibrate: camera, flippers, gravity, latency")
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate", "measure the lens, the camera homography, the flippers, gravity or the camera's latency");
+  cmd->add_option("kind", a.kind, "what to calibrate: intrinsics, camera, flippers, gravity, latency")
       ->required()
-      ->check(CLI::IsMember({"camera", "flippers", "gravity", "latency"}));
+      ->check(CLI::IsMember({"intrinsics", "camera", "flippers", "gravity", "latency"}));
   auto* sim = cmd->add_option("--sim", a.sim_board, "generate the inputs from the simulator on this board")
                   ->transform(data_file());
   cmd->add_option("--board", a.board, "the machine's board file (flipper names, sides, rough places)")
@@ -62,6 +71,44 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->default_str("");
   cmd->add_option("--method", a.method, "flippers: method written to the file when both ran")
       ->check(CLI::IsMember({"markers", "markerless"}));
+  cmd->add_option("--target", a.target,
+                  "intrinsics: the printed target, chessboard:SXxSY:SQUARE_M or "
+                  "charuco:SXxSY:SQUARE_M:MARKER_M[:DICTIONARY] (squares, metres)")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            try {
+              (void)calibration::parse_target(text);
+            } catch (const std::invalid_argument& e) {
+              return std::string(e.what());
+            }
+            return std::string();
+          },
+          "SPEC"))
+      ->capture_default_str();
+  cmd->add_option("--images", a.images, "intrinsics: images of the target (repeat), or a directory: its .png and .jpg")
+      ->check(CLI::ExistingPath)
+      ->default_str("")
+      ->excludes(sim);
+  cmd->add_option("--sim-views", a.sim_views, "intrinsics with --sim: views of the target to render (5 at least: the fit needs 5)")
+      ->check(CLI::Range(5, 500))
+      ->capture_default_str()
+      ->needs(sim);
+  cmd->add_option("--camera-size", a.camera_size, "intrinsics with --sim: the simulated camera's image size, WxH")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            int w = 0, h = 0;
+            char x = 0, rest = 0;
+            if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &rest) != 3 || x != 'x' || w < 32 || h < 32 ||
+                w > 8192 || h > 8192) {
+              return std::string("expected WxH, each in [32, 8192], e.g. 640x480");
+            }
+            return std::string();
+          },
+          "WxH"))
+      ->capture_default_str()
+      ->needs(sim);
+  cmd->add_option("--print-target", a.print_target,
+                  "intrinsics: write the printable target (PNG, 10 px/mm: print at 254 dpi, 100 %) and stop");
   cmd->add_option("--roll", a.rolls, "gravity: observation CSV (t,x,y) of one roll from rest (repeat)")
       ->check(CLI::ExistingFile)
       ->default_str("");
@@ -604,9 +651,232 @@ void run_latency_lab(Context& c) {
   report_latency(c, e, lo, name, nullptr);
 }
 
+// ---- intrinsics ----
+
+constexpr double kPrintPxPerM = 10'000.0;  // --print-target: 10 px/mm (254 dpi)
+
+cv::Size parse_size(const std::string& text) {
+  int w = 0, h = 0;
+  std::sscanf(text.c_str(), "%dx%d", &w, &h);  // checked by the option's validator
+  return {w, h};
+}
+
+std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+bool is_image_name(const std::filesystem::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+}
+
+// --images: files as given, a directory as its .png and .jpg files in name order.
+std::vector<std::string> image_paths(const std::vector<std::string>& given) {
+  std::vector<std::string> out;
+  for (const std::string& g : given) {
+    if (!std::filesystem::is_directory(g)) {
+      out.push_back(g);
+      continue;
+    }
+    std::vector<std::string> found;
+    for (const auto& e : std::filesystem::directory_iterator(g)) {
+      if (e.is_regular_file() && is_image_name(e.path())) found.push_back(e.path().string());
+    }
+    if (found.empty()) throw std::runtime_error(g + ": no .png or .jpg images in this directory");
+    std::sort(found.begin(), found.end());
+    out.insert(out.end(), found.begin(), found.end());
+  }
+  return out;
+}
+
+// The camera section and the lens must describe images of one size.
+void check_camera_size(const calibration::Calibration& existing, const std::string& file, const cv::Size& size) {
+  if (!existing.camera) return;
+  const calibration::CameraCalibration& k = *existing.camera;
+  if (k.image_width_px == size.width && k.image_height_px == size.height) return;
+  throw std::runtime_error(file + ": its camera section was measured on " +
+                           size_text(k.image_width_px, k.image_height_px) + " images, but the intrinsics images are " +
+                           size_text(size.width, size.height) +
+                           "; calibrate both at one size (or write the intrinsics to another file); nothing written");
+}
+
+// Files written all or not at all: each to a temporary beside it, renamed when every one is written.
+class Outputs {
+ public:
+  Outputs() = default;
+  Outputs(const Outputs&) = delete;
+  Outputs& operator=(const Outputs&) = delete;
+  ~Outputs() {
+    for (const auto& [path, tmp] : pending_) std::filesystem::remove(tmp);
+  }
+  void add(const std::string& path, const std::string& bytes) {
+    const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+    pending_.emplace_back(path, tmp);
+    std::ofstream f(tmp, std::ios::binary);
+    f << bytes;
+    f.close();
+    if (!f) throw std::runtime_error(path + ": cannot write");
+  }
+  void commit() {
+    for (const auto& [path, tmp] : pending_) std::filesystem::rename(tmp, path);
+    pending_.clear();
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::string>> pending_;
+};
+
+std::string png_bytes(const cv::Mat& image, const std::string& path) {
+  std::vector<unsigned char> buf;
+  if (!cv::imencode(".png", image, buf)) throw std::runtime_error(path + ": cannot encode the PNG");
+  return std::string(buf.begin(), buf.end());
+}
+
+int print_target(const CalibrateArgs& a, const calibration::TargetSpec& target, std::ostream& out) {
+  const int margin_px = static_cast<int>(std::lround(target.square_m * kPrintPxPerM));
+  const cv::Mat img = calibration::target_image(target, kPrintPxPerM, margin_px);
+  Outputs files;
+  files.add(a.print_target, png_bytes(img, a.print_target));
+  files.commit();
+  const double w_mm = img.cols / kPrintPxPerM * 1e3, h_mm = img.rows / kPrintPxPerM * 1e3;
+  if (a.json) {
+    out << nlohmann::json{{"kind", "intrinsics"},      {"target", target.describe()}, {"print_target", a.print_target},
+                          {"width_px", img.cols},      {"height_px", img.rows},       {"px_per_mm", kPrintPxPerM * 1e-3},
+                          {"sheet_width_mm", w_mm},    {"sheet_height_mm", h_mm},     {"square_mm", target.square_m * 1e3}}
+                  .dump(2)
+        << "\n";
+  } else {
+    out << "wrote " << a.print_target << ": " << target.describe() << ", " << img.cols << "x" << img.rows
+        << " px at 10 px/mm: print at 254 dpi, 100 % (no fit to page): " << format_number(w_mm) << " x "
+        << format_number(h_mm) << " mm with a white border one square wide; measure a printed square and give its side "
+        << "in --target\n";
+  }
+  return 0;
+}
+
+nlohmann::json lens_comparison_json(const calibration::LensComparison& c) {
+  return {{"fx_error_pct", c.fx_error_pct},
+          {"fy_error_pct", c.fy_error_pct},
+          {"principal_point_error_px", c.principal_point_error_px},
+          {"distortion_max_error_px", c.distortion_max_error_px},
+          {"distortion_sensor_max_error_px", c.distortion_sensor_max_error_px}};
+}
+
+int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err) {
+  const calibration::TargetSpec target = calibration::parse_target(a.target);
+  if (!a.print_target.empty()) return print_target(a, target, out);
+  const bool simulated = !a.sim_board.empty();
+  // The file to update: read first (a bad one is refused before any work).
+  calibration::Calibration cal;
+  if (!a.out.empty() && std::filesystem::exists(a.out)) cal = calibration::read_calibration(a.out);
+  std::vector<calibration::TargetImage> images;
+  std::optional<vision::CameraIntrinsics> truth;
+  if (simulated) {
+    (void)table::load_board(a.sim_board);  // the practice machine's board, named in the file
+    const cv::Size size = parse_size(a.camera_size);
+    if (!a.out.empty()) check_camera_size(cal, a.out, size);
+    truth = vision::typical_wide_lens(size.width, size.height);
+    const std::vector<simlab::TargetPose> poses = simlab::default_target_poses(target, *truth, a.sim_views, a.seed);
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      char name[48];
+      std::snprintf(name, sizeof name, "sim_view_%02zu.png", i + 1);
+      images.push_back({name, simlab::render_target_view(*truth, target, poses[i], {}, ball_seed(a.seed, i))});
+    }
+    err << "calibrate intrinsics: rendered " << poses.size() << " views of the target through the simulated "
+        << size_text(size.width, size.height) << " lens\n";
+  } else {
+    if (a.images.empty()) throw std::runtime_error("calibrate intrinsics: give --images FILES or DIR (or --sim BOARD)");
+    for (const std::string& path : image_paths(a.images)) {
+      cv::Mat gray;
+      try {
+        gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
+      } catch (const cv::Exception&) {
+        gray.release();
+      }
+      if (gray.empty()) throw std::runtime_error(path + ": cannot be read as an image");
+      images.push_back({path, gray});
+    }
+    if (!a.out.empty()) check_camera_size(cal, a.out, images.front().gray.size());
+  }
+  err << "calibrate intrinsics: " << images.size() << " images of the " << target.describe() << "\n";
+  const calibration::IntrinsicsFit fit = calibration::calibrate_intrinsics(images, target);
+  const calibration::IntrinsicsCalibration& in = fit.calibration;
+  const vision::CameraIntrinsics& lens = in.lens;
+
+  nlohmann::json per_image = nlohmann::json::array();
+  for (const calibration::ImageResult& r : fit.images) {
+    per_image.push_back({{"name", r.name},
+                         {"used", r.used},
+                         {"rejection", r.rejection},
+                         {"corners", r.corners},
+                         {"reprojection_rms_px", r.reprojection_rms_px}});
+  }
+  nlohmann::json report = {{"kind", "intrinsics"},
+                           {"target", in.target},
+                           {"simulated", simulated},
+                           {"out", a.out},
+                           {"lens", to_json_value(lens)},
+                           {"reprojection_rms_px", in.reprojection_rms_px},
+                           {"images_used", in.images_used},
+                           {"images_rejected", in.images_rejected},
+                           {"images", per_image}};
+  std::optional<calibration::LensComparison> against;
+  if (truth) {
+    against = calibration::compare_lenses(lens, *truth);
+    report["truth"] = lens_comparison_json(*against);
+    report["truth"]["lens"] = to_json_value(*truth);
+    report["sim_views"] = a.sim_views;
+    report["seed"] = a.seed;
+  }
+
+  // Every output at once, or none.
+  Outputs files;
+  if (!a.png.empty()) files.add(a.png, png_bytes(calibration::draw_intrinsics_figure(fit, images), a.png));
+  if (!a.out.empty()) {
+    cal.intrinsics = in;
+    if (simulated) cal.board = a.sim_board;
+    else if (!a.board.empty()) cal.board = a.board;
+    cal.date.clear();
+    files.add(a.out, calibration::calibration_to_yaml(cal));
+  }
+  files.commit();
+  if (!a.out.empty()) err << "calibrate: wrote " << a.out << "\n";
+
+  if (a.json) {
+    out << report.dump(2) << "\n";
+    return 0;
+  }
+  out << "intrinsics: " << in.target << "; " << fit.images.size() << " images, " << in.images_used << " used, "
+      << in.images_rejected << " rejected\n";
+  out << "lens (" << size_text(lens.width_px, lens.height_px) << "): fx " << format_number(lens.fx_px, 5) << " px, fy "
+      << format_number(lens.fy_px, 5) << " px, cx " << format_number(lens.cx_px, 4) << " px, cy "
+      << format_number(lens.cy_px, 4) << " px\n";
+  out << "distortion: k1 " << format_number(lens.k1) << ", k2 " << format_number(lens.k2) << ", k3 "
+      << format_number(lens.k3) << ", p1 " << format_number(lens.p1) << ", p2 " << format_number(lens.p2) << "\n";
+  out << "reprojection rms " << format_number(in.reprojection_rms_px) << " px\n";
+  std::size_t width = 0;
+  for (const calibration::ImageResult& r : fit.images) width = std::max(width, r.name.size());
+  for (const calibration::ImageResult& r : fit.images) {
+    out << "  " << r.name << std::string(width - r.name.size() + 2, ' ');
+    if (r.used) {
+      out << "used      " << r.corners << " corners, rms " << format_number(r.reprojection_rms_px) << " px\n";
+    } else {
+      out << "rejected  " << r.rejection << "\n";
+    }
+  }
+  if (against) {
+    out << "against the simulated lens: fx " << format_number(against->fx_error_pct, 2) << " %, fy "
+        << format_number(against->fy_error_pct, 2) << " %, principal point "
+        << format_number(against->principal_point_error_px, 2) << " px off, distortion within "
+        << format_number(against->distortion_max_error_px, 2) << " px over the image ("
+        << format_number(against->distortion_sensor_max_error_px, 2) << " px to the sensor's corners)\n";
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) {
+  if (a.kind == "intrinsics") return run_intrinsics(a, out, err);
   const std::string board_path = a.sim_board.empty() ? a.board : a.sim_board;
   if (board_path.empty()) throw std::runtime_error("calibrate: give --board BOARD (or --sim BOARD)");
   Context c{a, err, table::load_board(board_path), nullptr, {}, {}, {}};

@@ -122,9 +122,9 @@ struct LearnArgs {
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& args);
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err);
 
-/// `pinball calibrate camera|flippers|gravity|latency`
+/// `pinball calibrate intrinsics|camera|flippers|gravity|latency`
 struct CalibrateArgs {
-  std::string kind;                  ///< camera | flippers | gravity | latency
+  std::string kind;                  ///< intrinsics | camera | flippers | gravity | latency
   std::string sim_board;             ///< --sim BOARD: generate the inputs from the simulator
   std::string board;                 ///< the machine's board file (names, sides, rough places)
   std::string image;                 ///< camera: marker image
@@ -133,6 +133,11 @@ struct CalibrateArgs {
   std::string up;                    ///< flippers: marker image, flippers held up
   std::vector<std::string> sweeps;   ///< flippers: one sweep video per flipper, board order
   std::string method = "markers";    ///< flippers: the method written to the file when both ran
+  std::string target = "chessboard:10x7:0.025";  ///< intrinsics: the printed target (calibration::parse_target)
+  std::vector<std::string> images;   ///< intrinsics: image files, or directories of .png/.jpg
+  int sim_views = 20;                ///< intrinsics with --sim: views to render
+  std::string camera_size = "640x480";  ///< intrinsics with --sim: the simulated camera's image size (WxH)
+  std::string print_target;          ///< intrinsics: write the printable target here (PNG, 10 px/mm) and stop
   std::vector<std::string> rolls;    ///< gravity: observation CSVs, one roll each
   int sim_rolls = 5;                 ///< gravity with --sim: rolls to simulate
   double sigma_m = 0.001;            ///< gravity: observation noise per coordinate (m)

@@ -9,8 +9,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "common/command_test.h"
 #include "pinball/calibration/calibration_file.h"
+#include "pinball/calibration/intrinsics_calibration.h"
+#include "pinball/core/rng.h"
+#include "pinball/simlab/sim_target_view.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/vision/camera_homography.h"
 
@@ -199,6 +204,141 @@ TEST_F(Calibrate, LatencyInTheLabWithoutHardwareFailsClearlyAndWritesNothing) {
           " --device /dev/video97 --can pinballcan7 --row-time-us 10 --out " + file);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(pinball::testing::slurp(file), before) << "a failed run leaves the file as it was";
+}
+
+// A calibration file with a camera section of this image size and a gravity section.
+pinball::calibration::Calibration lab_file(int width_px, int height_px) {
+  pinball::calibration::Calibration c;
+  c.board = "boards/mit1993.board";
+  c.camera.emplace();
+  c.camera->image_width_px = width_px;
+  c.camera->image_height_px = height_px;
+  c.camera->markers_used = 7;
+  c.gravity.emplace();
+  c.gravity->g_mps2 = 1.1;
+  c.gravity->ci_low_mps2 = 1.09;
+  c.gravity->ci_high_mps2 = 1.11;
+  c.gravity->rolls_used = 5;
+  return c;
+}
+
+TEST_F(Calibrate, IntrinsicsSimulatedWritesTheLensAndKeepsTheOtherSections) {
+  const std::string file = (dir_ / "lab.yaml").string();
+  const std::string png = (dir_ / "intrinsics.png").string();
+  pinball::calibration::write_calibration(lab_file(640, 480), file);
+  const Result r = run("calibrate intrinsics --sim boards/mit1993.board --sim-views 12 --out " + file + " --png " + png +
+                       " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("kind"), "intrinsics");
+  EXPECT_EQ(j.at("images_used"), 12);
+  EXPECT_EQ(j.at("images").size(), 12u);
+  EXPECT_EQ(j.at("images")[0].at("name"), "sim_view_01.png");
+  EXPECT_TRUE(j.at("images")[0].at("used").get<bool>());
+  EXPECT_LE(j.at("reprojection_rms_px").get<double>(), 0.3);
+  const nlohmann::json& truth = j.at("truth");
+  EXPECT_LT(std::abs(truth.at("fx_error_pct").get<double>()), 0.5);
+  EXPECT_LT(std::abs(truth.at("fy_error_pct").get<double>()), 0.5);
+  EXPECT_LT(truth.at("principal_point_error_px").get<double>(), 2.0);
+  EXPECT_LT(truth.at("distortion_max_error_px").get<double>(), 0.5);
+  EXPECT_EQ(truth.at("lens").at("fx_px"), 530.0);
+  EXPECT_TRUE(fs::exists(png));
+
+  const pinball::calibration::Calibration c = pinball::calibration::read_calibration(file);
+  ASSERT_TRUE(c.intrinsics);
+  EXPECT_EQ(c.intrinsics->lens.fx_px, j.at("lens").at("fx_px").get<double>());
+  EXPECT_EQ(c.intrinsics->images_used, 12);
+  EXPECT_EQ(c.intrinsics->target, "chessboard 10x7 squares (9x6 inner corners), 25 mm");
+  ASSERT_TRUE(c.camera);  // the other sections stay
+  EXPECT_EQ(c.camera->markers_used, 7);
+  ASSERT_TRUE(c.gravity);
+  EXPECT_EQ(c.gravity->g_mps2, 1.1);
+
+  // The text report: the lens, every image, the truth.
+  const Result text = run("calibrate intrinsics --sim boards/mit1993.board --sim-views 6");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("lens (640x480): fx "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("sim_view_06.png  used"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("against the simulated lens: fx "), std::string::npos) << text.out;
+}
+
+TEST_F(Calibrate, IntrinsicsRefusesAFileWhoseCameraHasAnotherSizeAndWritesNothing) {
+  const std::string file = (dir_ / "lab.yaml").string();
+  const std::string png = (dir_ / "intrinsics.png").string();
+  pinball::calibration::write_calibration(lab_file(800, 600), file);
+  const std::string before = pinball::testing::slurp(file);
+  const Result r = run("calibrate intrinsics --sim boards/mit1993.board --sim-views 12 --out " + file + " --png " + png);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(file + ": its camera section was measured on 800x600 images, but the intrinsics images are "
+                              "640x480"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(pinball::testing::count_lines(r.err), 1) << r.err;
+  EXPECT_EQ(pinball::testing::slurp(file), before);
+  EXPECT_FALSE(fs::exists(png));
+}
+
+// Real files: a directory of images, one of them without the target; an unreadable one refused by name.
+TEST_F(Calibrate, IntrinsicsFromADirectoryOfImages) {
+  const pinball::calibration::TargetSpec target = pinball::calibration::parse_target("charuco:10x7:0.025:0.018");
+  const pinball::vision::CameraIntrinsics lens = pinball::vision::typical_wide_lens(640, 480);
+  const fs::path images = dir_ / "shots";
+  fs::create_directories(images);
+  const std::vector<pinball::simlab::TargetPose> poses = pinball::simlab::default_target_poses(target, lens, 8, 3);
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    cv::imwrite((images / ("shot" + std::to_string(i) + ".png")).string(),
+                pinball::simlab::render_target_view(lens, target, poses[i], {}, pinball::ball_seed(3, i)));
+  }
+  cv::imwrite((images / "ceiling.jpg").string(), cv::Mat(480, 640, CV_8UC3, cv::Scalar(120, 130, 140)));
+  std::ofstream(images / "notes.txt") << "not an image, and not read\n";
+  const std::string file = (dir_ / "lens.yaml").string();
+  Result r = run("calibrate intrinsics --target charuco:10x7:0.025:0.018 --images " + images.string() + " --out " +
+                 file + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("images").size(), 9u);  // sorted: ceiling.jpg first
+  EXPECT_EQ(j.at("images")[0].at("name"), (images / "ceiling.jpg").string());
+  EXPECT_FALSE(j.at("images")[0].at("used").get<bool>());
+  EXPECT_EQ(j.at("images")[0].at("rejection"), "target not found");
+  EXPECT_EQ(j.at("images_used"), 8);
+  EXPECT_FALSE(j.contains("truth"));
+  const pinball::calibration::Calibration c = pinball::calibration::read_calibration(file);
+  ASSERT_TRUE(c.intrinsics);
+  EXPECT_NEAR(c.intrinsics->lens.fx_px, 530.0, 530.0 * 0.005);
+  EXPECT_FALSE(c.camera);
+
+  // An unreadable image: named, nothing written.
+  const std::string broken = (images / "broken.png").string();
+  std::ofstream(broken) << "this is text\n";
+  const std::string other = (dir_ / "other.yaml").string();
+  r = run("calibrate intrinsics --target charuco:10x7:0.025:0.018 --images " + images.string() + " --out " + other);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(broken + ": cannot be read as an image"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(other));
+}
+
+TEST_F(Calibrate, IntrinsicsPrintsTheTarget) {
+  const std::string png = (dir_ / "target.png").string();
+  const Result r = run("calibrate intrinsics --target chessboard:10x7:0.025 --print-target " + png + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("px_per_mm"), 10.0);
+  const cv::Mat img = cv::imread(png, cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(img.empty());
+  EXPECT_EQ(img.cols, 2500 + 2 * 250);  // 250 mm of squares and a square's margin each side, at 10 px/mm
+  EXPECT_EQ(img.rows, 1750 + 2 * 250);
+  EXPECT_EQ(img.channels(), 1);
+  EXPECT_EQ(img.at<std::uint8_t>(250 + 125, 250 + 125), 0);    // the top-left square is black
+  EXPECT_EQ(img.at<std::uint8_t>(250 + 125, 500 + 125), 255);  // its neighbour white
+}
+
+TEST_F(Calibrate, IntrinsicsBadArguments) {
+  EXPECT_EQ(run("calibrate intrinsics --target chessboard:10x7").exit_code, 2);
+  EXPECT_EQ(run("calibrate intrinsics --sim boards/mit1993.board --camera-size 640by480").exit_code, 2);
+  EXPECT_EQ(run("calibrate intrinsics --camera-size 640x480").exit_code, 2);  // needs --sim
+  const Result r = run("calibrate intrinsics");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("give --images"), std::string::npos) << r.err;
 }
 
 }  // namespace
