@@ -9,6 +9,7 @@
 #include "pinball/calibration/latency_calibration.h"
 #include "pinball/core/rng.h"
 #include "pinball/simlab/sim_latency_lab.h"
+#include "pinball/simlab/sim_target_view.h"
 #include "pinball/core/statistics.h"
 #include "pinball/track/tracker.h"
 #include "tracker_bench.h"
@@ -228,27 +229,6 @@ CameraCostFigures measure_cost(const table::Board& board, const std::vector<Came
   return c;
 }
 
-CalibratedLensFigures compare_lens(const vision::CameraIntrinsics& truth, const vision::CameraIntrinsics& fit,
-                                   const std::string& source) {
-  CalibratedLensFigures f;
-  f.present = true;
-  f.source = source;
-  f.truth = truth;
-  f.calibrated = fit;
-  f.fx_error_percent = 100.0 * (fit.fx_px - truth.fx_px) / truth.fx_px;
-  f.fy_error_percent = 100.0 * (fit.fy_px - truth.fy_px) / truth.fy_px;
-  f.principal_point_error_px = std::hypot(fit.cx_px - truth.cx_px, fit.cy_px - truth.cy_px);
-  // Both lenses applied to the same ideal points: the pixels they disagree on.
-  for (int j = 0; j <= 8; ++j) {
-    for (int i = 0; i <= 8; ++i) {
-      const cv::Point2d ideal(truth.width_px * i / 8.0, truth.height_px * j / 8.0);
-      const double d = cv::norm(vision::distort_pixel(truth, ideal) - vision::distort_pixel(fit, ideal));
-      f.max_distortion_error_px = std::max(f.max_distortion_error_px, d);
-    }
-  }
-  return f;
-}
-
 }  // namespace
 
 double measure_simulated_latency_s(const table::Board& board, const simlab::SimCameraRealism& camera, int events,
@@ -259,6 +239,12 @@ double measure_simulated_latency_s(const table::Board& board, const simlab::SimC
   o.camera.realism = camera;
   const simlab::SimLatencyRun run = simlab::simulate_latency_run(board, o);
   return calibration::measure_latency(run.recording, run.region, run.timing).latency_s;
+}
+
+vision::CameraIntrinsics calibrate_simulated_lens(const vision::CameraIntrinsics& lens, int views, std::uint64_t seed) {
+  const calibration::TargetSpec target;  // the default chessboard
+  return calibration::calibrate_intrinsics(simlab::simulated_target_images(lens, target, views, seed), target)
+      .calibration.lens;
 }
 
 CameraBenchOptions quick_camera_bench_options() {
@@ -385,7 +371,12 @@ CameraReport run_camera_bench(const table::Board& board, const CameraBenchOption
     if (r.scenario.corrected && !r.within_target) report.corrected_within_target = false;
   }
   if (options.calibrated_lens && options.camera.lens) {
-    report.calibrated_lens = compare_lens(*options.camera.lens, *options.calibrated_lens, options.calibrated_lens_source);
+    CalibratedLensFigures& l = report.calibrated_lens;
+    l.present = true;
+    l.source = options.calibrated_lens_source;
+    l.truth = *options.camera.lens;
+    l.calibrated = *options.calibrated_lens;
+    l.comparison = calibration::compare_lenses(l.calibrated, l.truth);
   }
   report.cost = measure_cost(board, scenarios, options);
   if (progress) progress("detector cost measured");

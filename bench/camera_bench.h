@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "detector_bench.h"
+#include "pinball/calibration/intrinsics_calibration.h"
 #include "pinball/simlab/sim_camera_source.h"
 #include "pinball/table/board.h"
 #include "pinball/vision/lens_model.h"
@@ -99,14 +100,11 @@ struct CameraScenarioResult {
 
 /// The lens a calibration recovered, against the true one.
 struct CalibratedLensFigures {
-  bool present = false;          ///< a calibrated lens was given
-  std::string source;            ///< how it was obtained
-  vision::CameraIntrinsics truth;      ///< the simulated camera's lens
-  vision::CameraIntrinsics calibrated; ///< the calibration's
-  double fx_error_percent = 0.0; ///< (fx − true fx) / true fx
-  double fy_error_percent = 0.0;
-  double principal_point_error_px = 0.0;  ///< |(cx, cy) − true|
-  double max_distortion_error_px = 0.0;   ///< largest |distort_pixel difference| over a grid of the image
+  bool present = false;                   ///< a calibrated lens was given
+  std::string source;                     ///< how it was obtained
+  vision::CameraIntrinsics truth;         ///< the simulated camera's lens
+  vision::CameraIntrinsics calibrated;    ///< the calibration's
+  calibration::LensComparison comparison; ///< focal lengths, principal point, distortion against the truth
 };
 
 /// Detector cost per frame with and without the corrections.
@@ -132,6 +130,10 @@ struct CameraReport {
 /// (`events` fires of the first flipper, seed `seed`), as the lab would.
 double measure_simulated_latency_s(const table::Board& board, const simlab::SimCameraRealism& camera, int events,
                                    std::uint64_t seed);
+
+/// The lens `pinball calibrate intrinsics --sim` recovers from `views`
+/// simulated views of the default chessboard through `lens`, as the lab would.
+vision::CameraIntrinsics calibrate_simulated_lens(const vision::CameraIntrinsics& lens, int views, std::uint64_t seed);
 
 /// Runs the measurement; `progress` (may be empty) receives one line per scenario.
 CameraReport run_camera_bench(const table::Board& board, const CameraBenchOptions& options,

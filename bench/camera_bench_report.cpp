@@ -58,10 +58,11 @@ nlohmann::json to_json(const CameraReport& r) {
     lens = {{"source", l.source},
             {"truth", to_json_value(l.truth)},
             {"calibrated", to_json_value(l.calibrated)},
-            {"fx_error_percent", l.fx_error_percent},
-            {"fy_error_percent", l.fy_error_percent},
-            {"principal_point_error_px", l.principal_point_error_px},
-            {"max_distortion_error_px", l.max_distortion_error_px}};
+            {"fx_error_pct", l.comparison.fx_error_pct},
+            {"fy_error_pct", l.comparison.fy_error_pct},
+            {"principal_point_error_px", l.comparison.principal_point_error_px},
+            {"distortion_max_error_px", l.comparison.distortion_max_error_px},
+            {"distortion_sensor_max_error_px", l.comparison.distortion_sensor_max_error_px}};
   }
   return {{"bench", "camera"},
           {"board", r.board},
@@ -118,9 +119,10 @@ std::string to_text(const CameraReport& r) {
   }
   if (r.calibrated_lens.present) {
     const CalibratedLensFigures& l = r.calibrated_lens;
-    s << std::setprecision(3) << "calibrated lens (" << l.source << "): fx " << l.fx_error_percent << " %, fy "
-      << l.fy_error_percent << " %, principal point " << l.principal_point_error_px << " px, distortion up to "
-      << l.max_distortion_error_px << " px from the true lens\n";
+    s << std::setprecision(3) << "calibrated lens (" << l.source << "): fx " << l.comparison.fx_error_pct << " %, fy "
+      << l.comparison.fy_error_pct << " %, principal point " << l.comparison.principal_point_error_px
+      << " px, distortion up to " << l.comparison.distortion_max_error_px << " px over the image ("
+      << l.comparison.distortion_sensor_max_error_px << " px to the sensor's corners) from the true lens\n";
   }
   if (r.options.measured_latency_s) {
     s << std::setprecision(3) << "measured latency (" << r.options.measured_latency_source << "): "

@@ -128,6 +128,11 @@ int run_camera(const BenchArgs& a, const table::Board& board, std::ostream& out,
   options.measured_latency_s = bench::measure_simulated_latency_s(board, options.camera, latency_events, a.seed);
   options.measured_latency_source =
       "pinball calibrate latency --sim, " + std::to_string(latency_events) + " events, seed " + std::to_string(a.seed);
+  // The lens as the lab calibrates it (`pinball calibrate intrinsics --sim`: the chessboard), not the truth.
+  const int views = a.quick ? 8 : 20;
+  options.calibrated_lens = bench::calibrate_simulated_lens(*options.camera.lens, views, a.seed);
+  options.calibrated_lens_source =
+      "pinball calibrate intrinsics --sim, chessboard, " + std::to_string(views) + " views, seed " + std::to_string(a.seed);
   const bench::CameraReport report =
       bench::run_camera_bench(board, options, [&](const std::string& line) { err << "bench camera: " << line << "\n"; });
   if (a.json) {

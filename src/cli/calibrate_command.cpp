@@ -775,13 +775,8 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
     const cv::Size size = parse_size(a.camera_size);
     if (!a.out.empty()) check_camera_size(cal, a.out, size);
     truth = vision::typical_wide_lens(size.width, size.height);
-    const std::vector<simlab::TargetPose> poses = simlab::default_target_poses(target, *truth, a.sim_views, a.seed);
-    for (std::size_t i = 0; i < poses.size(); ++i) {
-      char name[48];
-      std::snprintf(name, sizeof name, "sim_view_%02zu.png", i + 1);
-      images.push_back({name, simlab::render_target_view(*truth, target, poses[i], {}, ball_seed(a.seed, i))});
-    }
-    err << "calibrate intrinsics: rendered " << poses.size() << " views of the target through the simulated "
+    images = simlab::simulated_target_images(*truth, target, a.sim_views, a.seed);
+    err << "calibrate intrinsics: rendered " << images.size() << " views of the target through the simulated "
         << size_text(size.width, size.height) << " lens\n";
   } else {
     if (a.images.empty()) throw std::runtime_error("calibrate intrinsics: give --images FILES or DIR (or --sim BOARD)");

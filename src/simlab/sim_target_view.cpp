@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include <opencv2/calib3d.hpp>
@@ -88,6 +89,19 @@ cv::Point2d ideal_from_distorted_px(const vision::CameraIntrinsics& lens, const 
   double x = xd, y = yd;
   distortion_of(lens).invert(xd, yd, x, y);
   return {lens.fx_px * x + lens.cx_px, lens.fy_px * y + lens.cy_px};
+}
+
+std::vector<calibration::TargetImage> simulated_target_images(const vision::CameraIntrinsics& lens,
+                                                              const calibration::TargetSpec& target, int views,
+                                                              std::uint64_t seed) {
+  const std::vector<TargetPose> poses = default_target_poses(target, lens, views, seed);
+  std::vector<calibration::TargetImage> images;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    char name[48];
+    std::snprintf(name, sizeof name, "sim_view_%02zu.png", i + 1);
+    images.push_back({name, render_target_view(lens, target, poses[i], {}, ball_seed(seed, i))});
+  }
+  return images;
 }
 
 std::vector<TargetPose> default_target_poses(const calibration::TargetSpec& target,

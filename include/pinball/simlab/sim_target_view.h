@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "pinball/calibration/calibration_target.h"
+#include "pinball/calibration/intrinsics_calibration.h"
 #include "pinball/vision/lens_model.h"
 
 namespace pinball::simlab {
@@ -57,6 +58,13 @@ RangeViolation check_target_view_options(const TargetViewOptions& options);
 /// target or option.
 cv::Mat render_target_view(const vision::CameraIntrinsics& lens, const calibration::TargetSpec& target,
                            const TargetPose& pose, const TargetViewOptions& options, std::uint64_t seed);
+
+/// `views` images of `target` through `lens` at default_target_poses(...,
+/// seed), named sim_view_01.png ... and each rendered with ball_seed(seed, i):
+/// what `pinball calibrate intrinsics --sim` calibrates on.
+std::vector<calibration::TargetImage> simulated_target_images(const vision::CameraIntrinsics& lens,
+                                                              const calibration::TargetSpec& target, int views,
+                                                              std::uint64_t seed);
 
 /// The ideal (pinhole) pixel that `lens` images at `distorted_px`: the inverse
 /// of vision::distort_pixel by Newton's method, to 1e-12 in the normalised
