@@ -99,7 +99,8 @@ std::string to_text(const CameraReport& r) {
     h << std::setprecision(0) << std::fixed << v << " m/s mm | p99 | dt";
     s << std::setw(24) << h.str();
   }
-  s << std::setw(10) << "x ideal" << std::setw(10) << "|dh|" << std::setw(12) << "|dt_imp| ms" << "valid\n";
+  s << std::setw(10) << "x ideal" << std::setw(16) << "|dh| (x ideal)" << std::setw(23) << "|dt_imp| ms (x ideal)"
+    << "valid\n";
   for (const CameraScenarioResult& c : r.scenarios) {
     s << std::left << std::setw(32) << c.scenario.name;
     for (const CameraDetectorFigures& d : c.detector) {
@@ -110,10 +111,12 @@ std::string to_text(const CameraReport& r) {
     }
     std::ostringstream ratio, dh, dt, valid;
     ratio << std::fixed << std::setprecision(2) << c.ratio_to_ideal;
-    dh << std::fixed << std::setprecision(3) << c.tracker.median_abs_dh;
-    dt << std::fixed << std::setprecision(2) << c.tracker.median_abs_dt_impact_ms;
+    dh << std::fixed << std::setprecision(4) << c.tracker.median_abs_dh << " (" << std::setprecision(2)
+       << c.tracker_dh_ratio_to_ideal << ")";
+    dt << std::fixed << std::setprecision(3) << c.tracker.median_abs_dt_impact_ms << " (" << std::setprecision(2)
+       << c.tracker_dt_ratio_to_ideal << ")";
     valid << std::fixed << std::setprecision(2) << c.tracker.valid_fraction;
-    s << std::setw(10) << ratio.str() << std::setw(10) << dh.str() << std::setw(12) << dt.str() << valid.str();
+    s << std::setw(10) << ratio.str() << std::setw(16) << dh.str() << std::setw(23) << dt.str() << valid.str();
     if (c.scenario.corrected) s << (c.within_target ? "  within 10 % of ideal" : "  NOT within 10 % of ideal");
     s << "\n";
   }
