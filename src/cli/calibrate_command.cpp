@@ -130,6 +130,11 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--sim-theta-offset-deg", a.sim_theta_offset_deg, "--sim: both flipper stops this much higher (degrees)")
       ->check(CLI::Range(-10.0, 10.0))
       ->needs(sim);
+  cmd->add_option("--sim-camera", a.sim_camera,
+                  "camera, flippers with --sim: the simulated camera, ideal or typical (a wide lens: calibrate "
+                  "intrinsics into the same --out first, docs/calibration.md)")
+      ->check(CLI::IsMember({"ideal", "typical"}))
+      ->needs(sim);
   cmd->add_option("--device", a.device, "latency: the camera, /dev/videoN");
   cmd->add_option("--can", a.can, "latency: the driver board's SocketCAN interface, e.g. can0");
   cmd->add_option("--flipper", a.flipper, "latency: the flipper to fire, by the board's name (default: the first)");
@@ -197,7 +202,20 @@ calibration::HomographyFit camera(Context& c) {
   const cv::Mat image = c.lab ? c.lab->camera_image() : read_gray(c.a.image);
   c.err << "calibrate camera: " << layout.size() << " markers in the layout, image " << image.cols << "x" << image.rows
         << "\n";
-  calibration::HomographyFit fit = calibration::calibrate_camera(image, layout);
+  // The homography maps the board into the ideal image: with the file's lens the markers are undistorted first.
+  const std::optional<vision::CameraIntrinsics> lens =
+      c.cal.intrinsics ? std::optional<vision::CameraIntrinsics>(c.cal.intrinsics->lens) : std::nullopt;
+  if (lens) c.err << "calibrate camera: markers undistorted through the file's intrinsics\n";
+  calibration::HomographyFit fit;
+  try {
+    fit = calibration::calibrate_camera(image, layout, {}, {}, lens);
+  } catch (const std::runtime_error& e) {
+    if (lens) throw;
+    // A wide lens moves markers too far for any homography to match them.
+    throw std::runtime_error(std::string(e.what()) +
+                             " (without the lens's intrinsics in the file: if the lens bends the image, run "
+                             "`pinball calibrate intrinsics` into the same --out first)");
+  }
   c.err << "calibrate camera: " << fit.detections << " detected, " << fit.calibration.markers_used
         << " used, reprojection rms " << fit.calibration.reprojection_rms_px << " px\n";
   if (c.a.kind == "camera" && !c.a.png.empty()) sim::write_png(calibration::draw_camera_figure(image, fit), c.a.png);
@@ -237,19 +255,28 @@ void run_flippers(Context& c) {
   // The homography: the simulated camera calibrated afresh, or the file's.
   cv::Mat background;
   std::optional<vision::CameraHomography> h;
+  std::optional<calibration::IntrinsicsCalibration> lens = c.cal.intrinsics;  // the lens the homography was fitted after
   if (c.lab) {
     h.emplace(camera(c).calibration.image_from_board);
   } else {
     const std::string from = c.a.calibration.empty() ? c.a.out : c.a.calibration;
     if (from.empty()) throw std::runtime_error("calibrate flippers: give --calibration FILE with a camera section");
-    h.emplace(calibration::camera_homography(calibration::read_calibration(from), from));
+    const calibration::Calibration from_file = calibration::read_calibration(from);
+    h.emplace(calibration::camera_homography(from_file, from));
+    lens = from_file.intrinsics;
   }
   std::vector<Vec2> down, up;
   if (markers) {
     const cv::Mat di = c.lab ? c.lab->flipper_markers_image(false) : read_gray(c.a.down);
     const cv::Mat ui = c.lab ? c.lab->flipper_markers_image(true) : read_gray(c.a.up);
-    for (const auto& m : calibration::detect_markers(di)) down.push_back(h->board_from_image(m.uv_px));
-    for (const auto& m : calibration::detect_markers(ui)) up.push_back(h->board_from_image(m.uv_px));
+    std::vector<calibration::DetectedMarker> seen_down = calibration::detect_markers(di);
+    std::vector<calibration::DetectedMarker> seen_up = calibration::detect_markers(ui);
+    if (lens) {  // the homography is the ideal image's
+      calibration::undistort_markers(seen_down, lens->lens);
+      calibration::undistort_markers(seen_up, lens->lens);
+    }
+    for (const auto& m : seen_down) down.push_back(h->board_from_image(m.uv_px));
+    for (const auto& m : seen_up) up.push_back(h->board_from_image(m.uv_px));
     background = di;
     c.err << "calibrate flippers: " << down.size() << " markers down, " << up.size() << " up\n";
   }
@@ -881,6 +908,7 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
     o.pivot_offset_m = Vec2{a.sim_pivot_offset_mm.at(0), a.sim_pivot_offset_mm.at(1)} * 1e-3;
     o.length_offset_m = a.sim_length_offset_mm * 1e-3;
     o.theta_offset_rad = a.sim_theta_offset_deg / kDeg;
+    if (a.sim_camera == "typical") o.camera.realism.lens = vision::typical_wide_lens(o.camera.width_px, o.camera.height_px);
     c.lab = std::make_unique<simlab::SimLab>(c.board, o);
     c.report["sim_mounting_error"] = {{"pivot_offset_mm", a.sim_pivot_offset_mm},
                                       {"length_offset_mm", a.sim_length_offset_mm},

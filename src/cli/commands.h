@@ -151,6 +151,7 @@ struct CalibrateArgs {
   std::vector<double> sim_pivot_offset_mm{0.0, 0.0};
   double sim_length_offset_mm = 0.0;
   double sim_theta_offset_deg = 0.0;
+  std::string sim_camera = "ideal";  ///< --sim: the simulated camera, ideal or typical (lens, rolling shutter, ...)
   std::string device;                ///< latency: the camera, /dev/videoN
   std::string can;                   ///< latency: the driver board's SocketCAN interface (can0)
   std::string flipper;               ///< latency: the flipper fired (board name); empty: the board's first

@@ -341,4 +341,25 @@ TEST_F(Calibrate, IntrinsicsBadArguments) {
   EXPECT_NE(r.err.find("give --images"), std::string::npos) << r.err;
 }
 
+TEST_F(Calibrate, ThroughAWideLensTheHomographyNeedsTheIntrinsicsFirst) {
+  const std::string file = (dir_ / "lens.yaml").string();
+  // Without the lens the markers cannot be matched by any homography: a clear error with the remedy, nothing written.
+  Result r = run("calibrate camera --sim boards/mit1993.board --sim-camera typical --out " + file);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("pinball calibrate intrinsics"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(file));
+  // The lab's order: the lens, then the homography on undistorted markers, then the flippers.
+  r = run("calibrate intrinsics --sim boards/mit1993.board --sim-views 12 --out " + file);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = run("calibrate camera --sim boards/mit1993.board --sim-camera typical --out " + file + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_LT(j.at("camera").at("reprojection_rms_px").get<double>(), 0.3);
+  EXPECT_LT(j.at("camera").at("truth").at("homography_max_error_mm").get<double>(), 1.0);
+  r = run("calibrate flippers --sim boards/mit1993.board --sim-camera typical --out " + file + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  for (const auto& f : j.at("flippers")) EXPECT_LT(f.at("markers").at("truth").at("pivot_error_mm").get<double>(), 1.0);
+}
+
 }  // namespace
