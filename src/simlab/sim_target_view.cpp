@@ -16,32 +16,6 @@ namespace {
 
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
-// The lens's distortion in the normalised plane and its Jacobian (the model of vision::distort_pixel).
-struct Distortion {
-  double k1, k2, k3, p1, p2;
-
-  // Solves distort(x, y) = (xd, yd) from the start (x, y), in place.
-  void invert(double xd, double yd, double& x, double& y) const {
-    for (int it = 0; it < 30; ++it) {
-      const double r2 = x * x + y * y;
-      const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-      const double dradial = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);  // d radial / d r2
-      const double fx = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) - xd;
-      const double fy = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y - yd;
-      const double a = radial + 2.0 * x * x * dradial + 2.0 * p1 * y + 6.0 * p2 * x;
-      const double b = 2.0 * x * y * dradial + 2.0 * p1 * x + 2.0 * p2 * y;
-      const double d = radial + 2.0 * y * y * dradial + 6.0 * p1 * y + 2.0 * p2 * x;
-      const double det = a * d - b * b;  // the Jacobian is symmetric: [[a, b], [b, d]]
-      const double dx = (d * fx - b * fy) / det, dy = (a * fy - b * fx) / det;
-      x -= dx;
-      y -= dy;
-      if (std::abs(dx) + std::abs(dy) < 1e-12) return;
-    }
-  }
-};
-
-Distortion distortion_of(const vision::CameraIntrinsics& l) { return {l.k1, l.k2, l.k3, l.p1, l.p2}; }
-
 void check_lens_and_target(const vision::CameraIntrinsics& lens, const calibration::TargetSpec& target) {
   check_input(vision::check_intrinsics(lens), "lens");
   check_input(calibration::check_target(target), "target");
@@ -84,13 +58,6 @@ bool in_view(const std::vector<cv::Point3d>& outline, const cv::Matx33d& r, cons
 
 }  // namespace
 
-cv::Point2d ideal_from_distorted_px(const vision::CameraIntrinsics& lens, const cv::Point2d& distorted_px) {
-  const double xd = (distorted_px.x - lens.cx_px) / lens.fx_px, yd = (distorted_px.y - lens.cy_px) / lens.fy_px;
-  double x = xd, y = yd;
-  distortion_of(lens).invert(xd, yd, x, y);
-  return {lens.fx_px * x + lens.cx_px, lens.fy_px * y + lens.cy_px};
-}
-
 std::vector<calibration::TargetImage> simulated_target_images(const vision::CameraIntrinsics& lens,
                                                               const calibration::TargetSpec& target, int views,
                                                               std::uint64_t seed) {
@@ -125,7 +92,8 @@ std::vector<TargetPose> default_target_poses(const calibration::TargetSpec& targ
   // The pose with the target's centre seen at (ax, ay) (fractions of the image).
   const auto placed = [&](const cv::Matx33d& r, double fill, double ax, double ay) {
     const double depth_m = width_m * lens.fx_px / (fill * lens.width_px);
-    const cv::Point2d ideal = ideal_from_distorted_px(lens, {ax * (lens.width_px - 1), ay * (lens.height_px - 1)});
+    const cv::Point2d ideal =
+        vision::ideal_from_distorted_newton(lens, {ax * (lens.width_px - 1), ay * (lens.height_px - 1)});
     const cv::Vec3d ray((ideal.x - lens.cx_px) / lens.fx_px, (ideal.y - lens.cy_px) / lens.fy_px, 1.0);
     return cv::Vec3d(depth_m * ray - r * centre);
   };
@@ -191,7 +159,6 @@ cv::Mat render_target_view(const vision::CameraIntrinsics& lens, const calibrati
   check_lens_and_target(lens, target);
   check_input(check_target_view_options(o), "target view");
   const calibration::TargetPattern pattern(target);
-  const Distortion distortion = distortion_of(lens);
   cv::Matx33d r;
   cv::Rodrigues(pose.rvec, r);
   // The camera in the target frame: centre o, and each ray's direction R^T d.
@@ -222,7 +189,7 @@ cv::Mat render_target_view(const vision::CameraIntrinsics& lens, const calibrati
     auto* ip = ideal.ptr<cv::Vec2d>(v);
     auto* sp = seen.ptr<std::uint8_t>(v);
     for (int u = 0; u <= w; ++u) {
-      distortion.invert((u - 0.5 - lens.cx_px) / lens.fx_px, yd, x, y);
+      vision::undistort_normalised(lens, (u - 0.5 - lens.cx_px) / lens.fx_px, yd, x, y);
       ip[u] = {x, y};
       sp[u] = what(x, y);
     }
@@ -265,7 +232,8 @@ cv::Mat render_target_view(const vision::CameraIntrinsics& lens, const calibrati
         const cv::Vec2d start =
             (1 - off.y) * ((1 - off.x) * c00 + off.x * c10) + off.y * ((1 - off.x) * c01 + off.x * c11);
         double x = start[0], y = start[1];
-        distortion.invert((u - 0.5 + off.x - lens.cx_px) / lens.fx_px, (v - 0.5 + off.y - lens.cy_px) / lens.fy_px, x, y);
+        vision::undistort_normalised(lens, (u - 0.5 + off.x - lens.cx_px) / lens.fx_px,
+                                     (v - 0.5 + off.y - lens.cy_px) / lens.fy_px, x, y);
         total += gray[what(x, y)];
       }
       row[u] = total / static_cast<double>(offsets.size());

@@ -88,6 +88,32 @@ cv::Point2d distort_pixel(const CameraIntrinsics& c, const cv::Point2d& ideal_px
   return {c.fx_px * xd + c.cx_px, c.fy_px * yd + c.cy_px};
 }
 
+void undistort_normalised(const CameraIntrinsics& c, double xd, double yd, double& x, double& y) {
+  for (int it = 0; it < 30; ++it) {
+    const double r2 = x * x + y * y;
+    const double radial = 1.0 + r2 * (c.k1 + r2 * (c.k2 + r2 * c.k3));
+    const double dradial = c.k1 + r2 * (2.0 * c.k2 + 3.0 * r2 * c.k3);  // d radial / d r2
+    const double fx = x * radial + 2.0 * c.p1 * x * y + c.p2 * (r2 + 2.0 * x * x) - xd;
+    const double fy = y * radial + c.p1 * (r2 + 2.0 * y * y) + 2.0 * c.p2 * x * y - yd;
+    const double a = radial + 2.0 * x * x * dradial + 2.0 * c.p1 * y + 6.0 * c.p2 * x;
+    const double b = 2.0 * x * y * dradial + 2.0 * c.p1 * x + 2.0 * c.p2 * y;
+    const double d = radial + 2.0 * y * y * dradial + 6.0 * c.p1 * y + 2.0 * c.p2 * x;
+    const double det = a * d - b * b;  // the Jacobian is symmetric: [[a, b], [b, d]]
+    const double dx = (d * fx - b * fy) / det, dy = (a * fy - b * fx) / det;
+    x -= dx;
+    y -= dy;
+    if (std::abs(dx) + std::abs(dy) < 1e-12) return;
+  }
+}
+
+cv::Point2d ideal_from_distorted_newton(const CameraIntrinsics& c, const cv::Point2d& distorted_px) {
+  const double xd = (distorted_px.x - c.cx_px) / c.fx_px;
+  const double yd = (distorted_px.y - c.cy_px) / c.fy_px;
+  double x = xd, y = yd;
+  undistort_normalised(c, xd, yd, x, y);
+  return {c.fx_px * x + c.cx_px, c.fy_px * y + c.cy_px};
+}
+
 PointUndistorter::PointUndistorter(const CameraIntrinsics& intrinsics)
     : intrinsics_(intrinsics), k_(camera_matrix(intrinsics)) {
   check_input(check_intrinsics(intrinsics), "lens");

@@ -24,12 +24,12 @@ TEST(SimTargetView, InvertsTheLensModel) {
   for (int i = 0; i <= 8; ++i) {
     for (int k = 0; k <= 6; ++k) {
       const cv::Point2d seen(639.0 * i / 8, 479.0 * k / 6);
-      const cv::Point2d ideal = ideal_from_distorted_px(kLens, seen);
+      const cv::Point2d ideal = vision::ideal_from_distorted_newton(kLens, seen);
       EXPECT_LT(cv::norm(vision::distort_pixel(kLens, ideal) - seen), 1e-9) << seen;
     }
   }
   // The barrel lens shows the corner's ray well inside: its ideal pixel lies outside the image.
-  EXPECT_LT(ideal_from_distorted_px(kLens, {0.0, 0.0}).x, -20.0);
+  EXPECT_LT(vision::ideal_from_distorted_newton(kLens, {0.0, 0.0}).x, -20.0);
 }
 
 // The chessboard's corners land where cv::projectPoints with the true lens

@@ -62,6 +62,19 @@ TEST(LensModel, UndistortionInvertsDistortionEverywhereInTheImage) {
   EXPECT_LT(worst, 1e-4);
 }
 
+TEST(LensModel, TheSimulatorsNewtonInverseAgreesWithOpenCvs) {
+  // Two independent inverses: the simulator's (Newton) and the detector's (cv::undistortPoints).
+  const CameraIntrinsics lens = typical_wide_lens();
+  const PointUndistorter undistorter(lens);
+  for (double v = 0.0; v <= 479.0; v += 95.8) {
+    for (double u = 0.0; u <= 639.0; u += 127.8) {
+      const cv::Point2d sensor(u, v);
+      EXPECT_LT(cv::norm(ideal_from_distorted_newton(lens, sensor) - undistorter.ideal_from_distorted(sensor)), 1e-4);
+      EXPECT_LT(cv::norm(distort_pixel(lens, ideal_from_distorted_newton(lens, sensor)) - sensor), 1e-9);
+    }
+  }
+}
+
 TEST(LensModel, ScalesWithTheImage) {
   const CameraIntrinsics small = typical_wide_lens(640, 480);
   const CameraIntrinsics large = typical_wide_lens(1280, 960);

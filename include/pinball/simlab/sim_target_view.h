@@ -66,9 +66,5 @@ std::vector<calibration::TargetImage> simulated_target_images(const vision::Came
                                                               const calibration::TargetSpec& target, int views,
                                                               std::uint64_t seed);
 
-/// The ideal (pinhole) pixel that `lens` images at `distorted_px`: the inverse
-/// of vision::distort_pixel by Newton's method, to 1e-12 in the normalised
-/// plane (the renderer's inverse, for every sample).
-cv::Point2d ideal_from_distorted_px(const vision::CameraIntrinsics& lens, const cv::Point2d& distorted_px);
 
 }  // namespace pinball::simlab

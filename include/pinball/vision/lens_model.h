@@ -79,6 +79,18 @@ CameraIntrinsics intrinsics_from_opencv(const cv::Matx33d& k, const cv::Mat& coe
 /// Where the lens puts a point the ideal pinhole camera sees at `ideal_px` (closed form).
 cv::Point2d distort_pixel(const CameraIntrinsics& intrinsics, const cv::Point2d& ideal_px);
 
+/// The ideal (pinhole) pixel that `intrinsics` images at `distorted_px`: the
+/// inverse of distort_pixel by Newton's method on the normalised plane, to
+/// 1e-12. The simulator's inverse, cheap enough for every rendered sample;
+/// the detector uses OpenCV's (PointUndistorter), so the two sides of every
+/// simulated measurement are computed independently.
+cv::Point2d ideal_from_distorted_newton(const CameraIntrinsics& intrinsics, const cv::Point2d& distorted_px);
+
+/// The same on the normalised plane: solves distortion(x, y) = (xd, yd) for
+/// (x, y), starting from the (x, y) given (a neighbour's solution converges in
+/// a step or two).
+void undistort_normalised(const CameraIntrinsics& intrinsics, double xd, double yd, double& x, double& y);
+
 /// Undistorts single points without allocating: cv::undistortPoints on
 /// fixed-size buffers with K and the coefficients held as cv::Matx.
 class PointUndistorter {
