@@ -9,6 +9,8 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-videoio-dev
   libopencv-calib3d-dev
   libopencv-contrib-dev   # aruco: ChArUco targets for `pinball calibrate intrinsics`
+  libopencv-highgui-dev   # the windows of `pinball view` and `pinball play`
+  xvfb xauth              # a virtual display: the viewer's and play's tests run headless
   liblcm-dev liblcm-bin
   libgtest-dev libgmock-dev googletest
   libbenchmark-dev
