@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <array>
 #include <fstream>
 #include <stdexcept>
 
@@ -95,6 +96,41 @@ LcmLogCheck check_lcm_log(const std::string& path) {
   }
   c.offset = offset;
   return c;
+}
+
+void require_lcm_log(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot read the LCM log");
+  std::array<unsigned char, 4> word{};
+  in.read(reinterpret_cast<char*>(word.data()), static_cast<std::streamsize>(word.size()));
+  if (in.gcount() == 0) throw std::runtime_error(path + ": is empty (0 bytes), not an LCM log");
+  if (in.gcount() < 4 || static_cast<std::uint32_t>(get_be(word.data(), 4)) != kLcmLogSync) {
+    throw std::runtime_error(path + ": not an LCM log (no LCM event header at byte 0)");
+  }
+  const LcmLogCheck c = check_lcm_log(path);
+  if (!c.ok) {
+    throw std::runtime_error(path + ": damaged LCM log at byte " + std::to_string(c.offset) + ": " + c.problem +
+                             " (" + std::to_string(c.events) + " whole events before it)");
+  }
+}
+
+std::vector<LcmLogEvent> read_lcm_log(const std::string& path) {
+  require_lcm_log(path);
+  std::ifstream in(path, std::ios::binary);
+  std::vector<LcmLogEvent> events;
+  unsigned char buf[kLcmEventHeaderBytes];
+  while (in.read(reinterpret_cast<char*>(buf), sizeof buf)) {
+    const LcmEventHeader h = read_lcm_event_header(buf);
+    LcmLogEvent e;
+    e.utime = h.utime;
+    e.channel.resize(static_cast<std::size_t>(h.channel_bytes));
+    e.data.resize(static_cast<std::size_t>(h.data_bytes));
+    in.read(e.channel.data(), h.channel_bytes);
+    in.read(reinterpret_cast<char*>(e.data.data()), h.data_bytes);
+    if (!in) throw std::runtime_error(path + ": cannot read the LCM log (it changed while being read)");
+    events.push_back(std::move(e));
+  }
+  return events;
 }
 
 }  // namespace pinball::bus

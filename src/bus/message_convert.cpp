@@ -155,4 +155,23 @@ bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m) {
          m.cause <= M::CAUSE_BUS_FAULT;
 }
 
+bool valid_projection(const pinball_lcm::lcmt_pinball_projection& m) {
+  const bool finite = std::isfinite(m.speed_mps) && std::isfinite(m.angle_rad) && std::isfinite(m.h) &&
+                      std::isfinite(m.d_m) && std::isfinite(m.t_impact_s) && std::isfinite(m.impact_x_m) &&
+                      std::isfinite(m.impact_y_m);
+  if (m.utime < 0 || !finite || m.flipper < -1 || m.flipper > 1) return false;
+  if (!m.valid) return m.reason >= 0 && m.reason <= static_cast<int>(track::NoProjection::kNumerical);
+  return m.flipper >= 0 && m.speed_mps >= 0.0 && m.d_m >= 0.0 && m.t_impact_s >= 0.0 &&
+         std::abs(m.angle_rad) <= 2.0 && std::abs(m.h) < 1e3;
+}
+
+std::optional<std::int64_t> encoded_utime(const void* data, std::size_t size) {
+  constexpr std::size_t kFingerprintBytes = 8;
+  if (data == nullptr || size < kFingerprintBytes + 8) return std::nullopt;
+  const auto* p = static_cast<const unsigned char*>(data) + kFingerprintBytes;
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
+  return static_cast<std::int64_t>(v);
+}
+
 }  // namespace pinball::bus

@@ -182,4 +182,24 @@ CLI::App* add_replay_command(CLI::App& app, ReplayArgs& args);
 /// Exit 0 when reproduced, 3 when the decisions differ, 1 for bad input.
 int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err);
 
+/// `pinball view`
+struct ViewArgs {
+  std::string log;            ///< LCM log to play; empty: live from lcm_url
+  std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";  ///< live: the daemon's LCM URL
+  std::string config;         ///< pinballd configuration: board, calibration, controller, LCM URL
+  std::string board;          ///< board override
+  std::string calibration;    ///< calibration override
+  std::string controller;     ///< controller override (d_critical)
+  std::string snapshot;       ///< PNG to write
+  double at_s = -1.0;         ///< snapshot time (s from the log's start or from listening); negative: the end
+  double quit_at_s = -1.0;    ///< window: play until this time, write the snapshot, quit; negative: never
+  double speed = 1.0;         ///< log playback speed
+  double px_per_m = 800.0;    ///< scale of the table
+  double wait_s = 10.0;       ///< live snapshot: give up when nothing arrives for this long (s)
+  bool json = false;          ///< one JSON object on stdout
+};
+CLI::App* add_view_command(CLI::App& app, ViewArgs& args);
+/// Exit 0; 1 for bad input, no display for a window, or a live source that sent nothing.
+int run_view(const ViewArgs& args, std::ostream& out, std::ostream& err);
+
 }  // namespace pinball::cli

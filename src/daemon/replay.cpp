@@ -34,34 +34,15 @@ bool decided_by_observations(int cause) {
          cause == static_cast<int>(CommandCause::kBallLost);
 }
 
-// An LCM log is a sequence of events, each starting with the sync word
-// 0xEDA1DA01 (big-endian); liblcm reads anything else as an empty log, stops
-// silently at a damaged event and trusts the lengths it reads (a length of
-// 0x7fffffff crashes liblcm 1.3.1). So every header is checked against the
-// file's size before liblcm sees the file.
-void require_lcm_log(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot read the LCM log");
-  std::array<unsigned char, 4> word{};
-  in.read(reinterpret_cast<char*>(word.data()), static_cast<std::streamsize>(word.size()));
-  if (in.gcount() == 0) throw std::runtime_error(path + ": is empty (0 bytes), not an LCM log");
-  std::uint32_t sync = 0;
-  for (const unsigned char b : word) sync = (sync << 8) | b;
-  if (in.gcount() < 4 || sync != bus::kLcmLogSync) {
-    throw std::runtime_error(path + ": not an LCM log (no LCM event header at byte 0)");
-  }
-  const bus::LcmLogCheck c = bus::check_lcm_log(path);
-  if (!c.ok) {
-    throw std::runtime_error(path + ": damaged LCM log at byte " + std::to_string(c.offset) + ": " + c.problem +
-                             " (" + std::to_string(c.events) + " whole events before it); nothing replayed");
-  }
-}
-
 }  // namespace
 
 ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
                         const std::function<void(const std::string&)>& progress) {
-  require_lcm_log(log_path);
+  try {
+    bus::require_lcm_log(log_path);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string(e.what()) + "; nothing replayed");
+  }
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
   const table::Board board = table::load_board(config.mode == "sim" ? config.sim.board : config.board);

@@ -148,5 +148,40 @@ TEST(MessageConvert, FlipperCommandRange) {
   EXPECT_FALSE(valid_flipper_command(m));
 }
 
+template <class T>
+std::optional<std::int64_t> utime_of_encoded(T m, std::int64_t utime) {
+  m.utime = utime;
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  return encoded_utime(buf.data(), buf.size());
+}
+
+TEST(MessageConvert, EveryTypeCarriesItsUtimeFirst) {
+  constexpr std::int64_t kUtime = 1'700'000'123'456'789;
+  EXPECT_EQ(utime_of_encoded(pinball_lcm::lcmt_pinball_observation{}, kUtime), kUtime);
+  EXPECT_EQ(utime_of_encoded(pinball_lcm::lcmt_pinball_projection{}, kUtime), kUtime);
+  EXPECT_EQ(utime_of_encoded(pinball_lcm::lcmt_pinball_flipper_command{}, kUtime), kUtime);
+  EXPECT_EQ(utime_of_encoded(pinball_lcm::lcmt_pinball_driver_status{}, kUtime), kUtime);
+  EXPECT_EQ(utime_of_encoded(pinball_lcm::lcmt_pinball_game_event{}, kUtime), kUtime);
+  EXPECT_EQ(utime_of_encoded(pinball_lcm::lcmt_pinball_daemon_stats{}, kUtime), kUtime);
+  const std::uint8_t short_message[12] = {};
+  EXPECT_FALSE(encoded_utime(short_message, sizeof short_message).has_value());
+}
+
+TEST(MessageConvert, ValidProjectionRefusesNonFiniteAndNegativeFields) {
+  pinball_lcm::lcmt_pinball_projection m{};
+  EXPECT_TRUE(valid_projection(m));  // an invalid projection of zeros is well formed
+  m.valid = true;
+  EXPECT_TRUE(valid_projection(m));
+  m.t_impact_s = -0.01;
+  EXPECT_FALSE(valid_projection(m));
+  m.t_impact_s = 0.1;
+  m.impact_x_m = std::nan("");
+  EXPECT_FALSE(valid_projection(m));
+  m.impact_x_m = 0.1;
+  m.flipper = 2;
+  EXPECT_FALSE(valid_projection(m));
+}
+
 }  // namespace
 }  // namespace pinball::bus

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace pinball::bus {
 
@@ -49,5 +50,21 @@ struct LcmLogCheck {
 /// reading only the headers. Throws std::runtime_error naming the file when
 /// it cannot be read.
 LcmLogCheck check_lcm_log(const std::string& path);
+
+/// Throws std::runtime_error naming the file unless `path` is a readable,
+/// non-empty LCM log whose every event is whole and well-formed. liblcm reads
+/// anything else as an empty log, stops silently at a damaged event and trusts
+/// the lengths it reads, so every reader checks a log with this first.
+void require_lcm_log(const std::string& path);
+
+/// One event of a log, read into memory.
+struct LcmLogEvent {
+  std::int64_t utime = 0;          ///< the event's timestamp (us since the epoch, as written)
+  std::string channel;             ///< channel name
+  std::vector<std::uint8_t> data;  ///< the encoded message
+};
+
+/// Every event of the log at `path`, in file order, after require_lcm_log.
+std::vector<LcmLogEvent> read_lcm_log(const std::string& path);
 
 }  // namespace pinball::bus

@@ -4,7 +4,9 @@
 // received messages field by field (a decoded message can still carry NaN or
 // an out-of-range code; such a message is malformed).
 
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 
 #include "pinball_lcm/lcmt_pinball_daemon_stats.hpp"
@@ -74,5 +76,14 @@ bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& 
 
 /// A received flipper command is well formed (flipper -1..1, cause 0..5).
 bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m);
+
+/// The utime of an encoded pinball message without decoding it: every type in
+/// src/bus/lcmtypes starts with `int64_t utime`, which LCM encodes big-endian
+/// right after its 8-byte type fingerprint. Empty when the bytes are too short.
+std::optional<std::int64_t> encoded_utime(const void* data, std::size_t size);
+
+/// A received projection is well formed: every number finite, flipper -1..1,
+/// and a valid one has speed, d and t_impact >= 0 and h, angle in range.
+bool valid_projection(const pinball_lcm::lcmt_pinball_projection& m);
 
 }  // namespace pinball::bus

@@ -1,0 +1,285 @@
+// `pinball view [LOG]`: a window onto a running pinballd (live over LCM) or a
+// recorded LCM log (pause, seek, frame by frame), or one picture of either
+// with --snapshot, without a display.
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/highgui.hpp>
+
+#include "commands.h"
+#include "data_file.h"
+#include "pinball/core/format.h"
+#include "pinball/daemon/daemon_config.h"
+#include "pinball/sim/renderer.h"
+#include "pinball/view/lcm_listener.h"
+#include "pinball/view/log_player.h"
+#include "pinball/view/view_render.h"
+
+namespace pinball::cli {
+namespace {
+
+constexpr const char* kWindow = "pinball view";
+constexpr double kFramePeriod_s = 1.0 / 60.0;
+
+double steady_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+bool has_display() {
+  const char* x = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  return (x != nullptr && *x != '\0') || (wayland != nullptr && *wayland != '\0');
+}
+
+// The board, calibration and controller the daemon runs with: --config's,
+// then the overrides; the daemon's defaults otherwise.
+view::ViewScene scene_for(const ViewArgs& a) {
+  daemon::DaemonConfig config;
+  if (!a.config.empty()) config = daemon::load_daemon_config(a.config);
+  std::string board = config.mode == "lab" ? config.board : config.sim.board;
+  std::string calibration = config.calibration;
+  std::string controller = a.config.empty() ? std::string() : config.controller;
+  if (!a.board.empty()) board = a.board;
+  if (!a.calibration.empty()) calibration = a.calibration;
+  if (!a.controller.empty()) controller = a.controller;
+  return view::load_view_scene(find_data_file(board), calibration, controller, a.px_per_m);
+}
+
+std::string live_url(const ViewArgs& a) {
+  if (!a.config.empty() && a.lcm_url == ViewArgs{}.lcm_url) return daemon::load_daemon_config(a.config).lcm_url;
+  return a.lcm_url;
+}
+
+// What the window shows and the summary reports.
+struct Session {
+  std::uint64_t frames_drawn = 0;
+  double draw_s = 0.0;
+  cv::Mat last;
+};
+
+nlohmann::json ball_json(const view::ViewScene& scene, const view::ViewState& state) {
+  const std::optional<view::Sighting> ball = state.ball();
+  if (!ball) return nullptr;
+  const cv::Point2d px = view::view_pixel(scene, ball->p_board);
+  return {{"x_m", ball->p_board.x()}, {"y_m", ball->p_board.y()}, {"t_s", ball->t_s}, {"u_px", px.x}, {"v_px", px.y}};
+}
+
+void report(const ViewArgs& a, const std::string& source, double t_s, const view::ViewScene& scene,
+            const view::ViewState& state, const Session& s, std::ostream& out) {
+  const view::DaemonFigures f = state.figures();
+  const double draw_fps = s.draw_s > 0.0 ? static_cast<double>(s.frames_drawn) / s.draw_s : 0.0;
+  if (a.json) {
+    nlohmann::json j{{"source", source},
+                     {"t_s", t_s},
+                     {"messages", state.messages()},
+                     {"malformed", state.malformed()},
+                     {"observations", state.observations()},
+                     {"ball", ball_json(scene, state)},
+                     {"projection_valid", state.projection().has_value()},
+                     {"commands_listed", state.commands().size()},
+                     {"camera_fps", f.frame_rate_hz},
+                     {"frames_dropped", f.frames_dropped},
+                     {"camera_stalls", f.camera_stalls},
+                     {"frame_to_can_p99_us", f.has_stats && f.frame_to_can_p99_us >= 0.0 ? nlohmann::json(f.frame_to_can_p99_us)
+                                                                                       : nlohmann::json(nullptr)},
+                     {"frames_drawn", s.frames_drawn},
+                     {"draw_fps", draw_fps}};
+    j["snapshot"] = a.snapshot.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.snapshot);
+    out << j.dump(2) << "\n";
+    return;
+  }
+  out << source << " at " << format_number(t_s) << " s: " << state.messages() << " messages (" << state.malformed()
+      << " malformed), " << state.observations() << " observations";
+  if (const std::optional<view::Sighting> b = state.ball()) {
+    out << ", ball at (" << format_number(b->p_board.x()) << ", " << format_number(b->p_board.y()) << ") m";
+  } else {
+    out << ", no ball in the last frame";
+  }
+  out << "\n";
+  if (s.frames_drawn > 0) out << "drew " << s.frames_drawn << " frames at " << format_number(draw_fps) << " frames/s\n";
+  if (!a.snapshot.empty()) out << "wrote " << a.snapshot << "\n";
+}
+
+void write_snapshot(const ViewArgs& a, const cv::Mat& picture) {
+  if (!a.snapshot.empty()) sim::write_png(picture, a.snapshot);
+}
+
+// The window's keys, for the help line and the docs.
+constexpr const char* kKeys = "space pause | . , frame +/- | l j 1 s +/- | L J 10 s +/- | + - speed | s snapshot | q quit";
+
+void check_snapshot_path(const ViewArgs& a) {
+  if (a.snapshot.empty()) return;
+  const std::filesystem::path dir = std::filesystem::path(a.snapshot).parent_path();
+  if (!dir.empty() && !std::filesystem::is_directory(dir)) {
+    throw std::runtime_error("--snapshot " + a.snapshot + ": the folder " + dir.string() + " does not exist");
+  }
+}
+
+int view_log_snapshot(const ViewArgs& a, const view::ViewScene& scene, view::LogPlayer& player, std::ostream& out) {
+  const double t_s = a.at_s < 0.0 ? player.duration_s() : a.at_s;
+  if (t_s > player.duration_s() + 1e-9) {
+    throw std::runtime_error("--at " + format_number(t_s) + ": the log " + a.log + " ends at " +
+                             format_number(player.duration_s()) + " s");
+  }
+  player.seek(t_s);
+  const cv::Mat picture = view::render_view(scene, player.state(), {a.log, "log " + format_number(t_s) + " s"});
+  write_snapshot(a, picture);
+  report(a, a.log, t_s, scene, player.state(), Session{}, out);
+  return 0;
+}
+
+int view_log_window(const ViewArgs& a, const view::ViewScene& scene, view::LogPlayer& player, std::ostream& out) {
+  cv::namedWindow(kWindow, cv::WINDOW_AUTOSIZE);
+  Session s;
+  bool paused = false;
+  double speed = a.speed;
+  double position_s = 0.0;
+  double last_tick_s = steady_s();
+  const double start_s = last_tick_s;
+  while (true) {
+    const double now_s = steady_s();
+    if (!paused) position_s = std::min(player.duration_s(), position_s + speed * (now_s - last_tick_s));
+    last_tick_s = now_s;
+    if (a.quit_at_s >= 0.0) position_s = std::min(position_s, a.quit_at_s);
+    player.seek(position_s);
+    char status[160];
+    std::snprintf(status, sizeof status, "log %.3f / %.3f s  x%.3g%s   %s", position_s, player.duration_s(), speed,
+                  paused ? "  paused" : "", kKeys);
+    s.last = view::render_view(scene, player.state(), {a.log, status});
+    cv::imshow(kWindow, s.last);
+    ++s.frames_drawn;
+    if (a.quit_at_s >= 0.0 && position_s >= a.quit_at_s - 1e-9) break;
+    const int wait_ms = std::max(1, static_cast<int>(1e3 * (kFramePeriod_s - (steady_s() - now_s))));
+    const int key = cv::waitKey(wait_ms);
+    if (key == 'q' || key == 27) break;
+    if (cv::getWindowProperty(kWindow, cv::WND_PROP_VISIBLE) < 1.0) break;  // closed by its frame
+    switch (key) {
+      case ' ': paused = !paused; break;
+      case '.': paused = true; player.step_frame_forward(); position_s = player.position_s(); break;
+      case ',': paused = true; player.step_frame_back(); position_s = player.position_s(); break;
+      case 'l': position_s = std::min(player.duration_s(), position_s + 1.0); break;
+      case 'j': position_s = std::max(0.0, position_s - 1.0); break;
+      case 'L': position_s = std::min(player.duration_s(), position_s + 10.0); break;
+      case 'J': position_s = std::max(0.0, position_s - 10.0); break;
+      case '+': case '=': speed = std::min(64.0, speed * 2.0); break;
+      case '-': speed = std::max(1.0 / 64.0, speed / 2.0); break;
+      case 's': {
+        char name[64];
+        std::snprintf(name, sizeof name, "view_%.3f.png", position_s);
+        sim::write_png(s.last, name);
+        break;
+      }
+      default: break;
+    }
+  }
+  s.draw_s = steady_s() - start_s;
+  write_snapshot(a, s.last);
+  cv::destroyAllWindows();
+  report(a, a.log, player.position_s(), scene, player.state(), s, out);
+  return 0;
+}
+
+int view_live(const ViewArgs& a, const view::ViewScene& scene, bool window, std::ostream& out, std::ostream& err) {
+  const std::string url = live_url(a);
+  view::ViewState state;
+  view::LcmListener listener(url, state);
+  if (window) cv::namedWindow(kWindow, cv::WINDOW_AUTOSIZE);
+  Session s;
+  const double start_s = steady_s();
+  double last_message_s = start_s;
+  bool ended = false;
+  // Without a window, a snapshot is taken once the view reaches --at (message
+  // time from the first message), or when the source ends or goes quiet.
+  const double until_s = window ? a.quit_at_s : a.at_s;
+  while (true) {
+    const int n = ended ? 0 : listener.poll(window ? 5 : 50);
+    if (n < 0) ended = true;
+    const double now_s = steady_s();
+    if (n > 0) last_message_s = now_s;
+    const bool reached = until_s >= 0.0 && listener.received() > 0 && state.now_s() >= until_s;
+    const bool quiet = now_s - last_message_s > a.wait_s;
+    if (window) {
+      const std::string status = "live " + format_number(state.now_s()) + " s" +
+                                 (listener.received() == 0 ? "  (nothing received yet)" : "") + "   q quit, s snapshot";
+      s.last = view::render_view(scene, state, {url, status});
+      cv::imshow(kWindow, s.last);
+      ++s.frames_drawn;
+      const int key = cv::waitKey(std::max(1, static_cast<int>(1e3 * (kFramePeriod_s - (steady_s() - now_s)))));
+      if (key == 'q' || key == 27 || reached) break;
+      if (key == 's') sim::write_png(s.last, "view_live.png");
+      if (cv::getWindowProperty(kWindow, cv::WND_PROP_VISIBLE) < 1.0) break;
+    } else if (reached || ended || quiet) {
+      break;
+    }
+  }
+  s.draw_s = steady_s() - start_s;
+  if (listener.received() == 0) {
+    throw std::runtime_error(url + ": nothing arrived on the daemon's channels in " +
+                             format_number(steady_s() - start_s) + " s (is pinballd running with this --lcm-url?)");
+  }
+  if (!window) s.last = view::render_view(scene, state, {url, "live " + format_number(state.now_s()) + " s"});
+  if (!window && a.at_s >= 0.0 && state.now_s() < a.at_s) {
+    err << "view: the source " << (ended ? "ended" : "went quiet") << " at " << format_number(state.now_s())
+        << " s, before --at " << format_number(a.at_s) << " s: the snapshot shows its last moment\n";
+  }
+  write_snapshot(a, s.last);
+  if (window) cv::destroyAllWindows();
+  report(a, url, state.now_s(), scene, state, s, out);
+  return 0;
+}
+
+}  // namespace
+
+CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
+  CLI::App* cmd = app.add_subcommand(
+      "view", "watch pinballd: live over LCM, or a recorded LCM log with pause, seek and frame stepping");
+  cmd->add_option("log", a.log, "LCM log to play (pinballd --lcm-url file://...?mode=w, lcm-logger); none: live")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--lcm-url", a.lcm_url, "live: the LCM URL pinballd publishes on (default: --config's, else udpm)");
+  cmd->add_option("--config", a.config, "the pinballd configuration: board, calibration, controller, LCM URL")
+      ->transform(data_file());
+  cmd->add_option("--board", a.board, "board file (default: the configuration's, boards/mit1993.board)")
+      ->transform(data_file());
+  cmd->add_option("--calibration", a.calibration, "calibration file: flipper geometry and g (default: the configuration's)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--controller", a.controller, "controller file, for d_critical (default: the configuration's, else none)")
+      ->transform(data_file());
+  cmd->add_option("--snapshot", a.snapshot,
+                  "PNG to write: with --at, the picture at that time and no window; with --quit-at, the window's last frame");
+  cmd->add_option("--at", a.at_s, "snapshot time: seconds from the log's first event or the first live message (default: the end)")
+      ->check(CLI::Range(0.0, 1e9));
+  cmd->add_option("--quit-at", a.quit_at_s, "window: play until this time (s), write --snapshot, quit")
+      ->check(CLI::Range(0.0, 1e9));
+  cmd->add_option("--speed", a.speed, "log playback speed (keys + and - change it)")->check(CLI::Range(1.0 / 64.0, 64.0));
+  cmd->add_option("--px-per-m", a.px_per_m, "scale of the table in pixels per metre")->check(CLI::Range(100.0, 4000.0));
+  cmd->add_option("--wait-s", a.wait_s, "live without a window: stop when nothing arrives for this long (s)")
+      ->check(CLI::Range(0.1, 3600.0));
+  cmd->add_flag("--json", a.json, "print one JSON object (what the view showed last)");
+  return cmd;
+}
+
+int run_view(const ViewArgs& a, std::ostream& out, std::ostream& err) {
+  check_snapshot_path(a);
+  const bool window = a.snapshot.empty() || a.quit_at_s >= 0.0;
+  if (window && !has_display()) {
+    throw std::runtime_error(
+        "pinball view needs a display for its window (DISPLAY is not set); "
+        "write a picture without one with --snapshot FILE.png --at SECONDS");
+  }
+  const view::ViewScene scene = scene_for(a);
+  if (!a.log.empty()) {
+    view::LogPlayer player(bus::read_lcm_log(a.log));
+    return window ? view_log_window(a, scene, player, out) : view_log_snapshot(a, scene, player, out);
+  }
+  return view_live(a, scene, window, out, err);
+}
+
+}  // namespace pinball::cli

@@ -1,0 +1,56 @@
+#include "pinball/view/lcm_listener.h"
+
+#include <lcm/lcm.h>
+
+#include <stdexcept>
+
+#include "pinball/bus/channels.h"
+#include "pinball/bus/message_convert.h"
+
+namespace pinball::view {
+namespace {
+
+void on_lcm_message(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
+  static_cast<LcmListener*>(user)->on_message(channel, rbuf->data, rbuf->data_size, rbuf->recv_utime);
+}
+
+}  // namespace
+
+LcmListener::LcmListener(const std::string& url, ViewState& state) : state_(state) {
+  lcm_ = lcm_create(url.c_str());
+  if (lcm_ == nullptr) throw std::runtime_error("lcm: cannot open '" + url + "'");
+  for (const char* channel : {bus::kObservationChannel, bus::kProjectionChannel, bus::kFlipperCommandChannel,
+                              bus::kDriverStatusChannel, bus::kGameChannel, bus::kStatsChannel}) {
+    if (lcm_subscribe(lcm_, channel, &on_lcm_message, this) == nullptr) {
+      lcm_destroy(lcm_);
+      throw std::runtime_error("lcm: cannot subscribe to " + std::string(channel) + " on '" + url + "'");
+    }
+  }
+}
+
+LcmListener::~LcmListener() { lcm_destroy(lcm_); }
+
+int LcmListener::poll(int timeout_ms) {
+  // lcm_handle_timeout handles one message; drain what waits (bounded, so a
+  // flood cannot starve the window) after waiting at most timeout_ms for the first.
+  constexpr int kMaxPerPoll = 20000;
+  handled_in_poll_ = 0;
+  for (int i = 0; i < kMaxPerPoll; ++i) {
+    const int r = lcm_handle_timeout(lcm_, i == 0 ? timeout_ms : 0);
+    if (r < 0) return handled_in_poll_ > 0 ? handled_in_poll_ : -1;
+    if (r == 0) break;
+  }
+  return handled_in_poll_;
+}
+
+void LcmListener::on_message(const char* channel, const void* data, std::size_t size, std::int64_t recv_utime) {
+  // The daemon's own clock (each message's utime) when the message has one,
+  // so the view's times do not depend on the network's delays.
+  const std::int64_t utime = bus::encoded_utime(data, size).value_or(recv_utime);
+  if (first_utime_ < 0) first_utime_ = utime;
+  ++received_;
+  ++handled_in_poll_;
+  state_.apply(channel, data, size, 1e-6 * static_cast<double>(utime - first_utime_));
+}
+
+}  // namespace pinball::view

@@ -1,0 +1,99 @@
+// `pinball view` without a display: snapshots of a log and of a live source,
+// and its errors.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/command_test.h"
+#include "pinball/view/view_render.h"
+#include "view/view_log.h"
+
+namespace pinball::testing {
+namespace {
+
+class ViewCommand : public CommandTest {
+ protected:
+  void SetUp() override {
+    CommandTest::SetUp();
+    log_ = (dir_ / "game.lcmlog").string();
+    events_ = write_view_log(log_);
+  }
+  // Runs without a display, as on a lab server or in CI.
+  CommandResult view(const std::string& args) { return run_shell("env -u DISPLAY -u WAYLAND_DISPLAY " PINBALL_EXE " view " + args); }
+  std::string log_;
+  int events_ = 0;
+};
+
+cv::Point2d ball_in(const std::string& png) {
+  return colour_centroid(cv::imread(png, cv::IMREAD_COLOR), view::kViewBallColour);
+}
+
+TEST_F(ViewCommand, SnapshotOfALogShowsTheBallWhereTheLogSaysItWas) {
+  const std::string png = (dir_ / "at.png").string();
+  const CommandResult r = view(log_ + " --snapshot " + png + " --at 0.4001 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const Vec2 truth = view_log_ball(0.4);
+  EXPECT_NEAR(j["ball"]["x_m"].get<double>(), truth.x(), 1e-9);
+  EXPECT_NEAR(j["ball"]["y_m"].get<double>(), truth.y(), 1e-9);
+  EXPECT_EQ(j["snapshot"], png);
+  EXPECT_EQ(j["frames_dropped"], 1);  // frame 50 is missing
+  const cv::Point2d c = ball_in(png);
+  EXPECT_NEAR(c.x, j["ball"]["u_px"].get<double>(), 1.0);
+  EXPECT_NEAR(c.y, j["ball"]["v_px"].get<double>(), 1.0);
+}
+
+TEST_F(ViewCommand, SnapshotOfALiveSourceThroughLiblcm) {
+  const std::string png = (dir_ / "live.png").string();
+  const CommandResult r = view("--lcm-url 'file://" + log_ + "?speed=0' --snapshot " + png + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["observations"], kViewLogFrames - 1);
+  EXPECT_DOUBLE_EQ(j["frame_to_can_p99_us"].get<double>(), 812.0);
+  EXPECT_GT(ball_in(png).x, 0.0);
+}
+
+TEST_F(ViewCommand, AWindowWithoutADisplayIsAClearError) {
+  const CommandResult r = view(log_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("needs a display"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--snapshot"), std::string::npos) << r.err;
+}
+
+TEST_F(ViewCommand, BadLogsAreNamedAndNothingIsWritten) {
+  const std::string png = (dir_ / "never.png").string();
+  std::ofstream(dir_ / "empty.lcmlog").close();
+  std::ofstream(dir_ / "text.lcmlog") << "not a log at all";
+  std::string cut = slurp(log_);
+  cut.resize(cut.size() - 7);
+  std::ofstream(dir_ / "cut.lcmlog", std::ios::binary) << cut;
+  for (const auto& [name, what] : {std::pair<std::string, std::string>{"empty.lcmlog", "is empty"},
+                                   {"text.lcmlog", "not an LCM log"},
+                                   {"cut.lcmlog", "damaged LCM log"}}) {
+    const CommandResult r = view((dir_ / name).string() + " --snapshot " + png + " --at 0");
+    EXPECT_EQ(r.exit_code, 1) << name;
+    EXPECT_NE(r.err.find(name), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+    EXPECT_EQ(count_lines(r.err), 1) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(png)) << name;
+  }
+}
+
+TEST_F(ViewCommand, ATimePastTheEndOfTheLogIsRefused) {
+  const std::string png = (dir_ / "late.png").string();
+  const CommandResult r = view(log_ + " --snapshot " + png + " --at 5");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("ends at 1 s"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(png));
+}
+
+TEST_F(ViewCommand, ASnapshotIntoAMissingFolderIsRefusedFirst) {
+  const CommandResult r = view(log_ + " --snapshot " + (dir_ / "no" / "x.png").string() + " --at 0.1");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace pinball::testing
