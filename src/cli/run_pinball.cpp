@@ -18,6 +18,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   LearnArgs learn;
   ReplayArgs replay;
   CalibrateArgs calibrate;
+  PlayArgs play;
   CLI::App* sim_cmd = add_sim_command(app, sim);
   CLI::App* render_cmd = add_render_command(app, render);
   CLI::App* bench_cmd = add_bench_command(app, bench);
@@ -25,6 +26,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   CLI::App* learn_cmd = add_learn_command(app, learn);
   CLI::App* replay_cmd = add_replay_command(app, replay);
   CLI::App* calibrate_cmd = add_calibrate_command(app, calibrate);
+  CLI::App* play_cmd = add_play_command(app, play);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -48,6 +50,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
     if (learn_cmd->parsed()) return run_learn(learn, out, err);
     if (replay_cmd->parsed()) return run_replay(replay, out, err);
     if (calibrate_cmd->parsed()) return run_calibrate(calibrate, out, err);
+    if (play_cmd->parsed()) return run_play(play, out, err);
   } catch (const std::exception& e) {
     err << "pinball: " << e.what() << "\n";
     return 1;
