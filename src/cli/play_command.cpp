@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -17,6 +18,7 @@
 #include "commands.h"
 #include "pinball/core/data_path.h"
 #include "pinball/core/format.h"
+#include "pinball/core/json_write_archive.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/simlab/human_play.h"
 #include "pinball/simlab/play_scores.h"
@@ -47,31 +49,15 @@ std::string key_script_text(const std::string& keys) {
   return s.str();
 }
 
-nlohmann::json interval_json(double half_width) {
-  return std::isfinite(half_width) ? nlohmann::json(half_width) : nlohmann::json(nullptr);
-}
-
 int run_stats(const PlayArgs& a, std::ostream& out) {
   const std::vector<simlab::PlayRow> rows = simlab::read_play_csv(a.stats);
   const std::vector<simlab::PlayerStats> stats = simlab::play_stats(rows);
   if (a.json) {
     nlohmann::json players = nlohmann::json::array();
-    nlohmann::json pooled = nullptr;
-    for (const simlab::PlayerStats& s : stats) {
-      const nlohmann::json j = {{"player", s.player},
-                                {"balls", s.balls},
-                                {"mean_score_per_ball", s.mean_score},
-                                {"score_ci95_half_width", interval_json(s.ci95_half_width)},
-                                {"max_score", s.max_score}};
-      if (&s == &stats.back()) {
-        pooled = j;
-      } else {
-        players.push_back(j);
-      }
-    }
+    for (std::size_t i = 0; i + 1 < stats.size(); ++i) players.push_back(to_json_value(stats[i]));
     out << nlohmann::json{{"file", a.stats},
                           {"players", players},
-                          {"pooled", pooled},
+                          {"pooled", stats.empty() ? nlohmann::json(nullptr) : to_json_value(stats.back())},
                           {"thesis_human_mean_per_ball", kThesisHumanMeanPerBall}}
                .dump(2)
         << "\n";
@@ -200,10 +186,7 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
 
   if (a.json) {
     nlohmann::json balls = nlohmann::json::array();
-    for (std::size_t i = 0; i < recorded; ++i) {
-      const simlab::PlayedBall& b = session.balls()[i];
-      balls.push_back({{"ball", i + 1}, {"score", b.score}, {"duration_s", b.duration_s}, {"cut", b.cut}});
-    }
+    for (std::size_t i = 0; i < recorded; ++i) balls.push_back(to_json_value(session.balls()[i]));
     nlohmann::json j = {{"board", a.board},
                         {"player", player},
                         {"csv", a.csv},
@@ -212,24 +195,17 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
                         {"balls", recorded},
                         {"ball_scores", balls},
                         {"mean_score_per_ball", score.mean()},
-                        {"score_ci95_half_width", interval_json(recorded < 2 ? INFINITY : score.ci95_half_width())},
+                        {"score_ci95_half_width", recorded < 2 ? std::numeric_limits<double>::infinity() : score.ci95_half_width()},
                         {"dt_s", world->dt_s()},
                         {"physics_hz", physics_hz},
-                        {"steps", c.steps},
                         {"simulated_s", session.time_s()},
-                        {"wall_s", wall_s},
-                        {"steps_per_s", steps_per_s},
-                        {"fell_behind", c.fell_behind},
-                        {"dropped_s", c.dropped_s},
-                        {"key_events", c.key_events}};
+                        {"steps_per_s", steps_per_s}};
+    j.update(to_json_value(c));
     if (!a.headless) {
-      j["frames"] = window.frames;
-      j["draw_fps"] = window.draw_fps;
+      j.update(to_json_value(window));
       j["target_fps"] = a.fps;
-      j["mean_draw_ms"] = window.mean_draw_ms;
-      j["keyboard"] = window.keyboard;
-      j["quit_by_player"] = window.quit;
     }
+    j["wall_s"] = wall_s;
     j.update(world_report(a.world, a.board, *world.world));
     out << j.dump(2) << "\n";
     return 0;

@@ -57,6 +57,9 @@ PlayWindowReport play_in_window(simlab::PlaySession& session, const table::Board
   double release_at_s[3] = {-1.0, -1.0, -1.0};  // waitKey fallback: when each pressed key lets go
   std::size_t next_event = 0;
   double draw_s = 0.0;
+  // The first frame maps the window, which takes a while: show it before the game's clock starts.
+  cv::imshow(o.title, sim::render_board(board, &session.state(), o.render));
+  cv::waitKey(1);
   const Clock::time_point start = Clock::now();
   while (true) {
     const double wall_s = seconds_since(start);
@@ -77,7 +80,7 @@ PlayWindowReport play_in_window(simlab::PlaySession& session, const table::Board
     if (o.after_frame) o.after_frame();
 
     if (code == kEsc || code == 'q' || code == 'Q') {
-      report.quit = true;
+      report.quit_by_player = true;
       break;
     }
     if (o.script == nullptr) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "pinball/core/name_value.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/simlab/human_play.h"
 #include "pinball/table/board.h"
@@ -31,7 +32,18 @@ struct PlayWindowReport {
   double draw_fps = 0.0;       ///< frames / wall_s
   double mean_draw_ms = 0.0;   ///< mean time to render and show one frame (ms)
   std::string keyboard;        ///< "x11" (true key state) or "waitkey" (presses held a short time)
-  bool quit = false;           ///< the player pressed Esc or q
+  bool quit_by_player = false; ///< the player pressed Esc or q
+
+  /// The figures as reports spell them (core/json_write_archive.h).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(frames));
+    a->Visit(PINBALL_NVP(wall_s));
+    a->Visit(PINBALL_NVP(draw_fps));
+    a->Visit(PINBALL_NVP(mean_draw_ms));
+    a->Visit(PINBALL_NVP(keyboard));
+    a->Visit(PINBALL_NVP(quit_by_player));
+  }
 };
 
 /// Opens the window and plays until the player quits, `balls` balls are

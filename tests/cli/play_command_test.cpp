@@ -76,22 +76,24 @@ TEST_F(Play, WithoutADisplayItSaysSoAndWritesNothing) {
 }
 
 TEST_F(Play, BadInputIsRefusedBeforeTheGameAndWritesNothing) {
-  const std::string keys = " --headless --keys 0.1:launch --csv " + csv();
-  const CommandResult board = run("play boards/no-such.board" + keys);
-  EXPECT_EQ(board.exit_code, 1);
-  EXPECT_NE(board.err.find("no-such.board"), std::string::npos) << board.err;
-  const CommandResult script = run("play boards/mit1993.board --headless --keys '0.1:launch,0.5:jump' --csv " + csv());
-  EXPECT_EQ(script.exit_code, 1);
-  EXPECT_NE(script.err.find("entry 2 '0.5:jump': unknown action 'jump'"), std::string::npos) << script.err;
-  const CommandResult unwritable = run("play boards/mit1993.board --headless --keys 0.1:launch --csv /no-such-dir/s.csv");
-  EXPECT_EQ(unwritable.exit_code, 1);
-  EXPECT_NE(unwritable.err.find("/no-such-dir/s.csv"), std::string::npos) << unwritable.err;
-  const CommandResult name = run("play boards/mit1993.board --player 'a,b'" + keys);
-  EXPECT_EQ(name.exit_code, 1);
-  EXPECT_NE(name.err.find("player name"), std::string::npos) << name.err;
-  const CommandResult no_script = run("play boards/mit1993.board --headless --csv " + csv());
-  EXPECT_EQ(no_script.exit_code, 1);
-  EXPECT_NE(no_script.err.find("--headless needs --keys"), std::string::npos) << no_script.err;
+  const std::string to_csv = " --csv " + csv();
+  const struct {
+    std::string args;  // after `play`
+    std::string says;  // in the one-line error
+  } cases[] = {
+      {"boards/no-such.board --headless --keys 0.1:launch" + to_csv, "no-such.board"},
+      {"boards/mit1993.board --headless --keys '0.1:launch,0.5:jump'" + to_csv, "entry 2 '0.5:jump': unknown action 'jump'"},
+      {"boards/mit1993.board --headless --keys 0.1:launch --csv /no-such-dir/s.csv", "/no-such-dir/s.csv"},
+      {"boards/mit1993.board --player 'a,b' --headless --keys 0.1:launch" + to_csv, "player name"},
+      {"boards/mit1993.board --headless" + to_csv, "--headless needs --keys"},
+      {"boards/mit1993.board --pull 0.01 --headless --keys 0.1:launch" + to_csv, "pull"},
+  };
+  for (const auto& c : cases) {
+    const CommandResult r = run("play " + c.args);
+    EXPECT_EQ(r.exit_code, 1) << c.args;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  }
   EXPECT_FALSE(fs::exists(csv()));
 }
 

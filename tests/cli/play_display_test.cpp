@@ -33,7 +33,7 @@ TEST_F(PlayDisplay, AScriptedBallInTheWindowGetsItsRow) {
   EXPECT_EQ(j.at("balls"), 1);
   EXPECT_GT(j.at("frames").get<long>(), 10);
   EXPECT_GT(j.at("steps").get<double>(), 0.0);
-  EXPECT_EQ(j.at("fell_behind").get<int>() >= 0, true);
+  EXPECT_GE(j.at("key_events").get<int>(), 4);  // the launch and the first flip reached the game
   // Reported, not asserted: a loaded CI machine may draw slower than a player's.
   std::cout << "draw rate " << j.at("draw_fps") << " frames/s (target " << j.at("target_fps") << "), physics "
             << j.at("steps_per_s") << " steps/s (real time " << j.at("physics_hz") << "), keyboard "

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "pinball/core/name_value.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/world.h"
 
@@ -49,6 +50,15 @@ struct PlayedBall {
   double duration_s = 0.0;  ///< simulated time from its first launch to its loss or cut (s)
   int launches = 0;         ///< launches (a ball back in the chute is launched again by the key)
   bool cut = false;         ///< stopped at max_ball_time_s rather than lost
+
+  /// The fields as reports spell them (core/json_write_archive.h).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(score));
+    a->Visit(PINBALL_NVP(duration_s));
+    a->Visit(PINBALL_NVP(launches));
+    a->Visit(PINBALL_NVP(cut));
+  }
 };
 
 /// What a session did so far.
@@ -58,6 +68,16 @@ struct PlayCounters {
   std::uint64_t fell_behind = 0;    ///< advance_to calls that hit the step cap and dropped the rest
   double dropped_s = 0.0;           ///< wall time dropped that way (s): the game ran that much slow
   std::uint64_t key_events = 0;     ///< presses and releases taken
+
+  /// The counters as reports spell them (core/json_write_archive.h).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(steps));
+    a->Visit(PINBALL_NVP(advances));
+    a->Visit(PINBALL_NVP(fell_behind));
+    a->Visit(PINBALL_NVP(dropped_s));
+    a->Visit(PINBALL_NVP(key_events));
+  }
 };
 
 /// One person's game on one world.

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "pinball/core/name_value.h"
+
 namespace pinball::simlab {
 
 /// The header line every play score file starts with.
@@ -60,6 +62,17 @@ struct PlayerStats {
   double mean_score = 0.0;    ///< mean score per ball
   double ci95_half_width = 0.0;  ///< half-width of the mean's 95 % interval (Student's t; infinite for one ball)
   double max_score = 0.0;     ///< best ball
+
+  /// The line as reports spell it (the keys of `pinball sim`'s report; an
+  /// infinite interval is written as null).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(player));
+    a->Visit(PINBALL_NVP(balls));
+    a->Visit(make_name_value("mean_score_per_ball", &mean_score));
+    a->Visit(make_name_value("score_ci95_half_width", &ci95_half_width));
+    a->Visit(PINBALL_NVP(max_score));
+  }
 };
 
 /// Per player (sorted by name), then all players pooled (last, named "all").
