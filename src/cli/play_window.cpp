@@ -85,12 +85,18 @@ PlayWindowReport play_in_window(simlab::PlaySession& session, const table::Board
     }
     if (o.script == nullptr) {
       const double now_s = seconds_since(start);
+      Key k{};
+      const bool pressed = code >= 0 && key_of(code, &k);
       if (keyboard.available()) {
         keyboard.poll();
-        for (const Key k : {Key::kLeftFlipper, Key::kRightFlipper, Key::kLaunch}) session.key(k, keyboard.down(k));
+        for (const Key each : {Key::kLeftFlipper, Key::kRightFlipper, Key::kLaunch}) {
+          session.key(each, keyboard.down(each));
+        }
+        // A tap shorter than a frame is gone from the key map but not from the window's presses:
+        // it flips for one frame.
+        if (pressed) session.press(k);
       } else {
-        Key k{};
-        if (code >= 0 && key_of(code, &k)) {
+        if (pressed) {
           session.press(k);
           release_at_s[static_cast<int>(k)] = now_s + kTapHold_s;
         }

@@ -9,7 +9,6 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <sstream>
 #include <stdexcept>
 #include <string_view>
 
@@ -52,12 +51,16 @@ double finite_number(const std::string& path, int line, const std::string& text,
   return v;
 }
 
+// The shortest text that reads back as the same double.
+std::string exact(double v) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, end) : std::string("nan");
+}
+
 std::string csv_line(const PlayRow& r) {
-  std::ostringstream s;
-  s.precision(17);
-  s << r.player << ',' << r.date << ',' << r.board << ',' << r.world << ',' << r.ball << ',' << r.score << ','
-    << r.duration_s << ',' << (r.cut ? 1 : 0) << '\n';
-  return s.str();
+  return r.player + ',' + r.date + ',' + r.board + ',' + r.world + ',' + std::to_string(r.ball) + ',' + exact(r.score) +
+         ',' + exact(r.duration_s) + ',' + (r.cut ? "1" : "0") + '\n';
 }
 
 // The first line of an existing file, or "" for an empty one.
