@@ -120,7 +120,8 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
   const table::Board board = table::load_board(board_path);
   const simlab::OwnedWorld world = simlab::make_world(a.world, board);
   const std::string player = a.player.empty() ? default_player() : a.player;
-  simlab::check_player_name(player);
+  const std::string world_name(world->name());
+  simlab::check_play_row({player, "", a.board, world_name});
   simlab::check_play_csv_appendable(a.csv);
   std::vector<simlab::KeyEvent> script;
   if (!a.keys.empty()) script = simlab::parse_key_script(key_script_text(a.keys));
@@ -139,7 +140,6 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
   simlab::PlaySession session(*world, config);
 
   // Each finished ball goes to the file at once: a crash or a closed window loses none.
-  const std::string world_name(world->name());
   std::size_t recorded = 0;
   RunningStats score;
   auto record = [&] {

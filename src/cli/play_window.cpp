@@ -79,7 +79,8 @@ PlayWindowReport play_in_window(simlab::PlaySession& session, const table::Board
     ++report.frames;
     if (o.after_frame) o.after_frame();
 
-    if (code == kEsc || code == 'q' || code == 'Q') {
+    // Esc, q, or the window closed by its title bar's button.
+    if (code == kEsc || code == 'q' || code == 'Q' || cv::getWindowProperty(o.title, cv::WND_PROP_VISIBLE) < 1.0) {
       report.quit_by_player = true;
       break;
     }

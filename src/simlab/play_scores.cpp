@@ -84,7 +84,11 @@ void check_text_field(const std::string& value, const char* what) {
 
 }  // namespace
 
-void check_player_name(const std::string& name) { check_text_field(name, "player name"); }
+void check_play_row(const PlayRow& row) {
+  check_text_field(row.player, "player name");
+  check_text_field(row.board, "board name");
+  check_text_field(row.world, "world name");
+}
 
 void check_play_csv_appendable(const std::string& path) {
   namespace fs = std::filesystem;
@@ -108,10 +112,7 @@ void check_play_csv_appendable(const std::string& path) {
 }
 
 void append_play_rows(const std::string& path, const std::vector<PlayRow>& rows) {
-  for (const PlayRow& r : rows) {
-    check_player_name(r.player);
-    check_text_field(r.board, "board name");
-  }
+  for (const PlayRow& r : rows) check_play_row(r);
   const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0) throw std::runtime_error(path + ": cannot open the score file: " + errno_text());
   std::string text;

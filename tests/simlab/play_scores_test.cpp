@@ -102,9 +102,16 @@ TEST(PlayScores, ABadRowIsNamedByFileAndLine) {
 TEST(PlayScores, AnUnwritablePlaceAndBadNamesAreRefused) {
   EXPECT_THROW(check_play_csv_appendable("/nonexistent-folder/scores.csv"), std::runtime_error);
   EXPECT_THROW(check_play_csv_appendable(::testing::TempDir()), std::runtime_error);  // a folder
-  EXPECT_THROW(check_player_name(""), std::invalid_argument);
-  EXPECT_THROW(check_player_name("smith, j"), std::invalid_argument);
-  EXPECT_NO_THROW(check_player_name("Ada L."));
+  PlayRow named = row("Ada L.", 1, 0.0);
+  EXPECT_NO_THROW(check_play_row(named));
+  named.player = "";
+  EXPECT_THROW(check_play_row(named), std::invalid_argument);
+  named.player = "smith, j";
+  EXPECT_THROW(check_play_row(named), std::invalid_argument);
+  EXPECT_THROW(append_play_rows(temp_path("play_scores", "never.csv"), {named}), std::invalid_argument);
+  named.player = "ada";
+  named.board = "my,board";
+  EXPECT_THROW(check_play_row(named), std::invalid_argument);
 }
 
 TEST(PlayScores, TheDateIsIso8601Utc) {

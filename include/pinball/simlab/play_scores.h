@@ -36,9 +36,11 @@ struct PlayRow {
   bool cut = false;        ///< cut at the time limit
 };
 
-/// Throws std::invalid_argument unless `name` can be a player's name in the
-/// file: not empty, no comma, quote or control character.
-void check_player_name(const std::string& name);
+/// Throws std::invalid_argument unless the row's text fields (player, board,
+/// world) can stand in the file: not empty, no comma, quote or control
+/// character. append_play_rows checks every row; a command checks its
+/// first row before the game, so that nothing fails after it.
+void check_play_row(const PlayRow& row);
 
 /// Throws std::runtime_error naming `path` unless rows can be appended to it:
 /// an existing file must be writable and be empty or start with the header;
