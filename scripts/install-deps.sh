@@ -11,6 +11,7 @@ packages=(
   libopencv-contrib-dev   # aruco: ChArUco targets for `pinball calibrate intrinsics`
   libopencv-highgui-dev   # the windows of `pinball view` and `pinball play`
   xvfb xauth              # a virtual display: the viewer's and play's tests run headless
+  libx11-dev              # pinball play: XQueryKeymap, a flipper key's true up/down state (waitKey sees presses only)
   liblcm-dev liblcm-bin
   libgtest-dev libgmock-dev googletest
   libbenchmark-dev

@@ -166,6 +166,26 @@ struct CalibrateArgs {
 CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& args);
 int run_calibrate(const CalibrateArgs& args, std::ostream& out, std::ostream& err);
 
+/// `pinball play` (docs/play.md)
+struct PlayArgs {
+  std::string board;                  ///< board file to play (not with --stats)
+  std::string stats;                  ///< --stats FILE: print the players' means of this score file and stop
+  std::string player;                 ///< the player's name; empty: $USER, else "player"
+  std::string csv = "play_scores.csv";///< score file each ball is appended to
+  int balls = 0;                      ///< stop after this many balls; 0: when the player quits
+  double max_ball_time_s = 300.0;     ///< a ball still in play after this is cut (simulated s)
+  double pull = -1.0;                 ///< launcher pull fraction; negative: the board's
+  std::uint64_t seed = 1;             ///< launch noise seed
+  simlab::WorldSpec world;            ///< the world (default: the model of `board` on the thesis stepper)
+  std::string keys;                   ///< key script (file or text); empty: the keyboard
+  bool headless = false;              ///< no window: play the script as fast as possible
+  double fps = 100.0;                 ///< frames drawn per wall second (at most)
+  double px_per_m = 800.0;            ///< drawing scale
+  bool json = false;                  ///< one JSON object on stdout
+};
+CLI::App* add_play_command(CLI::App& app, PlayArgs& args);
+int run_play(const PlayArgs& args, std::ostream& out, std::ostream& err);
+
 /// Parses argv and runs the chosen subcommand; returns the exit code
 /// (0 success, 1 bad input or failure, 2 bad usage).
 int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostream& err);

@@ -19,6 +19,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   ReplayArgs replay;
   CalibrateArgs calibrate;
   ViewArgs view;
+  PlayArgs play;
   CLI::App* sim_cmd = add_sim_command(app, sim);
   CLI::App* render_cmd = add_render_command(app, render);
   CLI::App* bench_cmd = add_bench_command(app, bench);
@@ -27,6 +28,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   CLI::App* replay_cmd = add_replay_command(app, replay);
   CLI::App* calibrate_cmd = add_calibrate_command(app, calibrate);
   CLI::App* view_cmd = add_view_command(app, view);
+  CLI::App* play_cmd = add_play_command(app, play);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -51,6 +53,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
     if (replay_cmd->parsed()) return run_replay(replay, out, err);
     if (calibrate_cmd->parsed()) return run_calibrate(calibrate, out, err);
     if (view_cmd->parsed()) return run_view(view, out, err);
+    if (play_cmd->parsed()) return run_play(play, out, err);
   } catch (const std::exception& e) {
     err << "pinball: " << e.what() << "\n";
     return 1;
