@@ -28,21 +28,24 @@
 #include "protocol_bench.h"
 #include "speed_bench.h"
 #include "tracker_bench.h"
+#include "draw_bench.h"
 
 namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   CLI::App* cmd = app.add_subcommand(
       "bench",
-      "run a benchmark (speed, tracker, latency, detector, camera, calibration, precision, ceiling, transfer, protocol)");
+      "run a benchmark (speed, tracker, latency, detector, camera, calibration, precision, ceiling, transfer, protocol, "
+      "draw)");
   cmd->add_option("kind", a.which,
                   "which benchmark: speed, tracker, latency, detector, camera (a real camera's faults, uncorrected and "
                   "corrected), calibration, precision, ceiling, transfer "
-                  "(every controller in several worlds and a sweep of world errors, the belief nominal), protocol")
+                  "(every controller in several worlds and a sweep of world errors, the belief nominal), protocol, "
+                  "draw (the pictures of pinball play and pinball view)")
       ->required()
       ->check(CLI::IsMember(
           {"speed", "tracker", "latency", "detector", "camera", "calibration", "precision", "ceiling", "transfer",
-           "protocol"}));
+           "protocol", "draw"}));
   cmd->add_option("--board", a.board, "board file (ceiling, transfer: the belief)")->transform(data_file());
   cmd->add_option("--steps", a.steps, "speed: steps per timed run (the MuJoCo twin's runs: a tenth)")
       ->check(CLI::Range(1000, 1'000'000'000));
@@ -343,6 +346,27 @@ int run_protocol(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   return violations == 0 ? 0 : 1;
 }
 
+int run_draw(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
+  bench::DrawBenchOptions o;
+  if (a.quick) o.frames = 200;
+  o.repeats = a.repeats;
+  const bench::DrawBenchReport r =
+      bench::run_draw_bench(board, o, [&](const std::string& line) { err << "bench draw: " << line << "\n"; });
+  if (a.json) {
+    out << bench::to_json(r).dump(2) << "\n";
+    return 0;
+  }
+  auto row = [&](const char* what, const bench::DrawCost& c) {
+    out << what << c.width_px << "x" << c.height_px << " px: " << format_number(c.frames_per_s) << " frames/s ("
+        << format_number(c.ms_per_frame) << " ms each)\n";
+  };
+  row("pinball play picture ", r.play);
+  row("pinball view picture ", r.view);
+  row("baseline: a copy of  ", r.copy);
+  out << "best of " << r.repeats << " runs of " << r.frames << " pictures, one core, headless; the windows need 60 frames/s\n";
+  return 0;
+}
+
 }  // namespace
 
 int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
@@ -361,6 +385,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   if (a.which == "precision") return run_precision(a, board, out, err);
   if (a.which == "ceiling") return run_ceiling(a, board, out, err);
   if (a.which == "transfer") return run_transfer(a, board, out, err);
+  if (a.which == "draw") return run_draw(a, board, out, err);
   bench::SpeedBenchOptions options;
   options.steps = a.steps;
   options.twin_steps = std::max<std::uint64_t>(1000, a.steps / 10);

@@ -64,7 +64,7 @@ int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 
 /// `pinball bench`
 struct BenchArgs {
-  std::string which;                                 ///< speed | tracker | latency | detector | calibration | precision | ceiling | transfer | protocol
+  std::string which;                                 ///< speed | tracker | latency | detector | camera | calibration | precision | ceiling | transfer | protocol | draw
   std::string board = "boards/mit1993.board";        ///< board to measure on
   std::uint64_t steps = 2'000'000;                   ///< steps per timed run
   int repeats = 3;                                   ///< timed runs per configuration
