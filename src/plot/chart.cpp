@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
-
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 #include "pinball/plot/ticks.h"
 
@@ -20,7 +19,7 @@ struct Scale {
   bool log = false;
   double lo = 0.0, hi = 1.0;  // drawn range (values)
   std::vector<double> ticks;
-  double step = 1.0;          // linear tick step (labels)
+  double step = 1.0;  // linear tick step (labels)
 
   double t(double v) const { return log ? std::log10(v) : v; }
   double fraction(double v) const { return (t(v) - t(lo)) / (t(hi) - t(lo)); }
@@ -61,7 +60,7 @@ Extent data_extent(const Panel& p, bool x_axis) {
   return e;
 }
 
-Scale resolve(const Axis& axis, Extent e, int max_ticks) {
+Scale resolve(const Axis& axis, Extent e, int max_ticks, double margin) {
   Scale s;
   s.log = axis.log;
   if (axis.lo) e.lo = *axis.lo;
@@ -70,6 +69,11 @@ Scale resolve(const Axis& axis, Extent e, int max_ticks) {
   if (!s.log && axis.include_zero) {
     e.lo = std::min(e.lo, 0.0);
     e.hi = std::max(e.hi, 0.0);
+  }
+  if (!s.log && margin > 0.0) {  // data on the frame is hard to see: a little room at free ends
+    const double room = margin * (e.hi - e.lo);
+    if (!axis.lo && e.lo != 0.0) e.lo -= room;
+    if (!axis.hi && e.hi != 0.0) e.hi += room;
   }
   if (s.log) {
     s.ticks = decade_ticks(e.lo, e.hi, max_ticks);
@@ -102,7 +106,7 @@ void put_vertical_text(cv::Mat& image, const std::string& text, cv::Point centre
 
 // Consecutive drawable points as runs (a non-finite point breaks a line).
 std::vector<std::vector<cv::Point2d>> runs(const Series& s, const Scale& sx, const Scale& sy, cv::Size area,
-                                            const std::vector<double>& ys) {
+                                           const std::vector<double>& ys) {
   std::vector<std::vector<cv::Point2d>> out(1);
   for (std::size_t i = 0; i < s.x.size() && i < ys.size(); ++i) {
     if (!sx.drawable(s.x[i]) || !sy.drawable(ys[i])) {
@@ -129,7 +133,8 @@ void draw_series(cv::Mat& area, const Series& s, const Scale& sx, const Scale& s
       std::vector<cv::Point> poly;
       for (const cv::Point2d& p : low[r]) poly.emplace_back(cvRound(p.x), cvRound(p.y));
       for (auto it = high[r].rbegin(); it != high[r].rend(); ++it) poly.emplace_back(cvRound(it->x), cvRound(it->y));
-      if (poly.size() >= 3) cv::fillPoly(overlay, std::vector<std::vector<cv::Point>>{poly}, tint(s.colour, 0.55), cv::LINE_AA);
+      if (poly.size() >= 3)
+        cv::fillPoly(overlay, std::vector<std::vector<cv::Point>>{poly}, tint(s.colour, 0.55), cv::LINE_AA);
     }
     cv::addWeighted(overlay, 0.45, area, 0.55, 0.0, area);
   }
@@ -138,7 +143,8 @@ void draw_series(cv::Mat& area, const Series& s, const Scale& sx, const Scale& s
       if (!sx.drawable(s.x[i]) || !sy.drawable(s.y_low[i]) || !sy.drawable(s.y_high[i])) continue;
       const double u = sx.fraction(s.x[i]) * area.cols;
       const double v0 = (1.0 - sy.fraction(s.y_low[i])) * area.rows, v1 = (1.0 - sy.fraction(s.y_high[i])) * area.rows;
-      const std::vector<cv::Point2d> bar{{u, v0}, {u, v1}}, cap0{{u - 3, v0}, {u + 3, v0}}, cap1{{u - 3, v1}, {u + 3, v1}};
+      const std::vector<cv::Point2d> bar{{u, v0}, {u, v1}}, cap0{{u - 3, v0}, {u + 3, v0}},
+          cap1{{u - 3, v1}, {u + 3, v1}};
       for (const auto* l : {&bar, &cap0, &cap1}) draw_polyline(area, *l, s.colour, 1, LineStyle::kSolid);
     }
   }
@@ -180,9 +186,10 @@ void draw_panel(cv::Mat& image, cv::Rect cell, const Panel& p, const Scale& sx, 
     if (!s.drawable(r.at)) continue;
     const double f = s.fraction(r.at);
     const std::vector<cv::Point2d> line =
-        r.vertical ? std::vector<cv::Point2d>{{f * plot.width, 0.0}, {f * plot.width, double(plot.height)}}
-                   : std::vector<cv::Point2d>{{0.0, (1 - f) * plot.height}, {double(plot.width), (1 - f) * plot.height}};
-    draw_polyline(area, line, r.colour, 2, r.line);
+        r.vertical
+            ? std::vector<cv::Point2d>{{f * plot.width, 0.0}, {f * plot.width, double(plot.height)}}
+            : std::vector<cv::Point2d>{{0.0, (1 - f) * plot.height}, {double(plot.width), (1 - f) * plot.height}};
+    draw_polyline(area, line, r.colour, 1, r.line);
   }
   for (const Series& s : p.series) draw_series(area, s, sx, sy);
   cv::rectangle(image, plot, kAxisFrame, 1);
@@ -210,7 +217,8 @@ cv::Mat legend_strip(const std::vector<LegendEntry>& entries, int width) {
   const cv::Rect frame(10, 2, used + 2 * kStripPad, y + kLegendRow_px + 2 * kStripPad - 4);
   cv::Mat strip(frame.br().y + 4, std::max(width, frame.br().x + 2), CV_8UC3, kPaper);
   cv::rectangle(strip, frame, cv::Scalar(120, 120, 120), 1);
-  for (std::size_t i = 0; i < entries.size(); ++i) draw_legend_row(strip, entries[i], frame.tl() + cv::Point(kStripPad, kStripPad) + at[i]);
+  for (std::size_t i = 0; i < entries.size(); ++i)
+    draw_legend_row(strip, entries[i], frame.tl() + cv::Point(kStripPad, kStripPad) + at[i]);
   return strip;
 }
 
@@ -238,10 +246,11 @@ cv::Mat render(const Figure& figure) {
   if (figure.panels.empty()) throw std::invalid_argument("plot::render: a figure needs at least one panel");
   for (const Panel& p : figure.panels) {
     for (const Series& s : p.series) {
-      const bool interval_ok = (s.y_low.empty() || s.y_low.size() == s.y.size()) &&
-                               (s.y_high.empty() || s.y_high.size() == s.y.size());
+      const bool interval_ok =
+          (s.y_low.empty() || s.y_low.size() == s.y.size()) && (s.y_high.empty() || s.y_high.size() == s.y.size());
       if (s.x.size() != s.y.size() || !interval_ok) {
-        throw std::invalid_argument("plot::render: series '" + s.label + "' has x, y and interval of different lengths");
+        throw std::invalid_argument("plot::render: series '" + s.label +
+                                    "' has x, y and interval of different lengths");
       }
     }
   }
@@ -255,8 +264,8 @@ cv::Mat render(const Figure& figure) {
   cv::Mat grid(rows * figure.panel_size.height, columns * figure.panel_size.width, CV_8UC3, kPaper);
   for (int i = 0; i < n; ++i) {
     const Panel& p = figure.panels[static_cast<std::size_t>(i)];
-    const Scale sx = resolve(p.x, figure.share_x ? shared_x : data_extent(p, true), figure.max_ticks);
-    const Scale sy = resolve(p.y, figure.share_y ? shared_y : data_extent(p, false), figure.max_ticks);
+    const Scale sx = resolve(p.x, figure.share_x ? shared_x : data_extent(p, true), figure.max_ticks, 0.0);
+    const Scale sy = resolve(p.y, figure.share_y ? shared_y : data_extent(p, false), figure.max_ticks, 0.03);
     const cv::Rect cell(cv::Point((i % columns) * figure.panel_size.width, (i / columns) * figure.panel_size.height),
                         figure.panel_size);
     draw_panel(grid, cell, p, sx, sy);

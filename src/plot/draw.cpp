@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <stdexcept>
-
+#include <cstring>
+#include <utility>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 #include "pinball/plot/ticks.h"
 
@@ -37,25 +38,43 @@ constexpr int kSwatch = 28, kPad = 6;
 cv::Scalar palette_colour(int i) {
   // Okabe and Ito (2008), BGR; yellow last, it reads worst on white.
   static const std::array<cv::Scalar, 8> kPalette{
-      cv::Scalar(178, 114, 0),   cv::Scalar(0, 94, 213),    cv::Scalar(115, 158, 0),  cv::Scalar(0, 159, 230),
-      cv::Scalar(167, 121, 204), cv::Scalar(233, 180, 86),  cv::Scalar(0, 0, 0),      cv::Scalar(66, 228, 240)};
+      cv::Scalar(178, 114, 0),   cv::Scalar(0, 94, 213),   cv::Scalar(115, 158, 0), cv::Scalar(0, 159, 230),
+      cv::Scalar(167, 121, 204), cv::Scalar(233, 180, 86), cv::Scalar(0, 0, 0),     cv::Scalar(66, 228, 240)};
   const int n = static_cast<int>(kPalette.size());
   return kPalette[static_cast<std::size_t>(((i % n) + n) % n)];
 }
 
 cv::Scalar muted_colour() { return {150, 150, 150}; }
 
+std::string hershey_text(const std::string& text) {
+  // The Hershey fonts have ASCII only: the project's few other signs in words.
+  static const std::pair<const char*, const char*> kSigns[] = {
+      {"\u00b1", "+/-"}, {"\u2014", "-"}, {"\u2013", "-"}, {"\u00b0", " deg"}, {"\u00b2", "^2"},
+      {"\u03c3", "sigma"}, {"\u03b8", "theta"}, {"\u03bc", "mu"}, {"\u00b5", "u"}, {"\u03c1", "rho"},
+      {"\u00d7", "x"}, {"\u2212", "-"}};
+  std::string out = text;
+  for (const auto& [sign, words] : kSigns) {
+    for (std::size_t at = out.find(sign); at != std::string::npos; at = out.find(sign, at + std::strlen(words))) {
+      out.replace(at, std::strlen(sign), words);
+    }
+  }
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) >= 0x80) c = '?';
+  }
+  return out;
+}
+
 void put_text(cv::Mat& image, const std::string& text, cv::Point origin, double scale, const cv::Scalar& colour) {
-  cv::putText(image, text, origin, kFont, scale, colour, 1, cv::LINE_AA);
+  cv::putText(image, hershey_text(text), origin, kFont, scale, colour, 1, cv::LINE_AA);
 }
 
 cv::Size text_size(const std::string& text, double scale) {
   int baseline = 0;
-  return cv::getTextSize(text, kFont, scale, 1, &baseline);
+  return cv::getTextSize(hershey_text(text), kFont, scale, 1, &baseline);
 }
 
 void draw_marker(cv::Mat& image, cv::Point2d at, Marker marker, const cv::Scalar& colour, int size_px) {
-  const double h = 0.5 * size_px;
+  const double h = std::floor(0.5 * size_px);  // whole pixels: crisp edges about a whole-pixel centre
   switch (marker) {
     case Marker::kNone:
       return;
@@ -112,15 +131,22 @@ void draw_polyline(cv::Mat& image, std::span<const cv::Point2d> points, const cv
   }
 }
 
-int legend_row_width(const LegendEntry& entry) {
-  return kSwatch + 6 + text_size(entry.label, kLabelScale).width;
+LegendEntry marker_entry(std::string label, const cv::Scalar& colour, Marker marker) {
+  return {std::move(label), colour, marker, LineStyle::kNone, false};
 }
+
+LegendEntry line_entry(std::string label, const cv::Scalar& colour, LineStyle style, Marker marker) {
+  return {std::move(label), colour, marker, style, false};
+}
+
+int legend_row_width(const LegendEntry& entry) { return kSwatch + 6 + text_size(entry.label, kLabelScale).width; }
 
 void draw_legend_row(cv::Mat& image, const LegendEntry& e, cv::Point top_left) {
   const int y = top_left.y + 8;
   const cv::Point2d a(top_left.x, y), b(top_left.x + kSwatch, y);
   if (e.band) {
-    const cv::Rect r = cv::Rect(cv::Point(top_left.x, y - 6), cv::Size(kSwatch, 13)) & cv::Rect(0, 0, image.cols, image.rows);
+    const cv::Rect r =
+        cv::Rect(cv::Point(top_left.x, y - 6), cv::Size(kSwatch, 13)) & cv::Rect(0, 0, image.cols, image.rows);
     cv::Mat patch = image(r);
     cv::Mat tint(patch.size(), patch.type(), e.colour);
     cv::addWeighted(tint, 0.25, patch, 0.75, 0.0, patch);

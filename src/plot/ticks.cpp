@@ -98,8 +98,8 @@ std::string tick_label(double value, double step) {
   if (std::abs(value) < step * 1e-9) value = 0.0;
   const double magnitude = std::max(std::abs(value), step);
   if (step < 1e-4 || magnitude >= 1e6) {
-    const int digits = std::clamp(static_cast<int>(std::floor(std::log10(magnitude)) - std::floor(std::log10(step))) + 1,
-                                  1, 15);
+    const int digits =
+        std::clamp(static_cast<int>(std::floor(std::log10(magnitude)) - std::floor(std::log10(step))) + 1, 1, 15);
     std::snprintf(buf, sizeof buf, "%.*g", digits, value);
     return buf;
   }

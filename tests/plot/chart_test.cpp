@@ -1,9 +1,9 @@
 #include "pinball/plot/chart.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <stdexcept>
-
-#include <gtest/gtest.h>
 
 #include "common/figure_check.h"
 
@@ -21,7 +21,8 @@ Figure two_series_figure() {
   p.x.label = "time (s)";
   p.y.label = "height (m)";
   Series rising{.label = "rising", .colour = palette_colour(0)};
-  Series falling{.label = "falling", .colour = palette_colour(1), .line = LineStyle::kDashed, .marker = Marker::kSquare};
+  Series falling{
+      .label = "falling", .colour = palette_colour(1), .line = LineStyle::kDashed, .marker = Marker::kSquare};
   for (int i = 0; i <= 20; ++i) {
     rising.x.push_back(0.37 * i);
     rising.y.push_back(0.01 * i * i);
@@ -32,7 +33,8 @@ Figure two_series_figure() {
   }
   rising.interval = IntervalStyle::kBand;
   p.series = {rising, falling};
-  p.references.push_back({.vertical = false, .at = 0.0, .colour = muted_colour(), .line = LineStyle::kDashed, .label = "zero"});
+  p.references.push_back(
+      {.vertical = false, .at = 0.0, .colour = muted_colour(), .line = LineStyle::kDashed, .label = "zero"});
   f.panels.push_back(p);
   return f;
 }

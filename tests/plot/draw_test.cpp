@@ -1,11 +1,11 @@
 #include "pinball/plot/draw.h"
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "common/figure_check.h"
 #include "common/temp_path.h"
@@ -37,7 +37,7 @@ TEST(LegendTest, DrawsEverySwatchInItsColourInTheCorner) {
   EXPECT_GT(count_colour(box, palette_colour(0), 20), 3);
   EXPECT_GT(count_colour(box, palette_colour(1), 20), 20);
   EXPECT_GT(count_colour(box, muted_colour(), 20), 10);
-  EXPECT_GT(count_colour(box, cv::Scalar(255, 255, 255), 5), size.area() / 3);  // a white box
+  EXPECT_GT(count_colour(box, cv::Scalar(255, 255, 255), 5), size.area() / 3);                       // a white box
   EXPECT_EQ(count_colour(image(cv::Rect(0, 150, 400, 150)), cv::Scalar(30, 30, 30), 0), 400 * 150);  // only there
 }
 

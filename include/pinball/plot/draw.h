@@ -5,11 +5,10 @@
 // (pinball/plot/chart.h) and the annotated camera pictures of calibration
 // both draw with these, so every figure looks and reads alike.
 
+#include <opencv2/core.hpp>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace pinball::plot {
 
@@ -28,6 +27,9 @@ enum class LineStyle { kNone, kSolid, kDashed };
 inline constexpr double kLabelScale = 0.5;
 inline constexpr double kTitleScale = 0.62;
 
+/// `text` in the font's ASCII: ±, —, °, ², σ, θ, µ, ρ, × and − spelled out; any
+/// other non-ASCII byte becomes '?'. put_text and text_size apply it.
+std::string hershey_text(const std::string& text);
 /// Draws `text` with its baseline starting at `origin` (anti-aliased HERSHEY_SIMPLEX).
 void put_text(cv::Mat& image, const std::string& text, cv::Point origin, double scale, const cv::Scalar& colour);
 /// Width and height (above the baseline) of `text` in px.
@@ -41,12 +43,18 @@ void draw_polyline(cv::Mat& image, std::span<const cv::Point2d> points_px, const
 
 /// One row of a legend: a swatch (line, marker, or a band's patch) and its label.
 struct LegendEntry {
-  std::string label{};                      ///< text
-  cv::Scalar colour{};                      ///< BGR
-  Marker marker = Marker::kNone;            ///< drawn at the swatch's middle
-  LineStyle line = LineStyle::kSolid;       ///< the swatch's line
-  bool band = false;                        ///< a shaded patch (an interval) behind the line
+  std::string label{};                 ///< text
+  cv::Scalar colour{};                 ///< BGR
+  Marker marker = Marker::kNone;       ///< drawn at the swatch's middle
+  LineStyle line = LineStyle::kSolid;  ///< the swatch's line
+  bool band = false;                   ///< a shaded patch (an interval) behind the line
 };
+
+/// A legend row for points drawn with `marker` and no line.
+LegendEntry marker_entry(std::string label, const cv::Scalar& colour, Marker marker);
+/// A legend row for a line of `style` (and, optionally, a marker on it).
+LegendEntry line_entry(std::string label, const cv::Scalar& colour, LineStyle style = LineStyle::kSolid,
+                       Marker marker = Marker::kNone);
 
 /// Corner of an image.
 enum class Corner { kTopLeft, kTopRight, kBottomLeft, kBottomRight };
