@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <opencv2/imgproc.hpp>
 #include <string>
+
+#include <opencv2/imgproc.hpp>
 
 #include "pinball/core/format.h"
 #include "pinball/plot/chart.h"

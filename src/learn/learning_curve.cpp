@@ -21,8 +21,8 @@ void write_curve_csv(const SearchResult& r, const std::string& path) {
 void plot_curve_png(const SearchResult& r, const std::string& path) {
   plot::Figure figure;
   figure.title = "Learning curve of " + r.method + ": mean score per ball - pinball learn";
-  figure.notes = {"population: the mean over each generation's balls, band: its 95 % interval (Student's t); "
-                  "generation best and best so far: estimated means"};
+  figure.notes = {"population: the mean over each generation's balls, band: its 95 % interval (Student's t)",
+                  "generation best and best so far: the controllers' estimated means"};
   plot::Panel panel;
   panel.x.label = "balls played";
   panel.x.lo = 0.0;

@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <opencv2/imgproc.hpp>
 #include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
 
 #include "pinball/plot/ticks.h"
 

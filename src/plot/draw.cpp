@@ -4,10 +4,11 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <utility>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <stdexcept>
 
 #include "pinball/plot/ticks.h"
 

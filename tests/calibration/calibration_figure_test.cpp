@@ -1,9 +1,9 @@
 #include "pinball/calibration/calibration_figure.h"
 
-#include <gtest/gtest.h>
-
 #include <cstdio>
 #include <string>
+
+#include <gtest/gtest.h>
 
 #include "common/figure_check.h"
 #include "common/temp_path.h"

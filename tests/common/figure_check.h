@@ -3,11 +3,11 @@
 // enough ink, the palette's colours present (the series and their legend
 // swatches), shared by every figure's test.
 
-#include <gtest/gtest.h>
+#include <string>
 
+#include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <string>
 
 #include "pinball/plot/draw.h"
 

@@ -1,9 +1,9 @@
 #include "pinball/plot/chart.h"
 
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <stdexcept>
+
+#include <gtest/gtest.h>
 
 #include "common/figure_check.h"
 

@@ -1,11 +1,11 @@
 #include "pinball/plot/draw.h"
 
-#include <gtest/gtest.h>
-
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "common/figure_check.h"
 #include "common/temp_path.h"

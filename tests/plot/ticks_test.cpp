@@ -1,10 +1,10 @@
 #include "pinball/plot/ticks.h"
 
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include <gtest/gtest.h>
 
 namespace pinball::plot {
 namespace {

@@ -5,10 +5,11 @@
 // (learning curves, the gravity fit, the precision and transfer benches) is
 // one Figure; the colours come from palette_colour (pinball/plot/draw.h).
 
-#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "pinball/plot/draw.h"
 

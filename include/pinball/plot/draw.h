@@ -5,10 +5,11 @@
 // (pinball/plot/chart.h) and the annotated camera pictures of calibration
 // both draw with these, so every figure looks and reads alike.
 
-#include <opencv2/core.hpp>
 #include <span>
 #include <string>
 #include <vector>
+
+#include <opencv2/core.hpp>
 
 namespace pinball::plot {
 
