@@ -32,10 +32,11 @@ int run_render(const RenderArgs& a, std::ostream& out, std::ostream&) {
   options.draw_hud = false;
   options.draw_scale_bar = true;
   const sim::GameState state = sim::make_game_state(board, 0);
-  const std::vector<std::string> notes{"x right, y up the table; a lighter shade: the obstacle scores; scale bar at the bottom left"};
+  const std::vector<std::string> notes{
+      "x right, y up the table; a lighter shade: the obstacle scores; scale bar at the bottom left"};
+  const std::string title = "Board " + std::filesystem::path(a.board).filename().string() + " - pinball render";
   const cv::Mat image =
-      plot::annotated_picture(sim::render_board(board, &state, options), sim::board_legend(),
-                              "Board " + std::filesystem::path(a.board).filename().string() + " - pinball render", notes);
+      plot::annotated_picture(sim::render_board(board, &state, options), sim::board_legend(), title, notes);
   plot::write_png(image, a.out);
   if (a.json) {
     out << nlohmann::json{{"board", a.board},          {"out", a.out},

@@ -30,7 +30,8 @@ void plot_curve_png(const SearchResult& r, const std::string& path) {
   panel.y.include_zero = true;
   plot::Series population{.label = "population mean (95 % interval)", .colour = plot::palette_colour(0)};
   population.interval = plot::IntervalStyle::kBand;
-  plot::Series generation{.label = "generation best", .colour = plot::palette_colour(1), .line = plot::LineStyle::kDashed};
+  plot::Series generation{
+      .label = "generation best", .colour = plot::palette_colour(1), .line = plot::LineStyle::kDashed};
   plot::Series best{.label = "best so far", .colour = plot::palette_colour(2)};
   for (const CurvePoint& p : r.curve) {
     const double balls = static_cast<double>(p.balls);

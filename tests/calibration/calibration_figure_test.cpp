@@ -87,5 +87,17 @@ TEST_F(CalibrationFigure, GravityFigureHasOneColourPerRollAndResiduals) {
   expect_written(plot, "gravity.png", cv::Size(960, 2 * 380), usable, static_cast<int>(rolls.size()));
 }
 
+TEST_F(CalibrationFigure, GravityFigureDrawsARollLeftOutInGrey) {
+  const std::vector<GravityRoll> rolls = lab_.rolls(3);
+  GravityCalibration g = calibrate_gravity(rolls);
+  ASSERT_TRUE(g.rolls[1].usable);
+  const int grey_before = count_colour(draw_gravity_figure(rolls, g), plot::muted_colour());
+  g.rolls[1].outlier = true;
+  const cv::Mat plot = draw_gravity_figure(rolls, g);
+  // Its points, its dashed parabola and its legend swatch turn grey; its own colour is gone.
+  EXPECT_GT(count_colour(plot, plot::muted_colour()), grey_before + 200);
+  EXPECT_LT(count_colour(plot, plot::palette_colour(1)), 20);
+}
+
 }  // namespace
 }  // namespace pinball::calibration
