@@ -8,9 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
+#include "pinball/plot/chart.h"
 #include "pinball/sim/event_stepper.h"
 
 namespace pinball::bench {
@@ -175,84 +173,40 @@ std::string to_markdown(const PrecisionReport& report) {
 }
 
 void plot_precision_png(const PrecisionReport& report, const std::string& path) {
-  std::vector<std::string> scenes;
-  double t_lo = 1e300, t_hi = 0.0, e_lo = 1e300, e_hi = 0.0;
+  plot::Figure figure;
+  figure.title = "Precision: max position error against run time per scene - pinball bench precision";
+  char note[200];
+  std::snprintf(note, sizeof(note),
+                "log-log; thesis stepper over its dt sweep, event stepper over its tolerance sweep; "
+                "errors below %g m drawn at %g m",
+                kPrecisionErrorFloor_m, kPrecisionErrorFloor_m);
+  figure.notes = {note};
+  figure.panel_size = {470, 360};
+  figure.share_x = figure.share_y = true;  // panels compare
   for (const PrecisionPoint& p : report.points) {
-    if (std::find(scenes.begin(), scenes.end(), p.scene) == scenes.end()) scenes.push_back(p.scene);
-    const double e = std::max(p.max_error_m, kPrecisionErrorFloor_m);
-    t_lo = std::min(t_lo, p.run_time_s);
-    t_hi = std::max(t_hi, p.run_time_s);
-    e_lo = std::min(e_lo, e);
-    e_hi = std::max(e_hi, e);
+    const auto same_scene = [&](const plot::Panel& panel) { return panel.title == p.scene; };
+    auto panel = std::find_if(figure.panels.begin(), figure.panels.end(), same_scene);
+    if (panel == figure.panels.end()) {
+      plot::Panel fresh;
+      fresh.title = p.scene;
+      fresh.x = {.label = "run time (s)", .log = true};
+      fresh.y = {.label = "max position error (m)", .log = true};
+      const plot::LineStyle solid = plot::LineStyle::kSolid;
+      fresh.series = {{.label = "thesis (dt sweep)", .colour = plot::palette_colour(0), .line = solid,
+                       .marker = plot::Marker::kCircle, .thickness_px = 1},
+                      {.label = "event (tolerance sweep)", .colour = plot::palette_colour(1), .line = solid,
+                       .marker = plot::Marker::kSquare, .thickness_px = 1}};
+      figure.panels.push_back(std::move(fresh));
+      panel = figure.panels.end() - 1;
+    }
+    // In sweep order, so a curve runs from coarse to fine.
+    plot::Series& s = panel->series[p.stepper == "thesis" ? 0 : 1];
+    s.x.push_back(p.run_time_s);
+    s.y.push_back(std::max(p.max_error_m, kPrecisionErrorFloor_m));
   }
-  if (scenes.empty()) throw std::runtime_error(path + ": nothing to plot");
-  // Whole decades around the data, shared by every panel so that panels compare.
-  const int tx0 = static_cast<int>(std::floor(std::log10(std::max(t_lo, 1e-12))));
-  const int tx1 = std::max(tx0 + 1, static_cast<int>(std::ceil(std::log10(std::max(t_hi, 1e-12)))));
-  const int ey0 = static_cast<int>(std::floor(std::log10(e_lo)));
-  const int ey1 = std::max(ey0 + 1, static_cast<int>(std::ceil(std::log10(e_hi))));
-  constexpr int kPanelW = 460, kPanelH = 360, kCols = 3, kLeft = 62, kRight = 26, kTop = 30, kBottom = 44;
-  constexpr int kHeader = 40;
-  const int rows = (static_cast<int>(scenes.size()) + kCols - 1) / kCols;
-  cv::Mat img(kHeader + rows * kPanelH, kCols * kPanelW, CV_8UC3, cv::Scalar(255, 255, 255));
-  const cv::Scalar black(0, 0, 0), grey(215, 215, 215), thesis_colour(200, 90, 0), event_colour(0, 0, 210);
-  const auto font = cv::FONT_HERSHEY_SIMPLEX;
-  cv::putText(img, "max position error (m) against run time (s), log-log; blue o: thesis (dt sweep), red []: event (tolerance sweep)",
-              cv::Point(10, 26), font, 0.5, black, 1, cv::LINE_AA);
-  for (std::size_t k = 0; k < scenes.size(); ++k) {
-    const int ox = static_cast<int>(k % kCols) * kPanelW;
-    const int oy = kHeader + static_cast<int>(k / kCols) * kPanelH;
-    const int w = kPanelW - kLeft - kRight, h = kPanelH - kTop - kBottom;
-    auto to_px = [&](double t, double e) {
-      const double fx = (std::log10(t) - tx0) / (tx1 - tx0);
-      const double fy = (std::log10(std::max(e, kPrecisionErrorFloor_m)) - ey0) / (ey1 - ey0);
-      return cv::Point(ox + kLeft + static_cast<int>(w * fx), oy + kTop + h - static_cast<int>(h * fy));
-    };
-    char label[32];
-    for (int d = tx0; d <= tx1; ++d) {
-      const cv::Point a = to_px(std::pow(10.0, d), std::pow(10.0, ey0));
-      cv::line(img, a, to_px(std::pow(10.0, d), std::pow(10.0, ey1)), grey, 1);
-      std::snprintf(label, sizeof(label), "1e%d", d);
-      cv::putText(img, label, a + cv::Point(-14, 16), font, 0.38, black, 1, cv::LINE_AA);
-    }
-    const int ey_step = std::max(1, (ey1 - ey0 + 7) / 8);  // at most ~8 labelled decades
-    for (int d = ey0; d <= ey1; ++d) {
-      const cv::Point a = to_px(std::pow(10.0, tx0), std::pow(10.0, d));
-      cv::line(img, a, to_px(std::pow(10.0, tx1), std::pow(10.0, d)), grey, 1);
-      if ((d - ey0) % ey_step != 0) continue;
-      std::snprintf(label, sizeof(label), "1e%d", d);
-      cv::putText(img, label, a + cv::Point(-44, 4), font, 0.38, black, 1, cv::LINE_AA);
-    }
-    cv::rectangle(img, to_px(std::pow(10.0, tx0), std::pow(10.0, ey1)), to_px(std::pow(10.0, tx1), std::pow(10.0, ey0)),
-                  black, 1);
-    cv::putText(img, scenes[k] + ": error (m)", cv::Point(ox + kLeft - 40, oy + kTop - 8), font, 0.5, black, 1,
-                cv::LINE_AA);
-    cv::putText(img, "run time (s)", cv::Point(ox + kLeft + w / 2 - 40, oy + kPanelH - 8), font, 0.4, black, 1,
-                cv::LINE_AA);
-    for (const std::string stepper : {"thesis", "event"}) {
-      std::vector<cv::Point> pts;  // in sweep order, so a curve runs from coarse to fine
-      for (const PrecisionPoint& p : report.points) {
-        if (p.scene == scenes[k] && p.stepper == stepper) pts.push_back(to_px(p.run_time_s, p.max_error_m));
-      }
-      const bool is_thesis = stepper == std::string("thesis");
-      const cv::Scalar colour = is_thesis ? thesis_colour : event_colour;
-      if (pts.size() >= 2) cv::polylines(img, pts, false, colour, 1, cv::LINE_AA);
-      for (const cv::Point& q : pts) {
-        if (is_thesis) {
-          cv::circle(img, q, 4, colour, 1, cv::LINE_AA);
-        } else {
-          cv::rectangle(img, q - cv::Point(3, 3), q + cv::Point(3, 3), colour, 1);
-        }
-      }
-    }
-    // Legend in each panel's top right corner.
-    const cv::Point lg(ox + kPanelW - kRight - 90, oy + kTop + 16);
-    cv::circle(img, lg, 4, thesis_colour, 1, cv::LINE_AA);
-    cv::putText(img, "thesis", lg + cv::Point(10, 4), font, 0.4, thesis_colour, 1, cv::LINE_AA);
-    cv::rectangle(img, lg + cv::Point(-3, 15), lg + cv::Point(3, 21), event_colour, 1);
-    cv::putText(img, "event", lg + cv::Point(10, 22), font, 0.4, event_colour, 1, cv::LINE_AA);
-  }
-  if (!cv::imwrite(path, img)) throw std::runtime_error(path + ": cannot write PNG");
+  if (figure.panels.empty()) throw std::runtime_error(path + ": nothing to plot");
+  figure.columns = std::min(3, static_cast<int>(figure.panels.size()));
+  plot::write_png(plot::render(figure), path);
 }
 
 }  // namespace pinball::bench

@@ -9,6 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "charuco_board.h"
+#include "pinball/plot/draw.h"
+#include "pinball/plot/ticks.h"
 
 namespace pinball::calibration {
 namespace {
@@ -334,23 +336,19 @@ LensComparison compare_lenses(const vision::CameraIntrinsics& lens, const vision
 
 namespace {
 
-const cv::Scalar kFigureBackground(40, 40, 40), kText(240, 240, 240), kUsed(0, 200, 0), kPoor(0, 140, 255),
-    kNotFound(60, 60, 230), kArrow(255, 80, 255);
+// Roles, each one palette colour (pinball/plot/draw.h).
+const cv::Scalar kFigureBackground(40, 40, 40), kText(240, 240, 240), kUsed = plot::palette_colour(2),
+    kPoor = plot::palette_colour(3), kNotFound = plot::palette_colour(1), kArrow = plot::palette_colour(4);
 
 void put(cv::Mat& img, const std::string& text, cv::Point at, double scale, const cv::Scalar& colour) {
-  cv::putText(img, text, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
+  plot::put_text(img, text, at, scale, colour);
 }
 
-// The largest of 1, 2, 5, 10, 20, 50, ... that draws `residual_px` (image px)
+// The largest round gain (1, 2, 5, 10, ...) that draws `residual_px` (image px)
 // at most `room_px` long on a thumbnail `scale` times the image's size.
 double arrow_gain(double residual_px, double scale, double room_px) {
-  double best = 1.0;
-  for (double decade = 1.0; decade <= 1e5; decade *= 10.0) {
-    for (const double step : {1.0, 2.0, 5.0}) {
-      if (residual_px * decade * step * scale <= room_px) best = decade * step;
-    }
-  }
-  return best;
+  if (!(residual_px * scale > 0.0)) return 1.0;
+  return std::clamp(plot::round_at_most(room_px / (residual_px * scale)), 1.0, 5e5);
 }
 
 }  // namespace
@@ -358,14 +356,14 @@ double arrow_gain(double residual_px, double scale, double room_px) {
 cv::Mat draw_intrinsics_figure(const IntrinsicsFit& fit, std::span<const TargetImage> images) {
   check_input(images.size() == fit.images.size() && !images.empty(), "draw_intrinsics_figure",
               "needs the images the fit was made from, in the same order");
-  constexpr int kColumns = 4, kThumbWidth = 320, kCaption = 40, kGap = 8, kTitle = 74;
+  constexpr int kColumns = 4, kThumbWidth = 320, kCaption = 40, kGap = 8, kTop = kGap;
   const cv::Size size = images[0].gray.size();
   const double scale = std::min(1.0, double(kThumbWidth) / size.width);
   const int tw = static_cast<int>(std::lround(size.width * scale)), th = static_cast<int>(std::lround(size.height * scale));
   const int n = static_cast<int>(images.size());
   const int columns = std::min(kColumns, n), rows = (n + kColumns - 1) / kColumns;
   const int width = std::max(kColumns * (kThumbWidth + kGap) + kGap, columns * (tw + kGap) + kGap);
-  cv::Mat img(kTitle + rows * (th + kCaption + kGap), width, CV_8UC3, kFigureBackground);
+  cv::Mat img(kTop + rows * (th + kCaption + kGap), width, CV_8UC3, kFigureBackground);
 
   // One scale for every arrow: the largest residual of a used image about 20 px long.
   double largest = 0.0;
@@ -380,18 +378,18 @@ cv::Mat draw_intrinsics_figure(const IntrinsicsFit& fit, std::span<const TargetI
   const IntrinsicsCalibration& c = fit.calibration;
   const vision::CameraIntrinsics& l = c.lens;
   char line[256];
-  put(img, "pinball calibrate intrinsics: " + c.target, {kGap, 20}, 0.55, kText);
+  std::vector<std::string> notes;
   std::snprintf(line, sizeof line, "%d of %zu images used, reprojection rms %.3f px; arrows: residual x%g",
                 c.images_used, fit.images.size(), c.reprojection_rms_px, gain);
-  put(img, line, {kGap, 42}, 0.5, kText);
+  notes.emplace_back(line);
   std::snprintf(line, sizeof line,
                 "%dx%d: fx %.2f fy %.2f cx %.2f cy %.2f px; k1 %.4f k2 %.4f k3 %.4f p1 %.5f p2 %.5f", l.width_px,
                 l.height_px, l.fx_px, l.fy_px, l.cx_px, l.cy_px, l.k1, l.k2, l.k3, l.p1, l.p2);
-  put(img, line, {kGap, 64}, 0.5, kText);
+  notes.emplace_back(line);
 
   for (int i = 0; i < n; ++i) {
     const ImageResult& r = fit.images[static_cast<std::size_t>(i)];
-    const cv::Point origin(kGap + (i % kColumns) * (tw + kGap), kTitle + (i / kColumns) * (th + kCaption + kGap));
+    const cv::Point origin(kGap + (i % kColumns) * (tw + kGap), kTop + (i / kColumns) * (th + kCaption + kGap));
     cv::Mat thumb, bgr;
     const cv::Mat& gray = images[static_cast<std::size_t>(i)].gray;
     if (gray.size() == size && gray.type() == CV_8UC1) {
@@ -419,7 +417,13 @@ cv::Mat draw_intrinsics_figure(const IntrinsicsFit& fit, std::span<const TargetI
                : "rejected: " + r.rejection;
     put(img, status, caption + cv::Point(0, 17), 0.42, colour);
   }
-  return img;
+  const std::vector<plot::LegendEntry> legend{
+      plot::marker_entry("corner, image used", kUsed, plot::Marker::kCircle),
+      plot::marker_entry("corner, image fits poorly (left out)", kPoor, plot::Marker::kCircle),
+      plot::marker_entry("image left out, target not found", kNotFound, plot::Marker::kCircle),
+      plot::line_entry("reprojection residual, drawn x" + number("%g", gain), kArrow)};
+  return plot::annotated_picture(img, legend, "Lens intrinsics from " + c.target + " - pinball calibrate intrinsics",
+                                 notes);
 }
 
 }  // namespace pinball::calibration

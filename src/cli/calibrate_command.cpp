@@ -38,11 +38,11 @@
 #include "pinball/firmware/can_link.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/socketcan_transport.h"
+#include "pinball/plot/draw.h"
 #include "pinball/simlab/sim_lab.h"
 #include "pinball/simlab/sim_latency_lab.h"
 #include "pinball/simlab/sim_target_view.h"
 #include "pinball/table/board_loader.h"
-#include "pinball/sim/renderer.h"
 #include "pinball/track/observation_io.h"
 #include "pinball/vision/capture_source.h"
 #include "pinball/vision/lens_model.h"
@@ -218,7 +218,7 @@ calibration::HomographyFit camera(Context& c) {
   }
   c.err << "calibrate camera: " << fit.detections << " detected, " << fit.calibration.markers_used
         << " used, reprojection rms " << fit.calibration.reprojection_rms_px << " px\n";
-  if (c.a.kind == "camera" && !c.a.png.empty()) sim::write_png(calibration::draw_camera_figure(image, fit), c.a.png);
+  if (c.a.kind == "camera" && !c.a.png.empty()) plot::write_png(calibration::draw_camera_figure(image, fit), c.a.png);
   return fit;
 }
 
@@ -336,7 +336,7 @@ void run_flippers(Context& c) {
       items.push_back({sweeps ? &tracks[i] : nullptr, markers ? &by_markers[i] : nullptr,
                        sweeps ? &markerless[i] : nullptr});
     }
-    sim::write_png(calibration::draw_flipper_figure(background, *h, items), c.a.png);
+    plot::write_png(calibration::draw_flipper_figure(background, *h, items), c.a.png);
   }
 }
 
@@ -381,7 +381,7 @@ void run_gravity(Context& c) {
   c.err << "calibrate gravity: g = " << e.g_mps2 << " m/s^2, " << e.confidence * 100 << "% interval ["
         << e.ci_low_mps2 << ", " << e.ci_high_mps2 << "]\n";
   c.cal.gravity = e;
-  if (!c.a.png.empty()) sim::write_png(calibration::draw_gravity_figure(rolls, g), c.a.png);
+  if (!c.a.png.empty()) plot::write_png(calibration::draw_gravity_figure(rolls, g), c.a.png);
 }
 
 // ---- latency: the camera's latency against a flipper fired at a known time ----

@@ -1,11 +1,13 @@
 // `pinball render BOARD --out FILE.png`: draws a board file.
 
+#include <filesystem>
 #include <ostream>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "data_file.h"
+#include "pinball/plot/draw.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/renderer.h"
@@ -28,9 +30,14 @@ int run_render(const RenderArgs& a, std::ostream& out, std::ostream&) {
   options.px_per_m = a.px_per_m;
   options.draw_normals = a.normals;
   options.draw_hud = false;
+  options.draw_scale_bar = true;
   const sim::GameState state = sim::make_game_state(board, 0);
-  const cv::Mat image = sim::render_board(board, &state, options);
-  sim::write_png(image, a.out);
+  const std::vector<std::string> notes{
+      "x right, y up the table; a lighter shade: the obstacle scores; scale bar at the bottom left"};
+  const std::string title = "Board " + std::filesystem::path(a.board).filename().string() + " - pinball render";
+  const cv::Mat image =
+      plot::annotated_picture(sim::render_board(board, &state, options), sim::board_legend(), title, notes);
+  plot::write_png(image, a.out);
   if (a.json) {
     out << nlohmann::json{{"board", a.board},          {"out", a.out},
                           {"width_px", image.cols},     {"height_px", image.rows},

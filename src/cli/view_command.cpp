@@ -18,7 +18,7 @@
 #include "data_file.h"
 #include "pinball/core/format.h"
 #include "pinball/daemon/daemon_config.h"
-#include "pinball/sim/renderer.h"
+#include "pinball/plot/draw.h"
 #include "pinball/view/lcm_listener.h"
 #include "pinball/view/log_player.h"
 #include "pinball/view/view_render.h"
@@ -109,7 +109,7 @@ void report(const ViewArgs& a, const std::string& source, double t_s, const view
 }
 
 void write_snapshot(const ViewArgs& a, const cv::Mat& picture) {
-  if (!a.snapshot.empty()) sim::write_png(picture, a.snapshot);
+  if (!a.snapshot.empty()) plot::write_png(picture, a.snapshot);
 }
 
 // The window's keys, for the help line and the docs.
@@ -174,7 +174,7 @@ int view_log_window(const ViewArgs& a, const view::ViewScene& scene, view::LogPl
       case 's': {
         char name[64];
         std::snprintf(name, sizeof name, "view_%.3f.png", position_s);
-        sim::write_png(s.last, name);
+        plot::write_png(s.last, name);
         break;
       }
       default: break;
@@ -214,7 +214,7 @@ int view_live(const ViewArgs& a, const view::ViewScene& scene, bool window, std:
       ++s.frames_drawn;
       const int key = cv::waitKey(std::max(1, static_cast<int>(1e3 * (kFramePeriod_s - (steady_s() - now_s)))));
       if (key == 'q' || key == 27 || reached) break;
-      if (key == 's') sim::write_png(s.last, "view_live.png");
+      if (key == 's') plot::write_png(s.last, "view_live.png");
       if (cv::getWindowProperty(kWindow, cv::WND_PROP_VISIBLE) < 1.0) break;
     } else if (reached || ended || quiet) {
       break;

@@ -35,6 +35,13 @@ struct RaceResult {
   std::uint64_t balls = 0;           // balls played
 };
 
+// Half-width of the 95 % interval of the mean over every ball of a race.
+double population_ci95(const RaceResult& race) {
+  RunningStats all;
+  for (const RunningStats& s : race.stats) all.merge(s);
+  return all.ci95_half_width();
+}
+
 // Each round, every candidate still in plays the same fresh balls; the better
 // half goes on with twice the balls.
 RaceResult halving_race(SearchRun& run, const std::vector<control::ControllerSpec>& cand,
@@ -161,7 +168,7 @@ SearchResult run_cross_entropy(const BallObjective& objective, const SearchConfi
     winners.push_back(cand[winner]);
     if (winners.size() > static_cast<std::size_t>(c.final_race_size)) winners.erase(winners.begin());
     run.end_generation(race.balls > 0 ? race.balls_sum / static_cast<double>(race.balls) : 0.0,
-                       stats[winner].mean());
+                       stats[winner].mean(), population_ci95(race));
   }
   // The final race: the recent winners and the distribution's mean (every
   // gain at mu, each flipper the likelier one), on as many balls as the rest
@@ -181,7 +188,8 @@ SearchResult run_cross_entropy(const BallObjective& objective, const SearchConfi
       run.count("final_race_candidates", static_cast<double>(finalists.size()));
       run.count("final_race_winner_balls", static_cast<double>(race.stats[winner].count()));
       run.count("final_race_mean_won", winner + 1 == finalists.size() ? 1.0 : 0.0);
-      run.end_generation(race.balls_sum / static_cast<double>(race.balls), race.stats[winner].mean());
+      run.end_generation(race.balls_sum / static_cast<double>(race.balls), race.stats[winner].mean(),
+                         population_ci95(race));
     }
   }
   return run.finish();

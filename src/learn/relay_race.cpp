@@ -82,7 +82,8 @@ SearchResult run_relay_race(const BallObjective& objective, const SearchConfig& 
       generation_best = mean_score(e, 0, e.size());
       run.offer(best, generation_best, eval_balls);
     }
-    run.end_generation(mean_score(out, 0, out.size()), generation_best);
+    const RunningStats population = score_stats(out, 0, out.size());
+    run.end_generation(population.mean(), generation_best, population.ci95_half_width());
   }
   return run.finish();
 }

@@ -41,13 +41,14 @@ void SearchRun::set_best(const control::ControllerSpec& spec, double mean, std::
   has_best_ = true;
 }
 
-void SearchRun::end_generation(double population_mean, double generation_best) {
+void SearchRun::end_generation(double population_mean, double generation_best, double population_ci95) {
   CurvePoint p;
   p.generation = ++result_.generations;
   p.balls = balls_;
   p.population_mean = population_mean;
   p.generation_best = generation_best;
   p.best_so_far = result_.best_mean;
+  p.population_ci95 = population_ci95;
   p.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   result_.curve.push_back(p);
   if (config_.progress) {
@@ -84,6 +85,12 @@ double mean_score(const std::vector<BallOutcome>& outcomes, std::size_t begin, s
   double sum = 0.0;
   for (std::size_t i = begin; i < end; ++i) sum += outcomes[i].score;
   return sum / static_cast<double>(end - begin);
+}
+
+RunningStats score_stats(const std::vector<BallOutcome>& outcomes, std::size_t begin, std::size_t end) {
+  RunningStats s;
+  for (std::size_t i = begin; i < end && i < outcomes.size(); ++i) s.add(outcomes[i].score);
+  return s;
 }
 
 control::ControllerSpec seed_controller(SearchRun& run, const control::ControllerSpec& prototype) {

@@ -37,7 +37,8 @@ SearchResult run_tournament(const BallObjective& objective, const SearchConfig& 
     }
     run.count("parent_replaced", winner != 0 ? 1.0 : 0.0);
     parent = family[winner];  // 2(c)
-    run.end_generation(mean_score(out, 0, out.size()), winner_mean);
+    const RunningStats population = score_stats(out, 0, out.size());
+    run.end_generation(population.mean(), winner_mean, population.ci95_half_width());
   }
   return run.finish();
 }

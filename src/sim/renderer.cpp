@@ -7,8 +7,9 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "pinball/plot/draw.h"
 
 namespace pinball::sim {
 namespace {
@@ -43,6 +44,7 @@ constexpr double kDashOn_px = 7.0;   // hidden obstacles: drawn length of a dash
 constexpr double kDashOff_px = 6.0;  // gap between dashes (round caps eat about 2 px of it)
 constexpr double kFlipperWidth_m = 0.010;  // drawn width; the model's flipper is a segment
 constexpr double kNormalTick_m = 0.015;    // length of a normal tick
+constexpr int kScaleBarStrip_px = 44;      // the strip below the playfield that holds the scale bar
 
 // Pixel (u, v) as an OpenCV fixed-point point for `shift = kShift`.
 cv::Point to_fixed(const cv::Point2d& uv_px) {
@@ -235,11 +237,24 @@ void draw_hud(cv::Mat& image, const GameState& state) {
   cv::putText(image, line, {x_px, y_px}, font, font_scale, kHudText, 1, cv::LINE_AA);
 }
 
+// The colours above and what they mean (board_legend).
+std::vector<plot::LegendEntry> legend_entries() {
+  using plot::line_entry, plot::LineStyle;
+  return {line_entry("wall", darken(kWall, 0.85)),
+          line_entry("kicker (rho > 1 or a kick)", darken(kKicker, 0.85)),
+          line_entry("ball eater", darken(kEater, 0.85)),
+          line_entry("hidden until a flag shows it", kHidden, LineStyle::kDashed),
+          line_entry("sensor", kSensor),
+          line_entry("flipper (at rest)", kFlipper),
+          plot::marker_entry("launcher", kLauncher, plot::Marker::kSquare)};
+}
+
 }  // namespace
 
 cv::Size render_size(const table::Board& board, const RenderOptions& options) {
   const int w_px = static_cast<int>(std::lround(board.width_m * options.px_per_m)) + 2 * options.margin_px;
-  const int h_px = static_cast<int>(std::lround(board.height_m * options.px_per_m)) + 2 * options.margin_px;
+  const int h_px = static_cast<int>(std::lround(board.height_m * options.px_per_m)) + 2 * options.margin_px +
+                   (options.draw_scale_bar ? kScaleBarStrip_px : 0);
   return {w_px, h_px};
 }
 
@@ -264,17 +279,10 @@ cv::Mat render_board(const table::Board& board, const GameState* state, const Re
     if (state->ball_in_play) draw_ball(image, board, *state, options);
     if (options.draw_hud) draw_hud(image, *state);
   }
+  if (options.draw_scale_bar) plot::draw_scale_bar(image, options.px_per_m, plot::Corner::kBottomLeft);
   return image;
 }
 
-void write_png(const cv::Mat& image, const std::string& path) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error("write_png: cannot write '" + path + "': " + e.what());
-  }
-  if (!ok) throw std::runtime_error("write_png: cannot write '" + path + "'");
-}
+std::vector<plot::LegendEntry> board_legend() { return legend_entries(); }
 
 }  // namespace pinball::sim

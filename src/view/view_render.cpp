@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pinball/calibration/calibration_file.h"
+#include "pinball/plot/draw.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/track/projection.h"
@@ -17,6 +18,7 @@ namespace {
 
 constexpr int kPanelWidth_px = 330;
 constexpr int kStripHeight_px = 44;
+constexpr int kMinTableHeight_px = 560;  // room for the panel's text and legend beside a small table
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kFontScale = 0.45;
 constexpr int kLine_px = 17;
@@ -24,7 +26,6 @@ const cv::Scalar kPanelBackground{40, 40, 40};
 const cv::Scalar kText{235, 235, 235};
 const cv::Scalar kDimText{150, 150, 150};
 const cv::Scalar kVColour{120, 120, 120};
-const cv::Scalar kFireColour{40, 40, 230};
 const cv::Scalar kReleaseColour{200, 160, 60};
 const cv::Scalar kCoilOffColour{90, 90, 90};
 
@@ -132,7 +133,7 @@ void draw_commands_on_flippers(cv::Mat& image, const ViewScene& scene, const Vie
     if (!c) continue;
     const cv::Point pivot = to_point(view_pixel(scene, scene.board.flippers[i].pivot));
     text(image, c->energize ? "FIRE" : "release", pivot + cv::Point(i == 0 ? -10 : -50, 28),
-         c->energize ? kFireColour : kReleaseColour);
+         c->energize ? kViewCoilOnColour : kReleaseColour);
   }
 }
 
@@ -156,7 +157,7 @@ void draw_panel(cv::Mat& panel, const ViewScene& scene, const ViewState& state) 
          (p->hittable ? "" : " (not hittable)") + (p->rolling ? " rolling" : ""));
     line(format("d %.1f mm, t_impact %.1f ms", 1e3 * p->d_m, 1e3 * p->t_impact_s));
     if (const std::optional<double> dc = d_critical_m(scene, *p)) {
-      line(format("d_critical %.1f mm", 1e3 * *dc), p->d_m <= *dc ? kFireColour : kText);
+      line(format("d_critical %.1f mm", 1e3 * *dc), p->d_m <= *dc ? kViewCoilOnColour : kText);
     } else {
       line("d_critical: no controller given", kDimText);
     }
@@ -183,8 +184,21 @@ void draw_panel(cv::Mat& panel, const ViewScene& scene, const ViewState& state) 
     char buf[96];
     std::snprintf(buf, sizeof buf, "%8.3f s %-5s %-7s %s", it->t_s, flipper_name(it->flipper),
                   it->energize ? "fire" : "release", cause_name(it->cause));
-    line(buf, it->energize ? kFireColour : kReleaseColour);
+    line(buf, it->energize ? kViewCoilOnColour : kReleaseColour);
   }
+}
+
+// What the colours mean, at the foot of the panel.
+void draw_legend(cv::Mat& panel) {
+  const std::vector<plot::LegendEntry> entries{
+      plot::marker_entry("ball (last frame)", kViewBallColour, plot::Marker::kDot),
+      plot::line_entry("its sightings, last 0.5 s", kViewTrailColour),
+      plot::line_entry("projected path, impact", kViewTrajectoryColour, plot::LineStyle::kSolid,
+                       plot::Marker::kTiltedCross),
+      plot::line_entry("flippers' V", kVColour),
+      plot::marker_entry("coil on / fire command", kViewCoilOnColour, plot::Marker::kSquare),
+      plot::marker_entry("release command", kReleaseColour, plot::Marker::kSquare)};
+  plot::draw_legend(panel, entries, plot::Corner::kBottomLeft);
 }
 
 void draw_strip(cv::Mat& strip, const ViewState& state, const ViewCaption& caption) {
@@ -196,7 +210,7 @@ void draw_strip(cv::Mat& strip, const ViewState& state, const ViewCaption& capti
                                           : std::string("   frame->CAN p99: no PINBALL_STATS yet");
   if (state.malformed() > 0) figures += format("   malformed %.0f", static_cast<double>(state.malformed()));
   text(strip, figures, {10, 17});
-  text(strip, caption.source + "   " + caption.status, {10, 36}, kDimText);
+  text(strip, "pinball view: " + caption.source + "   " + caption.status, {10, 36}, kDimText);
 }
 
 }  // namespace
@@ -245,23 +259,31 @@ Vec2 projected_path_point(const ViewScene& scene, const Vec2& origin, const pinb
   return origin + v0 * t_s + 0.5 * g * t_s * t_s;
 }
 
+cv::Rect view_table_rect(const ViewScene& scene) {
+  sim::RenderOptions options = scene.render;
+  options.draw_hud = false;
+  return {cv::Point(0, 0), sim::render_size(scene.board, options)};
+}
+
 cv::Point2d view_pixel(const ViewScene& scene, const Vec2& p_board) {
   return sim::board_to_pixel(scene.board, scene.render, p_board);
 }
 
 cv::Mat render_view(const ViewScene& scene, const ViewState& state, const ViewCaption& caption) {
   cv::Mat table = draw_table(scene, state);
+  plot::draw_scale_bar(table, scene.render.px_per_m, plot::Corner::kTopLeft);
   draw_v(table, scene);
   if (const auto& p = state.projection()) draw_projection(table, scene, state, *p);
   draw_trail_and_ball(table, scene, state);
   draw_commands_on_flippers(table, scene, state);
 
   const int width_px = table.cols + kPanelWidth_px;
-  const int height_px = std::max(table.rows, 360) + kStripHeight_px;
+  const int height_px = std::max(table.rows, kMinTableHeight_px) + kStripHeight_px;
   cv::Mat picture(height_px, width_px, CV_8UC3, kPanelBackground);
   table.copyTo(picture(cv::Rect(0, 0, table.cols, table.rows)));
   cv::Mat panel = picture(cv::Rect(table.cols, 0, kPanelWidth_px, height_px - kStripHeight_px));
   draw_panel(panel, scene, state);
+  draw_legend(panel);
   cv::Mat strip = picture(cv::Rect(0, height_px - kStripHeight_px, width_px, kStripHeight_px));
   strip.setTo(cv::Scalar(25, 25, 25));
   draw_strip(strip, state, caption);

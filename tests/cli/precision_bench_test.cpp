@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "common/figure_check.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/sim/penetration.h"
 
@@ -96,6 +97,8 @@ TEST(PrecisionBench, QuickRunErrorsAreSane) {
   const auto png = std::filesystem::temp_directory_path() / "pinball_precision_test.png";
   plot_precision_png(r, png.string());
   EXPECT_GT(std::filesystem::file_size(png), 10'000u);
+  // Six scenes in two rows of three panels; both steppers' colours (curves and legend swatches).
+  pinball::testing::expect_figure(png.string(), cv::Size(3 * 470, 2 * 360 + 60), 2, 2);
   std::filesystem::remove(png);
 }
 

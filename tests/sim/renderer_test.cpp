@@ -11,6 +11,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/figure_check.h"
+#include "pinball/plot/draw.h"
 #include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 
@@ -417,33 +419,39 @@ TEST(RendererTest, RejectsBadOptions) {
   EXPECT_THROW(render_board(b, nullptr, o), std::invalid_argument);
 }
 
-TEST_F(RendererFileTest, WritePngRoundTrips) {
+TEST(RendererTest, ScaleBarAddsAStripBelowThePlayfield) {
   const table::Board b = line_board();
-  const cv::Mat image = render_board(b, nullptr, test_options());
+  RenderOptions o = test_options();
+  const cv::Mat plain = render_board(b, nullptr, o);
+  o.draw_scale_bar = true;
+  const cv::Mat with_bar = render_board(b, nullptr, o);
+  EXPECT_EQ(with_bar.size(), render_size(b, o));
+  EXPECT_EQ(with_bar.cols, plain.cols);
+  EXPECT_GT(with_bar.rows, plain.rows);
+  // The playfield is drawn the same; the strip holds a white box with a black bar.
+  EXPECT_TRUE(same_image(with_bar(cv::Rect(0, 0, plain.cols, plain.rows)), plain));
+  const cv::Mat strip = with_bar(cv::Rect(0, plain.rows, plain.cols, with_bar.rows - plain.rows));
+  EXPECT_GT(pinball::testing::count_colour(strip, cv::Scalar(255, 255, 255), 5), 200);
+  EXPECT_GT(pinball::testing::count_colour(strip, cv::Scalar(0, 0, 0), 10), 60);
+}
+
+TEST_F(RendererFileTest, BoardFigureIsWrittenWithLegendAndNotTrivial) {
+  // What `pinball render` writes: the board with its scale bar, the legend beside it, a title above.
+  const table::Board b = line_board();
+  RenderOptions o = test_options();
+  o.draw_scale_bar = true;
+  const std::vector<plot::LegendEntry> legend = board_legend();
+  EXPECT_GE(legend.size(), 6u);
+  const cv::Mat board_image = render_board(b, nullptr, o);
   const std::string path = (dir_ / "board.png").string();
-  write_png(image, path);
-  ASSERT_TRUE(fs::exists(path));
-  const cv::Mat back = cv::imread(path, cv::IMREAD_COLOR);
+  plot::write_png(plot::annotated_picture(board_image, legend, "Board test - pinball render"), path);
+  const cv::Mat back = pinball::testing::read_figure(path);
   ASSERT_FALSE(back.empty());
-  EXPECT_EQ(back.size(), image.size());
-  EXPECT_TRUE(same_image(back, image));  // PNG is lossless
-}
-
-TEST_F(RendererFileTest, WritePngToMissingDirectoryThrowsNamingThePath) {
-  const cv::Mat image = render_board(line_board(), nullptr, test_options());
-  const std::string path = (dir_ / "no_such_dir" / "board.png").string();
-  try {
-    write_png(image, path);
-    FAIL() << "write_png did not throw";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  EXPECT_GT(back.cols, board_image.cols + 100);  // the legend beside the board
+  EXPECT_GT(back.rows, board_image.rows);          // the title above
+  for (const plot::LegendEntry& e : legend) {
+    EXPECT_GT(pinball::testing::count_colour(back, e.colour, 20), 8) << e.label;
   }
-  EXPECT_FALSE(fs::exists(path));
-}
-
-TEST_F(RendererFileTest, WritePngOfEmptyImageThrows) {
-  const std::string path = (dir_ / "empty.png").string();
-  EXPECT_THROW(write_png(cv::Mat(), path), std::runtime_error);
 }
 
 }  // namespace

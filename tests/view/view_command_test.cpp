@@ -27,7 +27,7 @@ class ViewCommand : public CommandTest {
 };
 
 cv::Point2d ball_in(const std::string& png) {
-  return colour_centroid(cv::imread(png, cv::IMREAD_COLOR), view::kViewBallColour);
+  return ball_on_table(cv::imread(png, cv::IMREAD_COLOR));
 }
 
 TEST_F(ViewCommand, SnapshotOfALogShowsTheBallWhereTheLogSaysItWas) {

@@ -16,6 +16,7 @@
 #include "common/temp_path.h"
 #include "pinball/core/geometry.h"
 #include "pinball/view/log_player.h"
+#include "pinball/view/view_render.h"
 #include "pinball_lcm/lcmt_pinball_daemon_stats.hpp"
 #include "pinball_lcm/lcmt_pinball_driver_status.hpp"
 #include "pinball_lcm/lcmt_pinball_flipper_command.hpp"
@@ -139,6 +140,17 @@ inline cv::Point2d colour_centroid(const cv::Mat& image, const cv::Scalar& colou
   const cv::Moments m = cv::moments(mask, true);
   if (count != nullptr) *count = static_cast<int>(m.m00);
   return m.m00 == 0 ? cv::Point2d(-1, -1) : cv::Point2d(m.m10 / m.m00, m.m01 / m.m00);
+}
+
+/// The scene the view's tests draw on: the thesis table at 800 px/m, no calibration or controller.
+inline view::ViewScene test_view_scene() {
+  return view::load_view_scene(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board", "", "", 800.0);
+}
+
+/// Centroid (px) of the ball's colour on the table part of a view picture (the
+/// panel's legend shows the colour too).
+inline cv::Point2d ball_on_table(const cv::Mat& picture) {
+  return colour_centroid(picture(view::view_table_rect(test_view_scene())), view::kViewBallColour);
 }
 
 }  // namespace pinball::testing

@@ -23,15 +23,16 @@ TEST(ViewRender, DrawsTheBallWhereTheLogSaysItWas) {
   player.seek(0.6001);
   const cv::Mat picture = render_view(scene, player.state(), {"game.lcmlog", "log 0.6 s"});
   int n = 0;
-  const cv::Point2d c = pinball::testing::colour_centroid(picture, kViewBallColour, &n);
+  const cv::Mat table = picture(view_table_rect(scene));  // the panel's legend shows the colours too
+  const cv::Point2d c = pinball::testing::colour_centroid(table, kViewBallColour, &n);
   const cv::Point2d truth = view_pixel(scene, pinball::testing::view_log_ball(0.6));
   EXPECT_GT(n, 50);  // a disc of about 11 px radius
   EXPECT_NEAR(c.x, truth.x, 1.0);
   EXPECT_NEAR(c.y, truth.y, 1.0);
   // The trail and the projected path are drawn too.
   int trail = 0, path = 0;
-  pinball::testing::colour_centroid(picture, kViewTrailColour, &trail);
-  pinball::testing::colour_centroid(picture, kViewTrajectoryColour, &path);
+  pinball::testing::colour_centroid(table, kViewTrailColour, &trail);
+  pinball::testing::colour_centroid(table, kViewTrajectoryColour, &path);
   EXPECT_GT(trail, 20);
   EXPECT_GT(path, 20);
 }

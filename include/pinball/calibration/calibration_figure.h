@@ -15,9 +15,10 @@
 
 namespace pinball::calibration {
 
-/// The marker image (8-bit gray), enlarged: every detection (yellow circle),
-/// the layout reprojected through the fit (green cross: inlier, red: outlier)
-/// and the reprojection figures. BGR.
+/// The marker image (8-bit gray), enlarged: every detection (circle), the
+/// layout reprojected through the fit (cross: inlier or outlier, each its
+/// palette colour), a legend beside it and the reprojection figures in the
+/// title banner (pinball/plot). BGR.
 cv::Mat draw_camera_figure(const cv::Mat& gray, const HomographyFit& fit);
 
 /// One flipper for the flipper figure.
@@ -28,13 +29,16 @@ struct FlipperFigureItem {
 };
 
 /// A frame of the table (8-bit gray), enlarged, with each flipper's tip
-/// points (cyan), fitted circle and arc between the stops (magenta), and the
-/// marker method's pivot and tips (green). BGR.
+/// points, fitted circle and arc between the stops, and the marker method's
+/// pivot and tip; below it a zoomed inset of each flipper with a scale bar;
+/// a legend beside and the figures in the title banner. BGR.
 cv::Mat draw_flipper_figure(const cv::Mat& gray, const vision::CameraHomography& homography,
                             std::span<const FlipperFigureItem> flippers);
 
-/// y against t of every roll (points), its fitted parabola over the part used
-/// (line; red when the roll was left out), and the estimate. BGR.
+/// A chart of two panels sharing time: y against t of every roll (points)
+/// with its fitted parabola over the part used (one palette colour per roll;
+/// grey dashed when left out), and below each roll's residuals (mm); the
+/// estimate and its interval in the title. BGR.
 cv::Mat draw_gravity_figure(std::span<const GravityRoll> rolls, const GravityCalibration& result);
 
 }  // namespace pinball::calibration

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "pinball/core/rng.h"
+#include "pinball/core/running_stats.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
 
@@ -37,6 +38,7 @@ struct CurvePoint {
   double generation_best = 0.0;      ///< the generation's best controller's estimated mean
   double best_so_far = 0.0;          ///< the best controller's estimated mean so far
   double wall_s = 0.0;               ///< wall time since the start (s)
+  double population_ci95 = 0.0;      ///< half-width of population_mean's 95 % interval (Student's t; 0: unknown)
 };
 
 /// What a search returns.
@@ -75,8 +77,9 @@ class SearchRun {
   void offer(const control::ControllerSpec& spec, double mean, std::uint64_t balls);
   /// Makes `spec` the best so far unconditionally (a comparison on common random numbers decided it).
   void set_best(const control::ControllerSpec& spec, double mean, std::uint64_t balls);
-  /// Closes a generation: a curve row and a progress line.
-  void end_generation(double population_mean, double generation_best);
+  /// Closes a generation: a curve row and a progress line. `population_ci95`:
+  /// half-width of the population mean's 95 % interval (0 when unknown).
+  void end_generation(double population_mean, double generation_best, double population_ci95 = 0.0);
   /// Adds a method-specific counter.
   void count(const std::string& name, double value);
   /// The best estimated mean so far (0 before any).
@@ -107,5 +110,8 @@ control::ControllerSpec seed_controller(SearchRun& run, const control::Controlle
 
 /// Mean score per ball of a set of outcomes.
 double mean_score(const std::vector<BallOutcome>& outcomes, std::size_t begin, std::size_t end);
+
+/// Mean, spread and 95 % interval of the scores of a set of outcomes.
+RunningStats score_stats(const std::vector<BallOutcome>& outcomes, std::size_t begin, std::size_t end);
 
 }  // namespace pinball::learn

@@ -2,9 +2,11 @@
 // Draws a board and, optionally, a game state into an OpenCV image: for
 // `pinball render`, `pinball sim --video`, and people checking a board file.
 
-#include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
+
+#include "pinball/plot/draw.h"
 
 #include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
@@ -17,6 +19,7 @@ struct RenderOptions {
   int margin_px = 12;        ///< border around the playfield
   bool draw_normals = false; ///< draw each line's normal as a short tick (debugging one-sided lines)
   bool draw_hud = true;      ///< score, balls and time in the top-left corner (needs a state)
+  bool draw_scale_bar = false;  ///< a strip below the playfield with a round-length scale bar (`pinball render`)
 };
 
 /// Image size (width, height in px) that render_board produces for `board`.
@@ -29,7 +32,8 @@ cv::Point2d board_to_pixel(const table::Board& board, const RenderOptions& optio
 /// flags greyed out, the ball and the HUD. Returns an 8-bit BGR image.
 cv::Mat render_board(const table::Board& board, const GameState* state, const RenderOptions& options);
 
-/// Writes an image as PNG. Throws std::runtime_error naming the path on failure.
-void write_png(const cv::Mat& image, const std::string& path);
+/// What render_board's colours mean (walls, kickers, ball eaters, hidden
+/// obstacles, sensors, flippers), for a legend beside the picture.
+std::vector<plot::LegendEntry> board_legend();
 
 }  // namespace pinball::sim

@@ -58,6 +58,9 @@ Vec2 projected_path_point(const ViewScene& scene, const Vec2& origin, const pinb
 /// The picture: the table with its overlays, a side panel and the strip. BGR.
 cv::Mat render_view(const ViewScene& scene, const ViewState& state, const ViewCaption& caption);
 
+/// Where the table lies in render_view's picture (the panel, its legend and the strip lie outside).
+cv::Rect view_table_rect(const ViewScene& scene);
+
 /// The pixel of board point `p_board` in render_view's picture (the table sits at its top-left).
 cv::Point2d view_pixel(const ViewScene& scene, const Vec2& p_board);
 

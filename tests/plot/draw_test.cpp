@@ -1,0 +1,99 @@
+#include "pinball/plot/draw.h"
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/figure_check.h"
+#include "common/temp_path.h"
+
+namespace pinball::plot {
+namespace {
+
+namespace fs = std::filesystem;
+using pinball::testing::count_colour;
+using pinball::testing::count_ink;
+
+TEST(PaletteTest, EightDistinctColoursThatCycle) {
+  for (int i = 0; i < 8; ++i) {
+    for (int k = i + 1; k < 8; ++k) EXPECT_NE(palette_colour(i), palette_colour(k)) << i << " " << k;
+  }
+  EXPECT_EQ(palette_colour(9), palette_colour(1));
+  EXPECT_EQ(palette_colour(-1), palette_colour(7));
+}
+
+TEST(LegendTest, DrawsEverySwatchInItsColourInTheCorner) {
+  cv::Mat image(300, 400, CV_8UC3, cv::Scalar(30, 30, 30));
+  const std::vector<LegendEntry> entries{
+      {.label = "tips", .colour = palette_colour(0), .marker = Marker::kDot, .line = LineStyle::kNone},
+      {.label = "fitted circle", .colour = palette_colour(1)},
+      {.label = "left out", .colour = muted_colour(), .marker = Marker::kNone, .line = LineStyle::kDashed}};
+  draw_legend(image, entries, Corner::kTopRight);
+  const cv::Size size = legend_size(entries);
+  const cv::Mat box = image(cv::Rect(image.cols - 8 - size.width, 8, size.width, size.height));
+  EXPECT_GT(count_colour(box, palette_colour(0), 20), 3);
+  EXPECT_GT(count_colour(box, palette_colour(1), 20), 20);
+  EXPECT_GT(count_colour(box, muted_colour(), 20), 10);
+  EXPECT_GT(count_colour(box, cv::Scalar(255, 255, 255), 5), size.area() / 3);                       // a white box
+  EXPECT_EQ(count_colour(image(cv::Rect(0, 150, 400, 150)), cv::Scalar(30, 30, 30), 0), 400 * 150);  // only there
+}
+
+TEST(ScaleBarTest, RoundLengthAtMostAQuarterOfTheWidth) {
+  cv::Mat image(400, 430, CV_8UC3, cv::Scalar(20, 20, 20));
+  const double length_m = draw_scale_bar(image, 800.0, Corner::kBottomRight);
+  EXPECT_DOUBLE_EQ(length_m, 0.1);  // a quarter of 430 px at 800 px/m is 13 cm: 10 cm
+  // The bar: 80 px of black in the bottom-right box.
+  const cv::Mat corner = image(cv::Rect(430 - 120, 400 - 60, 120, 60));
+  EXPECT_GE(count_colour(corner, cv::Scalar(0, 0, 0), 10), 80 * 5);
+  EXPECT_THROW(draw_scale_bar(image, 0.0, Corner::kTopLeft), std::invalid_argument);
+}
+
+TEST(TitleTest, BannerAboveTheImageWithTheText) {
+  const cv::Mat image(100, 200, CV_8UC3, cv::Scalar(40, 40, 40));
+  const std::vector<std::string> notes{"a note under the title"};
+  const cv::Mat titled = with_title(image, "A long title naming pinball render and the board file", notes);
+  EXPECT_GT(titled.rows, image.rows + 40);
+  EXPECT_GT(titled.cols, image.cols);  // the text is wider than the image: the banner widens it
+  const cv::Mat banner = titled(cv::Rect(0, 0, titled.cols, titled.rows - image.rows));
+  EXPECT_GT(count_ink(banner), 300);
+  EXPECT_EQ(count_colour(titled(cv::Rect(0, titled.rows - 100, 200, 100)), cv::Scalar(40, 40, 40), 0), 200 * 100);
+}
+
+TEST(PlaceTest, SideBySideAndStacked) {
+  const std::vector<cv::Mat> parts{cv::Mat(50, 60, CV_8UC3, cv::Scalar(0, 0, 255)),
+                                   cv::Mat(30, 40, CV_8UC3, cv::Scalar(255, 0, 0))};
+  EXPECT_EQ(place(parts, true, 8).size(), cv::Size(108, 50));
+  EXPECT_EQ(place(parts, false, 8).size(), cv::Size(60, 88));
+}
+
+TEST(WritePngTest, RoundTrips) {
+  cv::Mat image(40, 50, CV_8UC3, cv::Scalar(10, 200, 30));
+  image.at<cv::Vec3b>(3, 4) = cv::Vec3b(1, 2, 3);
+  const std::string path = pinball::testing::temp_path("plot_draw_test", "round.png");
+  write_png(image, path);
+  const cv::Mat back = cv::imread(path, cv::IMREAD_COLOR);
+  ASSERT_EQ(back.size(), image.size());
+  EXPECT_EQ(cv::norm(back, image, cv::NORM_INF), 0.0);  // PNG is lossless
+  fs::remove(path);
+}
+
+TEST(WritePngTest, UnwritablePathThrowsNamingThePath) {
+  const std::string path = pinball::testing::temp_path("plot_draw_test", "no_such_dir") + "/figure.png";
+  try {
+    write_png(cv::Mat(10, 10, CV_8UC3, cv::Scalar::all(0)), path);
+    FAIL() << "write_png did not throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(path));
+}
+
+TEST(WritePngTest, EmptyImageThrows) {
+  EXPECT_THROW(write_png(cv::Mat(), pinball::testing::temp_path("plot_draw_test", "empty.png")), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace pinball::plot
