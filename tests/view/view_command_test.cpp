@@ -55,6 +55,26 @@ TEST_F(ViewCommand, SnapshotOfALiveSourceThroughLiblcm) {
   EXPECT_GT(ball_in(png).x, 0.0);
 }
 
+// The lab's way: pinballd publishing on UDP multicast, the view listening on
+// the same URL (a port of its own, so no other test's daemon is heard).
+TEST_F(ViewCommand, LiveFromARunningPinballdOverUdpMulticast) {
+  const std::string url = "'udpm://239.255.76.67:7671?ttl=0'";
+  const std::string png = (dir_ / "udpm.png").string();
+  const CommandResult r = run_shell("(sleep 0.3; timeout -s INT 8 " PINBALLD_EXE " --lcm-url " + url +
+                                    " --realtime --balls 1 > /dev/null 2>&1) & env -u DISPLAY " PINBALL_EXE
+                                    " view --lcm-url " + url + " --snapshot " + png +
+                                    " --at 1 --wait-s 15 --json; status=$?; wait; exit $status");  // pinballd stops at 8 s
+  if (r.exit_code == 1 && r.err.find("nothing arrived") != std::string::npos) {
+    GTEST_SKIP() << "UDP multicast does not loop back on this machine: " << r.err;
+  }
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GE(j["t_s"].get<double>(), 1.0);
+  EXPECT_GT(j["observations"].get<int>(), 100);  // 200 frames/s for a second
+  EXPECT_EQ(j["malformed"], 0);
+  EXPECT_TRUE(std::filesystem::exists(png));
+}
+
 TEST_F(ViewCommand, AWindowWithoutADisplayIsAClearError) {
   const CommandResult r = view(log_);
   EXPECT_EQ(r.exit_code, 1);
