@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "pinball/bus/channels.h"
+#include "pinball/bus/message_convert.h"
 #include "pinball_lcm/lcmt_pinball_observation.hpp"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/game_state.h"
@@ -22,8 +23,7 @@ double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock:
 
 template <class T>
 void feed(view::ViewState& state, const char* channel, const T& m, double t_s) {
-  std::vector<std::uint8_t> data(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(data.data(), 0, static_cast<int>(data.size()));
+  const std::vector<std::uint8_t> data = bus::encode_message(m);
   state.apply(channel, data.data(), data.size(), t_s);
 }
 

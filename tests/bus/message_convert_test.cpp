@@ -151,8 +151,7 @@ TEST(MessageConvert, FlipperCommandRange) {
 template <class T>
 std::optional<std::int64_t> utime_of_encoded(T m, std::int64_t utime) {
   m.utime = utime;
-  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  const std::vector<std::uint8_t> buf = encode_message(m);
   return encoded_utime(buf.data(), buf.size());
 }
 

@@ -13,6 +13,7 @@
 
 #include "pinball/bus/channels.h"
 #include "pinball/bus/lcm_log_format.h"
+#include "pinball/bus/message_convert.h"
 #include "common/temp_path.h"
 #include "pinball/core/geometry.h"
 #include "pinball/view/log_player.h"
@@ -40,8 +41,7 @@ inline int write_view_log(const std::string& path) {
   std::string bytes;
   std::int64_t n = 0;
   auto add = [&](const char* channel, double t_s, const auto& m) {
-    std::vector<std::uint8_t> data(static_cast<std::size_t>(m.getEncodedSize()));
-    m.encode(data.data(), 0, static_cast<int>(data.size()));
+    const std::vector<std::uint8_t> data = bus::encode_message(m);
     const std::int64_t utime = kViewLogStart_us + static_cast<std::int64_t>(t_s * 1e6 + 0.5);
     bus::append_lcm_event(bytes, n++, utime, channel, data.data(), data.size());
   };

@@ -7,20 +7,14 @@
 #include <vector>
 
 #include "pinball/bus/channels.h"
+#include "pinball/bus/message_convert.h"
 #include "pinball_lcm/lcmt_pinball_observation.hpp"
 
 namespace pinball::view {
 namespace {
 
-template <class T>
-std::vector<std::uint8_t> encode(const T& m) {
-  std::vector<std::uint8_t> data(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(data.data(), 0, static_cast<int>(data.size()));
-  return data;
-}
-
 bool apply(ViewState& s, const char* channel, const auto& m, double t_s) {
-  const std::vector<std::uint8_t> d = encode(m);
+  const std::vector<std::uint8_t> d = bus::encode_message(m);
   return s.apply(channel, d.data(), d.size(), t_s);
 }
 

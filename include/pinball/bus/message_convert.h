@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <vector>
 #include <span>
 
 #include "pinball_lcm/lcmt_pinball_daemon_stats.hpp"
@@ -76,6 +77,15 @@ bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& 
 
 /// A received flipper command is well formed (flipper -1..1, cause 0..5).
 bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m);
+
+/// A message's LCM encoding (fingerprint and fields), for logs, tests and
+/// benches; the daemon's bus encodes into its own buffer instead (no allocation).
+template <class T>
+std::vector<std::uint8_t> encode_message(const T& m) {
+  std::vector<std::uint8_t> data(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(data.data(), 0, static_cast<int>(data.size()));
+  return data;
+}
 
 /// The utime of an encoded pinball message without decoding it: every type in
 /// src/bus/lcmtypes starts with `int64_t utime`, which LCM encodes big-endian
