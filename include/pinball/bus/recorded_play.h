@@ -1,0 +1,55 @@
+#pragma once
+// Recorded play: what `lcm-logger` (or pinballd's own file:// log) keeps of a
+// game that a lab can learn the table from (issue 20): every camera frame's
+// ball sighting with the flipper contact switches (PINBALL_OBSERVATION) and
+// every coil command (PINBALL_FLIPPER_CMD). Other channels are skipped.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pinball/core/geometry.h"
+
+namespace pinball::bus {
+
+/// One camera frame as recorded.
+struct RecordedFrame {
+  double t_s = 0.0;              ///< exposure time on the daemon's clock (s)
+  std::int64_t seq = 0;          ///< camera frame number (a gap: dropped frames)
+  bool found = false;            ///< the detector saw the ball
+  Vec2 p_board = Vec2::Zero();   ///< ball centre (m, board frame) when found
+  bool contact_left = false;     ///< left flipper contact switch closed
+  bool contact_right = false;    ///< right flipper contact switch closed
+};
+
+/// One coil command as recorded.
+struct RecordedCommand {
+  double t_s = 0.0;       ///< when the controller gave it, daemon's clock (s)
+  int flipper = 0;        ///< 0 left, 1 right, -1 every flipper
+  bool energize = false;  ///< true: fire (pulse then hold); false: release
+  int cause = 0;          ///< lcmt_pinball_flipper_command's CAUSE_ code
+};
+
+/// A log's recorded play, frames and commands each in time order.
+struct RecordedPlay {
+  std::string source;                     ///< the log file
+  std::vector<RecordedFrame> frames;      ///< PINBALL_OBSERVATION, sorted by t_s
+  std::vector<RecordedCommand> commands;  ///< PINBALL_FLIPPER_CMD, sorted by t_s
+  std::uint64_t malformed = 0;            ///< messages on those channels that failed to decode or check
+  double duration_s() const { return frames.empty() ? 0.0 : frames.back().t_s - frames.front().t_s; }
+};
+
+/// Reads the recorded play of the LCM log at `path`. Throws
+/// std::runtime_error naming the file and what is missing: a file that is
+/// unreadable, empty, not an LCM log or truncated (bus::require_lcm_log);
+/// a log with no PINBALL_OBSERVATION or no PINBALL_FLIPPER_CMD messages (the
+/// message lists the channels it has); a log whose messages on those channels
+/// are not pinball messages (none decodes); and one where no frame saw the ball.
+RecordedPlay read_recorded_play(const std::string& path);
+
+/// `play` as the bytes of an LCM log (frames and commands interleaved in time
+/// order, stamped with their own times), which read_recorded_play reads back:
+/// for tests and benches that make recordings from a simulation.
+std::string recorded_play_log(const RecordedPlay& play);
+
+}  // namespace pinball::bus

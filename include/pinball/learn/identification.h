@@ -1,0 +1,102 @@
+#pragma once
+// System identification (issue 20): the model's physical parameters from
+// recorded play (bus::RecordedPlay, what `lcm-logger` keeps of pinballd), so
+// the belief is the table that was recorded rather than the board file's
+// guesses. What each kind of event identifies:
+//  - free flights (free_flight.h): g along the table, with a sideways tilt
+//    and a drag reported as diagnostics the model cannot play;
+//  - rebounds, two free flights joined at a board obstacle: the normal speed
+//    out against the normal speed in gives ρ (and the kick, for obstacles the
+//    board gives one) of each material group: the obstacles the board file
+//    gives the same ρ and kick;
+//  - launches, flights that start at the launcher: the pull and noise.
+// Every figure comes with its standard uncertainty and the events behind it;
+// a parameter without enough events is listed with the reason instead.
+// Flipper μ, the stroke speed, the coil's rise delay and the camera's latency
+// are not identified here (docs/identification.md says why and what measures
+// them).
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "pinball/bus/recorded_play.h"
+#include "pinball/learn/free_flight.h"
+#include "pinball/table/board.h"
+#include "pinball/table/board_overlay.h"
+
+namespace pinball::learn {
+
+/// Settings of an identification.
+struct IdentifyOptions {
+  FlightOptions flights;             ///< how free flights are found
+  bool fit_drag = true;              ///< report the drag c that the flights show (the overlay's g is fitted without)
+  int bootstrap = 50;                ///< resamples of flights for g's uncertainty (0: the fit's covariance)
+  std::uint64_t seed = 1;            ///< bootstrap draws
+  double max_rebound_gap_s = 0.05;   ///< two flights further apart in time are not one rebound (s)
+  double contact_tolerance_m = 0.002;///< the extrapolated ball reaches the obstacle within this of its radius (m)
+  double join_tolerance_m = 0.006;   ///< both flights put the ball within this of each other at contact (m)
+  double min_normal_speed_mps = 0.15;///< a slower approach gives no usable ratio (m/s)
+  int min_rebounds = 8;              ///< a group needs this many rebounds for ρ (and 2 more for a kick)
+  int min_launches = 5;              ///< launches needed for the pull and the noise
+  double launch_reach_m = 0.03;      ///< a launch flight starts this close to the launcher's rest position (m)
+};
+
+/// One rebound off a board obstacle.
+struct Rebound {
+  int group = -1;                 ///< index into IdentificationResult::groups
+  int obstacle = -1;              ///< index into Board::obstacles
+  double t_s = 0.0;               ///< contact time (s)
+  Vec2 contact_m = Vec2::Zero();  ///< ball centre at contact (m)
+  double speed_in_mps = 0.0;      ///< normal speed towards the obstacle (m/s, > 0)
+  double speed_out_mps = 0.0;     ///< normal speed away from it (m/s)
+};
+
+/// One material group and what its rebounds say.
+struct GroupResult {
+  table::ObstacleGroupOverlay overlay;  ///< board values, names and (when identified) the fit
+  bool identified = false;              ///< enough rebounds
+  std::string why_not;                  ///< when not identified
+  int rebounds = 0;                     ///< rebounds seen (before trimming outliers)
+  int outliers = 0;                     ///< left out: residual beyond 3.5 robust σ
+  double rms_nominal_mps = 0.0;         ///< RMS of speed out − board prediction (m/s)
+  double rms_fitted_mps = 0.0;          ///< ... − identified prediction (m/s)
+};
+
+/// A parameter the recordings could not identify, and why.
+struct NotIdentified {
+  std::string parameter;  ///< e.g. "flipper mu", "obstacle group rho=1.4 kick=0.6 m/s"
+  std::string why;        ///< what is missing or what else measures it
+};
+
+/// Everything an identification found.
+struct IdentificationResult {
+  table::BoardOverlay overlay;            ///< what the belief should lay over the board
+  FlightGravity gravity;                  ///< shared acceleration, fitted with drag when asked (diagnostic)
+  FlightGravity gravity_no_drag;          ///< the same without drag: what the model plays (the overlay's g)
+  std::vector<GroupResult> groups;        ///< every material group of the board with obstacles
+  std::vector<Rebound> rebounds;          ///< every rebound used
+  std::vector<double> launch_speeds_mps;  ///< launch speed at the launcher of every launch seen
+  std::vector<NotIdentified> not_identified;
+  std::size_t frames = 0;                 ///< frames read
+  std::size_t sightings = 0;              ///< frames that saw the ball
+  std::size_t commands = 0;               ///< coil commands read
+  double recorded_s = 0.0;                ///< total duration of the recordings (s)
+  std::size_t flights = 0;                ///< free flights found
+};
+
+/// The board's material groups: obstacles with the same ρ and kick, named by
+/// their obstacles' names (ball eaters left out: no ball comes back).
+std::vector<table::ObstacleGroupOverlay> material_groups(const table::Board& board);
+
+/// Identifies what `recordings` show of the table `board` describes (the
+/// belief: its geometry must be the recorded table's). `progress(stage,
+/// done, total)` reports long stages. Throws std::runtime_error when the
+/// recordings hold fewer than 2 free flights (nothing at all can be fitted).
+IdentificationResult identify_table(const table::Board& board, std::span<const bus::RecordedPlay> recordings,
+                                    const IdentifyOptions& options = {},
+                                    const std::function<void(const std::string&, int, int)>& progress = {});
+
+}  // namespace pinball::learn

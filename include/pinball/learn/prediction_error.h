@@ -1,0 +1,64 @@
+#pragma once
+// How well a belief predicts recorded play (issue 20): from a moment of a
+// recording, the ball's state as the tracker would estimate it from the last
+// frames (a parabola under the belief's g), the belief's model plays on for
+// a horizon with the flippers down, and the predicted ball is compared with
+// where the camera saw it. The moments are chosen from the recording alone
+// (never from the belief), so two beliefs are judged on the same moments:
+// the ball was seen in every frame of the history and at the horizon, the
+// history fits one parabola, and no coil command falls near the window.
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "pinball/bus/recorded_play.h"
+#include "pinball/core/name_value.h"
+#include "pinball/table/board.h"
+
+namespace pinball::learn {
+
+/// How moments are chosen and predicted.
+struct PredictionOptions {
+  double horizon_s = 0.1;         ///< how far ahead (s)
+  int history_frames = 6;         ///< frames the start state is fitted to
+  double sigma_m = 0.001;         ///< detector noise, for the history's χ² test (m)
+  double command_margin_s = 0.3;  ///< no coil command this long before the moment, nor before the horizon (s)
+  int stride_frames = 5;          ///< frames between moments (they overlap less)
+};
+
+/// One moment to predict from.
+struct PredictionStart {
+  std::size_t recording = 0;  ///< index into the recordings
+  std::size_t frame = 0;      ///< the history's last frame: the moment
+};
+
+/// Prediction errors over moments.
+struct PredictionError {
+  std::size_t moments = 0;    ///< moments predicted
+  double mean_m = 0.0;        ///< mean distance between predicted and seen ball (m)
+  double median_m = 0.0;      ///< median (m)
+  double p90_m = 0.0;         ///< 90th percentile (m)
+  double mean_ci95_m = 0.0;   ///< half-width of the mean's 95 % interval (Student's t, m)
+
+  /// Every figure, for --json (core/json_write_archive.h).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(moments));
+    a->Visit(PINBALL_NVP(mean_m));
+    a->Visit(PINBALL_NVP(mean_ci95_m));
+    a->Visit(PINBALL_NVP(median_m));
+    a->Visit(PINBALL_NVP(p90_m));
+  }
+};
+
+/// The moments of `recordings` to predict from (see the file comment).
+std::vector<PredictionStart> prediction_starts(std::span<const bus::RecordedPlay> recordings,
+                                               const PredictionOptions& options = {});
+
+/// How far the model of `belief` (thesis stepper) lands from the seen ball
+/// `options.horizon_s` after each moment.
+PredictionError prediction_error(const table::Board& belief, std::span<const bus::RecordedPlay> recordings,
+                                 std::span<const PredictionStart> starts, const PredictionOptions& options = {});
+
+}  // namespace pinball::learn

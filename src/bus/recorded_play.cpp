@@ -1,0 +1,110 @@
+#include "pinball/bus/recorded_play.h"
+
+#include <algorithm>
+#include <map>
+#include <stdexcept>
+
+#include "pinball/bus/channels.h"
+#include "pinball/bus/lcm_log_format.h"
+#include "pinball/bus/message_convert.h"
+#include "pinball/core/utime.h"
+#include "pinball_lcm/lcmt_pinball_flipper_command.hpp"
+#include "pinball_lcm/lcmt_pinball_observation.hpp"
+
+namespace pinball::bus {
+namespace {
+
+// "A (12), B (3)": what a log holds, for the message that says what it lacks.
+std::string describe_channels(const std::map<std::string, std::uint64_t>& counts) {
+  if (counts.empty()) return "no messages";
+  std::string text;
+  for (const auto& [channel, n] : counts) {
+    if (!text.empty()) text += ", ";
+    text += channel + " (" + std::to_string(n) + ")";
+  }
+  return text;
+}
+
+template <class Message>
+bool decode(const LcmLogEvent& e, Message& m) {
+  return m.decode(e.data.data(), 0, static_cast<int>(e.data.size())) == static_cast<int>(e.data.size());
+}
+
+}  // namespace
+
+RecordedPlay read_recorded_play(const std::string& path) {
+  const std::vector<LcmLogEvent> events = read_lcm_log(path);  // refuses empty, non-LCM and damaged logs
+  RecordedPlay play;
+  play.source = path;
+  std::map<std::string, std::uint64_t> channel_counts;
+  std::uint64_t observation_messages = 0, command_messages = 0, sightings = 0;
+  for (const LcmLogEvent& e : events) {
+    ++channel_counts[e.channel];
+    if (e.channel == kObservationChannel) {
+      ++observation_messages;
+      pinball_lcm::lcmt_pinball_observation m;
+      bool found = false;
+      track::Observation o;
+      track::ContactSensors contacts;
+      if (!decode(e, m) || !from_lcm_observation(m, found, o, contacts)) {
+        ++play.malformed;
+        continue;
+      }
+      play.frames.push_back({o.t_s, m.seq, found, o.p_board, contacts.left, contacts.right});
+      sightings += found ? 1 : 0;
+    } else if (e.channel == kFlipperCommandChannel) {
+      ++command_messages;
+      pinball_lcm::lcmt_pinball_flipper_command m;
+      if (!decode(e, m) || !valid_flipper_command(m)) {
+        ++play.malformed;
+        continue;
+      }
+      play.commands.push_back({from_utime(m.utime), m.flipper, m.energize != 0, m.cause});
+    }
+  }
+  const std::string has = " (it has " + describe_channels(channel_counts) + ")";
+  if (observation_messages == 0)
+    throw std::runtime_error(path + ": no " + kObservationChannel + " messages: the camera's sightings are missing" + has);
+  if (command_messages == 0)
+    throw std::runtime_error(path + ": no " + kFlipperCommandChannel + " messages: the coil commands are missing" + has);
+  if (play.frames.empty())
+    throw std::runtime_error(path + ": none of its " + std::to_string(observation_messages) + " " +
+                             kObservationChannel + " messages decodes as lcmt_pinball_observation (another type?)");
+  if (play.commands.empty())
+    throw std::runtime_error(path + ": none of its " + std::to_string(command_messages) + " " +
+                             kFlipperCommandChannel + " messages decodes as lcmt_pinball_flipper_command (another type?)");
+  if (sightings == 0) throw std::runtime_error(path + ": no frame of its " + std::to_string(play.frames.size()) +
+                                               " saw the ball");
+  // A log keeps the order messages were written in; threads may interleave.
+  std::stable_sort(play.frames.begin(), play.frames.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  std::stable_sort(play.commands.begin(), play.commands.end(),
+                   [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  return play;
+}
+
+std::string recorded_play_log(const RecordedPlay& play) {
+  std::string log;
+  std::int64_t event = 0;
+  std::size_t f = 0, c = 0;
+  while (f < play.frames.size() || c < play.commands.size()) {
+    const bool frame_next =
+        c == play.commands.size() || (f < play.frames.size() && play.frames[f].t_s <= play.commands[c].t_s);
+    if (frame_next) {
+      const RecordedFrame& r = play.frames[f++];
+      track::Observation o{r.t_s, r.p_board, r.found ? 1.0 : 0.0, 0.0};
+      auto m = to_lcm_observation(to_utime(r.t_s), r.seq, r.found, o, 0.0, 0.0, {r.contact_left, r.contact_right});
+      const std::vector<std::uint8_t> data = encode_message(m);
+      append_lcm_event(log, event++, m.utime, kObservationChannel, data.data(), data.size());
+    } else {
+      const RecordedCommand& r = play.commands[c];
+      auto m = to_lcm_flipper_command(to_utime(r.t_s), static_cast<std::int64_t>(c), -1,
+                                      r.flipper, r.energize, static_cast<std::int8_t>(r.cause));
+      ++c;
+      const std::vector<std::uint8_t> data = encode_message(m);
+      append_lcm_event(log, event++, m.utime, kFlipperCommandChannel, data.data(), data.size());
+    }
+  }
+  return log;
+}
+
+}  // namespace pinball::bus

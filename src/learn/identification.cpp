@@ -1,0 +1,273 @@
+#include "pinball/learn/identification.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "pinball/core/format.h"
+#include "pinball/core/statistics.h"
+
+namespace pinball::learn {
+namespace {
+
+constexpr double kContactStep_s = 0.00025;  // extrapolation step when looking for the contact
+constexpr double kOutlierRobustSigmas = 3.5;
+constexpr double kMadToSigma = 1.4826;      // a normal's σ over its median absolute deviation
+
+// Unit normal of `shape` at the ball centre p, pointing from the surface to
+// the ball (the gradient of the distance; central differences).
+Vec2 surface_normal(const table::Shape& shape, const Vec2& p) {
+  constexpr double h = 1e-6;
+  const Vec2 g((table::distance_to_shape(shape, p + Vec2(h, 0)) - table::distance_to_shape(shape, p - Vec2(h, 0))),
+               (table::distance_to_shape(shape, p + Vec2(0, h)) - table::distance_to_shape(shape, p - Vec2(0, h))));
+  return g.norm() > 0.0 ? Vec2(g / g.norm()) : Vec2::Zero();
+}
+
+std::string group_label(const table::ObstacleGroupOverlay& g) {
+  return "obstacle group rho=" + format_number(g.board_rho) +
+         (g.board_kick_mps > 0.0 ? " kick=" + format_number(g.board_kick_mps) + " m/s" : std::string()) + " (" +
+         (g.obstacles.empty() ? std::string() : g.obstacles.front()) +
+         (g.obstacles.size() > 1 ? ", ... " + std::to_string(g.obstacles.size()) + " obstacles" : std::string()) + ")";
+}
+
+// speed_out ≈ rho·speed_in (+ kick): least squares with each coefficient's
+// standard error; one pass leaves out residuals beyond 3.5 robust σ.
+struct RatioFit {
+  double rho = 0.0, kick = 0.0, rho_stderr = 0.0, kick_stderr = 0.0;
+  int used = 0, outliers = 0;
+};
+
+RatioFit fit_ratio(const std::vector<std::pair<double, double>>& in_out, bool with_kick) {
+  const auto solve = [&](const std::vector<std::pair<double, double>>& xy) {
+    RatioFit f;
+    const double n = static_cast<double>(xy.size());
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (const auto& [x, y] : xy) sx += x, sy += y, sxx += x * x, sxy += x * y;
+    if (with_kick) {
+      const double sxx_c = sxx - sx * sx / n;
+      f.rho = (sxy - sx * sy / n) / sxx_c;
+      f.kick = (sy - f.rho * sx) / n;
+    } else {
+      f.rho = sxy / sxx;
+    }
+    double ss = 0;
+    for (const auto& [x, y] : xy) ss += std::pow(y - f.rho * x - f.kick, 2);
+    const double unknowns = with_kick ? 2.0 : 1.0;
+    const double s2 = ss / std::max(1.0, n - unknowns);
+    if (with_kick) {
+      const double sxx_c = sxx - sx * sx / n;
+      f.rho_stderr = std::sqrt(s2 / sxx_c);
+      f.kick_stderr = std::sqrt(s2 * (1.0 / n + (sx / n) * (sx / n) / sxx_c));
+    } else {
+      f.rho_stderr = std::sqrt(s2 / sxx);
+    }
+    f.used = static_cast<int>(xy.size());
+    return f;
+  };
+  RatioFit first = solve(in_out);
+  std::vector<double> abs_residuals;
+  for (const auto& [x, y] : in_out) abs_residuals.push_back(std::abs(y - first.rho * x - first.kick));
+  const double robust_sigma = kMadToSigma * median(abs_residuals);
+  std::vector<std::pair<double, double>> kept;
+  for (const auto& [x, y] : in_out)
+    if (robust_sigma <= 0.0 || std::abs(y - first.rho * x - first.kick) <= kOutlierRobustSigmas * robust_sigma)
+      kept.emplace_back(x, y);
+  if (kept.size() == in_out.size() || kept.size() < (with_kick ? 3u : 2u)) return first;
+  RatioFit second = solve(kept);
+  second.outliers = static_cast<int>(in_out.size() - kept.size());
+  return second;
+}
+
+double rms_of(const std::vector<std::pair<double, double>>& in_out, double rho, double kick) {
+  double ss = 0;
+  for (const auto& [x, y] : in_out) ss += std::pow(y - rho * x - kick, 2);
+  return in_out.empty() ? 0.0 : std::sqrt(ss / static_cast<double>(in_out.size()));
+}
+
+// The rebound joining flight a to flight b, when the ball met one board
+// obstacle in between; false otherwise.
+bool find_rebound(const table::Board& board, const std::vector<int>& group_of, const FreeFlight& a,
+                  const FreeFlight& b, const IdentifyOptions& o, Rebound& out) {
+  const double radius = board.ball.radius_m;
+  for (double t = a.t_last_s; t <= b.t_first_s; t += kContactStep_s) {
+    const Vec2 p = a.fit.position_at(t);
+    int nearest = -1;
+    double nearest_d = INFINITY;
+    for (std::size_t k = 0; k < board.shapes.size(); ++k) {
+      const double d = table::distance_to_shape(board.shapes[k], p);
+      if (d < nearest_d) nearest_d = d, nearest = static_cast<int>(k);
+    }
+    if (nearest < 0 || nearest_d > radius + o.contact_tolerance_m) continue;
+    if (group_of[static_cast<std::size_t>(nearest)] < 0) return false;  // a ball eater
+    // Another material this close too: a corner, whose ratio belongs to neither.
+    for (std::size_t k = 0; k < board.shapes.size(); ++k)
+      if (group_of[k] != group_of[static_cast<std::size_t>(nearest)] &&
+          table::distance_to_shape(board.shapes[k], p) < radius + 2.0 * o.contact_tolerance_m)
+        return false;
+    if (!ball_clear_of_flippers(board, p, o.contact_tolerance_m)) return false;
+    if ((b.fit.position_at(t) - p).norm() > o.join_tolerance_m) return false;
+    const Vec2 n = surface_normal(board.shapes[static_cast<std::size_t>(nearest)], p);
+    out.group = group_of[static_cast<std::size_t>(nearest)];
+    out.obstacle = nearest;
+    out.t_s = t;
+    out.contact_m = p;
+    out.speed_in_mps = -a.fit.velocity_at(t).dot(n);
+    out.speed_out_mps = b.fit.velocity_at(t).dot(n);
+    return out.speed_in_mps >= o.min_normal_speed_mps && out.speed_out_mps > 0.0;
+  }
+  return false;
+}
+
+void identify_groups(const table::Board& board, const std::vector<FreeFlight>& flights, const IdentifyOptions& o,
+                     IdentificationResult& result) {
+  for (const table::ObstacleGroupOverlay& g : material_groups(board)) {
+    GroupResult group;
+    group.overlay = g;
+    result.groups.push_back(group);
+  }
+  std::vector<int> group_of(board.obstacles.size(), -1);
+  for (std::size_t k = 0; k < board.obstacles.size(); ++k)
+    for (std::size_t g = 0; g < result.groups.size(); ++g) {
+      const auto& names = result.groups[g].overlay.obstacles;
+      if (std::find(names.begin(), names.end(), board.obstacles[k].name) != names.end()) group_of[k] = static_cast<int>(g);
+    }
+  for (std::size_t k = 1; k < flights.size(); ++k) {
+    const FreeFlight& a = flights[k - 1];
+    const FreeFlight& b = flights[k];
+    if (a.recording != b.recording || b.t_first_s - a.t_last_s > o.max_rebound_gap_s) continue;
+    Rebound r;
+    if (find_rebound(board, group_of, a, b, o, r)) result.rebounds.push_back(r);
+  }
+  for (std::size_t g = 0; g < result.groups.size(); ++g) {
+    GroupResult& group = result.groups[g];
+    std::vector<std::pair<double, double>> in_out;
+    for (const Rebound& r : result.rebounds)
+      if (r.group == static_cast<int>(g)) in_out.emplace_back(r.speed_in_mps, r.speed_out_mps);
+    group.rebounds = static_cast<int>(in_out.size());
+    const bool with_kick = group.overlay.board_kick_mps > 0.0;
+    const int needed = o.min_rebounds + (with_kick ? 2 : 0);
+    group.rms_nominal_mps = rms_of(in_out, group.overlay.board_rho, group.overlay.board_kick_mps);
+    if (group.rebounds < needed) {
+      group.why_not = std::to_string(group.rebounds) + " clean rebounds (both flights seen, one obstacle near), needs " +
+                      std::to_string(needed);
+      result.not_identified.push_back({group_label(group.overlay) + (with_kick ? ": rho and kick" : ": rho"),
+                                       group.why_not});
+      continue;
+    }
+    const RatioFit fit = fit_ratio(in_out, with_kick);
+    group.identified = true;
+    group.outliers = fit.outliers;
+    group.overlay.rho = {fit.rho, fit.rho_stderr, fit.used};
+    if (with_kick) group.overlay.kick_mps = table::IdentifiedValue{fit.kick, fit.kick_stderr, fit.used};
+    group.rms_fitted_mps = rms_of(in_out, fit.rho, fit.kick);
+    result.overlay.obstacle_groups.push_back(group.overlay);
+  }
+}
+
+void identify_launcher(const table::Board& board, std::span<const bus::RecordedPlay> recordings,
+                       const std::vector<FreeFlight>& flights, const IdentifyOptions& o, double g_mps2,
+                       IdentificationResult& result) {
+  const Vec2 rest = board.launcher.position;
+  const double clamp = board.ball.speed_max_mps;
+  for (const FreeFlight& f : flights) {
+    const Vec2 p = recordings[f.recording].frames[f.first].p_board;
+    const Vec2 v = f.fit.velocity_at(f.t_first_s);
+    const double rise = p.y() - rest.y();
+    if (std::abs(p.x() - rest.x()) > o.launch_reach_m || rise < 0.0 || rise > 5.0 * o.launch_reach_m || v.y() <= 0.0)
+      continue;
+    // Back to the rest position along the chute: energy, no drag.
+    const double speed = std::sqrt(v.y() * v.y() + 2.0 * g_mps2 * rise);
+    if (speed > 0.25 * clamp) result.launch_speeds_mps.push_back(speed);
+  }
+  const std::vector<double>& s = result.launch_speeds_mps;
+  const int n = static_cast<int>(s.size());
+  if (n < o.min_launches) {
+    result.not_identified.push_back({"launcher pull and noise", std::to_string(n) + " launches seen leaving the rest "
+                                                                "position, needs " + std::to_string(o.min_launches)});
+    return;
+  }
+  // Speeds P·(1 − R)·clamp with R uniform: the unbiased estimates of a uniform's ends.
+  const auto [lo_it, hi_it] = std::minmax_element(s.begin(), s.end());
+  const double spread = *hi_it - *lo_it;
+  const double top = *hi_it + spread / (n - 1), bottom = *lo_it - spread / (n - 1);
+  const double end_stderr = spread / (n + 1);
+  table::LauncherOverlay launcher;
+  launcher.pull = {std::min(1.0, top / clamp), end_stderr / clamp, n};
+  launcher.noise_max = {std::clamp(1.0 - bottom / top, 0.0, 0.999), std::sqrt(2.0) * end_stderr / top, n};
+  result.overlay.launcher = launcher;
+}
+
+}  // namespace
+
+std::vector<table::ObstacleGroupOverlay> material_groups(const table::Board& board) {
+  std::vector<table::ObstacleGroupOverlay> groups;
+  for (const table::Obstacle& o : board.obstacles) {
+    if (o.action.eats_ball) continue;
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const table::ObstacleGroupOverlay& g) {
+      return g.board_rho == o.rho && g.board_kick_mps == o.action.kick_mps;
+    });
+    if (it == groups.end()) {
+      groups.push_back({});
+      it = groups.end() - 1;
+      it->board_rho = o.rho;
+      it->board_kick_mps = o.action.kick_mps;
+    }
+    if (std::find(it->obstacles.begin(), it->obstacles.end(), o.name) == it->obstacles.end())
+      it->obstacles.push_back(o.name);
+  }
+  return groups;
+}
+
+IdentificationResult identify_table(const table::Board& board, std::span<const bus::RecordedPlay> recordings,
+                                    const IdentifyOptions& options,
+                                    const std::function<void(const std::string&, int, int)>& progress) {
+  IdentificationResult result;
+  std::vector<FreeFlight> flights;
+  for (std::size_t r = 0; r < recordings.size(); ++r) {
+    const bus::RecordedPlay& play = recordings[r];
+    result.overlay.recordings.push_back(play.source);
+    result.frames += play.frames.size();
+    result.commands += play.commands.size();
+    result.recorded_s += play.duration_s();
+    for (const bus::RecordedFrame& f : play.frames) result.sightings += f.found ? 1 : 0;
+    const std::vector<FreeFlight> found = find_free_flights(play, r, board, options.flights);
+    flights.insert(flights.end(), found.begin(), found.end());
+    if (progress) progress("free flights", static_cast<int>(r + 1), static_cast<int>(recordings.size()));
+  }
+  result.flights = flights.size();
+  if (flights.size() < 2)
+    throw std::runtime_error("the recordings hold " + std::to_string(flights.size()) +
+                             " free flights (at least " + std::to_string(options.flights.min_points) +
+                             " sightings in a row clear of everything); nothing can be identified");
+  const auto bootstrap_progress = [&](int done, int total) {
+    if (progress) progress("gravity bootstrap", done, total);
+  };
+  result.gravity_no_drag = fit_flight_gravity(recordings, flights, board.gravity_mps2, options.flights.sigma_m, false,
+                                              options.bootstrap, options.seed, bootstrap_progress);
+  if (options.fit_drag)
+    result.gravity = fit_flight_gravity(recordings, flights, board.gravity_mps2, options.flights.sigma_m, true, 0,
+                                        options.seed);
+  else
+    result.gravity = result.gravity_no_drag;
+  const FlightGravity& g = result.gravity_no_drag;
+  result.overlay.gravity_mps2 = table::IdentifiedValue{g.g_mps2, g.g_stderr_mps2, g.flights};
+  identify_groups(board, flights, options, result);
+  identify_launcher(board, recordings, flights, options, g.g_mps2, result);
+  for (const table::Flipper& f : board.flippers)
+    result.not_identified.push_back(
+        {"flipper " + f.name + " mu, stroke speed and rise delay",
+         "not identified from ball tracks in this version: what a shot gives the ball depends on where the bat is "
+         "when it meets it, which the log does not show; measure the bat's stroke with a camera that sees it "
+         "(docs/calibration.md) and keep the board's values"});
+  result.not_identified.push_back(
+      {"camera latency", "a constant error in it shifts the ball's frames against the commands by the same amount "
+                         "as the coil's rise delay, so ball tracks cannot tell them apart; `pinball calibrate "
+                         "latency` measures it (docs/calibration.md)"});
+  result.not_identified.push_back(
+      {"speed clamp", "the model's clamp stands in for friction; the drag the free flights show is reported "
+                      "instead (the model cannot play it)"});
+  result.overlay.board = board.source;
+  return result;
+}
+
+}  // namespace pinball::learn

@@ -1,0 +1,123 @@
+#include "pinball/learn/identification.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "common/thesis_board.h"
+#include "model_recording.h"
+
+namespace pinball::learn {
+namespace {
+
+// The thesis table as it "really" is in these tests: a flatter slope, deader
+// walls, weaker bumpers, a weaker launch.
+table::Board recorded_table() {
+  table::Board world = pinball::testing::thesis_board();
+  world.gravity_mps2 = 0.95;
+  for (table::Obstacle& o : world.obstacles) {
+    if (o.rho == 0.6 && o.action.kick_mps == 0.0) o.rho = 0.5;
+    if (o.action.kick_mps == 0.8) o.action.kick_mps = 0.6;
+  }
+  world.launcher.pull = 0.9;
+  world.launcher.noise_max = 0.05;
+  return world;
+}
+
+const std::vector<bus::RecordedPlay>& recordings() {
+  static const std::vector<bus::RecordedPlay> plays = [] {
+    static const table::Board world = recorded_table();
+    return std::vector<bus::RecordedPlay>{pinball::testing::record_model_play(world, 60, 0.0005, 21)};
+  }();
+  return plays;
+}
+
+const GroupResult* group_with(const IdentificationResult& r, double board_rho, double board_kick) {
+  for (const GroupResult& g : r.groups)
+    if (g.overlay.board_rho == board_rho && g.overlay.board_kick_mps == board_kick) return &g;
+  return nullptr;
+}
+
+TEST(Identification, MaterialGroupsAreTheBoardsDistinctRhoAndKick) {
+  const std::vector<table::ObstacleGroupOverlay> groups = material_groups(pinball::testing::thesis_board());
+  const auto has = [&](double rho, double kick, const std::string& name) {
+    return std::any_of(groups.begin(), groups.end(), [&](const auto& g) {
+      return g.board_rho == rho && g.board_kick_mps == kick &&
+             std::find(g.obstacles.begin(), g.obstacles.end(), name) != g.obstacles.end();
+    });
+  };
+  EXPECT_TRUE(has(0.6, 0.0, "left_wall_low"));
+  EXPECT_TRUE(has(0.6, 0.0, "top_right_arc"));
+  EXPECT_TRUE(has(1.1, 0.8, "bumper_low"));
+  EXPECT_TRUE(has(1.4, 0.6, "left_sling"));
+  EXPECT_TRUE(has(0.9, 0.0, "post_right"));
+  for (const auto& g : groups) {
+    EXPECT_EQ(std::count(g.obstacles.begin(), g.obstacles.end(), "top_right_arc"), g.board_rho == 0.6 ? 1 : 0);
+    EXPECT_EQ(std::count(g.obstacles.begin(), g.obstacles.end(), "drain"), 0);  // eats the ball
+  }
+}
+
+TEST(Identification, RecoversTheRecordedTablesGravityRhoKickAndLaunch) {
+  IdentifyOptions options;
+  options.flights.sigma_m = 0.0005;
+  options.bootstrap = 20;
+  const IdentificationResult r = identify_table(pinball::testing::thesis_board(), recordings(), options);
+  ASSERT_TRUE(r.overlay.gravity_mps2.has_value());
+  const table::IdentifiedValue& g = *r.overlay.gravity_mps2;
+  EXPECT_NEAR(g.value, 0.95, std::max(4.0 * g.stderr_, 0.01));
+  EXPECT_GT(g.stderr_, 0.0);
+  EXPECT_GT(g.events, 50);
+  EXPECT_LT(r.gravity_no_drag.rms_fitted_m, r.gravity_no_drag.rms_nominal_m);
+  EXPECT_NEAR(r.gravity.drag_per_s, 0.0, std::max(4.0 * r.gravity.drag_stderr_per_s, 0.02));  // the model has none
+
+  const GroupResult* walls = group_with(r, 0.6, 0.0);
+  ASSERT_NE(walls, nullptr);
+  ASSERT_TRUE(walls->identified) << walls->why_not;
+  EXPECT_NEAR(walls->overlay.rho.value, 0.5, std::max(4.0 * walls->overlay.rho.stderr_, 0.03));
+  EXPECT_LT(walls->rms_fitted_mps, walls->rms_nominal_mps);
+  EXPECT_FALSE(walls->overlay.kick_mps.has_value());
+
+  const GroupResult* bumpers = group_with(r, 1.1, 0.8);
+  ASSERT_NE(bumpers, nullptr);
+  if (bumpers->identified) {
+    ASSERT_TRUE(bumpers->overlay.kick_mps.has_value());
+    EXPECT_NEAR(bumpers->overlay.kick_mps->value, 0.6, std::max(4.0 * bumpers->overlay.kick_mps->stderr_, 0.1));
+  }
+
+  ASSERT_TRUE(r.overlay.launcher.has_value());
+  EXPECT_EQ(r.overlay.launcher->pull.events, 60);
+  EXPECT_NEAR(r.overlay.launcher->pull.value, 0.9, 0.02);
+  EXPECT_NEAR(r.overlay.launcher->noise_max.value, 0.05, 0.02);
+  EXPECT_EQ(r.overlay.recordings, std::vector<std::string>{"model"});
+  EXPECT_EQ(r.overlay.board, pinball::testing::thesis_board().source);
+}
+
+TEST(Identification, SaysWhichParametersItCouldNotIdentifyAndWhy) {
+  const table::Board world = recorded_table();
+  const std::vector<bus::RecordedPlay> short_play{pinball::testing::record_model_play(world, 2, 0.0005, 5)};
+  IdentifyOptions options;
+  options.bootstrap = 0;
+  const IdentificationResult r = identify_table(pinball::testing::thesis_board(), short_play, options);
+  EXPECT_FALSE(r.overlay.launcher.has_value());
+  const auto said = [&](const std::string& parameter) {
+    return std::any_of(r.not_identified.begin(), r.not_identified.end(), [&](const NotIdentified& n) {
+      return n.parameter.find(parameter) != std::string::npos && !n.why.empty();
+    });
+  };
+  EXPECT_TRUE(said("launcher pull and noise"));
+  EXPECT_TRUE(said("camera latency"));
+  EXPECT_TRUE(said("flipper left_flipper mu"));
+  EXPECT_TRUE(said("obstacle group rho=1.4 kick=0.6 m/s"));
+  for (const GroupResult& g : r.groups) EXPECT_EQ(g.identified, g.why_not.empty());
+}
+
+TEST(Identification, RefusesRecordingsWithoutFreeFlights) {
+  bus::RecordedPlay resting;
+  resting.source = "resting.lcm";
+  for (int i = 0; i < 200; ++i) resting.frames.push_back({0.005 * i, i, true, Vec2(0.25, 0.4), false, false});
+  const std::vector<bus::RecordedPlay> plays{resting};
+  EXPECT_THROW(identify_table(pinball::testing::thesis_board(), plays), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace pinball::learn
