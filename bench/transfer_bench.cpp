@@ -89,7 +89,7 @@ std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const Transfer
   simlab::WorldSpec twin;
   twin.kind = simlab::WorldKind::kTwin;
   twin.twin_params_path = o.twin_params_path;
-  add_factory_world("twin", twin);
+  add_factory_world("twin", simlab::world_for_belief(twin, belief.source, o.identified));
   for (const SweepFamily& family : o.sweep) {
     for (const double v : family.values) {
       if (std::fabs(v - nominal_value(family.kind, o)) < 1e-9) continue;  // the model world

@@ -93,6 +93,9 @@ struct TransferBenchOptions {
   /// The players after the spastic baseline, which always plays first (the ratios' denominator).
   std::vector<TransferController> controllers;
   std::string twin_params_path;     ///< the twin's parameters ("" : the shipped config/twin.yaml)
+  /// The identified overlay laid over the belief ("": none): the model worlds
+  /// play it, the twin plays the board file (simlab::world_for_belief).
+  std::string identified;
 };
 
 /// The value of `p` in the nominal (`model`) world: 0 for an offset, the

@@ -97,6 +97,7 @@ nlohmann::json to_json(const TransferReport& r) {
   }
   return {{"benchmark", "transfer"},
           {"board", r.board},
+          {"identified", o.identified.empty() ? nlohmann::json() : nlohmann::json(o.identified)},
           {"belief", kBelief},
           {"balls", o.balls},
           {"twin_balls", o.twin_balls},
@@ -124,7 +125,8 @@ std::string to_text(const TransferReport& r) {
   out << "transfer on " << r.board << ": " << names.size() << " controllers x " << r.worlds.size() << " worlds, "
       << o.balls << " balls per cell (seed " << o.seed << ", the same balls in every cell), balls cut at "
       << format_number(o.max_ball_time_s) << " s; wall " << format_duration(r.wall_s) << "\n"
-      << "belief: " << kBelief << "; pivots along " << kPivotAxis << "; wall rho " << kWallRhoRule << "\n"
+      << "belief: " << kBelief << (o.identified.empty() ? "" : ", " + o.identified + " laid over it")
+      << "; pivots along " << kPivotAxis << "; wall rho " << kWallRhoRule << "\n"
       << "mean score per ball (95 %), ratio to the spastic flipper in the same world (ratio interval: "
       << kRatioInterval << "), balls cut at " << format_number(o.max_ball_time_s) << " s:\n\n| world |";
   for (const std::string& n : names) out << ' ' << n << " |";

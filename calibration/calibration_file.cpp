@@ -1,28 +1,18 @@
 #include "pinball/calibration/calibration_file.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <ctime>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
 
+#include "pinball/core/utc_date.h"
 #include "pinball/core/yaml_read_archive.h"
 
 namespace pinball::calibration {
 namespace {
-
-std::string now_utc_iso8601() {
-  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
 
 void emit_vec2(YAML::Emitter& e, const char* key, const Vec2& v, const char* comment) {
   e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v.x() << v.y() << YAML::EndSeq;
@@ -97,7 +87,7 @@ std::string calibration_to_yaml(const Calibration& c) {
   e << YAML::Comment("pinball calibration file (docs/calibration.md): SI units, board frame (m, +y up the table)");
   e << YAML::BeginMap;
   e << YAML::Key << "version" << YAML::Value << c.version;
-  e << YAML::Key << "date" << YAML::Value << (c.date.empty() ? now_utc_iso8601() : c.date) << YAML::Comment("UTC");
+  e << YAML::Key << "date" << YAML::Value << (c.date.empty() ? utc_now_iso8601() : c.date) << YAML::Comment("UTC");
   e << YAML::Key << "board" << YAML::Value << c.board << YAML::Comment("the board file it calibrates");
   if (c.camera) {
     const CameraCalibration& k = *c.camera;

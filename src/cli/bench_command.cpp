@@ -13,7 +13,7 @@
 #include "progress_option.h"
 #include "commands.h"
 #include "world_options.h"
-#include "pinball/table/board_loader.h"
+#include "pinball/table/board_overlay.h"
 #include "calibration_bench.h"
 #include <optional>
 
@@ -47,6 +47,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
           {"speed", "tracker", "latency", "detector", "camera", "calibration", "precision", "ceiling", "transfer",
            "protocol", "draw"}));
   cmd->add_option("--board", a.board, "board file (ceiling, transfer: the belief)")->transform(data_file());
+  add_identified_option(*cmd, a.identified);
   cmd->add_option("--steps", a.steps, "speed: steps per timed run (the MuJoCo twin's runs: a tenth)")
       ->check(CLI::Range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
@@ -240,16 +241,18 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
     options.controller = &*controller;
     options.controller_name = a.controllers.front();
   }
-  const simlab::OwnedWorld world = simlab::make_world(a.world, board);
+  const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
+  const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
   const bench::CeilingReport report = bench::run_ceiling_bench(
       board, options, [&](const std::string& line) { err << "bench ceiling: " << line << "\n"; }, world.world.get());
-  const nlohmann::json world_json = world_report(a.world, a.board, *world.world);
+  const nlohmann::json world_json = world_report(world_spec, a.board, *world.world);
   if (a.json) {
     nlohmann::json j = bench::to_json(report);
+    j.update(identified_report(a.identified));
     j.update(world_json);
     out << j.dump(2) << "\n";
   } else {
-    out << bench::to_text(report);
+    out << bench::to_text(report) << identified_text_line(a.identified);
     if (a.world.kind == simlab::WorldKind::kTwin) out << world_text_line(world_json);
   }
   return 0;
@@ -284,6 +287,7 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
   options.max_ball_time_s = a.max_ball_time_s;
   options.camera = a.camera;
   options.twin_params_path = a.world.twin_params_path;
+  options.identified = a.identified;
   std::vector<std::string> files = a.controllers;
   if (files.empty()) {
     for (const char* f : {"controllers/best.json", "controllers/imitation.json", "controllers/cem.json"}) {
@@ -377,7 +381,10 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   std::ostream& err = progress_wanted(a.progress) ? all_err : no_progress;
   if (a.which == "latency") return run_latency(a, out, err);
   if (a.which == "protocol") return run_protocol(a, out, err);
-  const table::Board board = table::load_board(a.board);
+  if (!a.identified.empty() && a.which != "ceiling" && a.which != "transfer") {
+    throw std::invalid_argument("bench " + a.which + ": --identified applies to ceiling and transfer only");
+  }
+  const table::Board board = table::load_belief_board(a.board, a.identified);  // the belief of ceiling and transfer
   if (a.which == "tracker") return run_tracker(a, board, out, err);
   if (a.which == "detector") return run_detector(a, board, out, err);
   if (a.which == "camera") return run_camera(a, board, out, err);

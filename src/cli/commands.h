@@ -19,6 +19,7 @@ namespace pinball::cli {
 /// `pinball sim`
 struct SimArgs {
   std::string board;             ///< board file
+  std::string identified;        ///< identified overlay laid over the belief (docs/identification.md); empty: none
   std::string policy = "none";   ///< none | spastic | controller
   std::string controller;        ///< controller file (implies policy controller)
   int balls = 1;                 ///< balls to play
@@ -66,6 +67,7 @@ int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 struct BenchArgs {
   std::string which;                                 ///< speed | tracker | latency | detector | camera | calibration | precision | ceiling | transfer | protocol | draw
   std::string board = "boards/mit1993.board";        ///< board to measure on
+  std::string identified;                            ///< ceiling, transfer: overlay laid over the belief; empty: none
   std::uint64_t steps = 2'000'000;                   ///< steps per timed run
   int repeats = 3;                                   ///< timed runs per configuration
   int approaches = 2000;                             ///< tracker: free-flight approaches
@@ -91,6 +93,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& err);
 /// `pinball learn`
 struct LearnArgs {
   std::string board;                    ///< board file
+  std::string identified;               ///< identified overlay laid over the belief (docs/identification.md); empty: none
   std::string method;                   ///< tournament | relay | cem | none | spastic | evaluate | launcher
   std::uint64_t budget_balls = 2000;    ///< simulated balls the search may play
   std::uint64_t seed = 1;               ///< the only source of randomness

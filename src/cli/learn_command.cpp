@@ -40,13 +40,14 @@
 #include "pinball/learn/relay_race.h"
 #include "pinball/learn/team.h"
 #include "pinball/learn/tournament.h"
-#include "pinball/table/board_loader.h"
+#include "pinball/table/board_overlay.h"
 
 namespace pinball::cli {
 
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   CLI::App* cmd = app.add_subcommand("learn", "learn a flipper controller on the fast loop (or evaluate one)");
   cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->transform(data_file());
+  add_identified_option(*cmd, a.identified);
   cmd->add_option("--method", a.method,
                   "tournament (thesis 6.2), relay (Hoeffding relay race, 6.3), cem (cross-entropy with common "
                   "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller); "
@@ -188,7 +189,7 @@ std::string file_digest(const std::string& path) {
 // the bytes of every file read. Not --threads, the ranks, --out/--curve/--plot,
 // --json or --progress: results do not depend on them.
 std::string run_fingerprint(const LearnArgs& a) {
-  const nlohmann::json j = {
+  nlohmann::json j = {
       {"method", a.method}, {"board", a.board}, {"board_fnv1a", file_digest(a.board)},
       {"world_board", a.world.board_path},
       {"world_board_fnv1a", a.world.board_path.empty() ? "" : file_digest(a.world.board_path)},
@@ -205,6 +206,10 @@ std::string run_fingerprint(const LearnArgs& a) {
       {"loss_penalty", a.loss_penalty}, {"actuation_delay_s", a.actuation_delay_s},
       {"gravity_scale", a.gravity_scale},
       {"camera", to_json_value(a.camera)}};
+  if (!a.identified.empty()) {  // only then: a checkpoint of a run without an overlay still resumes
+    j["identified"] = a.identified;
+    j["identified_fnv1a"] = file_digest(a.identified);
+  }
   return "pinball learn " + j.dump();
 }
 
@@ -236,8 +241,9 @@ struct CheckpointScope {
 
 int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   // Thesis 5.1: 20 pull values x 10 launches; keep the one most often hittable.
-  const table::Board board = table::load_board(a.board);  // the belief
-  const simlab::OwnedWorld world = simlab::make_world(a.world, board);
+  const table::Board board = table::load_belief_board(a.board, a.identified);
+  const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
+  const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
   learn::LauncherSearchConfig config;
   config.seed = a.seed;
   config.camera = a.camera;
@@ -248,18 +254,19 @@ int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err
     tried.push_back({{"pull", r.pull[i]}, {"hittable", r.successes[i]}});
   }
   if (a.json) {
-    out << nlohmann::json{{"board", a.board},
-                          {"method", "launcher"},
-                          {"seed", a.seed},
-                          {"launches_per_pull", config.launches_per_pull},
-                          {"best_pull", r.best_pull},
-                          {"best_hittable", r.best_successes},
-                          {"pulls", tried}}
-               .dump(2)
-        << "\n";
+    nlohmann::json j = {{"board", a.board},
+                        {"method", "launcher"},
+                        {"seed", a.seed},
+                        {"launches_per_pull", config.launches_per_pull},
+                        {"best_pull", r.best_pull},
+                        {"best_hittable", r.best_successes},
+                        {"pulls", tried}};
+    j.update(identified_report(a.identified));
+    out << j.dump(2) << "\n";
     return 0;
   }
-  out << "launcher search on " << a.board << " (seed " << a.seed << "): pull -> launches reaching a hittable state\n";
+  out << "launcher search on " << a.board << " (seed " << a.seed << "): pull -> launches reaching a hittable state\n"
+      << identified_text_line(a.identified);
   for (std::size_t i = 0; i < r.pull.size(); ++i) {
     out << "  " << r.pull[i] << "  " << r.successes[i] << "/" << config.launches_per_pull << "\n";
   }
@@ -274,8 +281,11 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     throw std::invalid_argument("learn: --out CONTROLLER is required for a search");
   }
   if (a.method == "evaluate" && a.controller.empty()) throw std::invalid_argument("learn: evaluate needs --controller FILE");
-  const table::Board board = table::load_board(a.board);  // the belief
-  const simlab::OwnedWorld world = simlab::make_world(a.world, board);
+  const table::Board board = table::load_belief_board(a.board, a.identified);
+  const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
+  const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
+  // What a learned controller's note says it was learned on.
+  const std::string belief_args = a.board + (a.identified.empty() ? "" : " --identified " + a.identified);
   learn::EvaluatorConfig ec;
   ec.camera = a.camera;
   ec.actuation_delay_s = a.actuation_delay_s;
@@ -308,6 +318,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                       {"method", a.method},
                       {"seed", a.seed},
                       {"threads", a.threads}};
+  j.update(identified_report(a.identified));
   control::ControllerSpec result_spec;
   const control::ControllerSpec* eval_spec = nullptr;
   if (search) {
@@ -342,7 +353,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
       r = learn::run_cross_entropy(objective, sc, cc);
     }
     result_spec = r.best;
-    result_spec.note = "pinball learn " + a.board + " --method " + a.method + " --budget-balls " +
+    result_spec.note = "pinball learn " + belief_args + " --method " + a.method + " --budget-balls " +
                        std::to_string(a.budget_balls) + " --seed " + std::to_string(a.seed) + " --partitions " +
                        std::to_string(a.partitions) + "; estimated mean " + std::to_string(r.best_mean) + " over " +
                        std::to_string(r.best_balls) + " balls";
@@ -409,7 +420,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     }
     j["rounds"] = rounds;
     j["budget_balls"] = a.budget_balls;
-    result_spec.note = "pinball learn " + a.board + " --method imitate --budget-balls " + std::to_string(a.budget_balls) +
+    result_spec.note = "pinball learn " + belief_args + " --method imitate --budget-balls " + std::to_string(a.budget_balls) +
                        " --rounds " + std::to_string(a.rounds) + " --seed " + std::to_string(a.seed) + ": " +
                        std::to_string(im.table->examples().size()) +
                        " shots of a looking-ahead teacher on the true state";
@@ -430,13 +441,13 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     j["evaluation"]["gravity_scale"] = a.gravity_scale;
   }
   j["team"] = team_report();
-  j.update(world_report(a.world, a.board, *world.world));
+  j.update(world_report(world_spec, a.board, *world.world));
   if (a.json) {
     out << j.dump(2) << "\n";
   } else {
     out << "learn " << a.method << " on " << a.board << " (seed " << a.seed << ", " << a.threads << " threads";
     if (learn::team_size() > 1) out << " on each of " << learn::team_size() << " MPI ranks";
-    out << ")\n";
+    out << ")\n" << identified_text_line(a.identified);
     if (!a.world.board_path.empty() || j["world"] != "thesis") out << world_text_line(j);
     auto num = [](const nlohmann::json& x, int digits = 3) { return format_number(x.get<double>(), digits); };
     if (search) {

@@ -20,6 +20,7 @@
 #include "pinball/core/format.h"
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/running_stats.h"
+#include "pinball/core/utc_date.h"
 #include "pinball/simlab/human_play.h"
 #include "pinball/simlab/play_scores.h"
 #include "pinball/table/board_loader.h"
@@ -147,7 +148,7 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
     const std::size_t limit = a.balls > 0 ? static_cast<std::size_t>(a.balls) : session.balls().size();
     for (; recorded < session.balls().size() && recorded < limit; ++recorded) {
       const simlab::PlayedBall& b = session.balls()[recorded];
-      rows.push_back({player, simlab::utc_now_iso8601(), a.board, world_name, static_cast<int>(recorded + 1), b.score,
+      rows.push_back({player, utc_now_iso8601(), a.board, world_name, static_cast<int>(recorded + 1), b.score,
                       b.duration_s, b.cut});
       score.add(b.score);
       err << "ball " << recorded + 1 << ": " << format_number(b.score, 6) << " points in "

@@ -20,7 +20,7 @@
 #include "pinball/core/running_stats.h"
 #include "progress_option.h"
 #include "pinball/sim/ball_runner.h"
-#include "pinball/table/board_loader.h"
+#include "pinball/table/board_overlay.h"
 #include "pinball/simlab/can_flipper_drive.h"
 #include "pinball/simlab/delay_line.h"
 #include "pinball/control/controller_file.h"
@@ -37,6 +37,7 @@ namespace pinball::cli {
 CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
   CLI::App* cmd = app.add_subcommand("sim", "play balls on the embedded simulator and report the scores");
   cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->transform(data_file());
+  add_identified_option(*cmd, a.identified);
   cmd->add_option("--policy", a.policy,
                   "who flips: none, or spastic (flip the flipper the tracker's projection names whenever the "
                   "ball is within --reach of impact; sees the ball only through the camera model)")
@@ -71,8 +72,9 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
 }
 
 int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
-  const table::Board board = table::load_board(a.board);  // the belief
-  const simlab::OwnedWorld world = simlab::make_world(a.world, board);
+  const table::Board board = table::load_belief_board(a.board, a.identified);
+  const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
+  const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
   const table::Board& world_board = *world.board;  // what the camera films and the trace records
   const double dt_s = world->dt_s();
   sim::GameState state = sim::make_game_state(world_board, a.seed);
@@ -211,10 +213,12 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"events", events},
         {"events_per_s", events_per_s},
     };
-    j.update(world_report(a.world, a.board, *world.world));
+    j.update(identified_report(a.identified));
+    j.update(world_report(world_spec, a.board, *world.world));
     out << j.dump(2) << "\n";
   } else {
-    out << world_text_line(world_report(a.world, a.board, *world.world));
+    out << identified_text_line(a.identified);
+    out << world_text_line(world_report(world_spec, a.board, *world.world));
     out << "board            " << a.board << " (policy " << policy << ", actuation " << a.actuation
         << ", world " << world.world->name() << ", dt "
         << format_number(dt_s) << " s, seed " << a.seed << ")\n"

@@ -40,6 +40,20 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
       ->default_str("");  // 0: the board's
 }
 
+void add_identified_option(CLI::App& cmd, std::string& identified) {
+  cmd.add_option("--identified", identified,
+                 "identified parameters laid over the belief board (`pinball identify`, docs/identification.md)")
+      ->check(CLI::ExistingFile);
+}
+
+nlohmann::json identified_report(const std::string& identified) {
+  return {{"identified", identified.empty() ? nlohmann::json() : nlohmann::json(identified)}};
+}
+
+std::string identified_text_line(const std::string& identified) {
+  return identified.empty() ? "" : "identified       " + identified + " (laid over the belief)\n";
+}
+
 nlohmann::json world_report(const simlab::WorldSpec& spec, const std::string& belief_board, const sim::World& world) {
   const sim::WorldWarnings w = world.warnings();
   nlohmann::json j = {{"world", std::string(world.name())},

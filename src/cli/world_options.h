@@ -1,7 +1,8 @@
 #pragma once
 // The world flags shared by every command that plays a table (`pinball sim`,
 // `pinball learn`, `pinball bench ceiling`): the world is given apart from the
-// belief (the BOARD argument or --board), and defaults to it.
+// belief (the BOARD argument or --board, with --identified laid over it), and
+// defaults to it.
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,19 @@ namespace pinball::cli {
 
 /// Adds --world, --twin-params, --world-board, --stepper and --dt, writing into `world`.
 void add_world_options(CLI::App& cmd, simlab::WorldSpec& world);
+
+/// Adds --identified FILE: the identified parameters (`pinball identify`)
+/// laid over the belief board (table::load_belief_board). The world follows
+/// simlab::world_for_belief: a model world defaulting to the belief plays
+/// them too, the twin never.
+void add_identified_option(CLI::App& cmd, std::string& identified);
+
+/// `identified`: the overlay laid over the belief, or null when the belief is
+/// the board file alone, so that a reader of a report knows which belief played.
+nlohmann::json identified_report(const std::string& identified);
+
+/// The overlay as one text line ("identified       F (laid over the belief)"), empty without one.
+std::string identified_text_line(const std::string& identified);
 
 /// What a report says of the world it played: `world` (thesis, event or
 /// twin), `world_board`, `stepper`, `twin_params` (twin only) and

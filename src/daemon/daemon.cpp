@@ -28,7 +28,7 @@
 #include "pinball/firmware/socketcan_transport.h"
 #include "pinball/firmware/stream_transport.h"
 #include "pinball/simlab/world_factory.h"
-#include "pinball/table/board_loader.h"
+#include "pinball/table/board_overlay.h"
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/vision/capture_source.h"
 #include "pinball/simlab/sim_camera_source.h"
@@ -203,7 +203,7 @@ void Daemon::Impl::build() {
     std::fprintf(stderr, "pinballd: warning: %s\n", w.c_str());
     warnings.push_back(w);
   }
-  board = table::load_board(sim_mode ? config.sim.board : config.board);
+  board = table::load_belief_board(sim_mode ? config.sim.board : config.board, config.identified);
   spec = control::load_controller(config.controller);
   controller = control::make_flipper_controller(spec);
   driver_of_flipper = controller_stage_options_for(config, board).driver_of_flipper;
@@ -263,7 +263,7 @@ void Daemon::Impl::build() {
     ws.twin_params_path = config.sim.twin_params;
     ws.board_path = config.sim.world_board;
     ws.stepper = config.sim.stepper;
-    world_model = simlab::make_world(ws, board);
+    world_model = simlab::make_world(simlab::world_for_belief(ws, config.sim.board, config.identified), board);
     world = std::make_unique<simlab::SimWorld>(*world_model, *board_link, cc, wo);
     // A calibration file (e.g. from `pinball calibrate camera --sim`) stands in
     // for the simulated camera's true homography, as it would in the lab.
@@ -416,6 +416,7 @@ DaemonReport Daemon::Impl::report() const {
   DaemonReport r;
   r.mode = config.mode;
   r.lockstep = lockstep;
+  r.identified = config.identified;
   for (int s = 0; s < kStageCount; ++s) r.latency[static_cast<std::size_t>(s)] = h.latency[static_cast<std::size_t>(s)].summary();
   const CameraStageCounters& cc = camera_stage->counters();
   const ControllerStageCounters& kc = controller_stage->counters();
@@ -662,6 +663,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   nlohmann::json j;
   j["mode"] = r.mode;
   j["clock"] = r.mode == "sim" ? (r.lockstep ? "lockstep" : "realtime") : "steady";
+  j["identified"] = r.identified.empty() ? nlohmann::json() : nlohmann::json(r.identified);
   if (r.mode == "sim") {
     // "stepper" names the world (thesis, event or twin), as before the twin.
     j["world"] = {{"board", r.world_board},
@@ -739,6 +741,7 @@ std::string report_to_text(const DaemonReport& r) {
       o << "world " << r.world << " on " << r.world_board << "  " << describe(r.world_warnings) << "\n";
     }
   }
+  if (!r.identified.empty()) o << "identified " << r.identified << " laid over the belief\n";
   o << std::setprecision(1);
   o << "frames " << r.frames << " (dropped " << r.frames_dropped << ")  ball seen " << r.detections
     << "  projections " << r.projections << "  commands " << r.commands << "  stalls " << r.camera_stalls

@@ -167,6 +167,7 @@ std::vector<PathField> path_fields(DaemonConfig& c) {
       {"sim.twin_params", &c.sim.twin_params, use(world && c.sim.world == simlab::WorldKind::kTwin, PathUse::kRead)},
       {"board", &c.board, use(!sim, PathUse::kRead)},
       {"calibration", &c.calibration, PathUse::kRead},
+      {"identified", &c.identified, PathUse::kRead},
       {"controller", &c.controller, PathUse::kRead},
       {"camera.device", &c.camera.device, use(c.camera.source == "file", PathUse::kRead)},
       {"can.log", &c.can.log, PathUse::kWrite},

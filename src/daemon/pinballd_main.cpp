@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
       "3 ran, but a recording is incomplete (the --can-log file dropped frames, or LCM refused messages, e.g. a "
       "file:// log on a full disk): the report says what was lost.");
   std::string config_path, sim_board, world_board, world_kind, twin_params, stepper, controller, lcm_url, can_log,
-      sim_camera;
+      sim_camera, identified;
   int balls = -1;
   long long seed = -1;
   bool realtime = false, json = false, threads = false;
@@ -82,6 +82,9 @@ int main(int argc, char** argv) {
   app.add_option("--stepper", stepper, "simulation: the model world's integrator, thesis or event")
       ->check(CLI::IsMember({"thesis", "event"}))
       ->default_str(std::string(pinball::sim::stepper_kind_name(defaults.sim.stepper)));
+  app.add_option("--identified", identified,
+                 "identified parameters laid over the belief board (`pinball identify`, docs/identification.md)")
+      ->check(CLI::ExistingFile);
   app.add_option("--controller", controller, "controller file")
       ->check(CLI::ExistingFile)
       ->default_str(defaults.controller);
@@ -128,6 +131,7 @@ int main(int argc, char** argv) {
     if (!sim_camera.empty()) config.sim.camera = sim_camera;
     if (!twin_params.empty()) config.sim.twin_params = twin_params;
     if (!controller.empty()) config.controller = controller;
+    if (!identified.empty()) config.identified = identified;
     if (balls >= 0) config.sim.balls = balls;
     if (seed >= 0) config.sim.seed = static_cast<std::uint64_t>(seed);
     if (!lcm_url.empty()) config.lcm_url = lcm_url;

@@ -14,7 +14,7 @@
 #include "pinball/control/controller_file.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/firmware/stream_transport.h"
-#include "pinball/table/board_loader.h"
+#include "pinball/table/board_overlay.h"
 #include "pinball/track/flipper_geometry.h"
 
 namespace pinball::daemon {
@@ -45,7 +45,8 @@ ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
   }
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
-  const table::Board board = table::load_board(config.mode == "sim" ? config.sim.board : config.board);
+  const table::Board board =
+      table::load_belief_board(config.mode == "sim" ? config.sim.board : config.board, config.identified);
   const control::ControllerSpec spec = control::load_controller(config.controller);
   const std::unique_ptr<control::FlipperController> controller = control::make_flipper_controller(spec);
   const TrackingSetup setup = tracking_setup_for(config, board);

@@ -32,6 +32,11 @@ bool twin_available() {
 #endif
 }
 
+WorldSpec world_for_belief(WorldSpec spec, const std::string& belief_board, const std::string& identified) {
+  if (!identified.empty() && spec.kind == WorldKind::kTwin && spec.board_path.empty()) spec.board_path = belief_board;
+  return spec;
+}
+
 OwnedWorld make_world(const WorldSpec& spec, const table::Board& belief) {
   OwnedWorld out;
   out.board = std::make_unique<const table::Board>(spec.board_path.empty() ? belief

@@ -234,6 +234,50 @@ TEST_F(Cli, LearnImitateWritesAShotTableThatEvaluateAndSimPlay) {
   EXPECT_NE(run("learn boards/mit1993.board --method imitate --budget-balls 2").exit_code, 0);
 }
 
+// The overlay `pinball identify` writes (docs/identification.md) is part of
+// the belief: the report names it, and a bad one is refused naming file:key.
+TEST_F(Cli, SimNamesTheIdentifiedOverlayAndRefusesABadOne) {
+  const std::string head = "version: 1\ndate: 2026-12-02T13:45:21Z\nboard: boards/mit1993.board\nrecordings: []\n";
+  const fs::path over = dir_ / "over.yaml";
+  std::ofstream(over) << head << "gravity_mps2: {value: 1.0, stderr: 0.01, events: 40}\n";
+  const std::string sim = "sim boards/mit1993.board --policy spastic --balls 4 --seed 3 --max-ball-time 10 --json";
+  const CommandResult plain = run(sim);
+  const CommandResult identified = run(sim + " --identified " + over.string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  ASSERT_EQ(identified.exit_code, 0) << identified.err;
+  const auto p = nlohmann::json::parse(plain.out), i = nlohmann::json::parse(identified.out);
+  EXPECT_TRUE(p.at("identified").is_null());
+  EXPECT_EQ(i.at("identified"), over.string());
+  EXPECT_EQ(i.at("world_board"), "boards/mit1993.board");
+  EXPECT_NE(p.at("state_hash"), i.at("state_hash")) << "the model world plays the identified g";
+  const CommandResult text = run("sim boards/mit1993.board --balls 1 --max-ball-time 2 --identified " + over.string());
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("identified       " + over.string()), std::string::npos) << text.out;
+
+  const fs::path bad = dir_ / "bad.yaml";
+  std::ofstream(bad) << head << "gravity_mps2: {value: 25, stderr: 0.01, events: 40}\n";
+  const CommandResult r = run("sim boards/mit1993.board --balls 1 --identified " + bad.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(bad.string() + ":gravity_mps2.value: 25 is out of range"), std::string::npos) << r.err;
+  std::ofstream(bad) << head << "flippers:\n  - name: middle_flipper\n    mu: {value: 1.5, stderr: 0.1, events: 9}\n";
+  const CommandResult unknown = run("sim boards/mit1993.board --balls 1 --identified " + bad.string());
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_NE(unknown.err.find(bad.string() + ":flippers[0].name: 'middle_flipper' is not a flipper of the board"),
+            std::string::npos)
+      << unknown.err;
+  EXPECT_EQ(run("sim boards/mit1993.board --identified " + (dir_ / "none.yaml").string()).exit_code, 2);
+
+  if (!pinball::simlab::twin_available()) return;
+  // The twin stands in for the real table: it plays the board file, the belief the overlay.
+  const CommandResult twin =
+      run("sim boards/mit1993.board --world twin --balls 1 --max-ball-time 2 --json --identified " + over.string());
+  ASSERT_EQ(twin.exit_code, 0) << twin.err;
+  const auto t = nlohmann::json::parse(twin.out);
+  EXPECT_EQ(t.at("identified"), over.string());
+  EXPECT_EQ(t.at("world_board"), "boards/mit1993.board");
+}
+
 TEST_F(Cli, BadBoardFileIsOneLineNamingFileAndLine) {
   const fs::path bad = dir_ / "bad.board";
   std::ofstream(bad) << "pinball-board 1\nsize 0.5 1\ncirle 0.1 0.1 0.01\n";

@@ -294,6 +294,29 @@ TEST(DaemonConfig, AMissingFileNamesTheConfigurationTheKeyAndThePath) {
   EXPECT_EQ(load_error(file), "");
 }
 
+// `identified:` names the overlay laid over the belief (docs/identification.md):
+// a file the daemon reads in either mode, found beside the configuration.
+TEST(DaemonConfig, TheIdentifiedOverlayIsAFileTheDaemonReads) {
+  namespace fs = std::filesystem;
+  EXPECT_EQ(DaemonConfig{}.identified, "") << "by default the belief is the board file alone";
+  const std::vector<std::string> path_keys = daemon_config_path_keys();
+  EXPECT_EQ(std::set<std::string>(path_keys.begin(), path_keys.end()).count("identified"), 1u);
+  const fs::path dir = fresh_dir("config_identified");
+  write_file(dir / "over.yaml", "version: 1\n");  // the daemon reads it when it starts, not the configuration
+  const std::string file = (dir / "pinballd.yaml").string();
+  write_file(file, "version: 1\nidentified: over.yaml\n");
+  DaemonConfig c;
+  in_dir("/", [&] { c = load_daemon_config(file); });
+  EXPECT_EQ(c.identified, (dir / "over.yaml").string());
+  write_file(file,
+             "version: 1\nmode: lab\nboard: over.yaml\ncamera: {source: lcm}\ncan: {interface: can0}\n"
+             "identified: gone.yaml\n");
+  EXPECT_EQ(load_error(file), file + ": identified: 'gone.yaml' is " + (dir / "gone.yaml").string() +
+                                  " (a relative path is relative to the configuration's folder), which does not exist")
+      << "read in mode lab too";
+  EXPECT_EQ(error_of("identified: [a, b]"), "t.yaml: identified: expected text, got a list of 2 (line 1)");
+}
+
 // True when the mapping has the dotted key (const lookups: they never change the tree).
 bool gives(const YAML::Node& map, const std::string& dotted) {
   if (!map.IsMap()) return false;

@@ -114,13 +114,5 @@ TEST(PlayScores, AnUnwritablePlaceAndBadNamesAreRefused) {
   EXPECT_THROW(check_play_row(named), std::invalid_argument);
 }
 
-TEST(PlayScores, TheDateIsIso8601Utc) {
-  const std::string d = utc_now_iso8601();
-  ASSERT_EQ(d.size(), 20u);
-  EXPECT_EQ(d[4], '-');
-  EXPECT_EQ(d[10], 'T');
-  EXPECT_EQ(d.back(), 'Z');
-}
-
 }  // namespace
 }  // namespace pinball::simlab

@@ -11,6 +11,7 @@
 #include "common/thesis_board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/table/board_loader.h"
+#include "pinball/table/board_overlay.h"
 
 namespace pinball::simlab {
 namespace {
@@ -86,6 +87,49 @@ TEST(WorldFactory, AWorldWithOtherFlippersIsRefused) {
   spec.board_path = "/nonexistent/world.board";
   EXPECT_THROW(make_world(spec, thesis_board()), table::BoardError);
   std::remove(path.c_str());
+}
+
+// The rule for worlds (docs/identification.md): the overlay is the belief's
+// alone; a model world defaulting to the belief plays it, the twin never does.
+TEST(WorldFactory, TheTwinPlaysTheBoardFileNotTheIdentifiedBelief) {
+  const std::string board = PINBALL_SOURCE_DIR "/boards/mit1993.board";
+  table::BoardOverlay o;
+  table::ObstacleGroupOverlay bumpers;
+  bumpers.board_rho = 1.1;
+  bumpers.board_kick_mps = 0.8;
+  bumpers.obstacles = {"bumper_left", "bumper_right", "bumper_low"};
+  bumpers.rho = {0.9, 0.05, 30};
+  o.obstacle_groups = {bumpers};
+  const std::string overlay = (std::filesystem::temp_directory_path() / "world_factory_overlay.yaml").string();
+  table::write_board_overlay(o, overlay);
+  const table::Board belief = table::load_belief_board(board, overlay);
+  const auto rho_of = [](const table::Board& b, const std::string& name) {
+    for (const table::Obstacle& x : b.obstacles) {
+      if (x.name == name) return x.rho;
+    }
+    return -1.0;
+  };
+  ASSERT_EQ(rho_of(belief, "bumper_left"), 0.9);
+
+  WorldSpec twin;
+  twin.kind = WorldKind::kTwin;
+  EXPECT_EQ(world_for_belief(twin, board, overlay).board_path, board) << "the twin gets the file";
+  EXPECT_EQ(world_for_belief(twin, board, "").board_path, "") << "no overlay: the belief is the file";
+  EXPECT_EQ(world_for_belief(WorldSpec{}, board, overlay).board_path, "") << "a model world plays the belief";
+  WorldSpec own = twin;
+  own.board_path = "world.board";
+  EXPECT_EQ(world_for_belief(own, board, overlay).board_path, "world.board") << "a world board is kept";
+
+  const OwnedWorld model = make_world(world_for_belief(WorldSpec{}, board, overlay), belief);
+  EXPECT_EQ(rho_of(*model.board, "bumper_left"), 0.9) << "the model world plays the identified belief";
+  if (!twin_available()) {
+    std::remove(overlay.c_str());
+    GTEST_SKIP() << "this build has no MuJoCo twin: the rule is tested on world_for_belief alone";
+  }
+  const OwnedWorld t = make_world(world_for_belief(twin, board, overlay), belief);
+  EXPECT_EQ(&t->board(), t.board.get());
+  EXPECT_EQ(rho_of(*t.board, "bumper_left"), 1.1) << "the twin is built from the file's rho";
+  std::remove(overlay.c_str());
 }
 
 }  // namespace

@@ -48,6 +48,7 @@ const char* stage_name(int stage);
 struct DaemonReport {
   std::string mode;                          ///< sim or lab
   bool lockstep = false;                     ///< sim with the virtual clock
+  std::string identified;                    ///< the overlay laid over the belief board (`identified`); empty: none
   std::string world_board;                   ///< sim: the board the world plays
   std::string world;                         ///< sim: the world that played it (thesis, event, twin)
   sim::WorldWarnings world_warnings;         ///< sim: the world's warnings (the twin's MuJoCo warnings)

@@ -159,6 +159,10 @@ struct DaemonConfig {
   CameraSettings camera;         ///< frames
   std::string board;             ///< lab: the table's board file (flipper and ball geometry)
   std::string calibration;       ///< lab: calibration file (docs/calibration.md); empty: the board's geometry
+  /// Identified parameters laid over the belief board, in either mode
+  /// (`pinball identify`, docs/identification.md); empty: the board file alone.
+  /// A simulated twin still plays the board file (simlab::world_for_belief).
+  std::string identified;
   CanSettings can;               ///< CAN link
   firmware::DriverConfig coils;  ///< pulse, hold, caps and recycle time of every flipper coil (protocol limits)
   std::string controller = "controllers/best.json";  ///< controller file (docs/learning.md)
@@ -173,6 +177,7 @@ struct DaemonConfig {
     a->Visit(PINBALL_NVP(camera));
     a->Visit(PINBALL_NVP(board));
     a->Visit(PINBALL_NVP(calibration));
+    a->Visit(PINBALL_NVP(identified));
     a->Visit(PINBALL_NVP(can));
     a->Visit(PINBALL_NVP(coils));
     a->Visit(PINBALL_NVP(controller));

@@ -81,7 +81,4 @@ struct PlayerStats {
 /// Empty for no rows.
 std::vector<PlayerStats> play_stats(const std::vector<PlayRow>& rows);
 
-/// The current time as ISO 8601 UTC, to the second.
-std::string utc_now_iso8601();
-
 }  // namespace pinball::simlab

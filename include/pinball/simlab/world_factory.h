@@ -42,6 +42,18 @@ std::string default_twin_params_path();
 /// True when this build has the MuJoCo twin (configured with PINBALL_TWIN and libmujoco-dev).
 bool twin_available();
 
+/// The world of `spec` for a belief that is the board file `belief_board`
+/// with the identified overlay `identified` laid over it ("": none;
+/// table::load_belief_board). The rule for worlds (docs/identification.md):
+/// the overlay is part of the belief only. A model world that defaults to
+/// the belief plays it with the overlay (a controller is learned "on the
+/// identified model"), but the twin stands in for the real table: it is built
+/// from the board file, never from identified values (it classifies
+/// materials by the file's ρ). So with an overlay, a twin without a world
+/// board of its own gets `belief_board`; every other spec is returned as it is.
+/// Every command that takes --identified passes its spec through here.
+WorldSpec world_for_belief(WorldSpec spec, const std::string& belief_board, const std::string& identified);
+
 /// A world with the board it plays (the world borrows it, so they travel together).
 struct OwnedWorld {
   std::unique_ptr<const table::Board> board;  ///< the world's board

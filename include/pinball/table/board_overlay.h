@@ -131,7 +131,8 @@ BoardOverlay parse_board_overlay(const std::string& text, const std::string& nam
 /// name, every shape of a named obstacle), each flipper's μ (by name), the
 /// launcher's pull and noise. All or nothing: throws KeyError "name:key: ..."
 /// (`name` stands for the overlay file) for an obstacle or flipper name the
-/// board does not have, leaving `board` untouched.
+/// board does not have, or for a pull, noise and g with which a launch could
+/// not leave the launcher (the board loader's rule), leaving `board` untouched.
 void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, Board& board);
 
 /// The belief every playing command holds: the board file, with the overlay

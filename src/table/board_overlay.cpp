@@ -1,0 +1,211 @@
+#include "pinball/table/board_overlay.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+#include "pinball/core/utc_date.h"
+#include "pinball/core/yaml_read_archive.h"
+#include "pinball/core/yaml_write_archive.h"
+#include "pinball/table/board_loader.h"
+
+namespace pinball::table {
+namespace {
+
+// The version alone, read first: a file of another version is refused as such.
+struct VersionKey {
+  int version = 0;
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(version));
+  }
+};
+
+// An inclusive or open bound of a range check.
+struct Bound {
+  double value;
+  bool open;
+};
+
+// Throws KeyError "file:key: must be in [lo, hi] unit" unless `x` is in the range.
+void check_range(double x, Bound lo, Bound hi, const char* unit, const std::string& key, const YamlReadArchive& r) {
+  const bool above = lo.open ? x > lo.value : x >= lo.value;
+  const bool below = hi.open ? x < hi.value : x <= hi.value;
+  if (above && below) return;
+  std::ostringstream m;
+  m << x << " is out of range: must be in " << (lo.open ? "(" : "[") << lo.value << ", " << hi.value
+    << (hi.open ? ")" : "]") << unit;
+  r.fail(key, m.str());
+}
+
+void check_at_least_zero(double x, const char* unit, const std::string& key, const YamlReadArchive& r) {
+  if (x >= 0.0) return;
+  std::ostringstream m;
+  m << x << " is out of range: must be >= 0" << unit;
+  r.fail(key, m.str());
+}
+
+// The value's range, and stderr and events >= 0, for one identified number at `key`.
+void check_value(const IdentifiedValue& v, Bound lo, Bound hi, const char* unit, const std::string& key,
+                 const YamlReadArchive& r) {
+  check_range(v.value, lo, hi, unit, key + ".value", r);
+  check_at_least_zero(v.stderr_, unit, key + ".stderr", r);
+  if (v.events < 0) r.fail(key + ".events", std::to_string(v.events) + " is out of range: must be >= 0");
+}
+
+constexpr Bound kZero{0.0, false};
+constexpr Bound kAboveZero{0.0, true};
+
+// The checks a type cannot express, after reading (header: the ranges).
+void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
+  if (o.gravity_mps2) check_value(*o.gravity_mps2, kAboveZero, {20.0, false}, " m/s^2", "gravity_mps2", r);
+  for (std::size_t i = 0; i < o.obstacle_groups.size(); ++i) {
+    const ObstacleGroupOverlay& g = o.obstacle_groups[i];
+    const std::string key = "obstacle_groups[" + std::to_string(i) + "]";
+    check_at_least_zero(g.board_rho, "", key + ".board_rho", r);
+    check_at_least_zero(g.board_kick_mps, " m/s", key + ".board_kick_mps", r);
+    if (g.obstacles.empty()) r.fail(key + ".obstacles", "names no obstacle");
+    check_value(g.rho, kZero, {3.0, false}, "", key + ".rho", r);
+    if (g.kick_mps) check_value(*g.kick_mps, kZero, {10.0, false}, " m/s", key + ".kick_mps", r);
+  }
+  for (std::size_t i = 0; i < o.flippers.size(); ++i) {
+    const std::string key = "flippers[" + std::to_string(i) + "]";
+    if (o.flippers[i].name.empty()) r.fail(key + ".name", "is empty");
+    check_value(o.flippers[i].mu, kZero, {10.0, false}, "", key + ".mu", r);
+  }
+  if (o.launcher) {
+    check_value(o.launcher->pull, kAboveZero, {1.0, false}, "", "launcher.pull", r);
+    check_value(o.launcher->noise_max, kZero, {1.0, true}, "", "launcher.noise_max", r);
+  }
+}
+
+// "'a', 'b'" of the flippers' names, or "none".
+std::string names_of(const std::vector<Flipper>& flippers) {
+  std::string out;
+  for (const Flipper& f : flippers) out += (out.empty() ? "'" : ", '") + f.name + "'";
+  return out.empty() ? "none" : out;
+}
+
+}  // namespace
+
+std::string board_overlay_to_yaml(const BoardOverlay& overlay) {
+  BoardOverlay o = overlay;
+  if (o.date.empty()) o.date = utc_now_iso8601();
+  YAML::Emitter e;
+  e << YAML::Comment(
+      "pinball board overlay (docs/identification.md): identified parameters laid over the board file below,\n"
+      "written by `pinball identify`; read with --identified FILE. SI units; stderr: one standard uncertainty;\n"
+      "events: the recorded events each value rests on. A section left out keeps the board's values.");
+  YamlWriteArchive::emit(e, o);
+  return std::string(e.c_str()) + "\n";
+}
+
+void write_board_overlay(const BoardOverlay& overlay, const std::string& path) {
+  const std::string text = board_overlay_to_yaml(overlay);
+  // A temporary beside the file, renamed over it when whole: a failed write leaves no half a file.
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw std::runtime_error(path + ": cannot write");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(path + ": cannot write (" + ec.message() + ")");
+  }
+}
+
+BoardOverlay parse_board_overlay(const std::string& text, const std::string& name) {
+  const YAML::Node root = load_yaml(text, name);
+  // The version first, whatever else the file holds: another version is refused as such.
+  YamlReadArchive first(name, {.refuse_unknown_keys = false, .require_every_key = true});
+  if (!root.IsMap()) first.fail("version", "missing (not a board overlay file)");
+  VersionKey v;
+  first.read(root, "", &v);
+  if (v.version != kBoardOverlayVersion) {
+    first.fail("version", std::to_string(v.version) + " is not the supported version " +
+                              std::to_string(kBoardOverlayVersion));
+  }
+  // Every key is required and no other is allowed (a misspelt key must not
+  // pass unseen); the sections and a group's kick are optional. A repeated
+  // key is refused by the reader.
+  YamlReadArchive r(name, {.refuse_unknown_keys = true, .require_every_key = true});
+  BoardOverlay o;
+  r.read(root, "", &o);
+  check_overlay(o, r);
+  return o;
+}
+
+BoardOverlay read_board_overlay(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw std::runtime_error(path + ": cannot read");
+  return parse_board_overlay(s.str(), path);
+}
+
+void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, Board& board) {
+  Board b = board;  // all or nothing: the board changes only when every name is found
+  if (overlay.gravity_mps2) b.gravity_mps2 = overlay.gravity_mps2->value;
+  for (std::size_t i = 0; i < overlay.obstacle_groups.size(); ++i) {
+    const ObstacleGroupOverlay& g = overlay.obstacle_groups[i];
+    for (std::size_t j = 0; j < g.obstacles.size(); ++j) {
+      int shapes = 0;
+      for (Obstacle& o : b.obstacles) {
+        if (o.name != g.obstacles[j]) continue;
+        o.rho = g.rho.value;
+        if (g.kick_mps) o.action.kick_mps = g.kick_mps->value;
+        ++shapes;
+      }
+      if (shapes == 0) {
+        throw KeyError(name, "obstacle_groups[" + std::to_string(i) + "].obstacles[" + std::to_string(j) + "]",
+                       "'" + g.obstacles[j] + "' is not an obstacle of the board " + board.source +
+                           " (an obstacle's name is its name= in the board file)");
+      }
+    }
+  }
+  for (std::size_t i = 0; i < overlay.flippers.size(); ++i) {
+    const FlipperOverlay& f = overlay.flippers[i];
+    Flipper* target = nullptr;
+    for (Flipper& candidate : b.flippers) {
+      if (candidate.name == f.name) target = &candidate;
+    }
+    if (!target) {
+      throw KeyError(name, "flippers[" + std::to_string(i) + "].name",
+                     "'" + f.name + "' is not a flipper of the board " + board.source +
+                         " (its flippers: " + names_of(board.flippers) + ")");
+    }
+    target->mu = f.mu.value;
+  }
+  if (overlay.launcher) {
+    b.launcher.pull = overlay.launcher->pull.value;
+    b.launcher.noise_max = overlay.launcher->noise_max.value;
+  }
+  // The board loader's rule, for the new pull, noise and g: a launch must leave the launcher.
+  try {
+    check_launch_pull(b, b.launcher.pull);
+  } catch (const std::invalid_argument& e) {
+    throw KeyError(name, overlay.launcher ? "launcher.pull" : "gravity_mps2",
+                   std::string(e.what()) + " (on the board " + board.source + ")");
+  }
+  board = std::move(b);
+}
+
+Board load_belief_board(const std::string& board_path, const std::string& overlay_path) {
+  Board board = load_board(board_path);
+  if (!overlay_path.empty()) apply_board_overlay(read_board_overlay(overlay_path), overlay_path, board);
+  return board;
+}
+
+}  // namespace pinball::table
