@@ -258,16 +258,6 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
   return 0;
 }
 
-// A file the bench will write when it has finished: its folder must exist
-// now, so that a long run does not end in a write error.
-void check_output_folder(const std::string& path, const char* option) {
-  if (path.empty()) return;
-  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
-  if (!folder.empty() && !std::filesystem::is_directory(folder)) {
-    throw std::invalid_argument(std::string(option) + " " + path + ": no folder " + folder.string());
-  }
-}
-
 int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   const simlab::WorldSpec model_world;
   if (a.world.kind != model_world.kind || !a.world.board_path.empty() || a.world.stepper != model_world.stepper ||

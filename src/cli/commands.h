@@ -225,4 +225,21 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& args);
 /// Exit 0; 1 for bad input, no display for a window, or a live source that sent nothing.
 int run_view(const ViewArgs& args, std::ostream& out, std::ostream& err);
 
+/// `pinball identify`
+struct IdentifyArgs {
+  std::vector<std::string> logs;      ///< LCM logs of recorded play to identify from
+  std::vector<std::string> held_out;  ///< LCM logs to judge the 100 ms prediction on (never fitted)
+  std::string board = "boards/mit1993.board";  ///< the belief's board file: the recorded table's geometry
+  std::string out;                    ///< overlay file to write; empty: report only
+  double sigma_m = 0.001;             ///< detector noise of one coordinate (m)
+  int bootstrap = 50;                 ///< resamples of flights behind g's uncertainty
+  std::uint64_t seed = 1;             ///< bootstrap draws
+  bool json = false;                  ///< one JSON object on stdout
+  bool progress = false;              ///< percent and ETA on stderr even when it is not a terminal
+};
+CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& args);
+/// Exit 0; 1 for bad input (an empty, damaged or foreign log, a missing
+/// channel, recordings with nothing to fit, an unwritable --out): nothing written.
+int run_identify(const IdentifyArgs& args, std::ostream& out, std::ostream& err);
+
 }  // namespace pinball::cli

@@ -3,6 +3,8 @@
 // shipped data from any folder (pinball/core/data_path.h), as pinballd does:
 // `pinball sim boards/mit1993.board` works outside the source tree too.
 
+#include <filesystem>
+#include <stdexcept>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +21,16 @@ inline CLI::Validator data_file() {
         return CLI::ExistingFile(path);
       },
       "FILE");
+}
+
+/// A file a command writes when it has finished: its folder must exist now,
+/// so that a long run does not end in a write error. Throws
+/// std::runtime_error "OPTION PATH: the folder F does not exist".
+inline void check_output_folder(const std::string& path, const char* option) {
+  if (path.empty()) return;
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (!folder.empty() && !std::filesystem::is_directory(folder))
+    throw std::runtime_error(std::string(option) + " " + path + ": the folder " + folder.string() + " does not exist");
 }
 
 }  // namespace pinball::cli

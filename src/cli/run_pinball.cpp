@@ -20,6 +20,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   CalibrateArgs calibrate;
   ViewArgs view;
   PlayArgs play;
+  IdentifyArgs identify;
   CLI::App* sim_cmd = add_sim_command(app, sim);
   CLI::App* render_cmd = add_render_command(app, render);
   CLI::App* bench_cmd = add_bench_command(app, bench);
@@ -29,6 +30,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
   CLI::App* calibrate_cmd = add_calibrate_command(app, calibrate);
   CLI::App* view_cmd = add_view_command(app, view);
   CLI::App* play_cmd = add_play_command(app, play);
+  CLI::App* identify_cmd = add_identify_command(app, identify);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -54,6 +56,7 @@ int run_pinball(int argc, const char* const* argv, std::ostream& out, std::ostre
     if (calibrate_cmd->parsed()) return run_calibrate(calibrate, out, err);
     if (view_cmd->parsed()) return run_view(view, out, err);
     if (play_cmd->parsed()) return run_play(play, out, err);
+    if (identify_cmd->parsed()) return run_identify(identify, out, err);
   } catch (const std::exception& e) {
     err << "pinball: " << e.what() << "\n";
     return 1;

@@ -115,14 +115,6 @@ void write_snapshot(const ViewArgs& a, const cv::Mat& picture) {
 // The window's keys, for the help line and the docs.
 constexpr const char* kKeys = "space pause | . , frame +/- | l j 1 s +/- | L J 10 s +/- | + - speed | s snapshot | q quit";
 
-void check_snapshot_path(const ViewArgs& a) {
-  if (a.snapshot.empty()) return;
-  const std::filesystem::path dir = std::filesystem::path(a.snapshot).parent_path();
-  if (!dir.empty() && !std::filesystem::is_directory(dir)) {
-    throw std::runtime_error("--snapshot " + a.snapshot + ": the folder " + dir.string() + " does not exist");
-  }
-}
-
 int view_log_snapshot(const ViewArgs& a, const view::ViewScene& scene, view::LogPlayer& player, std::ostream& out) {
   const double t_s = a.at_s < 0.0 ? player.duration_s() : a.at_s;
   if (t_s > player.duration_s() + 1e-9) {
@@ -267,7 +259,7 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
 }
 
 int run_view(const ViewArgs& a, std::ostream& out, std::ostream& err) {
-  check_snapshot_path(a);
+  check_output_folder(a.snapshot, "--snapshot");
   const bool window = a.snapshot.empty() || a.quit_at_s >= 0.0;
   if (window && !has_display()) {
     throw std::runtime_error(

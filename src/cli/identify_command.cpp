@@ -1,0 +1,195 @@
+// `pinball identify LOG...`: the model's physical parameters from recorded
+// play (learn/identification.h), reported with their uncertainties and
+// residuals before and after, and written as a board overlay that every
+// command holding a belief reads with --identified (docs/identification.md).
+
+#include <ostream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "data_file.h"
+#include "pinball/core/format.h"
+#include "pinball/core/json_write_archive.h"
+#include "pinball/core/progress.h"
+#include "pinball/learn/identification.h"
+#include "pinball/learn/prediction_error.h"
+#include "pinball/table/board_loader.h"
+#include "pinball/table/board_overlay.h"
+#include "progress_option.h"
+
+namespace pinball::cli {
+namespace {
+
+std::vector<bus::RecordedPlay> read_all(const std::vector<std::string>& paths) {
+  std::vector<bus::RecordedPlay> plays;
+  for (const std::string& path : paths) plays.push_back(bus::read_recorded_play(path));
+  return plays;
+}
+
+std::string value_text(const table::IdentifiedValue& v, const char* unit) {
+  return format_number(v.value) + " ± " + format_number(v.stderr_, 2) + unit;
+}
+
+std::string prediction_text(const learn::PredictionError& e) {
+  return format_mean_ci(e.mean_m * 1000.0, e.mean_ci95_m * 1000.0) + " mm mean, " + format_number(e.median_m * 1000.0) +
+         " mm median, " + format_number(e.p90_m * 1000.0) + " mm p90";
+}
+
+struct HeldOut {
+  std::size_t moments = 0;
+  learn::PredictionError nominal, identified;
+};
+
+nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, const learn::IdentificationResult& r,
+                           const std::optional<HeldOut>& held_out) {
+  nlohmann::json groups = nlohmann::json::array();
+  for (const learn::GroupResult& g : r.groups) {
+    groups.push_back({{"board_rho", g.overlay.board_rho},
+                      {"board_kick_mps", g.overlay.board_kick_mps},
+                      {"obstacles", g.overlay.obstacles},
+                      {"identified", g.identified},
+                      {"why_not", g.identified ? nlohmann::json(nullptr) : nlohmann::json(g.why_not)},
+                      {"rebounds", g.rebounds},
+                      {"outliers", g.outliers},
+                      {"rho", g.identified ? to_json_value(g.overlay.rho) : nlohmann::json(nullptr)},
+                      {"kick_mps", g.overlay.kick_mps ? to_json_value(*g.overlay.kick_mps) : nlohmann::json(nullptr)},
+                      {"rms_nominal_mps", g.rms_nominal_mps},
+                      {"rms_fitted_mps", g.rms_fitted_mps}});
+  }
+  nlohmann::json not_identified = nlohmann::json::array();
+  for (const learn::NotIdentified& n : r.not_identified)
+    not_identified.push_back({{"parameter", n.parameter}, {"why", n.why}});
+  nlohmann::json j{{"board", board.source},
+                   {"recordings", a.logs},
+                   {"recorded_s", r.recorded_s},
+                   {"frames", r.frames},
+                   {"sightings", r.sightings},
+                   {"commands", r.commands},
+                   {"free_flights", r.flights},
+                   {"board_gravity_mps2", board.gravity_mps2},
+                   {"gravity", to_json_value(r.gravity_no_drag)},
+                   {"gravity_with_drag", to_json_value(r.gravity)},
+                   {"obstacle_groups", groups},
+                   {"rebounds", r.rebounds.size()},
+                   {"launches", r.launch_speeds_mps.size()},
+                   {"launcher", r.overlay.launcher ? to_json_value(*r.overlay.launcher) : nlohmann::json(nullptr)},
+                   {"not_identified", not_identified},
+                   {"overlay", a.out.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.out)},
+                   {"held_out", nullptr}};
+  if (held_out) {
+    j["held_out"] = {{"recordings", a.held_out},
+                     {"horizon_s", learn::PredictionOptions{}.horizon_s},
+                     {"nominal", to_json_value(held_out->nominal)},
+                     {"identified", to_json_value(held_out->identified)},
+                     {"error_ratio", held_out->nominal.mean_m > 0.0
+                                         ? held_out->identified.mean_m / held_out->nominal.mean_m
+                                         : 0.0}};
+  }
+  return j;
+}
+
+void print_text(const IdentifyArgs& a, const table::Board& board, const learn::IdentificationResult& r,
+                const std::optional<HeldOut>& held_out, std::ostream& out) {
+  const double seen = r.frames > 0 ? 100.0 * static_cast<double>(r.sightings) / static_cast<double>(r.frames) : 0.0;
+  out << "identify: " << a.logs.size() << " recording(s), " << format_number(r.recorded_s) << " s, " << r.frames
+      << " frames (" << format_number(seen) << " % saw the ball), " << r.commands << " commands, " << r.flights
+      << " free flights\n";
+  const learn::FlightGravity& g = r.gravity_no_drag;
+  out << "  g along the table  " << value_text(*r.overlay.gravity_mps2, " m/s²") << " (board "
+      << format_number(board.gravity_mps2) << "; " << g.flights << " flights, " << g.flights_dropped
+      << " left out; " << (g.bootstrap_resamples > 0 ? std::to_string(g.bootstrap_resamples) + " bootstrap resamples"
+                                                     : std::string("the fit's covariance"))
+      << "); flight residual " << format_number(g.rms_nominal_m * 1000.0) << " mm -> "
+      << format_number(g.rms_fitted_m * 1000.0) << " mm\n";
+  out << "  sideways tilt      " << format_number(g.lateral_mps2) << " ± " << format_number(g.lateral_stderr_mps2, 2)
+      << " m/s² (diagnostic: the model has none)\n";
+  if (r.gravity.drag_fitted)
+    out << "  drag               " << format_number(r.gravity.drag_per_s) << " ± "
+        << format_number(r.gravity.drag_stderr_per_s, 2) << " 1/s, with g " << format_number(r.gravity.g_mps2)
+        << " (diagnostic: the model has no drag; its speed clamp stands in)\n";
+  for (const learn::GroupResult& group : r.groups) {
+    if (!group.identified) continue;
+    out << "  rho " << format_number(group.overlay.board_rho);
+    if (group.overlay.board_kick_mps > 0.0) out << " kick " << format_number(group.overlay.board_kick_mps);
+    out << " (" << group.overlay.obstacles.size() << " obstacles: " << group.overlay.obstacles.front()
+        << (group.overlay.obstacles.size() > 1 ? ", ..." : "") << "): rho " << value_text(group.overlay.rho, "");
+    if (group.overlay.kick_mps) out << ", kick " << value_text(*group.overlay.kick_mps, " m/s");
+    out << " (" << group.rebounds << " rebounds, " << group.outliers << " outliers); residual "
+        << format_number(group.rms_nominal_mps) << " -> " << format_number(group.rms_fitted_mps) << " m/s\n";
+  }
+  if (r.overlay.launcher)
+    out << "  launcher           pull " << value_text(r.overlay.launcher->pull, "") << ", noise "
+        << value_text(r.overlay.launcher->noise_max, "") << " (" << r.launch_speeds_mps.size() << " launches)\n";
+  for (const learn::NotIdentified& n : r.not_identified)
+    out << "  not identified: " << n.parameter << ": " << n.why << "\n";
+  if (held_out) {
+    out << "  held out, ball " << format_number(learn::PredictionOptions{}.horizon_s * 1000.0) << " ms ahead ("
+        << held_out->nominal.moments << " moments): board " << prediction_text(held_out->nominal) << "; identified "
+        << prediction_text(held_out->identified) << "\n";
+  }
+  if (!a.out.empty()) out << "wrote " << a.out << " (use it with --identified)\n";
+}
+
+}  // namespace
+
+CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
+  CLI::App* cmd = app.add_subcommand(
+      "identify", "fit the model's physical parameters to recorded play (LCM logs of PINBALL_OBSERVATION and "
+                  "PINBALL_FLIPPER_CMD) and write a board overlay (docs/identification.md)");
+  cmd->add_option("logs", a.logs, "LCM logs of recorded play (pinballd --lcm-url file://...?mode=w, lcm-logger)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--held-out", a.held_out, "LCM logs never fitted: the 100 ms prediction error of board and overlay")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--board", a.board, "board file of the recorded table (its geometry; the values it guesses are fitted)")
+      ->transform(data_file());
+  cmd->add_option("--out", a.out, "overlay file to write (YAML); none: report only");
+  cmd->add_option("--sigma-m", a.sigma_m, "detector noise of one coordinate (m): the free-flight χ² test")
+      ->check(CLI::Range(1e-5, 0.05));
+  cmd->add_option("--bootstrap", a.bootstrap, "resamples of flights behind g's uncertainty (0: the fit's covariance)")
+      ->check(CLI::Range(0, 10000));
+  cmd->add_option("--seed", a.seed, "seed of the bootstrap");
+  cmd->add_flag("--json", a.json, "print one JSON object");
+  add_progress_flag(*cmd, a.progress);
+  return cmd;
+}
+
+int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
+  check_output_folder(a.out, "--out");
+  const table::Board board = table::load_board(a.board);
+  const std::vector<bus::RecordedPlay> plays = read_all(a.logs);
+  const std::vector<bus::RecordedPlay> held = read_all(a.held_out);
+  learn::IdentifyOptions options;
+  options.flights.sigma_m = a.sigma_m;
+  options.bootstrap = a.bootstrap;
+  options.seed = a.seed;
+  std::ostream* shown = progress_wanted(a.progress) ? &err : nullptr;
+  std::optional<ProgressMeter> meter;
+  std::string stage;
+  const learn::IdentificationResult r =
+      learn::identify_table(board, plays, options, [&](const std::string& name, int done, int total) {
+        if (name != stage) meter.emplace(shown, "identify: " + name, total, "");
+        stage = name;
+        meter->update(done);
+      });
+  std::optional<HeldOut> held_out;
+  if (!held.empty()) {
+    learn::PredictionOptions prediction;
+    prediction.sigma_m = a.sigma_m;
+    const std::vector<learn::PredictionStart> starts = learn::prediction_starts(held, prediction);
+    table::Board identified = board;
+    table::apply_board_overlay(r.overlay, "(identified)", identified);
+    held_out = HeldOut{starts.size(), learn::prediction_error(board, held, starts, prediction),
+                       learn::prediction_error(identified, held, starts, prediction)};
+  }
+  if (!a.out.empty()) table::write_board_overlay(r.overlay, a.out);
+  if (a.json)
+    out << result_json(a, board, r, held_out).dump(2) << "\n";
+  else
+    print_text(a, board, r, held_out, out);
+  return 0;
+}
+
+}  // namespace pinball::cli

@@ -1,0 +1,92 @@
+// `pinball identify` as a lab runs it: logs in, a report and an overlay out;
+// bad logs refused with one line naming the file, and nothing written.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "common/command_test.h"
+#include "common/thesis_board.h"
+#include "learn/model_recording.h"
+#include "pinball/table/board_overlay.h"
+
+namespace pinball {
+namespace {
+
+class IdentifyCommand : public pinball::testing::CommandTest {
+ protected:
+  // A log of `balls` balls played in the thesis model with a flatter slope.
+  std::string record(const std::string& name, int balls, std::uint64_t seed) {
+    table::Board world = pinball::testing::thesis_board();
+    world.gravity_mps2 = 0.95;
+    bus::RecordedPlay play = pinball::testing::record_model_play(world, balls, 0.0005, seed);
+    const std::filesystem::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << bus::recorded_play_log(play);
+    return path.string();
+  }
+  std::string write(const std::string& name, const std::string& bytes) {
+    const std::filesystem::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path.string();
+  }
+};
+
+TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
+  const std::string train = record("train.lcm", 30, 3);
+  const std::string held = record("held.lcm", 10, 4);
+  const std::string overlay = (dir_ / "identified.yaml").string();
+  const pinball::testing::CommandResult r =
+      run("identify " + train + " --held-out " + held + " --out " + overlay + " --bootstrap 5 --sigma-m 0.0005 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j["gravity"]["g_mps2"].get<double>(), 0.95, 0.02);
+  EXPECT_EQ(j["gravity"]["bootstrap_resamples"], 5);
+  EXPECT_GT(j["gravity"]["g_stderr_mps2"].get<double>(), 0.0);
+  EXPECT_GT(j["free_flights"].get<int>(), 20);
+  EXPECT_EQ(j["overlay"], overlay);
+  EXPECT_FALSE(j["not_identified"].empty());
+  EXPECT_GT(j["held_out"]["nominal"]["moments"].get<int>(), 50);
+  EXPECT_LT(j["held_out"]["identified"]["mean_m"].get<double>(), j["held_out"]["nominal"]["mean_m"].get<double>());
+  const table::BoardOverlay written = table::read_board_overlay(overlay);
+  ASSERT_TRUE(written.gravity_mps2.has_value());
+  EXPECT_DOUBLE_EQ(written.gravity_mps2->value, j["gravity"]["g_mps2"].get<double>());
+  EXPECT_EQ(written.recordings, std::vector<std::string>{train});
+
+  // The text report says the same and where the overlay went.
+  const pinball::testing::CommandResult text = run("identify " + train + " --bootstrap 0 --sigma-m 0.0005");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("g along the table"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("not identified: camera latency"), std::string::npos) << text.out;
+}
+
+TEST_F(IdentifyCommand, BadLogsAreRefusedNamingTheFileAndNothingIsWritten) {
+  const std::string overlay = (dir_ / "identified.yaml").string();
+  bus::RecordedPlay frames_only = pinball::testing::record_model_play(pinball::testing::thesis_board(), 1, 0.0005, 2);
+  frames_only.commands.clear();
+  const std::string good_log = bus::recorded_play_log(pinball::testing::record_model_play(
+      pinball::testing::thesis_board(), 1, 0.0005, 2));
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {write("empty.lcm", ""), "empty"},
+      {write("cut.lcm", good_log.substr(0, good_log.size() - 7)), "truncated"},
+      {write("notes.lcm", "this is not a log\n"), "notes.lcm"},
+      {write("nocmd.lcm", bus::recorded_play_log(frames_only)), "PINBALL_FLIPPER_CMD"},
+  };
+  for (const auto& [log, says] : cases) {
+    const pinball::testing::CommandResult r = run("identify " + log + " --out " + overlay);
+    EXPECT_EQ(r.exit_code, 1) << log;
+    EXPECT_EQ(pinball::testing::count_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(log), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(overlay)) << log;
+  }
+  const pinball::testing::CommandResult no_folder =
+      run("identify " + write("ok.lcm", good_log) + " --out " + (dir_ / "no" / "such.yaml").string());
+  EXPECT_EQ(no_folder.exit_code, 1);
+  EXPECT_NE(no_folder.err.find("does not exist"), std::string::npos) << no_folder.err;
+}
+
+}  // namespace
+}  // namespace pinball
