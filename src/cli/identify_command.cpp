@@ -158,7 +158,7 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
 
 int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
   check_output_folder(a.out, "--out");
-  const table::Board board = table::load_board(a.board);
+  const table::Board board = table::load_board(find_data_file(a.board));  // the default too, from any folder
   const std::vector<bus::RecordedPlay> plays = read_all(a.logs);
   const std::vector<bus::RecordedPlay> held = read_all(a.held_out);
   learn::IdentifyOptions options;
