@@ -8,6 +8,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "pinball/core/text_file.h"
 #include "pinball/core/utc_date.h"
 #include "pinball/core/yaml_read_archive.h"
 
@@ -208,13 +209,7 @@ Calibration parse_calibration(const std::string& text, const std::string& name) 
   return c;
 }
 
-Calibration read_calibration(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return parse_calibration(s.str(), path);
-}
+Calibration read_calibration(const std::string& path) { return parse_calibration(read_text_file(path), path); }
 
 track::FlipperGeometry flipper_geometry_from_calibration(const Calibration& c, const std::string& name) {
   const FlipperCalibration* left = nullptr;

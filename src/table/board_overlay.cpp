@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include "pinball/core/text_file.h"
 #include "pinball/core/utc_date.h"
 #include "pinball/core/yaml_read_archive.h"
 #include "pinball/core/yaml_write_archive.h"
@@ -146,14 +147,7 @@ BoardOverlay parse_board_overlay(const std::string& text, const std::string& nam
   return o;
 }
 
-BoardOverlay read_board_overlay(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) throw std::runtime_error(path + ": cannot read");
-  return parse_board_overlay(s.str(), path);
-}
+BoardOverlay read_board_overlay(const std::string& path) { return parse_board_overlay(read_text_file(path), path); }
 
 void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, Board& board) {
   Board b = board;  // all or nothing: the board changes only when every name is found
