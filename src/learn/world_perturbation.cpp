@@ -1,0 +1,93 @@
+#include "pinball/learn/world_perturbation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace pinball::learn {
+
+std::string_view perturbation_name(Perturbation p) {
+  switch (p) {
+    case Perturbation::kPivotY_mm: return "pivot_y_mm";
+    case Perturbation::kThetaMin_deg: return "theta_min_deg";
+    case Perturbation::kFlipperMu_pct: return "flipper_mu_pct";
+    case Perturbation::kWallRho: return "wall_rho";
+    case Perturbation::kGravity_pct: return "gravity_pct";
+    case Perturbation::kActuationDelay_ms: return "actuation_delay_ms";
+    case Perturbation::kCameraLatency_ms: return "camera_latency_ms";
+    case Perturbation::kCameraNoise_px: return "camera_noise_px";
+  }
+  return "?";
+}
+
+std::string_view perturbation_label(Perturbation p) {
+  switch (p) {
+    case Perturbation::kPivotY_mm: return "flipper pivots moved up the table (mm)";
+    case Perturbation::kThetaMin_deg: return "flipper rest angle theta_min (deg)";
+    case Perturbation::kFlipperMu_pct: return "flipper mu (%)";
+    case Perturbation::kWallRho: return "wall rho (added)";
+    case Perturbation::kGravity_pct: return "g along the table (%)";
+    case Perturbation::kActuationDelay_ms: return "actuation delay (ms)";
+    case Perturbation::kCameraLatency_ms: return "camera latency (ms)";
+    case Perturbation::kCameraNoise_px: return "camera noise (px)";
+  }
+  return "?";
+}
+
+bool is_offset(Perturbation p) {
+  return p != Perturbation::kActuationDelay_ms && p != Perturbation::kCameraLatency_ms &&
+         p != Perturbation::kCameraNoise_px;
+}
+
+WorldSettings perturb(const WorldSettings& nominal, Perturbation p, double value) {
+  if (!std::isfinite(value)) throw std::invalid_argument("perturbation: a perturbation's value must be finite");
+  WorldSettings w = nominal;
+  table::Board& b = w.board;
+  switch (p) {
+    case Perturbation::kPivotY_mm:
+      for (table::Flipper& f : b.flippers) f.pivot.y() += value * 1e-3;
+      break;
+    case Perturbation::kThetaMin_deg:
+      for (table::Flipper& f : b.flippers) {
+        f.theta_min_rad += value * std::numbers::pi / 180.0;
+        if (!(f.theta_min_rad < f.theta_max_rad)) {
+          throw std::invalid_argument("perturbation: theta_min " + std::to_string(value) +
+                                      " deg puts flipper " + f.name + "'s rest stop above its up stop");
+        }
+      }
+      break;
+    case Perturbation::kFlipperMu_pct:
+      for (table::Flipper& f : b.flippers) {
+        f.mu *= 1.0 + value / 100.0;
+        if (!(f.mu > 0.0)) throw std::invalid_argument("perturbation: flipper mu must stay > 0 (mu -100 % or less)");
+      }
+      break;
+    case Perturbation::kWallRho:
+      // Walls that lose energy (ρ ≤ 1); kickers (ρ > 1) and the drain keep theirs.
+      for (table::Obstacle& o : b.obstacles) {
+        if (o.rho <= 1.0 && !o.action.eats_ball) o.rho = std::clamp(o.rho + value, 0.0, 1.0);
+      }
+      break;
+    case Perturbation::kGravity_pct:
+      b.gravity_mps2 *= 1.0 + value / 100.0;
+      if (!(b.gravity_mps2 > 0.0)) throw std::invalid_argument("perturbation: g must stay > 0 (g -100 % or less)");
+      break;
+    case Perturbation::kActuationDelay_ms:
+      if (!(value >= 0.0 && value < 1000.0)) throw std::invalid_argument("perturbation: actuation delay must be in [0, 1000) ms");
+      w.actuation_delay_s = value * 1e-3;
+      break;
+    case Perturbation::kCameraLatency_ms:
+      if (!(value >= 0.0)) throw std::invalid_argument("perturbation: camera latency must be >= 0 ms");
+      w.camera.latency_s = value * 1e-3;
+      break;
+    case Perturbation::kCameraNoise_px:
+      if (!(value >= 0.0)) throw std::invalid_argument("perturbation: camera noise must be >= 0 px");
+      w.camera.noise_px = value;
+      break;
+  }
+  return w;
+}
+
+}  // namespace pinball::learn
