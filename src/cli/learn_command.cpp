@@ -34,6 +34,7 @@
 #include "pinball/learn/checkpoint.h"
 #include "pinball/learn/cross_entropy.h"
 #include "pinball/learn/evaluator.h"
+#include "pinball/learn/randomized_evaluator.h"
 #include "pinball/learn/launcher_search.h"
 #include "pinball/learn/learning_curve.h"
 #include "pinball/learn/parallel_runner.h"
@@ -48,6 +49,11 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   CLI::App* cmd = app.add_subcommand("learn", "learn a flipper controller on the fast loop (or evaluate one)");
   cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->transform(data_file());
   add_identified_option(*cmd, a.identified);
+  cmd->add_option("--randomize", a.randomize,
+                  "searches and imitate's learner: play each ball in a world drawn from this file's ranges (g, wall "
+                  "rho, flipper mu, pivots, delay, camera latency and noise, stepper) while the controller believes "
+                  "the board (docs/learning.md); the final evaluation plays the board itself")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--method", a.method,
                   "tournament (thesis 6.2), relay (Hoeffding relay race, 6.3), cem (cross-entropy with common "
                   "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller); "
@@ -206,6 +212,10 @@ std::string run_fingerprint(const LearnArgs& a) {
       {"loss_penalty", a.loss_penalty}, {"actuation_delay_s", a.actuation_delay_s},
       {"gravity_scale", a.gravity_scale},
       {"camera", to_json_value(a.camera)}};
+  if (!a.randomize.empty()) {  // likewise
+    j["randomize"] = a.randomize;
+    j["randomize_fnv1a"] = file_digest(a.randomize);
+  }
   if (!a.identified.empty()) {  // only then: a checkpoint of a run without an overlay still resumes
     j["identified"] = a.identified;
     j["identified_fnv1a"] = file_digest(a.identified);
@@ -227,6 +237,17 @@ nlohmann::json team_report() {
                        {"dropped_bytes", k.dropped_bytes}};
   }
   return j;
+}
+
+// What --randomize drew: the file and every world's values.
+nlohmann::json randomization_report(const std::string& file, const std::vector<learn::DrawnWorld>& worlds) {
+  nlohmann::json drawn = nlohmann::json::array();
+  for (const learn::DrawnWorld& w : worlds) {
+    nlohmann::json values = nlohmann::json::object();
+    for (const auto& [p, v] : w.values) values[std::string(learn::perturbation_name(p))] = v;
+    drawn.push_back({{"stepper", sim::stepper_kind_name(w.stepper)}, {"values", values}});
+  }
+  return {{"file", file}, {"worlds", drawn}};
 }
 
 // Closes the checkpoint however the run ends.
@@ -285,7 +306,8 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
   const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
   // What a learned controller's note says it was learned on.
-  const std::string belief_args = a.board + (a.identified.empty() ? "" : " --identified " + a.identified);
+  const std::string belief_args = a.board + (a.identified.empty() ? "" : " --identified " + a.identified) +
+                                  (a.randomize.empty() ? "" : " --randomize " + a.randomize);
   learn::EvaluatorConfig ec;
   ec.camera = a.camera;
   ec.actuation_delay_s = a.actuation_delay_s;
@@ -297,10 +319,23 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   ec.rolling_minicontrollers = a.rolling;
 
   // The prototype carries the launcher settings into every candidate.
+  if (!a.randomize.empty()) {
+    if (world_spec.kind != simlab::WorldKind::kModel || !world_spec.board_path.empty())
+      throw std::invalid_argument("learn: --randomize draws its worlds around the belief's model; it cannot be "
+                                  "combined with --world twin or --world-board");
+    if (!search) throw std::invalid_argument("learn: --randomize is for a search (tournament, relay, cem), not --method " + a.method);
+  }
+  // With --randomize the search plays the drawn worlds; the final evaluation
+  // (objective.ev) plays the belief's own world, the home world.
   struct Objective final : learn::BallObjective {
     Objective(const table::Board& b, const learn::EvaluatorConfig& c, const sim::World& w, const LearnArgs& args)
-        : ev(b, c, w.fork()), la(args) {}
-    learn::BallOutcome play(const control::ControllerSpec& s, std::uint64_t seed) const override { return ev.play(s, seed); }
+        : ev(b, c, w.fork()), la(args) {
+      if (!args.randomize.empty())
+        randomized = std::make_unique<learn::RandomizedEvaluator>(b, c, learn::load_randomization(args.randomize));
+    }
+    learn::BallOutcome play(const control::ControllerSpec& s, std::uint64_t seed) const override {
+      return randomized ? randomized->play(s, seed) : ev.play(s, seed);
+    }
     control::ControllerSpec prototype() const override {
       control::ControllerSpec s = ev.prototype();
       s.launcher_pull = la.pull;
@@ -308,8 +343,10 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
       return s;
     }
     learn::PinballEvaluator ev;
+    std::unique_ptr<learn::RandomizedEvaluator> randomized;
     const LearnArgs& la;
   } objective(board, ec, *world, a);
+
   const CheckpointScope checkpoint(learn::CheckpointOptions{a.checkpoint, a.resume, run_fingerprint(a)});
   // Every rank runs the whole command; rank 0 alone writes files.
   const bool writer = learn::team_root();
@@ -319,6 +356,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                       {"seed", a.seed},
                       {"threads", a.threads}};
   j.update(identified_report(a.identified));
+  if (objective.randomized) j["randomize"] = randomization_report(a.randomize, objective.randomized->worlds());
   control::ControllerSpec result_spec;
   const control::ControllerSpec* eval_spec = nullptr;
   if (search) {

@@ -82,7 +82,9 @@ PinballEvaluator::PinballEvaluator(const table::Board& belief, const EvaluatorCo
   if (!(config.gravity_scale > 0.0)) throw std::invalid_argument("evaluator: gravity scale must be > 0");
   if (!std::isfinite(config.loss_penalty)) throw std::invalid_argument("evaluator: loss penalty must be finite");
   track::CameraModel check(config.camera, 0);  // throws for a bad camera
+  track::CameraModel check_world(config.world_camera.value_or(config.camera), 0);
   (void)check;
+  (void)check_world;
 }
 
 control::ControllerSpec PinballEvaluator::prototype() const {
@@ -123,7 +125,8 @@ BallOutcome PinballEvaluator::run(control::FlipperController& controller,
   limits.max_ball_time_s = config_.max_ball_time_s;
   limits.pull = pull;
   const sim::BallResult r =
-      play_through_tracker(*world, board_, state, config_.camera, tracker, book, config_.actuation_delay_s, limits, seed,
+      play_through_tracker(*world, board_, state, config_.world_camera.value_or(config_.camera), tracker, book,
+                           config_.actuation_delay_s, limits, seed,
                            [](const sim::GameState&, const sim::StepEvents&) {});
   book.finish(!r.cut, config_.loss_penalty);
   outcome.score = r.score;

@@ -76,6 +76,35 @@ TEST_F(Cli, LearnAndBenchCeilingTakeTheWorldApartFromTheBelief) {
   EXPECT_EQ(c.at("world_board"), world.string());
 }
 
+TEST_F(Cli, LearnRandomizeSearchesAcrossDrawnWorldsAndJudgesInTheHomeWorld) {
+  const fs::path ranges = dir_ / "ranges.yaml";
+  std::ofstream(ranges) << "variants: 4\nseed: 2\nevent_stepper_share: 0.5\nranges:\n"
+                           "  gravity_pct: [-5, 5]\n  camera_latency_ms: [0, 10]\n";
+  const std::string cem = "learn boards/mit1993.board --method cem --budget-balls 64 --population 8 --seed 3 "
+                          "--threads 1 --eval-balls 8 --max-ball-time 10 --json --out " + (dir_ / "c.json").string();
+  const CommandResult r = run(cem + " --randomize " + ranges.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("randomize").at("worlds").size(), 4u);
+  EXPECT_EQ(j.at("randomize").at("file"), ranges.string());
+  EXPECT_EQ(j.at("randomize").at("worlds")[0].at("values").size(), 2u);
+  EXPECT_EQ(j.at("evaluation").at("balls"), 8);
+  EXPECT_EQ(j.at("world"), "thesis");  // the evaluation's: the belief's own model
+  const CommandResult plain = run(cem);
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_FALSE(nlohmann::json::parse(plain.out).contains("randomize"));
+  EXPECT_NE(nlohmann::json::parse(plain.out).at("best_estimated_mean"), j.at("best_estimated_mean"));
+
+  const CommandResult spastic = run("learn boards/mit1993.board --method spastic --eval-balls 2 --randomize " +
+                                    ranges.string());
+  EXPECT_EQ(spastic.exit_code, 1);
+  EXPECT_NE(spastic.err.find("--randomize"), std::string::npos) << spastic.err;
+  std::ofstream(dir_ / "bad.yaml") << "variants: 4\nseed: 2\nevent_stepper_share: 0\nranges:\n  g: [0, 1]\n";
+  const CommandResult bad = run(cem + " --randomize " + (dir_ / "bad.yaml").string());
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("bad.yaml:ranges.g"), std::string::npos) << bad.err;
+}
+
 TEST_F(Cli, SimLearnAndBenchCeilingPlayTheTwin) {
   if (!pinball::simlab::twin_available()) GTEST_SKIP() << "this build has no MuJoCo twin";
   const CommandResult sim = run("sim boards/mit1993.board --world twin --policy spastic --balls 2 --seed 3 --json");

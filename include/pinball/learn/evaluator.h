@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -50,7 +51,10 @@ class BallObjective {
 
 /// Settings of the pinball evaluator.
 struct EvaluatorConfig {
-  track::CameraModelConfig camera;     ///< the camera the tracker sees through
+  track::CameraModelConfig camera;     ///< the camera the tracker believes it sees through
+  /// The camera the world really has (latency, noise) when it is not the
+  /// believed one (`learn --randomize`); empty: `camera`.
+  std::optional<track::CameraModelConfig> world_camera;
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;    ///< command to flipper motion (s): the solenoid's rise
   double max_ball_time_s = 60.0;       ///< a ball alive after this is cut and reported as a cycle
   double loss_penalty = 500.0;         ///< reward of an opportunity that ended with the ball lost (6.3.1)
