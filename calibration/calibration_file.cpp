@@ -67,14 +67,6 @@ void check_calibration(const Calibration& c, const YamlReadArchive& r) {
   }
 }
 
-// The version alone, read first: a file of another version is refused as such.
-struct VersionKey {
-  int version = 0;
-  template <class Archive>
-  void Serialize(Archive* a) {
-    a->Visit(PINBALL_NVP(version));
-  }
-};
 
 }  // namespace
 
@@ -190,15 +182,7 @@ void write_calibration(const Calibration& calibration, const std::string& path) 
 
 Calibration parse_calibration(const std::string& text, const std::string& name) {
   const YAML::Node root = load_yaml(text, name);
-  // The version first, whatever else the file holds: another version is refused as such.
-  YamlReadArchive first(name, {.refuse_unknown_keys = false, .require_every_key = true});
-  if (!root.IsMap()) first.fail("version", "missing (not a calibration file)");
-  VersionKey v;
-  first.read(root, "", &v);
-  if (v.version != kCalibrationFileVersion) {
-    first.fail("version", std::to_string(v.version) + " is not the supported version " +
-                              std::to_string(kCalibrationFileVersion));
-  }
+  require_yaml_version(root, name, kCalibrationFileVersion, "a calibration file");
   // Every key is required and no other is allowed (a misspelt key must not
   // pass unseen); sections and `disagreement` are optional. A repeated key is
   // refused by the reader.

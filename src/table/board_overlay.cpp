@@ -16,14 +16,6 @@
 namespace pinball::table {
 namespace {
 
-// The version alone, read first: a file of another version is refused as such.
-struct VersionKey {
-  int version = 0;
-  template <class Archive>
-  void Serialize(Archive* a) {
-    a->Visit(PINBALL_NVP(version));
-  }
-};
 
 // An inclusive or open bound of a range check.
 struct Bound {
@@ -128,15 +120,7 @@ void write_board_overlay(const BoardOverlay& overlay, const std::string& path) {
 
 BoardOverlay parse_board_overlay(const std::string& text, const std::string& name) {
   const YAML::Node root = load_yaml(text, name);
-  // The version first, whatever else the file holds: another version is refused as such.
-  YamlReadArchive first(name, {.refuse_unknown_keys = false, .require_every_key = true});
-  if (!root.IsMap()) first.fail("version", "missing (not a board overlay file)");
-  VersionKey v;
-  first.read(root, "", &v);
-  if (v.version != kBoardOverlayVersion) {
-    first.fail("version", std::to_string(v.version) + " is not the supported version " +
-                              std::to_string(kBoardOverlayVersion));
-  }
+  require_yaml_version(root, name, kBoardOverlayVersion, "a board overlay file");
   // Every key is required and no other is allowed (a misspelt key must not
   // pass unseen); the sections and a group's kick are optional. A repeated
   // key is refused by the reader.

@@ -84,4 +84,26 @@ inline YAML::Node load_yaml(const std::string& text, const std::string& file) {
   return documents.empty() ? YAML::Node() : documents.front();
 }
 
+/// A versioned file's version, read first whatever else the file holds, so
+/// that a file of another version is refused as such (KeyError
+/// "file:version: ..."); `kind` names the file type ("a calibration file").
+namespace yaml_detail {
+struct VersionKey {  // the version alone
+  int version = 0;
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(version));
+  }
+};
+}  // namespace yaml_detail
+
+inline void require_yaml_version(const YAML::Node& root, const std::string& file, int version, const char* kind) {
+  ReadArchive<YamlDoc> first(file, {.refuse_unknown_keys = false, .require_every_key = true});
+  if (!root.IsMap()) first.fail("version", std::string("missing (not ") + kind + ")");
+  yaml_detail::VersionKey v;
+  first.read(root, "", &v);
+  if (v.version != version)
+    first.fail("version", std::to_string(v.version) + " is not the supported version " + std::to_string(version));
+}
+
 }  // namespace pinball
