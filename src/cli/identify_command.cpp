@@ -34,7 +34,9 @@ std::string value_text(const table::IdentifiedValue& v, const char* unit) {
 
 std::string prediction_text(const learn::PredictionError& e) {
   return format_mean_ci(e.mean_m * 1000.0, e.mean_ci95_m * 1000.0) + " mm mean, " + format_number(e.median_m * 1000.0) +
-         " mm median, " + format_number(e.p90_m * 1000.0) + " mm p90";
+         " mm median, " + format_number(e.p90_m * 1000.0) + " mm p90 (mean " + format_number(e.free_mean_m * 1000.0) +
+         " mm over " + std::to_string(e.free_moments) + " free flights, " + format_number(e.collision_mean_m * 1000.0) +
+         " mm where the ball hit something)";
 }
 
 struct HeldOut {

@@ -33,6 +33,15 @@ bool seen_at(const bus::RecordedPlay& play, std::size_t from, double t, Vec2& p)
   return false;
 }
 
+// True when the frames seen from the moment to the horizon fit one parabola.
+bool flew_free(const bus::RecordedPlay& play, std::size_t from, double t_end, double sigma_m) {
+  std::vector<track::Observation> obs;
+  for (std::size_t i = from; i < play.frames.size() && play.frames[i].t_s <= t_end; ++i)
+    if (play.frames[i].found) obs.push_back({play.frames[i].t_s, play.frames[i].p_board, 1.0, 0.0});
+  const track::TrajectoryFit fit = track::fit_free_gravity(obs, sigma_m);
+  return fit.valid && fit.chi2 <= track::chi2_threshold(fit.dof);
+}
+
 }  // namespace
 
 std::vector<PredictionStart> prediction_starts(std::span<const bus::RecordedPlay> recordings,
@@ -70,6 +79,7 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   const auto steps = static_cast<std::uint64_t>(std::llround(o.horizon_s / world->dt_s()));
   std::vector<double> errors;
   errors.reserve(starts.size());
+  RunningStats free, collided;
   for (const PredictionStart& s : starts) {
     const bus::RecordedPlay& play = recordings[s.recording];
     const track::TrajectoryFit fit =
@@ -82,6 +92,7 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
     state.ball_in_play = true;
     for (std::uint64_t k = 0; k < steps && state.ball_in_play; ++k) world->step(state);
     errors.push_back((state.ball.position_m - seen).norm());  // a lost ball: where the model lost it
+    (flew_free(play, s.frame, fit.t_ref_s + o.horizon_s, o.sigma_m) ? free : collided).add(errors.back());
   }
   PredictionError out;
   out.moments = errors.size();
@@ -92,6 +103,9 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   out.mean_ci95_m = stats.ci95_half_width();
   out.median_m = median(errors);
   out.p90_m = quantile(errors, 0.9);
+  out.free_moments = static_cast<std::size_t>(free.count());
+  out.free_mean_m = free.mean();
+  out.collision_mean_m = collided.mean();
   return out;
 }
 

@@ -25,6 +25,11 @@ TEST(PredictionError, TheTrueModelPredictsBetterThanAWrongOne) {
   EXPECT_LT(right.median_m, 0.004);  // the noise of a 6-frame start, carried 100 ms
   EXPECT_GT(right.mean_ci95_m, 0.0);
   EXPECT_LE(right.median_m, right.p90_m);
+  EXPECT_GT(right.free_moments, 50u);
+  EXPECT_LT(right.free_moments, right.moments);  // some windows hold a bounce
+  EXPECT_EQ(right.free_moments, wrong.free_moments);  // chosen from the recording alone
+  EXPECT_LT(right.free_mean_m, wrong.free_mean_m);
+  EXPECT_LT(right.free_mean_m, 0.004);
 }
 
 TEST(PredictionError, NoMomentNearACoilCommandOrWithoutTheBall) {

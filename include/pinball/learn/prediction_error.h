@@ -21,7 +21,7 @@ namespace pinball::learn {
 /// How moments are chosen and predicted.
 struct PredictionOptions {
   double horizon_s = 0.1;         ///< how far ahead (s)
-  int history_frames = 6;         ///< frames the start state is fitted to
+  int history_frames = 24;        ///< frames the start state is fitted to (the tracker's least window)
   double sigma_m = 0.001;         ///< detector noise, for the history's χ² test (m)
   double command_margin_s = 0.3;  ///< no coil command this long before the moment, nor before the horizon (s)
   int stride_frames = 5;          ///< frames between moments (they overlap less)
@@ -40,6 +40,11 @@ struct PredictionError {
   double median_m = 0.0;      ///< median (m)
   double p90_m = 0.0;         ///< 90th percentile (m)
   double mean_ci95_m = 0.0;   ///< half-width of the mean's 95 % interval (Student's t, m)
+  /// The moments whose seen window (moment to horizon) fits one parabola:
+  /// the ball flew free, and only g and the start's noise matter there.
+  std::size_t free_moments = 0;
+  double free_mean_m = 0.0;       ///< mean error over them (m)
+  double collision_mean_m = 0.0;  ///< mean error over the others: something was hit in the window (m)
 
   /// Every figure, for --json (core/json_write_archive.h).
   template <class Archive>
@@ -49,6 +54,9 @@ struct PredictionError {
     a->Visit(PINBALL_NVP(mean_ci95_m));
     a->Visit(PINBALL_NVP(median_m));
     a->Visit(PINBALL_NVP(p90_m));
+    a->Visit(PINBALL_NVP(free_moments));
+    a->Visit(PINBALL_NVP(free_mean_m));
+    a->Visit(PINBALL_NVP(collision_mean_m));
   }
 };
 
