@@ -76,6 +76,9 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
       ->check(CLI::Range(1, 64));
   cmd->add_flag("--partition-h", a.partition_by_h, "also partition by h (pivot-to-tip | tip-to-V-centre)");
   cmd->add_flag("--rolling", a.rolling, "a separate minicontroller for a ball rolling on each flipper");
+  cmd->add_flag("--lead", a.lead,
+                "searches: the controller acts on each projection advanced by the frame's camera latency plus "
+                "--actuation-delay, to when its coil acts (docs/learning.md, \"Lead\"); written into the controller");
   cmd->add_flag("--randomise-launch", a.randomise_launch, "draw the launcher pull per ball from [0.5, 1]");
   cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")
       ->check(CLI::Range(0.01, 1.0))
@@ -212,6 +215,7 @@ std::string run_fingerprint(const LearnArgs& a) {
       {"loss_penalty", a.loss_penalty}, {"actuation_delay_s", a.actuation_delay_s},
       {"gravity_scale", a.gravity_scale},
       {"camera", to_json_value(a.camera)}};
+  if (a.lead) j["lead"] = true;  // likewise
   if (!a.randomize.empty()) {  // likewise
     j["randomize"] = a.randomize;
     j["randomize_fnv1a"] = file_digest(a.randomize);
@@ -325,6 +329,8 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                                   "combined with --world twin or --world-board");
     if (!search) throw std::invalid_argument("learn: --randomize is for a search (tournament, relay, cem), not --method " + a.method);
   }
+  if (a.lead && !search)
+    throw std::invalid_argument("learn: --lead is for a search (tournament, relay, cem), not --method " + a.method);
   // With --randomize the search plays the drawn worlds; the final evaluation
   // (objective.ev) plays the belief's own world, the home world.
   struct Objective final : learn::BallObjective {
@@ -338,6 +344,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
     }
     control::ControllerSpec prototype() const override {
       control::ControllerSpec s = ev.prototype();
+      if (la.lead) s.actuator.lead_actuation_delay_s = la.actuation_delay_s;
       s.launcher_pull = la.pull;
       s.randomise_launch = la.randomise_launch;
       return s;

@@ -62,6 +62,7 @@ bool CameraModel::deliver(double now_s, Observation& out) {
   const Observation& o = pending_[head_];
   if (o.t_s + config_.latency_s > now_s + 1e-9) return false;
   out = o;
+  out.latency_s = config_.latency_s;  // what the lab's latency calibration tells the detector
   head_ = (head_ + 1) % kCapacity;
   --size_;
   return true;

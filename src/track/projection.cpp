@@ -1,5 +1,6 @@
 #include "pinball/track/projection.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -84,6 +85,23 @@ TrajectoryProjection project_trajectory(const TrajectoryFit& fit, const FlipperG
   }
   if (best.valid && !finite(best)) return none(NoProjection::kNumerical, fit.t_ref_s);
   return best;
+}
+
+TrajectoryProjection lead_projection(const TrajectoryProjection& p, const TrajectoryFit& fit, double lead_s) {
+  if (!p.valid || !(lead_s > 0.0)) return p;
+  TrajectoryProjection led = p;
+  if (lead_s >= p.t_impact_s) {
+    led.d_m = 0.0;
+    led.t_impact_s = 0.0;
+    return led;
+  }
+  led.t_impact_s = p.t_impact_s - lead_s;
+  if (p.rolling || !fit.valid) {
+    led.d_m = std::max(0.0, p.d_m - p.speed_mps * lead_s);
+  } else {
+    led.d_m = (p.impact_point - fit.position_at(p.t_observation_s + lead_s)).norm();
+  }
+  return led;
 }
 
 TrajectoryProjection rolling_projection(const FlipperGeometry& g, int rolling_on, const Vec2& p_now,

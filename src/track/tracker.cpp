@@ -101,6 +101,7 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
   if (rolling) {
     const int on = contacts.left ? kLeftFlipper : kRightFlipper;
     out_.projection = rolling_projection(geometry_, on, obs.p_board, rolling_speed(), obs.t_s);
+    out_.projection.latency_s = obs.latency_s;
     out_.launch = launch_.update(obs.p_board, false, 0.0, true);
     return out_;
   }
@@ -139,6 +140,7 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
   out_.window = static_cast<int>(std::min(n, size_));
   out_.projection = fit.valid ? project_trajectory(fit, geometry_) : TrajectoryProjection{};
   out_.projection.t_observation_s = obs.t_s;
+  out_.projection.latency_s = obs.latency_s;
   out_.launch = launch_.update(obs.p_board, fit.valid, fit.v_ref.y(), false);
   return out_;
 }

@@ -21,7 +21,9 @@ track::TrackerOutput approach(double d_m, int flipper = track::kLeftFlipper) {
 ActuatorController make(double a4, int flipper, double max_hold_s = 1.0) {
   ActionFunction af(uniform_partition(2));
   for (int i = 0; i < af.partitions(); ++i) af.minicontroller(i) = Minicontroller{{0.0, 0.0, 0.0, a4}, flipper};
-  return ActuatorController(af, ActuatorConfig{max_hold_s});
+  ActuatorConfig config;
+  config.max_hold_s = max_hold_s;
+  return ActuatorController(af, config);
 }
 
 TEST(ActuatorController, FiresExactlyOncePerApproachAndReleasesOnLaunch) {
@@ -85,6 +87,29 @@ TEST(ActuatorController, ReleasesACradledBallAfterMaxHold) {
   c.update(approach(0.01), 0.7, e);  // a new approach after the release
   EXPECT_TRUE(e[0]);
   EXPECT_EQ(c.fires(), 2);
+}
+
+TEST(ActuatorController, WithALeadItFiresWhereTheBallWillBeWhenTheCoilActs) {
+  // d_critical 0.05 m; the ball approaches at 1 m/s; 10 ms of latency plus
+  // 20 ms of actuation delay put it 0.03 m further on when the coil acts.
+  ActionFunction af(uniform_partition(2));
+  for (int i = 0; i < af.partitions(); ++i) af.minicontroller(i) = Minicontroller{{0.0, 0.0, 0.0, 0.05}, 0};
+  ActuatorConfig led_config;
+  led_config.lead_actuation_delay_s = 0.02;
+  ActuatorController led(af, led_config);
+  ActuatorController plain(af, ActuatorConfig{});
+  std::array<bool, 2> e_led{}, e_plain{};
+  track::TrackerOutput o = approach(0.075);
+  o.projection.t_impact_s = 0.075;  // 1 m/s
+  o.projection.latency_s = 0.01;
+  o.projection.rolling = true;      // advances at its speed (no fit needed)
+  led.update(o, 0.0, e_led);
+  plain.update(o, 0.0, e_plain);
+  EXPECT_TRUE(e_led[0]);    // 0.075 − 0.03 = 0.045 <= 0.05
+  EXPECT_FALSE(e_plain[0]); // 0.075 > 0.05
+  ActuatorConfig bad;
+  bad.lead_actuation_delay_s = 0.5;
+  EXPECT_THROW(ActuatorController(af, bad), std::invalid_argument);
 }
 
 }  // namespace

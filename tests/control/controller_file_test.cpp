@@ -20,6 +20,7 @@ TEST(ControllerFile, RoundTripKeepsEveryValue) {
   Rng rng(3);
   s.action_function.randomise(rng);
   s.actuator.max_hold_s = 0.75;
+  s.actuator.lead_actuation_delay_s = 0.004;
   s.launcher_pull = 0.95;
   s.randomise_launch = true;
   s.launch_pull_min = 0.6;
@@ -37,6 +38,7 @@ TEST(ControllerFile, RoundTripKeepsEveryValue) {
     EXPECT_EQ(r.action_function.minicontroller(i).flipper, s.action_function.minicontroller(i).flipper);
   }
   EXPECT_EQ(r.actuator.max_hold_s, 0.75);
+  EXPECT_EQ(r.actuator.lead_actuation_delay_s, 0.004);
   EXPECT_EQ(r.launcher_pull, 0.95);
   EXPECT_TRUE(r.randomise_launch);
   EXPECT_EQ(r.launch_pull_min, 0.6);
@@ -170,6 +172,11 @@ TEST(ControllerFile, GainsHoldsAndPartitionsHaveSaneRanges) {
   const std::string good = controller_to_json(s);
   expect_error(with(good, "\"max_hold_s\": 1.0", "\"max_hold_s\": 11"), "bad.json: actuator.max_hold_s: must be in [0, 10] s");
   expect_error(with(good, "\"max_hold_s\": 1.0", "\"max_hold_s\": -1"), "actuator.max_hold_s: must be in [0, 10] s");
+  expect_error(with(good, "\"max_hold_s\": 1.0", "\"max_hold_s\": 1.0, \"lead_actuation_delay_s\": 0.5"),
+               "actuator.lead_actuation_delay_s: must be in [0, 0.1] s");
+  // Without a lead the key is not written, and such a file (all before the lead) loads without one.
+  EXPECT_EQ(good.find("lead_actuation_delay_s"), std::string::npos);
+  EXPECT_FALSE(controller_from_json(good, "old.json").actuator.lead_actuation_delay_s.has_value());
   expect_error(with(good, "\"a\": [\n        0.0", "\"a\": [\n        1e6"), "minicontrollers[0].a: must each be in [-10, 10]");
   expect_error(with(good, "\"gain_range\": [\n      0.12", "\"gain_range\": [\n      50"),
                "partition.gain_range: must each be in [0, 10]");

@@ -253,5 +253,19 @@ TEST(CameraModel, BadSettingsThrow) {
   }
 }
 
+TEST(CameraModel, EachObservationCarriesTheCamerasLatency) {
+  CameraModelConfig c;
+  c.latency_s = 0.007;
+  CameraModel camera(c, 1);
+  Observation o;
+  bool delivered = false;
+  for (double t = 0.0; t < 0.05 && !delivered; t += 0.0005) {
+    camera.expose(t, {0.2, 0.5});
+    delivered = camera.deliver(t, o);
+  }
+  ASSERT_TRUE(delivered);
+  EXPECT_EQ(o.latency_s, 0.007);  // as a calibrated detector reports it
+}
+
 }  // namespace
 }  // namespace pinball::track

@@ -315,5 +315,37 @@ TEST(NoProjectionNames, AreDistinct) {
   EXPECT_STREQ(to_string(NoProjection::kNone), "none");
 }
 
+TEST(LeadProjection, AdvancesDistanceAndTimeAlongTheFitToWhenTheCoilActs) {
+  // The vertical fall above: impact after √1.25 s, 1.25 m below the start.
+  const TrajectoryFit fit = fit_of({-0.75, 1.0}, {0.0, 0.0}, 2.0);
+  TrajectoryProjection p = project_trajectory(fit, hand_v());
+  p.latency_s = 0.2;
+  const TrajectoryProjection led = lead_projection(p, fit, 0.5);
+  ASSERT_TRUE(led.valid);
+  EXPECT_NEAR(led.t_impact_s, std::sqrt(1.25) - 0.5, 1e-12);
+  EXPECT_NEAR(led.d_m, 1.25 - 0.5 * 2.0 * 0.25, 1e-12);  // fallen g·t²/2 = 0.25 m by then
+  EXPECT_EQ(led.impact_point, p.impact_point);
+  EXPECT_EQ(led.speed_mps, p.speed_mps);
+  EXPECT_EQ(led.h, p.h);
+  EXPECT_EQ(led.t_observation_s, p.t_observation_s);
+  // No lead, or an invalid projection: unchanged.
+  EXPECT_EQ(lead_projection(p, fit, 0.0).d_m, p.d_m);
+  const TrajectoryProjection none{};
+  EXPECT_FALSE(lead_projection(none, fit, 0.5).valid);
+  // The impact comes before the coil can act: d and t are 0, never negative.
+  const TrajectoryProjection late = lead_projection(p, fit, 2.0);
+  EXPECT_EQ(late.d_m, 0.0);
+  EXPECT_EQ(late.t_impact_s, 0.0);
+  EXPECT_TRUE(late.valid);
+}
+
+TEST(LeadProjection, ARollingBallAdvancesAtItsSpeed) {
+  const TrajectoryProjection p = rolling_projection(hand_v(), kLeftFlipper, {-0.75, -0.25}, 0.5, 3.0);
+  ASSERT_TRUE(p.rolling);
+  const TrajectoryProjection led = lead_projection(p, TrajectoryFit{}, 0.1);
+  EXPECT_NEAR(led.d_m, p.d_m - 0.05, 1e-12);
+  EXPECT_NEAR(led.t_impact_s, p.t_impact_s - 0.1, 1e-12);
+}
+
 }  // namespace
 }  // namespace pinball::track

@@ -4,6 +4,7 @@
 // releases on a detected launch or a lost ball.
 
 #include <array>
+#include <optional>
 
 #include "pinball/control/action_function.h"
 #include "pinball/control/flipper_controller.h"
@@ -18,10 +19,18 @@ struct ActuatorConfig {
   /// driver board's hold cap still applies). 0..kMaxHold_s.
   double max_hold_s = 1.0;
 
+  /// Lead (issue 20): act on the projection advanced to the moment a command
+  /// given now takes effect, the newest frame's camera latency plus this
+  /// actuation delay (s), so that d_critical means the same whatever the
+  /// latency (track::lead_projection). Absent: the thesis's projection from
+  /// the newest frame, which a learned d_critical tunes to one latency. 0..0.1 s.
+  std::optional<double> lead_actuation_delay_s;
+
   /// The keys of a controller file (docs/learning.md).
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(PINBALL_NVP(max_hold_s));
+    a->Visit(PINBALL_NVP(lead_actuation_delay_s));
   }
 };
 

@@ -35,6 +35,7 @@ struct TrajectoryProjection {
   double d_m = 0.0;              ///< d_impact: distance from the ball now to the impact point (m)
   double t_impact_s = 0.0;       ///< time from the newest observation to impact (s)
   double t_observation_s = 0.0;  ///< time of the newest observation (s)
+  double latency_s = 0.0;        ///< that observation's camera latency: it was delivered this long after (s)
   Vec2 impact_point = Vec2::Zero();  ///< where (m)
   bool hittable = false;         ///< impact on the 'V' (0 <= h <= h_apex): the controller acts on these only
   bool rolling = false;          ///< the rolling-ball projection of 4.1.2
@@ -50,6 +51,15 @@ TrajectoryProjection project_trajectory(const TrajectoryFit& fit, const FlipperG
 /// `speed_mps`, at the angle of the down flipper it rolls on.
 TrajectoryProjection rolling_projection(const FlipperGeometry& geometry, int rolling_on, const Vec2& p_now,
                                         double speed_mps, double t_now_s);
+
+/// The projection as it will be `lead_s` after its newest observation (the
+/// camera's latency plus the coil's actuation delay: when a command given now
+/// takes effect): d from where the ball will then be to the impact point and
+/// t_impact from then, along `fit` (a rolling ball: at its speed). An impact
+/// sooner than that gives d = 0 and t_impact = 0: the coil is already late.
+/// Impact point, speed, angle and h do not change; an invalid projection is
+/// returned as it is.
+TrajectoryProjection lead_projection(const TrajectoryProjection& projection, const TrajectoryFit& fit, double lead_s);
 
 /// Folds a direction angle into [−π/2, π/2] (the thesis's tan⁻¹(ẏ/ẋ)
 /// without a division).
