@@ -95,6 +95,12 @@ TEST_F(Cli, LearnRandomizeSearchesAcrossDrawnWorldsAndJudgesInTheHomeWorld) {
   EXPECT_FALSE(nlohmann::json::parse(plain.out).contains("randomize"));
   EXPECT_NE(nlohmann::json::parse(plain.out).at("best_estimated_mean"), j.at("best_estimated_mean"));
 
+  // --lead writes the actuation delay the search led its projections by into the controller.
+  const CommandResult led = run(cem + " --lead --actuation-delay 0.006");
+  ASSERT_EQ(led.exit_code, 0) << led.err;
+  EXPECT_EQ(nlohmann::json::parse(led.out).at("lead"), true);
+  EXPECT_NE(pinball::testing::slurp(dir_ / "c.json").find("\"lead_actuation_delay_s\": 0.006"), std::string::npos);
+
   const CommandResult spastic = run("learn boards/mit1993.board --method spastic --eval-balls 2 --randomize " +
                                     ranges.string());
   EXPECT_EQ(spastic.exit_code, 1);
