@@ -364,6 +364,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                       {"threads", a.threads}};
   j.update(identified_report(a.identified));
   if (objective.randomized) j["randomize"] = randomization_report(a.randomize, objective.randomized->worlds());
+  if (search) j["lead"] = a.lead;
   control::ControllerSpec result_spec;
   const control::ControllerSpec* eval_spec = nullptr;
   if (search) {
