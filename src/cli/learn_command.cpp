@@ -311,7 +311,7 @@ int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
   // What a learned controller's note says it was learned on.
   const std::string belief_args = a.board + (a.identified.empty() ? "" : " --identified " + a.identified) +
-                                  (a.randomize.empty() ? "" : " --randomize " + a.randomize);
+                                  (a.randomize.empty() ? "" : " --randomize " + a.randomize) + (a.lead ? " --lead" : "");
   learn::EvaluatorConfig ec;
   ec.camera = a.camera;
   ec.actuation_delay_s = a.actuation_delay_s;
