@@ -41,7 +41,7 @@ struct IdentifyOptions {
   double min_normal_speed_mps = 0.15;///< a slower approach gives no usable ratio (m/s)
   int min_rebounds = 8;              ///< a group needs this many rebounds for ρ (and 2 more for a kick)
   int min_launches = 5;              ///< launches needed for the pull and the noise
-  double launch_reach_m = 0.03;      ///< a launch flight starts this close to the launcher's rest position (m)
+  double launch_reach_m = 0.03;      ///< a launch flight starts within this of the rest position across the chute, and up to 5x this above it (m)
 };
 
 /// One rebound off a board obstacle.
