@@ -155,6 +155,22 @@ bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m) {
          m.cause <= M::CAUSE_BUS_FAULT;
 }
 
+track::TrajectoryProjection from_lcm_projection(const pinball_lcm::lcmt_pinball_projection& m) {
+  track::TrajectoryProjection p;
+  p.valid = m.valid;
+  p.reason = static_cast<track::NoProjection>(m.reason);
+  p.flipper = m.flipper;
+  p.speed_mps = m.speed_mps;
+  p.angle_rad = m.angle_rad;
+  p.h = m.h;
+  p.d_m = m.d_m;
+  p.t_impact_s = m.t_impact_s;
+  p.impact_point = Vec2(m.impact_x_m, m.impact_y_m);
+  p.hittable = m.hittable;
+  p.rolling = m.rolling;
+  return p;
+}
+
 bool valid_projection(const pinball_lcm::lcmt_pinball_projection& m) {
   const bool finite = std::isfinite(m.speed_mps) && std::isfinite(m.angle_rad) && std::isfinite(m.h) &&
                       std::isfinite(m.d_m) && std::isfinite(m.t_impact_s) && std::isfinite(m.impact_x_m) &&

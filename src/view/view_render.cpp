@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/bus/message_convert.h"
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/plot/draw.h"
 #include "pinball/sim/game_state.h"
@@ -42,21 +43,6 @@ const char* cause_name(int cause) {
 }
 
 const char* flipper_name(int flipper) { return flipper == 0 ? "left" : flipper == 1 ? "right" : "all"; }
-
-track::TrajectoryProjection to_projection(const pinball_lcm::lcmt_pinball_projection& m) {
-  track::TrajectoryProjection p;
-  p.valid = m.valid;
-  p.flipper = m.flipper;
-  p.speed_mps = m.speed_mps;
-  p.angle_rad = m.angle_rad;
-  p.h = m.h;
-  p.d_m = m.d_m;
-  p.t_impact_s = m.t_impact_s;
-  p.impact_point = Vec2(m.impact_x_m, m.impact_y_m);
-  p.hittable = m.hittable;
-  p.rolling = m.rolling;
-  return p;
-}
 
 cv::Point to_point(const cv::Point2d& p) { return {static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y))}; }
 
@@ -239,7 +225,7 @@ ViewScene load_view_scene(const std::string& board_path, const std::string& cali
 
 std::optional<double> d_critical_m(const ViewScene& scene, const pinball_lcm::lcmt_pinball_projection& m) {
   if (!scene.controller || !m.valid) return std::nullopt;
-  const track::TrajectoryProjection p = to_projection(m);
+  const track::TrajectoryProjection p = bus::from_lcm_projection(m);
   if (scene.controller->shot_table) {
     const control::ImitationDecision d = scene.controller->shot_table->decide(p);
     if (!d.fire) return std::nullopt;

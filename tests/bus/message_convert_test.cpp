@@ -66,6 +66,38 @@ TEST(MessageConvert, ProjectionCarriesEveryField) {
   EXPECT_EQ(m.observation_seq, 7);
 }
 
+TEST(MessageConvert, AProjectionReadBackIsTheOneSent) {
+  track::TrackerOutput out;
+  out.projection.valid = true;
+  out.projection.reason = track::NoProjection::kNone;
+  out.projection.flipper = track::kLeftFlipper;
+  out.projection.speed_mps = 2.5;
+  out.projection.angle_rad = -1.1;
+  out.projection.h = 0.4;
+  out.projection.d_m = 0.15;
+  out.projection.t_impact_s = 0.08;
+  out.projection.impact_point = Vec2(0.2, 0.18);
+  out.projection.hittable = true;
+  out.projection.rolling = true;
+  const track::TrajectoryProjection p = from_lcm_projection(round_trip(to_lcm_projection(1, 2, 3, out)));
+  EXPECT_TRUE(p.valid);
+  EXPECT_EQ(p.reason, track::NoProjection::kNone);
+  EXPECT_EQ(p.flipper, track::kLeftFlipper);
+  EXPECT_EQ(p.speed_mps, 2.5);
+  EXPECT_EQ(p.angle_rad, -1.1);
+  EXPECT_EQ(p.h, 0.4);
+  EXPECT_EQ(p.d_m, 0.15);
+  EXPECT_EQ(p.t_impact_s, 0.08);
+  EXPECT_EQ(p.impact_point, Vec2(0.2, 0.18));
+  EXPECT_TRUE(p.hittable);
+  EXPECT_TRUE(p.rolling);
+  track::TrackerOutput none;
+  none.projection.reason = track::NoProjection::kOutsideCritical;
+  const track::TrajectoryProjection q = from_lcm_projection(round_trip(to_lcm_projection(1, 2, 3, none)));
+  EXPECT_FALSE(q.valid);
+  EXPECT_EQ(q.reason, track::NoProjection::kOutsideCritical);
+}
+
 TEST(MessageConvert, InvalidProjectionNamesNoFlipper) {
   track::TrackerOutput out;
   out.projection.valid = false;

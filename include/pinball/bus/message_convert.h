@@ -92,6 +92,10 @@ std::vector<std::uint8_t> encode_message(const T& m) {
 /// right after its 8-byte type fingerprint. Empty when the bytes are too short.
 std::optional<std::int64_t> encoded_utime(const void* data, std::size_t size);
 
+/// The projection a message carries (check it with valid_projection first):
+/// the inverse of to_lcm_projection, for what reads projections back (the view).
+track::TrajectoryProjection from_lcm_projection(const pinball_lcm::lcmt_pinball_projection& m);
+
 /// A received projection is well formed: every number finite, flipper -1..1,
 /// and a valid one has speed, d and t_impact >= 0 and h, angle in range.
 bool valid_projection(const pinball_lcm::lcmt_pinball_projection& m);
