@@ -60,6 +60,23 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                       {"rms_nominal_mps", g.rms_nominal_mps},
                       {"rms_fitted_mps", g.rms_fitted_mps}});
   }
+  nlohmann::json strokes = nlohmann::json::array();
+  for (const learn::FlipperStrokeFit& f : r.flipper_strokes) {
+    strokes.push_back({{"name", f.name},
+                       {"shots", f.shots},
+                       {"outliers", f.outliers},
+                       {"identified", f.identified},
+                       {"why_not", f.identified ? nlohmann::json(nullptr) : nlohmann::json(f.why_not)},
+                       {"rise_delay_s", f.identified ? to_json_value(f.rise_delay_s) : nlohmann::json(nullptr)},
+                       {"omega_rad_s", f.identified ? to_json_value(f.omega_rad_s) : nlohmann::json(nullptr)},
+                       {"mu", f.mu ? to_json_value(*f.mu) : nlohmann::json(nullptr)},
+                       {"timing_rms_nominal_s", f.timing_rms_nominal_s},
+                       {"timing_rms_fitted_s", f.timing_rms_fitted_s},
+                       {"velocity_error_nominal_mps", f.velocity_error_nominal_mps},
+                       {"velocity_error_delay_only_mps", f.velocity_error_delay_only_mps},
+                       {"stroke_laid_over_board", f.identified && f.stroke_replays_better()},
+                       {"velocity_error_fitted_mps", f.velocity_error_fitted_mps}});
+  }
   nlohmann::json not_identified = nlohmann::json::array();
   for (const learn::NotIdentified& n : r.not_identified)
     not_identified.push_back({{"parameter", n.parameter}, {"why", n.why}});
@@ -76,6 +93,11 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                    {"obstacle_groups", groups},
                    {"rebounds", r.rebounds.size()},
                    {"launches", r.launch_speeds_mps.size()},
+                   {"flipper_shots", r.shots.size()},
+                   {"flippers", strokes},
+                   {"actuation_delay_s", table::identified_actuation_delay_s(r.overlay)
+                                             ? nlohmann::json(*table::identified_actuation_delay_s(r.overlay))
+                                             : nlohmann::json(nullptr)},
                    {"launcher", r.overlay.launcher ? to_json_value(*r.overlay.launcher) : nlohmann::json(nullptr)},
                    {"not_identified", not_identified},
                    {"overlay", a.out.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.out)},
@@ -121,6 +143,21 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     out << " (" << group.rebounds << " rebounds, " << group.outliers << " outliers); residual "
         << format_number(group.rms_nominal_mps) << " -> " << format_number(group.rms_fitted_mps) << " m/s\n";
   }
+  for (const learn::FlipperStrokeFit& f : r.flipper_strokes) {
+    if (!f.identified) continue;
+    out << "  flipper " << f.name << ": rise delay " << format_number(f.rise_delay_s.value * 1000.0) << " ± "
+        << format_number(f.rise_delay_s.stderr_ * 1000.0, 2) << " ms, stroke " << value_text(f.omega_rad_s, " rad/s")
+        << " (board " << format_number(board.flippers[&f - r.flipper_strokes.data()].omega_rad_s) << ")";
+    if (f.mu) out << ", mu " << value_text(*f.mu, "");
+    out << " (" << f.shots << " shots, " << f.outliers << " outliers); contact time residual "
+        << format_number(f.timing_rms_nominal_s * 1000.0) << " -> " << format_number(f.timing_rms_fitted_s * 1000.0)
+        << " ms; replayed shots' velocity error (median): board " << format_number(f.velocity_error_nominal_mps)
+        << ", identified delay " << format_number(f.velocity_error_delay_only_mps) << ", identified delay, stroke and mu "
+        << format_number(f.velocity_error_fitted_mps) << " m/s\n";
+  }
+  if (const std::optional<double> delay = table::identified_actuation_delay_s(r.overlay))
+    out << "  actuation delay    " << format_number(*delay * 1000.0)
+        << " ms, the flippers' mean rise delay: the model worlds of learn and bench play it with --identified\n";
   if (r.overlay.launcher)
     out << "  launcher           pull " << value_text(r.overlay.launcher->pull, "") << ", noise "
         << value_text(r.overlay.launcher->noise_max, "") << " (" << r.launch_speeds_mps.size() << " launches)\n";

@@ -5,14 +5,12 @@
 #include <stdexcept>
 
 #include "pinball/core/format.h"
-#include "pinball/core/statistics.h"
+#include "pinball/core/least_squares_line.h"
 
 namespace pinball::learn {
 namespace {
 
 constexpr double kContactStep_s = 0.00025;  // extrapolation step when looking for the contact
-constexpr double kOutlierRobustSigmas = 3.5;
-constexpr double kMadToSigma = 1.4826;      // a normal's σ over its median absolute deviation
 
 // Unit normal of `shape` at the ball centre p, pointing from the surface to
 // the ball (the gradient of the distance; central differences).
@@ -28,60 +26,6 @@ std::string group_label(const table::ObstacleGroupOverlay& g) {
          (g.board_kick_mps > 0.0 ? " kick=" + format_number(g.board_kick_mps) + " m/s" : std::string()) + " (" +
          (g.obstacles.empty() ? std::string() : g.obstacles.front()) +
          (g.obstacles.size() > 1 ? ", ... " + std::to_string(g.obstacles.size()) + " obstacles" : std::string()) + ")";
-}
-
-// speed_out ≈ rho·speed_in (+ kick): least squares with each coefficient's
-// standard error; one pass leaves out residuals beyond 3.5 robust σ.
-struct RatioFit {
-  double rho = 0.0, kick = 0.0, rho_stderr = 0.0, kick_stderr = 0.0;
-  int used = 0, outliers = 0;
-};
-
-RatioFit fit_ratio(const std::vector<std::pair<double, double>>& in_out, bool with_kick) {
-  const auto solve = [&](const std::vector<std::pair<double, double>>& xy) {
-    RatioFit f;
-    const double n = static_cast<double>(xy.size());
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    for (const auto& [x, y] : xy) sx += x, sy += y, sxx += x * x, sxy += x * y;
-    if (with_kick) {
-      const double sxx_c = sxx - sx * sx / n;
-      f.rho = (sxy - sx * sy / n) / sxx_c;
-      f.kick = (sy - f.rho * sx) / n;
-    } else {
-      f.rho = sxy / sxx;
-    }
-    double ss = 0;
-    for (const auto& [x, y] : xy) ss += std::pow(y - f.rho * x - f.kick, 2);
-    const double unknowns = with_kick ? 2.0 : 1.0;
-    const double s2 = ss / std::max(1.0, n - unknowns);
-    if (with_kick) {
-      const double sxx_c = sxx - sx * sx / n;
-      f.rho_stderr = std::sqrt(s2 / sxx_c);
-      f.kick_stderr = std::sqrt(s2 * (1.0 / n + (sx / n) * (sx / n) / sxx_c));
-    } else {
-      f.rho_stderr = std::sqrt(s2 / sxx);
-    }
-    f.used = static_cast<int>(xy.size());
-    return f;
-  };
-  RatioFit first = solve(in_out);
-  std::vector<double> abs_residuals;
-  for (const auto& [x, y] : in_out) abs_residuals.push_back(std::abs(y - first.rho * x - first.kick));
-  const double robust_sigma = kMadToSigma * median(abs_residuals);
-  std::vector<std::pair<double, double>> kept;
-  for (const auto& [x, y] : in_out)
-    if (robust_sigma <= 0.0 || std::abs(y - first.rho * x - first.kick) <= kOutlierRobustSigmas * robust_sigma)
-      kept.emplace_back(x, y);
-  if (kept.size() == in_out.size() || kept.size() < (with_kick ? 3u : 2u)) return first;
-  RatioFit second = solve(kept);
-  second.outliers = static_cast<int>(in_out.size() - kept.size());
-  return second;
-}
-
-double rms_of(const std::vector<std::pair<double, double>>& in_out, double rho, double kick) {
-  double ss = 0;
-  for (const auto& [x, y] : in_out) ss += std::pow(y - rho * x - kick, 2);
-  return in_out.empty() ? 0.0 : std::sqrt(ss / static_cast<double>(in_out.size()));
 }
 
 // The rebound joining flight a to flight b, when the ball met one board
@@ -146,7 +90,7 @@ void identify_groups(const table::Board& board, const std::vector<FreeFlight>& f
     group.rebounds = static_cast<int>(in_out.size());
     const bool with_kick = group.overlay.board_kick_mps > 0.0;
     const int needed = o.min_rebounds + (with_kick ? 2 : 0);
-    group.rms_nominal_mps = rms_of(in_out, group.overlay.board_rho, group.overlay.board_kick_mps);
+    group.rms_nominal_mps = rms_residual(in_out, {group.overlay.board_kick_mps, group.overlay.board_rho});
     if (group.rebounds < needed) {
       group.why_not = std::to_string(group.rebounds) + " clean rebounds (both flights seen, one obstacle near), needs " +
                       std::to_string(needed);
@@ -154,12 +98,13 @@ void identify_groups(const table::Board& board, const std::vector<FreeFlight>& f
                                        group.why_not});
       continue;
     }
-    const RatioFit fit = fit_ratio(in_out, with_kick);
+    // speed out ≈ ρ·speed in (+ kick)
+    const TrimmedLineFit fit = fit_line_trimmed(in_out, !with_kick);
     group.identified = true;
     group.outliers = fit.outliers;
-    group.overlay.rho = {fit.rho, fit.rho_stderr, fit.used};
-    if (with_kick) group.overlay.kick_mps = table::IdentifiedValue{fit.kick, fit.kick_stderr, fit.used};
-    group.rms_fitted_mps = rms_of(in_out, fit.rho, fit.kick);
+    group.overlay.rho = {fit.line.slope, fit.slope_stderr, fit.used};
+    if (with_kick) group.overlay.kick_mps = table::IdentifiedValue{fit.line.intercept, fit.intercept_stderr, fit.used};
+    group.rms_fitted_mps = rms_residual(in_out, fit.line);
     result.overlay.obstacle_groups.push_back(group.overlay);
   }
 }
@@ -195,6 +140,38 @@ void identify_launcher(const table::Board& board, std::span<const bus::RecordedP
   launcher.pull = {std::min(1.0, top / clamp), end_stderr / clamp, n};
   launcher.noise_max = {std::clamp(1.0 - bottom / top, 0.0, 0.999), std::sqrt(2.0) * end_stderr / top, n};
   result.overlay.launcher = launcher;
+}
+
+void identify_flippers(const table::Board& board, std::span<const bus::RecordedPlay> recordings,
+                       const std::vector<FreeFlight>& flights, const IdentifyOptions& o, IdentificationResult& result) {
+  result.shots = find_flipper_shots(board, recordings, flights, o.shots);
+  for (std::size_t k = 0; k < board.flippers.size(); ++k) {
+    FlipperStrokeFit fit =
+        fit_flipper_stroke(board, static_cast<int>(k), result.shots, o.nominal_actuation_delay_s, o.shots);
+    const std::string label = "flipper " + fit.name;
+    if (!fit.identified) {
+      result.not_identified.push_back({label + " rise delay, stroke speed and mu", fit.why_not});
+      result.flipper_strokes.push_back(fit);
+      continue;
+    }
+    table::FlipperOverlay overlay{fit.name, std::nullopt, std::nullopt, fit.rise_delay_s};
+    overlay.rise_delay_s->value = std::max(0.0, overlay.rise_delay_s->value);  // noise may put it below zero
+    if (fit.stroke_replays_better()) {
+      overlay.mu = fit.mu;
+      overlay.omega_rad_s = fit.omega_rad_s;
+    } else {
+      result.not_identified.push_back(
+          {label + " stroke speed and mu",
+           "the model replays its " + std::to_string(fit.shots) + " shots no closer by a fifth with the fitted values "
+           "(median velocity error " + format_number(fit.velocity_error_fitted_mps) + " m/s) than with the board's (" +
+               format_number(fit.velocity_error_nominal_mps) + " m/s at the nominal delay, " +
+               format_number(fit.velocity_error_delay_only_mps) +
+               " m/s at the identified one): the board's are kept; the timing fit's stroke speed only says when "
+               "the bat arrives"});
+    }
+    result.overlay.flippers.push_back(overlay);
+    result.flipper_strokes.push_back(fit);
+  }
 }
 
 }  // namespace
@@ -253,16 +230,12 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
   result.overlay.gravity_mps2 = table::IdentifiedValue{g.g_mps2, g.g_stderr_mps2, g.flights};
   identify_groups(board, flights, options, result);
   identify_launcher(board, recordings, flights, options, g.g_mps2, result);
-  for (const table::Flipper& f : board.flippers)
-    result.not_identified.push_back(
-        {"flipper " + f.name + " mu, stroke speed and rise delay",
-         "not identified from ball tracks in this version: what a shot gives the ball depends on where the bat is "
-         "when it meets it, which the log does not show; measure the bat's stroke with a camera that sees it "
-         "(docs/calibration.md) and keep the board's values"});
+  identify_flippers(board, recordings, flights, options, result);
   result.not_identified.push_back(
       {"camera latency", "a constant error in it shifts the ball's frames against the commands by the same amount "
-                         "as the coil's rise delay, so ball tracks cannot tell them apart; `pinball calibrate "
-                         "latency` measures it (docs/calibration.md)"});
+                         "as the coil's rise delay, so ball tracks cannot tell them apart (the identified rise delay "
+                         "holds both, which is what a controller leads by); `pinball calibrate latency` measures it "
+                         "(docs/calibration.md)"});
   result.not_identified.push_back(
       {"speed clamp", "the model's clamp stands in for friction; the drag the free flights show is reported "
                       "instead (the model cannot play it)"});

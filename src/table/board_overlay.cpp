@@ -67,7 +67,11 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
   for (std::size_t i = 0; i < o.flippers.size(); ++i) {
     const std::string key = "flippers[" + std::to_string(i) + "]";
     if (o.flippers[i].name.empty()) r.fail(key + ".name", "is empty");
-    check_value(o.flippers[i].mu, kZero, {10.0, false}, "", key + ".mu", r);
+    if (o.flippers[i].mu) check_value(*o.flippers[i].mu, kZero, {10.0, false}, "", key + ".mu", r);
+    if (o.flippers[i].omega_rad_s)
+      check_value(*o.flippers[i].omega_rad_s, kAboveZero, {200.0, false}, " rad/s", key + ".omega_rad_s", r);
+    if (o.flippers[i].rise_delay_s)
+      check_value(*o.flippers[i].rise_delay_s, kZero, {0.1, false}, " s", key + ".rise_delay_s", r);
   }
   if (o.launcher) {
     check_value(o.launcher->pull, kAboveZero, {1.0, false}, "", "launcher.pull", r);
@@ -164,7 +168,8 @@ void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, B
                      "'" + f.name + "' is not a flipper of the board " + board.source +
                          " (its flippers: " + names_of(board.flippers) + ")");
     }
-    target->mu = f.mu.value;
+    if (f.mu) target->mu = f.mu->value;
+    if (f.omega_rad_s) target->omega_rad_s = f.omega_rad_s->value;
   }
   if (overlay.launcher) {
     b.launcher.pull = overlay.launcher->pull.value;
@@ -178,6 +183,15 @@ void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, B
                    std::string(e.what()) + " (on the board " + board.source + ")");
   }
   board = std::move(b);
+}
+
+std::optional<double> identified_actuation_delay_s(const BoardOverlay& overlay) {
+  double sum = 0.0;
+  int n = 0;
+  for (const FlipperOverlay& f : overlay.flippers)
+    if (f.rise_delay_s) sum += f.rise_delay_s->value, ++n;
+  if (n == 0) return std::nullopt;
+  return sum / n;
 }
 
 Board load_belief_board(const std::string& board_path, const std::string& overlay_path) {

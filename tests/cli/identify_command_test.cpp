@@ -48,6 +48,12 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   EXPECT_GT(j["free_flights"].get<int>(), 20);
   EXPECT_EQ(j["overlay"], overlay);
   EXPECT_FALSE(j["not_identified"].empty());
+  // The recording's flippers never rose: each is reported, none identified, no delay.
+  ASSERT_EQ(j["flippers"].size(), 2u);
+  EXPECT_EQ(j["flippers"][0]["name"], "left_flipper");
+  EXPECT_FALSE(j["flippers"][0]["identified"].get<bool>());
+  EXPECT_EQ(j["flipper_shots"], 0);
+  EXPECT_TRUE(j["actuation_delay_s"].is_null());
   EXPECT_GT(j["held_out"]["nominal"]["moments"].get<int>(), 50);
   EXPECT_LT(j["held_out"]["identified"]["mean_m"].get<double>(), j["held_out"]["nominal"]["mean_m"].get<double>());
   const table::BoardOverlay written = table::read_board_overlay(overlay);

@@ -106,7 +106,7 @@ TEST(Identification, SaysWhichParametersItCouldNotIdentifyAndWhy) {
   };
   EXPECT_TRUE(said("launcher pull and noise"));
   EXPECT_TRUE(said("camera latency"));
-  EXPECT_TRUE(said("flipper left_flipper mu"));
+  EXPECT_TRUE(said("flipper left_flipper rise delay, stroke speed and mu"));
   EXPECT_TRUE(said("obstacle group rho=1.4 kick=0.6 m/s"));
   for (const GroupResult& g : r.groups) EXPECT_EQ(g.identified, g.why_not.empty());
 }

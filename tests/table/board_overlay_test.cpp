@@ -36,7 +36,8 @@ BoardOverlay full() {
   bumpers.rho = value(1.0, 0.05, 20);
   bumpers.kick_mps = value(0.7, 0.1, 20);
   o.obstacle_groups = {arcs, bumpers};
-  o.flippers = {{"left_flipper", value(1.4, 0.1, 55)}, {"right_flipper", value(1.7, 0.12, 48)}};
+  o.flippers = {{"left_flipper", value(1.4, 0.1, 55), value(40.0, 2.0, 54), value(0.012, 0.001, 54)},
+                {"right_flipper", value(1.7, 0.12, 48)}};
   o.launcher = LauncherOverlay{value(0.9, 0.01, 30), value(0.05, 0.01, 30)};
   return o;
 }
@@ -88,7 +89,11 @@ TEST(BoardOverlay, EveryFieldRoundTrips) {
   EXPECT_EQ(b.obstacle_groups[1].rho.events, 20);
   ASSERT_EQ(b.flippers.size(), 2u);
   EXPECT_EQ(b.flippers[1].name, "right_flipper");
-  EXPECT_EQ(b.flippers[1].mu.value, 1.7);
+  EXPECT_EQ(b.flippers[1].mu->value, 1.7);
+  EXPECT_FALSE(b.flippers[1].omega_rad_s);
+  ASSERT_TRUE(b.flippers[0].omega_rad_s && b.flippers[0].rise_delay_s);
+  EXPECT_EQ(b.flippers[0].omega_rad_s->value, 40.0);
+  EXPECT_EQ(b.flippers[0].rise_delay_s->stderr_, 0.001);
   ASSERT_TRUE(b.launcher);
   EXPECT_EQ(b.launcher->pull.value, 0.9);
   EXPECT_EQ(b.launcher->noise_max.stderr_, 0.01);
@@ -156,9 +161,9 @@ TEST(BoardOverlay, EveryRangeIsChecked) {
   o.gravity_mps2->value = 20.5;
   expect_key_error(board_overlay_to_yaml(o), "gravity_mps2.value", "must be in (0, 20] m/s^2");
   o = full();
-  o.flippers[1].mu.value = 10.5;
+  o.flippers[1].mu->value = 10.5;
   expect_key_error(board_overlay_to_yaml(o), "flippers[1].mu.value", "must be in [0, 10]");
-  o.flippers[1].mu.value = -1.0;
+  o.flippers[1].mu->value = -1.0;
   expect_key_error(board_overlay_to_yaml(o), "flippers[1].mu.value", "must be in [0, 10]");
   o = full();
   o.launcher->pull.value = 0.0;
@@ -174,7 +179,13 @@ TEST(BoardOverlay, EveryRangeIsChecked) {
   o.obstacle_groups[0].rho.stderr_ = -0.01;
   expect_key_error(board_overlay_to_yaml(o), "obstacle_groups[0].rho.stderr", "must be >= 0");
   o = full();
-  o.flippers[0].mu.events = -1;
+  o.flippers[0].omega_rad_s->value = 0.0;
+  expect_key_error(board_overlay_to_yaml(o), "flippers[0].omega_rad_s.value", "must be in (0, 200] rad/s");
+  o = full();
+  o.flippers[0].rise_delay_s->value = 0.2;
+  expect_key_error(board_overlay_to_yaml(o), "flippers[0].rise_delay_s.value", "must be in [0, 0.1] s");
+  o = full();
+  o.flippers[0].mu->events = -1;
   expect_key_error(board_overlay_to_yaml(o), "flippers[0].mu.events", "must be >= 0");
   o = full();
   o.obstacle_groups[0].board_rho = -1.0;
@@ -283,7 +294,8 @@ TEST(BoardOverlay, ApplyChangesExactlyTheNamedParameters) {
   bumpers.rho = value(0.95, 0.05, 20);
   bumpers.kick_mps = value(0.65, 0.1, 20);
   o.obstacle_groups = {arc, bumpers};
-  o.flippers = {{"right_flipper", value(1.3, 0.1, 40)}};
+  o.flippers = {{"right_flipper", value(1.3, 0.1, 40), value(42.0, 3.0, 40), value(0.015, 0.001, 40)},
+                {"left_flipper", std::nullopt, std::nullopt, value(0.019, 0.001, 30)}};
   o.launcher = LauncherOverlay{value(0.85, 0.01, 30), value(0.06, 0.01, 30)};
   Board b = file;
   apply_board_overlay(o, "over.yaml", b);
@@ -315,7 +327,11 @@ TEST(BoardOverlay, ApplyChangesExactlyTheNamedParameters) {
   EXPECT_EQ(arc_shapes, file_arc_shapes);
   for (std::size_t i = 0; i < b.flippers.size(); ++i) {
     EXPECT_EQ(b.flippers[i].mu, b.flippers[i].name == "right_flipper" ? 1.3 : file.flippers[i].mu);
+    EXPECT_EQ(b.flippers[i].omega_rad_s, b.flippers[i].name == "right_flipper" ? 42.0 : file.flippers[i].omega_rad_s);
   }
+  // The rise delay is not the board's: the actuation delay, the flippers' mean.
+  EXPECT_NEAR(*identified_actuation_delay_s(o), 0.017, 1e-15);
+  EXPECT_FALSE(identified_actuation_delay_s(BoardOverlay{}));
 }
 
 TEST(BoardOverlay, AnUnknownNameThrowsAndLeavesTheBoardUntouched) {

@@ -9,12 +9,14 @@
 //    out against the normal speed in gives ρ (and the kick, for obstacles the
 //    board gives one) of each material group: the obstacles the board file
 //    gives the same ρ and kick;
-//  - launches, flights that start at the launcher: the pull and noise.
+//  - launches, flights that start at the launcher: the pull and noise;
+//  - flipper shots, a free flight into a rising bat and one out of it after
+//    the flipper's energize command (flipper_shots.h): each flipper's rise
+//    delay, stroke speed and μ.
 // Every figure comes with its standard uncertainty and the events behind it;
 // a parameter without enough events is listed with the reason instead.
-// Flipper μ, the stroke speed, the coil's rise delay and the camera's latency
-// are not identified here (docs/identification.md says why and what measures
-// them).
+// The camera's latency is not identified apart from the rise delay: ball
+// tracks cannot tell the two apart (docs/identification.md).
 
 #include <cstdint>
 #include <functional>
@@ -23,6 +25,7 @@
 #include <vector>
 
 #include "pinball/bus/recorded_play.h"
+#include "pinball/learn/flipper_shots.h"
 #include "pinball/learn/free_flight.h"
 #include "pinball/table/board.h"
 #include "pinball/table/board_overlay.h"
@@ -42,6 +45,8 @@ struct IdentifyOptions {
   int min_rebounds = 8;              ///< a group needs this many rebounds for ρ (and 2 more for a kick)
   int min_launches = 5;              ///< launches needed for the pull and the noise
   double launch_reach_m = 0.03;      ///< a launch flight starts within this of the rest position across the chute, and up to 5x this above it (m)
+  ShotOptions shots;                 ///< how flipper shots are found and fitted
+  double nominal_actuation_delay_s = 0.004;  ///< the delay the board's stroke prediction assumes (firmware's default)
 };
 
 /// One rebound off a board obstacle.
@@ -79,6 +84,8 @@ struct IdentificationResult {
   std::vector<GroupResult> groups;        ///< every material group of the board with obstacles
   std::vector<Rebound> rebounds;          ///< every rebound used
   std::vector<double> launch_speeds_mps;  ///< launch speed at the launcher of every launch seen
+  std::vector<FlipperShot> shots;         ///< every flipper shot found
+  std::vector<FlipperStrokeFit> flipper_strokes;  ///< one per board flipper
   std::vector<NotIdentified> not_identified;
   std::size_t frames = 0;                 ///< frames read
   std::size_t sightings = 0;              ///< frames that saw the ball

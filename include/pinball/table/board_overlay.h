@@ -55,15 +55,19 @@ struct ObstacleGroupOverlay {
   }
 };
 
-/// One flipper's identified moment factor.
+/// One flipper as its shots identified it (learn/flipper_shots.h).
 struct FlipperOverlay {
   std::string name;  ///< the board's flipper name
-  IdentifiedValue mu;  ///< moment factor μ (dimensionless) at the board's stroke speed
+  std::optional<IdentifiedValue> mu;           ///< moment factor μ (dimensionless), at omega_rad_s when given, else the board's stroke speed
+  std::optional<IdentifiedValue> omega_rad_s;   ///< the stroke's angular speed (rad/s); identify writes it only with μ
+  std::optional<IdentifiedValue> rise_delay_s;  ///< command to the bat's first motion (s): the actuation delay
 
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(PINBALL_NVP(name));
     a->Visit(PINBALL_NVP(mu));
+    a->Visit(PINBALL_NVP(omega_rad_s));
+    a->Visit(PINBALL_NVP(rise_delay_s));
   }
 };
 
@@ -119,7 +123,8 @@ void write_board_overlay(const BoardOverlay& overlay, const std::string& path);
 
 /// Reads an overlay file. Throws KeyError "path:key: what is wrong" for a
 /// missing, unknown, repeated, mistyped or out-of-range key (ρ in [0, 3],
-/// kick in [0, 10] m/s, g in (0, 20] m/s², μ in [0, 10], pull in (0, 1],
+/// kick in [0, 10] m/s, g in (0, 20] m/s², μ in [0, 10], ω in (0, 200] rad/s,
+/// rise delay in [0, 0.1] s, pull in (0, 1],
 /// noise_max in [0, 1), stderr ≥ 0, events ≥ 0) or a wrong version;
 /// std::runtime_error naming the file when it cannot be read or parsed.
 BoardOverlay read_board_overlay(const std::string& path);
@@ -129,11 +134,16 @@ BoardOverlay parse_board_overlay(const std::string& text, const std::string& nam
 
 /// Lays the overlay over `board`: g, each group's obstacles' ρ and kick (by
 /// name, every shape of a named obstacle), each flipper's μ (by name), the
-/// launcher's pull and noise. All or nothing: throws KeyError "name:key: ..."
+/// launcher's pull and noise, and each flipper's stroke speed where given (its
+/// rise delay is not the board's: identified_actuation_delay_s). All or nothing: throws KeyError "name:key: ..."
 /// (`name` stands for the overlay file) for an obstacle or flipper name the
 /// board does not have, or for a pull, noise and g with which a launch could
 /// not leave the launcher (the board loader's rule), leaving `board` untouched.
 void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, Board& board);
+
+/// The actuation delay the overlay's flippers show: the mean of their
+/// identified rise delays (s); nullopt when none has one.
+std::optional<double> identified_actuation_delay_s(const BoardOverlay& overlay);
 
 /// The belief every playing command holds: the board file, with the overlay
 /// at `overlay_path` laid over it when that is not empty.
