@@ -68,6 +68,7 @@ std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const Transfer
   std::vector<PlannedWorld> out;
   const auto add_factory_world = [&](const std::string& name, const simlab::WorldSpec& spec) {
     PlannedWorld w{{}, nominal, {}};
+    if (spec.kind == simlab::WorldKind::kTwin) w.settings.actuation_delay_s = o.twin_actuation_delay_s;
     w.row.name = name;
     w.row.family = "nominal";
     w.row.world = std::string(simlab::world_name(spec));

@@ -71,7 +71,11 @@ struct TransferBenchOptions {
   std::uint64_t seed = 1;           ///< ball i plays ball_seed(seed, i)
   int threads = 2;                  ///< worker threads; results do not depend on it
   double max_ball_time_s = 60.0;    ///< a ball alive after this is cut (as in the evaluator)
-  double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< nominal command to flipper motion
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< nominal command to flipper motion in the model worlds
+  /// The twin's delay before its coil (the driver's): the twin plays the
+  /// coil's rise and the bat's inertia itself, which a model world's delay
+  /// stands in for (an identified delay holds them all).
+  double twin_actuation_delay_s = firmware::kDefaultActuationDelay_s;
   track::CameraModelConfig camera;  ///< the nominal camera (the tracker's belief in every world)
   std::vector<SweepFamily> sweep = default_transfer_sweep();  ///< the perturbations
   /// The players after the spastic baseline, which always plays first (the ratios' denominator).

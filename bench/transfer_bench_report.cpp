@@ -105,6 +105,7 @@ nlohmann::json to_json(const TransferReport& r) {
           {"threads", o.threads},
           {"max_ball_time_s", o.max_ball_time_s},
           {"actuation_delay_s", o.actuation_delay_s},
+          {"twin_actuation_delay_s", o.twin_actuation_delay_s},
           {"camera", to_json_value(o.camera)},
           {"pivot_axis", kPivotAxis},
           {"wall_rho_rule", kWallRhoRule},

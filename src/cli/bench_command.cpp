@@ -242,6 +242,7 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
     options.controller_name = a.controllers.front();
   }
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
+  options.actuation_delay_s = world_actuation_delay_s(std::nullopt, world_spec, a.identified);
   const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
   const bench::CeilingReport report = bench::run_ceiling_bench(
       board, options, [&](const std::string& line) { err << "bench ceiling: " << line << "\n"; }, world.world.get());
@@ -278,6 +279,8 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
   options.camera = a.camera;
   options.twin_params_path = a.world.twin_params_path;
   options.identified = a.identified;
+  // The model worlds play the identified delay when the overlay has one; the twin its driver's (world_actuation_delay_s).
+  options.actuation_delay_s = world_actuation_delay_s(std::nullopt, simlab::WorldSpec{}, a.identified);
   std::vector<std::string> files = a.controllers;
   if (files.empty()) {
     for (const char* f : {"controllers/best.json", "controllers/imitation.json", "controllers/cem.json"}) {

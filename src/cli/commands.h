@@ -115,7 +115,8 @@ struct LearnArgs {
   int rounds = 4;                       ///< imitate: rounds (1: the teacher's balls only; more: DAgger)
   double max_ball_time_s = 60.0;        ///< a ball alive after this is cut: a cycle
   double loss_penalty = 500.0;          ///< reward of an opportunity that lost the ball
-  double actuation_delay_s = firmware::kDefaultActuationDelay_s;     ///< command to flipper motion (s)
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;     ///< command to flipper motion (s): run_learn resolves it
+  bool actuation_delay_given = false;   ///< --actuation-delay was given (else the identified one, cli::world_actuation_delay_s)
   double gravity_scale = 1.0;           ///< tracker's g / board's g
   track::CameraModelConfig camera;      ///< the camera the tracker sees through
   simlab::WorldSpec world;              ///< the world (default: the model of `board` on the thesis stepper)

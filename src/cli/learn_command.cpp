@@ -95,7 +95,14 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball is cut (a cycle)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--loss-penalty", a.loss_penalty, "reward of a flip opportunity that lost the ball (6.3.1)");
-  cmd->add_option("--actuation-delay", a.actuation_delay_s, "command to flipper motion (s)")
+  cmd->add_option_function<double>(
+         "--actuation-delay",
+         [&a](const double& v) {
+           a.actuation_delay_s = v;
+           a.actuation_delay_given = true;
+         },
+         "command to flipper motion (s); default: in a model world the --identified overlay's (its flippers' rise "
+         "delay) when it has one, else the firmware's 0.004")
       ->check(CLI::Range(0.0, 0.5));
   cmd->add_option("--gravity-scale", a.gravity_scale, "tracker's g over the board's (miscalibration)")
       ->check(CLI::Range(0.1, 10.0));
@@ -299,7 +306,11 @@ int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err
   return 0;
 }
 
-int run_learn(const LearnArgs& a, std::ostream& out, std::ostream& err) {
+int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
+  LearnArgs a = args;
+  a.actuation_delay_s = world_actuation_delay_s(
+      args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,
+      args.identified);
   if (a.method == "launcher") return run_launcher_search(a, out, err);
   const bool search = a.method == "tournament" || a.method == "relay" || a.method == "cem";
   if ((search || a.method == "imitate") && a.out.empty()) {

@@ -3,6 +3,8 @@
 #include "data_file.h"
 #include "pinball/core/json_read_archive.h"
 #include "pinball/core/json_write_archive.h"
+#include "pinball/firmware/flipper_actuation.h"
+#include "pinball/table/board_overlay.h"
 
 #include <map>
 #include <string>
@@ -44,6 +46,16 @@ void add_identified_option(CLI::App& cmd, std::string& identified) {
   cmd.add_option("--identified", identified,
                  "identified parameters laid over the belief board (`pinball identify`, docs/identification.md)")
       ->check(CLI::ExistingFile);
+}
+
+double world_actuation_delay_s(std::optional<double> given_s, const simlab::WorldSpec& world,
+                               const std::string& identified) {
+  if (given_s) return *given_s;
+  if (world.kind == simlab::WorldKind::kModel && !identified.empty()) {
+    if (const std::optional<double> d = table::identified_actuation_delay_s(table::read_board_overlay(identified)))
+      return *d;
+  }
+  return firmware::kDefaultActuationDelay_s;
 }
 
 nlohmann::json identified_report(const std::string& identified) {

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 
 #include "pinball/simlab/world_factory.h"
@@ -21,6 +22,15 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world);
 /// simlab::world_for_belief: a model world defaulting to the belief plays
 /// them too, the twin never.
 void add_identified_option(CLI::App& cmd, std::string& identified);
+
+/// The delay from a coil command to the bat's first motion that a world
+/// plays: `given_s` (--actuation-delay) when set; else, in a model world, the
+/// overlay's identified actuation delay (table::identified_actuation_delay_s)
+/// when `identified` has one; else the firmware's default. The twin never
+/// takes the identified delay: it plays the coil's rise and the bat's inertia
+/// itself, behind the driver's default delay.
+double world_actuation_delay_s(std::optional<double> given_s, const simlab::WorldSpec& world,
+                               const std::string& identified);
 
 /// `identified`: the overlay laid over the belief, or null when the belief is
 /// the board file alone, so that a reader of a report knows which belief played.

@@ -74,6 +74,19 @@ TEST_F(TransferCommand, SameSeedSameJsonWhateverTheThreads) {
   EXPECT_EQ(without_timing(nlohmann::json::parse(one.out)).dump(), without_timing(nlohmann::json::parse(two.out)).dump());
 }
 
+// An identified delay is the model worlds' nominal; the twin keeps its driver's.
+TEST_F(TransferCommand, TheModelWorldsPlayTheIdentifiedDelayAndTheTwinItsOwn) {
+  const fs::path over = dir_ / "delay.yaml";
+  std::ofstream(over) << "version: 1\ndate: 2026-12-02T13:45:21Z\nboard: boards/mit1993.board\nrecordings: []\n"
+                         "flippers:\n  - name: left_flipper\n    rise_delay_s: {value: 0.016, stderr: 0.001, events: 9}\n";
+  const CommandResult r = run("bench transfer --quick --balls 1 --twin-balls 1 --max-ball-time 2 --json --identified " +
+                              over.string() + " --controller controllers/best.json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_DOUBLE_EQ(j.at("actuation_delay_s").get<double>(), 0.016);
+  EXPECT_DOUBLE_EQ(j.at("twin_actuation_delay_s").get<double>(), 0.004);
+}
+
 TEST_F(TransferCommand, TextIsARoundedTableWithTheCap) {
   const CommandResult r =
       run("bench transfer --quick --balls 2 --max-ball-time 5 --controller controllers/best.json");

@@ -313,6 +313,27 @@ TEST_F(Cli, SimNamesTheIdentifiedOverlayAndRefusesABadOne) {
   EXPECT_EQ(t.at("world_board"), "boards/mit1993.board");
 }
 
+// An overlay's flipper rise delays are the model world's actuation delay
+// unless --actuation-delay says otherwise; the twin keeps its driver's.
+TEST_F(Cli, LearnPlaysTheIdentifiedActuationDelayInTheModelWorld) {
+  const fs::path over = dir_ / "delay.yaml";
+  std::ofstream(over) << "version: 1\ndate: 2026-12-02T13:45:21Z\nboard: boards/mit1993.board\nrecordings: []\n"
+                         "flippers:\n"
+                         "  - name: left_flipper\n    rise_delay_s: {value: 0.014, stderr: 0.001, events: 9}\n"
+                         "  - name: right_flipper\n    rise_delay_s: {value: 0.018, stderr: 0.001, events: 9}\n";
+  const std::string learn = "learn boards/mit1993.board --method spastic --eval-balls 2 --seed 3 --json";
+  const auto delay_of = [&](const std::string& args) {
+    const CommandResult r = run(learn + args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(r.out).at("evaluation").at("actuation_delay_s").get<double>();
+  };
+  EXPECT_DOUBLE_EQ(delay_of(""), 0.004);
+  EXPECT_NEAR(delay_of(" --identified " + over.string()), 0.016, 1e-12);
+  EXPECT_DOUBLE_EQ(delay_of(" --identified " + over.string() + " --actuation-delay 0.009"), 0.009);
+  if (!pinball::simlab::twin_available()) return;
+  EXPECT_DOUBLE_EQ(delay_of(" --world twin --max-ball-time 2 --identified " + over.string()), 0.004);
+}
+
 TEST_F(Cli, BadBoardFileIsOneLineNamingFileAndLine) {
   const fs::path bad = dir_ / "bad.board";
   std::ofstream(bad) << "pinball-board 1\nsize 0.5 1\ncirle 0.1 0.1 0.01\n";
