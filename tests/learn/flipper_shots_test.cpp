@@ -94,7 +94,7 @@ TEST(FlipperShots, RecoverTheModelsRiseDelayStrokeSpeedAndMu) {
 TEST(FlipperShots, ABatAlreadyUpOrNoCommandGivesNoShot) {
   const table::Board board = flipper_scene();
   std::vector<bus::RecordedPlay> plays{record_shots(board, 0.01, 20, 5)};
-  // Every energize moved before the previous release: the bat was not down when the coil fired.
+  // Every energize stamped 0.2 s early: too soon after the last release, and too long before the contact.
   bus::RecordedPlay late = plays[0];
   for (std::size_t i = 0; i + 1 < late.commands.size(); i += 2) late.commands[i].t_s = late.commands[i].t_s - 0.2;
   std::vector<bus::RecordedPlay> no_commands{plays[0]};

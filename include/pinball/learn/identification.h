@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "pinball/bus/recorded_play.h"
+#include "pinball/firmware/flipper_actuation.h"
 #include "pinball/learn/flipper_shots.h"
 #include "pinball/learn/free_flight.h"
 #include "pinball/table/board.h"
@@ -46,7 +47,7 @@ struct IdentifyOptions {
   int min_launches = 5;              ///< launches needed for the pull and the noise
   double launch_reach_m = 0.03;      ///< a launch flight starts within this of the rest position across the chute, and up to 5x this above it (m)
   ShotOptions shots;                 ///< how flipper shots are found and fitted
-  double nominal_actuation_delay_s = 0.004;  ///< the delay the board's stroke prediction assumes (firmware's default)
+  double nominal_actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< the delay the board's stroke prediction assumes
 };
 
 /// One rebound off a board obstacle.
