@@ -7,6 +7,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "pinball/learn/planning_controller.h"
 #include "pinball/core/progress.h"
 #include "pinball/control/spastic_controller.h"
 #include "pinball/learn/evaluator.h"
@@ -52,7 +53,7 @@ CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper&
   } else if (kind == CeilingPlayerKind::kTrackerSpastic || kind == CeilingPlayerKind::kController) {
     // The evaluator's own loop and seeds: camera model, tracker, controller, actuation delay.
     const std::unique_ptr<control::FlipperController> controller =
-        kind == CeilingPlayerKind::kController ? control::make_flipper_controller(*options.controller)
+        kind == CeilingPlayerKind::kController ? learn::make_controller(*options.controller, board)
                                                : std::make_unique<control::SpasticController>();
     if (kind == CeilingPlayerKind::kController) limits.pull = options.controller->launcher_pull;
     r = learn::play_through_tracker(world, board, state, options.camera,

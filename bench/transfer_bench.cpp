@@ -8,6 +8,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "pinball/learn/planning_controller.h"
 #include "pinball/control/spastic_controller.h"
 #include "pinball/core/progress.h"
 #include "pinball/core/rng.h"
@@ -30,7 +31,7 @@ TransferBall play_transfer_ball(sim::World& world, const WorldSettings& settings
                                 const track::CameraModelConfig& belief_camera, const control::ControllerSpec* spec,
                                 double max_ball_time_s, std::uint64_t ball_seed) {
   const std::unique_ptr<control::FlipperController> controller =
-      spec != nullptr ? control::make_flipper_controller(*spec) : std::make_unique<control::SpasticController>();
+      spec != nullptr ? learn::make_controller(*spec, belief) : std::make_unique<control::SpasticController>();
   sim::GameState state = sim::make_game_state(world.board(), ball_seed);
   sim::BallLimits limits;
   limits.max_ball_time_s = max_ball_time_s;

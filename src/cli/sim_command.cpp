@@ -14,6 +14,7 @@
 #include "camera_options.h"
 #include "data_file.h"
 #include "commands.h"
+#include "pinball/learn/planning_controller.h"
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/format.h"
 #include "pinball/core/progress.h"
@@ -109,7 +110,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   double pull = -1.0;
   if (policy == "controller") {
     const control::ControllerSpec spec = control::load_controller(a.controller);
-    learned = control::make_flipper_controller(spec);
+    learned = learn::make_controller(spec, board);
     learned_player.emplace(board, a.camera, *learned, a.seed ^ 0x5DEECE66Dull);
     pull = spec.launcher_pull;
   }

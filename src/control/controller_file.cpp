@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -149,6 +150,12 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
     refuse(r, where, check_minicontroller(mc));
   }
   if (j.contains("imitation")) s.shot_table = std::make_shared<const ShotTable>(shot_table_from_json(j["imitation"], r));
+  if (j.contains("planner")) {
+    PlannerSettings p;
+    r.read(&j["planner"], "planner", &p);
+    refuse(r, "planner", check_planner_settings(p));
+    s.planner = p;
+  }
   if (j.contains("actuator")) {
     r.read(&j["actuator"], "actuator", &s.actuator);
     refuse(r, "actuator", check_actuator_config(s.actuator));
@@ -171,6 +178,9 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
 }  // namespace
 
 std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec) {
+  if (spec.planner) {
+    throw std::invalid_argument("controller: the planner needs the belief board (learn::make_controller)");
+  }
   if (spec.shot_table) return std::make_unique<ImitationController>(spec.shot_table);
   return std::make_unique<ActuatorController>(spec.action_function, spec.actuator);
 }
@@ -195,6 +205,7 @@ std::string controller_to_json(const ControllerSpec& s) {
       {"launcher", to_json_value(LauncherSection{s.launcher_pull, s.randomise_launch, s.launch_pull_min,
                                                  s.launch_pull_max})},
   };
+  if (s.planner) j["planner"] = to_json_value(*s.planner);
   if (!s.shot_table) return j.dump(2) + "\n";
   // One line per shot: the table stays readable (and diffable) at thousands of shots.
   json table = shot_table_json(*s.shot_table);

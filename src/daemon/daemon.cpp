@@ -32,6 +32,7 @@
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/vision/capture_source.h"
 #include "pinball/simlab/sim_camera_source.h"
+#include "pinball/learn/planning_controller.h"
 
 #include "camera_worker.h"
 #include "controller_worker.h"
@@ -205,7 +206,7 @@ void Daemon::Impl::build() {
   }
   board = table::load_belief_board(sim_mode ? config.sim.board : config.board, config.identified);
   spec = control::load_controller(config.controller);
-  controller = control::make_flipper_controller(spec);
+  controller = learn::make_controller(spec, board);
   driver_of_flipper = controller_stage_options_for(config, board).driver_of_flipper;
   const int drivers = static_cast<int>(board.flippers.size());
 

@@ -16,6 +16,7 @@
 #include "pinball/firmware/stream_transport.h"
 #include "pinball/table/board_overlay.h"
 #include "pinball/track/flipper_geometry.h"
+#include "pinball/learn/planning_controller.h"
 
 namespace pinball::daemon {
 namespace {
@@ -48,7 +49,7 @@ ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
   const table::Board board =
       table::load_belief_board(config.mode == "sim" ? config.sim.board : config.board, config.identified);
   const control::ControllerSpec spec = control::load_controller(config.controller);
-  const std::unique_ptr<control::FlipperController> controller = control::make_flipper_controller(spec);
+  const std::unique_ptr<control::FlipperController> controller = learn::make_controller(spec, board);
   const TrackingSetup setup = tracking_setup_for(config, board);
   track::Tracker tracker(setup.geometry, setup.tracker);
   CameraStage camera(nullptr, tracker, lost_after_s_for(config));

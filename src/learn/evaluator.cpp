@@ -6,6 +6,7 @@
 
 #include "pinball/control/actuator_controller.h"
 #include "pinball/sim/model_world.h"
+#include "pinball/learn/planning_controller.h"
 
 namespace pinball::learn {
 
@@ -97,7 +98,7 @@ control::ControllerSpec PinballEvaluator::prototype() const {
 }
 
 BallOutcome PinballEvaluator::play(const control::ControllerSpec& spec, std::uint64_t seed) const {
-  const std::unique_ptr<control::FlipperController> controller = control::make_flipper_controller(spec);
+  const std::unique_ptr<control::FlipperController> controller = make_controller(spec, board_);
   double pull = spec.launcher_pull;
   if (spec.randomise_launch) {
     Rng rng(seed ^ 0xA5A5A5A5DEADBEEFull);

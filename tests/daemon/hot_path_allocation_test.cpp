@@ -134,5 +134,11 @@ TEST(HotPath, TheImitationControllerAllocatesNothingPerFrame) {
   std::remove(path.c_str());
 }
 
+TEST(HotPath, TheOnlinePlannerAllocatesNothingPerFrame) {
+  if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
+  // Every plan copies the belief state into the planner's scratch state: same sizes, no allocation.
+  expect_no_allocation_per_frame(std::string(PINBALL_SOURCE_DIR) + "/controllers/planner.json");
+}
+
 }  // namespace
 }  // namespace pinball::daemon

@@ -4,12 +4,14 @@
 // ControllerFileError naming the file and the field.
 
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "pinball/control/action_function.h"
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/imitation_controller.h"
+#include "pinball/control/planner_settings.h"
 
 namespace pinball::control {
 
@@ -24,6 +26,11 @@ struct ControllerSpec {
   /// set, it drives the flippers instead of the action function.
   /// Shared, not copied, with every controller made from this spec.
   std::shared_ptr<const ShotTable> shot_table;
+  /// The online planner (learn::PlanningController): when set, it drives the
+  /// flippers, planning in the belief model, and the shot table and action
+  /// function are not used. Only learn::make_controller, which is given the
+  /// belief board, can build it.
+  std::optional<PlannerSettings> planner;
   double launcher_pull = -1.0;    ///< launcher pull fraction; negative: the board's
   bool randomise_launch = false;  ///< draw the pull per ball from [launch_pull_min, launch_pull_max] (thesis 7.1)
   double launch_pull_min = 0.5;   ///< lower end of a randomised pull
@@ -33,6 +40,8 @@ struct ControllerSpec {
 
 /// The flipper controller a spec describes: the imitation controller when it
 /// holds a shot table, the action function's actuator controller otherwise.
+/// Throws std::invalid_argument for a planner spec, which needs the belief
+/// board (learn::make_controller builds every kind).
 std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec);
 
 /// Bad controller input; what() is "file: field: message".

@@ -1,0 +1,43 @@
+#pragma once
+// The settings of the online planner (`learn::PlanningController`): every
+// camera frame while the ball falls near a flipper, it plays "don't fire" and
+// "fire at frame k, hold H" ahead in the belief model from the tracker's
+// estimate of the ball and acts on the best plan's first frame. A controller
+// file holds them under "planner" (docs/learning.md); the planner itself lives
+// in learn, which has the simulator.
+
+#include "pinball/core/check.h"
+#include "pinball/core/name_value.h"
+#include "pinball/firmware/flipper_actuation.h"
+
+namespace pinball::control {
+
+/// What the planner tries and what it believes of the coil.
+struct PlannerSettings {
+  int fire_frames = 8;           ///< fire candidates at frames 0..fire_frames from now (5 ms frames)
+  double short_hold_s = 0.03;    ///< the short hold candidate (s)
+  double long_hold_s = 0.10;     ///< the long hold candidate (s)
+  double zone_factor = 5.0;      ///< plan while the ball is within this many radii of a flipper's rest segment
+  double horizon_s = 1.5;        ///< longest branch (simulated s)
+  double drain_penalty = 20000.0;  ///< points a branch loses when the ball drains in it
+  /// Command to bat motion the planner assumes (s): the calibrated or identified delay.
+  double actuation_delay_s = firmware::kDefaultActuationDelay_s;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(fire_frames));
+    a->Visit(PINBALL_NVP(short_hold_s));
+    a->Visit(PINBALL_NVP(long_hold_s));
+    a->Visit(PINBALL_NVP(zone_factor));
+    a->Visit(PINBALL_NVP(horizon_s));
+    a->Visit(PINBALL_NVP(drain_penalty));
+    a->Visit(PINBALL_NVP(actuation_delay_s));
+  }
+};
+
+/// The first setting outside its range: fire_frames 0..40, holds in
+/// [0.005, 1] s, zone factor in (0, 50], horizon in (0, 10] s, drain penalty
+/// finite and >= 0, actuation delay in [0, 0.1] s.
+RangeViolation check_planner_settings(const PlannerSettings& settings);
+
+}  // namespace pinball::control
