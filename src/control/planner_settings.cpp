@@ -12,6 +12,7 @@ RangeViolation check_planner_settings(const PlannerSettings& s) {
   if (!(s.horizon_s > 0.0 && s.horizon_s <= 10.0)) return {"horizon_s", "must be in (0, 10] s"};
   if (!(std::isfinite(s.drain_penalty) && s.drain_penalty >= 0.0)) return {"drain_penalty", "must be finite and >= 0"};
   if (!(s.actuation_delay_s >= 0.0 && s.actuation_delay_s <= 0.1)) return {"actuation_delay_s", "must be in [0, 0.1] s"};
+  if (!(s.step_budget >= 1000 && s.step_budget <= 10'000'000)) return {"step_budget", "must be in [1000, 10^7] steps"};
   return {};
 }
 

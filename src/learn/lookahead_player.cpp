@@ -1,5 +1,6 @@
 #include "pinball/learn/lookahead_player.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -22,9 +23,17 @@ LookaheadPlanner::LookaheadPlanner(const sim::ThesisStepper& stepper, const Look
   if (!(config.zone_factor > 0.0)) throw std::invalid_argument("ceiling planner: zone_factor must be > 0");
   if (!(config.horizon_s > 0.0)) throw std::invalid_argument("ceiling planner: horizon must be > 0");
   if (!std::isfinite(config.drain_penalty)) throw std::invalid_argument("ceiling planner: drain penalty must be finite");
+  if (config.step_budget < 0) throw std::invalid_argument("ceiling planner: step budget must be >= 0");
   candidates_.push_back({});  // don't fire
   for (int k = 0; k <= config.fire_frames; ++k) {
     for (const int h : config.hold_frames) candidates_.push_back({k, h, 0.0, 0.0, false, 0.0});
+  }
+  const auto horizon_steps = static_cast<std::uint64_t>(std::llround(config.horizon_s / stepper.dt_s()));
+  max_branch_steps_ = std::max<std::uint64_t>(1, horizon_steps);
+  if (config.step_budget > 0) {
+    const auto share = static_cast<std::uint64_t>(config.step_budget) / candidates_.size();
+    if (share < 1) throw std::invalid_argument("ceiling planner: step budget is less than one step per candidate");
+    max_branch_steps_ = std::min(max_branch_steps_, share);
   }
 }
 
@@ -64,7 +73,6 @@ void LookaheadPlanner::play_branch(LookaheadCandidate& c, int flipper) {
   scratch_delay_ = *origin_delay_;
   const double score0 = scratch_.score;
   const double t0 = scratch_.time_s;
-  const double dt = stepper_.dt_s();
   bool on = false;
   bool left_zone = false;
   c.lost = false;
@@ -85,7 +93,7 @@ void LookaheadPlanner::play_branch(LookaheadCandidate& c, int flipper) {
       c.lost = true;
       break;
     }
-    if (scratch_.time_s - t0 >= config_.horizon_s - 0.5 * dt) break;
+    if (j + 1 >= max_branch_steps_) break;  // the horizon or the budget's share
     if (!in_zone(scratch_)) {
       left_zone = true;
     } else if (left_zone && scratch_.ball.velocity_mps.y() < -config_.falling_speed_mps) {

@@ -17,6 +17,7 @@ LookaheadConfig lookahead_config(const control::PlannerSettings& s, double dt_s)
   c.zone_factor = s.zone_factor;
   c.horizon_s = s.horizon_s;
   c.drain_penalty = s.drain_penalty;
+  c.step_budget = s.step_budget;
   return c;
 }
 
@@ -95,7 +96,9 @@ void PlanningController::update(const track::TrackerOutput& o, double now_s, std
   const int f = planner_->decision_flipper(state_);
   if (f >= 0) {
     ++decisions_;
+    const std::uint64_t steps_before = planner_->branch_steps();
     const LookaheadCandidate& best = planner_->evaluate(state_, delay_, f)[planner_->best()];
+    max_decision_steps_ = std::max(max_decision_steps_, planner_->branch_steps() - steps_before);
     if (best.fire_frame == 0) {
       command_[static_cast<std::size_t>(f)] = true;
       held_ = f;

@@ -24,6 +24,11 @@ TEST(PlannerSettings, DefaultsAreInRangeAndEachBadSettingIsNamed) {
   s = {};
   s.actuation_delay_s = 0.2;
   EXPECT_EQ(check_planner_settings(s).key, "actuation_delay_s");
+  s = {};
+  s.step_budget = 999;
+  EXPECT_EQ(check_planner_settings(s).key, "step_budget");
+  s.step_budget = 10'000'001;
+  EXPECT_EQ(check_planner_settings(s).key, "step_budget");
 }
 
 TEST(PlannerSettings, AControllerFileKeepsThemAndRefusesABadOne) {
@@ -31,10 +36,12 @@ TEST(PlannerSettings, AControllerFileKeepsThemAndRefusesABadOne) {
   spec.planner = PlannerSettings{};
   spec.planner->actuation_delay_s = 0.016;
   spec.planner->horizon_s = 2.0;
+  spec.planner->step_budget = 5000;
   const ControllerSpec back = controller_from_json(controller_to_json(spec), "p.json");
   ASSERT_TRUE(back.planner.has_value());
   EXPECT_DOUBLE_EQ(back.planner->actuation_delay_s, 0.016);
   EXPECT_DOUBLE_EQ(back.planner->horizon_s, 2.0);
+  EXPECT_EQ(back.planner->step_budget, 5000);
   // Without the belief board the plain factory cannot build it, and says so.
   EXPECT_THROW(make_flipper_controller(back), std::invalid_argument);
 

@@ -80,6 +80,31 @@ TEST(LookaheadPlanner, NoDecisionForARisingOrFarBall) {
   EXPECT_EQ(planner.decision_flipper(s), 1) << "over the right flipper";
 }
 
+TEST(LookaheadPlanner, AStepBudgetShortensEveryBranchAlikeAndBoundsTheDecision) {
+  const sim::ThesisStepper stepper(thesis_board());
+  const sim::GameState s = ball_on_left_flipper(thesis_board());
+  const simlab::DelayLine delay(s.flippers.size(), 0.004);
+  LookaheadPlanner unbounded(stepper, short_planner());
+  EXPECT_EQ(unbounded.max_branch_steps(), 2000u) << "1 s of 0.5 ms steps";
+  LookaheadConfig c = short_planner();
+  c.step_budget = 9 * 100 + 5;  // 9 candidates: 100 steps (50 ms) each, the rest unused
+  LookaheadPlanner bounded(stepper, c);
+  ASSERT_EQ(bounded.max_branch_steps(), 100u);
+  const auto& k = bounded.evaluate(s, delay, 0);
+  EXPECT_LE(bounded.branch_steps(), 900u);
+  for (const LookaheadCandidate& b : k) EXPECT_LE(b.length_s, 0.050 + 1e-9);
+  EXPECT_FALSE(k[0].lost) << "50 ms is too short to see the ball drain";
+  // A budget above what the horizon needs changes nothing.
+  c.step_budget = 1'000'000;
+  LookaheadPlanner roomy(stepper, c);
+  EXPECT_EQ(roomy.max_branch_steps(), 2000u);
+  const auto& a = roomy.evaluate(s, delay, 0);
+  const auto& b = unbounded.evaluate(s, delay, 0);
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].value, b[i].value);
+  c.step_budget = 8;  // less than a step per candidate
+  EXPECT_THROW(LookaheadPlanner(stepper, c), std::invalid_argument);
+}
+
 TEST(LookaheadPlanner, RejectsBadSettings) {
   const sim::ThesisStepper stepper(thesis_board());
   LookaheadConfig c = short_planner();
@@ -87,6 +112,9 @@ TEST(LookaheadPlanner, RejectsBadSettings) {
   EXPECT_THROW(LookaheadPlanner(stepper, c), std::invalid_argument);
   c = short_planner();
   c.frame_steps = 0;
+  EXPECT_THROW(LookaheadPlanner(stepper, c), std::invalid_argument);
+  c = short_planner();
+  c.step_budget = -1;
   EXPECT_THROW(LookaheadPlanner(stepper, c), std::invalid_argument);
 }
 

@@ -53,6 +53,24 @@ TEST(PlanningController, SavesABallFallingOntoTheLeftFlipperAndReleasesAfterTheH
   EXPECT_TRUE(frames_up == 6 || frames_up == 20) << frames_up << " frames: one of the two holds";
 }
 
+TEST(PlanningController, NoDecisionSimulatesMoreThanItsStepBudget) {
+  // Eight frames of the test ball, planned with the default horizon, then with
+  // a budget a tenth of what that horizon needs: the same first decision
+  // (fire), and never more steps than the budget.
+  control::PlannerSettings tight = short_planner();
+  tight.step_budget = 1000;  // 9 plans of 111 steps (55 ms) instead of 2000
+  PlanningController c(thesis_board(), tight);
+  std::array<bool, 2> energized{false, false};
+  double t = 1.0;
+  for (int frame = 0; frame < 8 && c.fires() == 0; ++frame, t += 0.005) {
+    c.update(seen(Vec2(0.235, 0.190), Vec2(0.5, -1.5), 1.0), t, energized);
+  }
+  EXPECT_GE(c.decisions(), 1);
+  EXPECT_GT(c.max_decision_steps(), 0u);
+  EXPECT_LE(c.max_decision_steps(), 1000u);
+  EXPECT_EQ(c.fires(), 1) << "55 ms ahead is still enough to see the ball roll off the flipper";
+}
+
 TEST(PlanningController, CompensatesTheCameraLatencyByPlanningWhereTheBallIsNow) {
   // Seen 100 ms ago, 0.14 m above the flippers and out of the planning zone,
   // falling fast: by the time of the update it is on the left flipper.

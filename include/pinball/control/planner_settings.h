@@ -14,14 +14,21 @@ namespace pinball::control {
 
 /// What the planner tries and what it believes of the coil.
 struct PlannerSettings {
-  int fire_frames = 8;           ///< fire candidates at frames 0..fire_frames from now (5 ms frames)
+  int fire_frames = 4;           ///< fire candidates at frames 0..fire_frames from now (5 ms frames)
   double short_hold_s = 0.03;    ///< the short hold candidate (s)
   double long_hold_s = 0.10;     ///< the long hold candidate (s)
   double zone_factor = 5.0;      ///< plan while the ball is within this many radii of a flipper's rest segment
-  double horizon_s = 1.5;        ///< longest branch (simulated s)
+  double horizon_s = 0.5;        ///< longest branch (simulated s)
   double drain_penalty = 20000.0;  ///< points a branch loses when the ball drains in it
   /// Command to bat motion the planner assumes (s): the calibrated or identified delay.
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;
+  /// Most belief steps (0.5 ms each) one decision simulates, all plans
+  /// together: the bound on a decision's time on the controller thread. Each
+  /// plan gets an equal share, so a share shorter than the horizon shortens
+  /// every plan alike. Steps near the flippers, where plans are made, cost up
+  /// to 0.29 us in pinballd (docs/results.md), so 12000 steps is 3.5 ms of the
+  /// 5 ms frame; the defaults (11 plans of 0.5 s) need 11000.
+  int step_budget = 12000;
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -32,12 +39,14 @@ struct PlannerSettings {
     a->Visit(PINBALL_NVP(horizon_s));
     a->Visit(PINBALL_NVP(drain_penalty));
     a->Visit(PINBALL_NVP(actuation_delay_s));
+    a->Visit(PINBALL_NVP(step_budget));
   }
 };
 
 /// The first setting outside its range: fire_frames 0..40, holds in
 /// [0.005, 1] s, zone factor in (0, 50], horizon in (0, 10] s, drain penalty
-/// finite and >= 0, actuation delay in [0, 0.1] s.
+/// finite and >= 0, actuation delay in [0, 0.1] s, step budget in [1000,
+/// 10^7] steps.
 RangeViolation check_planner_settings(const PlannerSettings& settings);
 
 }  // namespace pinball::control

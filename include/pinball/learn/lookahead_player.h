@@ -32,6 +32,12 @@ struct LookaheadConfig {
   double falling_speed_mps = 0.05;       ///< the ball counts as falling when vy < -this
   double horizon_s = 3.0;                ///< longest branch (simulated s)
   double drain_penalty = 20000.0;        ///< subtracted from a branch in which the ball is lost
+  /// Most stepper steps one evaluate() may simulate, all candidates together
+  /// (0: only the horizon bounds them). Each branch gets an equal share, so
+  /// the candidates are still compared over the same length; a branch cut by
+  /// it ends as one cut by the horizon. What bounds a decision's time on the
+  /// controller thread, deterministically (the same plans on every machine).
+  std::int64_t step_budget = 0;
 };
 
 /// One candidate plan and its branch's outcome.
@@ -61,6 +67,8 @@ class LookaheadPlanner {
                                                 int flipper);
   /// Index of the best candidate of the last evaluate(): the first of the highest value.
   std::size_t best() const;
+  /// The longest branch in steps: the horizon, or the step budget's share if shorter.
+  std::uint64_t max_branch_steps() const { return max_branch_steps_; }
   /// Stepper steps simulated in branches so far.
   std::uint64_t branch_steps() const { return branch_steps_; }
   /// The settings.
@@ -78,6 +86,7 @@ class LookaheadPlanner {
   const sim::GameState* origin_ = nullptr;
   const simlab::DelayLine* origin_delay_ = nullptr;
   std::uint64_t branch_steps_ = 0;
+  std::uint64_t max_branch_steps_ = 0;
 };
 
 /// The looking-ahead player on the true state: plans every frame while no flip

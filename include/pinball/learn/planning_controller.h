@@ -44,6 +44,8 @@ class PlanningController final : public control::FlipperController {
   long decisions() const { return decisions_; }
   long fires() const { return fires_; }
   std::uint64_t branch_steps() const { return planner_->branch_steps(); }
+  /// The most belief steps one decision simulated: never above the settings' step_budget.
+  std::uint64_t max_decision_steps() const { return max_decision_steps_; }
 
  private:
   void advance_bats_to(double now_s);
@@ -63,6 +65,7 @@ class PlanningController final : public control::FlipperController {
   double frame_s_ = 0.0;
   long decisions_ = 0;
   long fires_ = 0;
+  std::uint64_t max_decision_steps_ = 0;
 };
 
 /// The flipper controller a spec describes, every kind: the planner (which
