@@ -20,6 +20,7 @@
 #include "ceiling_bench.h"
 #include "transfer_bench.h"
 #include "pinball/control/controller_file.h"
+#include "pinball/learn/planning_controller.h"
 #include "camera_bench.h"
 #include "detector_bench.h"
 #include "daemon_latency_bench.h"
@@ -72,7 +73,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--threads", a.threads, "ceiling, transfer: worker threads (results do not depend on it)")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--controller", a.controllers,
-                  "ceiling: also play this controller file through the camera model and tracker; transfer "
+                  "ceiling: also play this controller file through the camera model and tracker (a planner file: the ceiling plans with its settings); transfer "
                   "(repeatable): play these instead of controllers/best.json, imitation.json and cem.json")
       ->transform(data_file())
       ->default_str("ceiling none, transfer controllers/best.json imitation.json cem.json");
@@ -240,6 +241,9 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
     controller = control::load_controller(a.controllers.front());
     options.controller = &*controller;
     options.controller_name = a.controllers.front();
+    // The online planner beside the same planner on the true state: what the
+    // tracker's view of the ball costs it, and nothing else.
+    if (controller->planner) options.planner = learn::lookahead_config(*controller->planner, board.dt_s);
   }
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
   options.actuation_delay_s = world_actuation_delay_s(std::nullopt, world_spec, a.identified);

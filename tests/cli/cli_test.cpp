@@ -411,6 +411,18 @@ TEST_F(Cli, BenchCeilingJsonAndBadBallCount) {
   EXPECT_EQ(run("bench ceiling --balls 0").exit_code, 2);
 }
 
+TEST_F(Cli, BenchCeilingWithThePlannerPlansWithItsSettingsOnTheTrueState) {
+  const CommandResult r =
+      run("bench ceiling --balls 1 --max-ball-time 2 --threads 1 --controller controllers/planner.json --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("players").size(), 5u);
+  const auto& planner = j.at("planner");
+  EXPECT_EQ(planner.at("fire_frames"), 4) << "the file's settings, not the ceiling's own";
+  EXPECT_EQ(planner.at("horizon_s"), 0.5);
+  EXPECT_EQ(planner.at("step_budget"), 12000);
+}
+
 TEST_F(Cli, BenchPrecisionQuickWritesJsonCsvAndPng) {
   const fs::path csv = dir_ / "precision.csv";
   const fs::path png = dir_ / "precision.png";
