@@ -3,6 +3,7 @@
 // residuals before and after, and written as a board overlay that every
 // command holding a belief reads with --identified (docs/identification.md).
 
+#include <algorithm>
 #include <ostream>
 #include <stdexcept>
 
@@ -167,6 +168,16 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     out << "  held out, ball " << format_number(learn::PredictionOptions{}.horizon_s * 1000.0) << " ms ahead ("
         << held_out->nominal.moments << " moments): board " << prediction_text(held_out->nominal) << "; identified "
         << prediction_text(held_out->identified) << "\n";
+    out << "  held out, where the ball hit something, by what the identified model hit first (mean error, board -> "
+           "identified):\n";
+    for (const learn::CollisionError& c : held_out->identified.collisions_by_model_hit) {
+      const auto& board_hits = held_out->nominal.collisions_by_model_hit;
+      const auto same = std::find_if(board_hits.begin(), board_hits.end(),
+                                     [&](const learn::CollisionError& b) { return b.model_hit == c.model_hit; });
+      out << "    " << c.model_hit << ": " << c.moments << " moments, "
+          << (same == board_hits.end() ? std::string("-") : format_number(same->mean_m * 1000.0)) << " -> "
+          << format_number(c.mean_m * 1000.0) << " mm\n";
+    }
   }
   if (!a.out.empty()) out << "wrote " << a.out << " (use it with --identified)\n";
 }

@@ -69,12 +69,9 @@ void identify_groups(const table::Board& board, const std::vector<FreeFlight>& f
     group.overlay = g;
     result.groups.push_back(group);
   }
-  std::vector<int> group_of(board.obstacles.size(), -1);
-  for (std::size_t k = 0; k < board.obstacles.size(); ++k)
-    for (std::size_t g = 0; g < result.groups.size(); ++g) {
-      const auto& names = result.groups[g].overlay.obstacles;
-      if (std::find(names.begin(), names.end(), board.obstacles[k].name) != names.end()) group_of[k] = static_cast<int>(g);
-    }
+  std::vector<table::ObstacleGroupOverlay> overlays;
+  for (const GroupResult& g : result.groups) overlays.push_back(g.overlay);
+  const std::vector<int> group_of = material_group_of(board, overlays);
   for (std::size_t k = 1; k < flights.size(); ++k) {
     const FreeFlight& a = flights[k - 1];
     const FreeFlight& b = flights[k];
@@ -175,6 +172,16 @@ void identify_flippers(const table::Board& board, std::span<const bus::RecordedP
 }
 
 }  // namespace
+
+std::vector<int> material_group_of(const table::Board& board, const std::vector<table::ObstacleGroupOverlay>& groups) {
+  std::vector<int> group_of(board.obstacles.size(), -1);
+  for (std::size_t k = 0; k < board.obstacles.size(); ++k)
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const auto& names = groups[g].obstacles;
+      if (std::find(names.begin(), names.end(), board.obstacles[k].name) != names.end()) group_of[k] = static_cast<int>(g);
+    }
+  return group_of;
+}
 
 std::vector<table::ObstacleGroupOverlay> material_groups(const table::Board& board) {
   std::vector<table::ObstacleGroupOverlay> groups;

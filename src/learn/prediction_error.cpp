@@ -5,6 +5,7 @@
 
 #include "pinball/core/running_stats.h"
 #include "pinball/core/statistics.h"
+#include "pinball/learn/identification.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/track/trajectory_fit.h"
@@ -29,6 +30,23 @@ bool seen_at(const bus::RecordedPlay& play, std::size_t from, double t, Vec2& p)
     const double s = (t - a.t_s) / (b.t_s - a.t_s);
     p = a.p_board + s * (b.p_board - a.p_board);
     return true;
+  }
+  return false;
+}
+
+// True when the ball never moved faster than max_speed_mps between two frames
+// that saw it, from `from` to the first frame at or past t_end: one ball all
+// along (a drained ball and the next one in the shooter lane are two).
+bool one_ball(const bus::RecordedPlay& play, std::size_t from, double t_end, double max_speed_mps) {
+  std::size_t last_seen = from;
+  for (std::size_t i = from + 1; i < play.frames.size(); ++i) {
+    const bus::RecordedFrame& b = play.frames[i];
+    if (b.found) {
+      const bus::RecordedFrame& a = play.frames[last_seen];
+      if (!(b.t_s > a.t_s) || (b.p_board - a.p_board).norm() > max_speed_mps * (b.t_s - a.t_s)) return false;
+      last_seen = i;
+    }
+    if (b.t_s >= t_end) return true;
   }
   return false;
 }
@@ -62,7 +80,7 @@ std::vector<PredictionStart> prediction_starts(std::span<const bus::RecordedPlay
       if (next_command < play.commands.size() && play.commands[next_command].t_s <= t + o.horizon_s) continue;
       if (next_command > 0 && play.commands[next_command - 1].energize) continue;
       Vec2 seen;
-      if (!seen_at(play, i, t + o.horizon_s, seen)) continue;
+      if (!seen_at(play, i, t + o.horizon_s, seen) || !one_ball(play, i, t + o.horizon_s, o.max_speed_mps)) continue;
       const std::vector<track::Observation> obs = history_of(play, i, o.history_frames);
       const track::TrajectoryFit fit = track::fit_free_gravity(obs, o.sigma_m);
       if (!fit.valid || fit.chi2 > track::chi2_threshold(fit.dof)) continue;
@@ -80,6 +98,13 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   std::vector<double> errors;
   errors.reserve(starts.size());
   RunningStats free, collided;
+  // What the model's ball hit first: a material group, then the flippers, then nothing, then lost.
+  const std::vector<table::ObstacleGroupOverlay> groups = material_groups(belief);
+  const std::vector<int> group_of = material_group_of(belief, groups);
+  const std::size_t flipper_hit = groups.size();
+  const std::size_t nothing_hit = flipper_hit + belief.flippers.size();
+  const std::size_t lost = nothing_hit + 1;
+  std::vector<RunningStats> by_hit(lost + 1);
   for (const PredictionStart& s : starts) {
     const bus::RecordedPlay& play = recordings[s.recording];
     const track::TrajectoryFit fit =
@@ -90,9 +115,38 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
     state.ball.position_m = fit.p_ref;
     state.ball.velocity_mps = fit.v_ref;
     state.ball_in_play = true;
-    for (std::uint64_t k = 0; k < steps && state.ball_in_play; ++k) world->step(state);
-    errors.push_back((state.ball.position_m - seen).norm());  // a lost ball: where the model lost it
-    (flew_free(play, s.frame, fit.t_ref_s + o.horizon_s, o.sigma_m) ? free : collided).add(errors.back());
+    std::size_t first_hit = nothing_hit;
+    Vec2 predicted = state.ball.position_m;
+    const double t_end = state.time_s + static_cast<double>(steps) * world->dt_s();
+    for (std::uint64_t k = 0; k < steps; ++k) {
+      const Vec2 p = state.ball.position_m;
+      const Vec2 v = state.ball.velocity_mps;
+      const double t = state.time_s;
+      const sim::StepEvents e = world->step(state);
+      predicted = state.ball.position_m;
+      if (e.has(sim::StepEvents::kBallLost)) {
+        // The model takes a lost ball off the table (to the launcher); the
+        // camera still sees it go on. Past the eat line the model has nothing
+        // left to hit, so the ball flies on under g from where it was lost.
+        predicted = track::exact_trajectory(p, v, belief.gravity_mps2, t).position_at(t_end);
+        if (first_hit == nothing_hit) first_hit = lost;
+        break;
+      }
+      if (first_hit != nothing_hit) continue;
+      if (e.has(sim::StepEvents::kHitObstacle) && e.obstacle >= 0 &&
+                 group_of[static_cast<std::size_t>(e.obstacle)] >= 0) {
+        first_hit = static_cast<std::size_t>(group_of[static_cast<std::size_t>(e.obstacle)]);
+      } else if ((e.has(sim::StepEvents::kHitFlipper) || e.has(sim::StepEvents::kFlipperPush)) && e.flipper >= 0) {
+        first_hit = flipper_hit + static_cast<std::size_t>(e.flipper);
+      }
+    }
+    errors.push_back((predicted - seen).norm());
+    if (flew_free(play, s.frame, fit.t_ref_s + o.horizon_s, o.sigma_m)) {
+      free.add(errors.back());
+    } else {
+      collided.add(errors.back());
+      by_hit[first_hit].add(errors.back());
+    }
   }
   PredictionError out;
   out.moments = errors.size();
@@ -106,6 +160,19 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   out.free_moments = static_cast<std::size_t>(free.count());
   out.free_mean_m = free.mean();
   out.collision_mean_m = collided.mean();
+  for (std::size_t h = 0; h < by_hit.size(); ++h) {
+    if (by_hit[h].count() == 0) continue;
+    const std::vector<std::string>& names = h < flipper_hit ? groups[h].obstacles : std::vector<std::string>{};
+    const std::string what = h < flipper_hit
+                                 ? "obstacles " + names.front() +
+                                       (names.size() > 1 ? " and " + std::to_string(names.size() - 1) + " more" : "")
+                             : h < nothing_hit ? "flipper " + belief.flippers[h - flipper_hit].name
+                             : h == nothing_hit ? std::string("nothing")
+                                                : std::string("lost");
+    out.collisions_by_model_hit.push_back({what, static_cast<std::size_t>(by_hit[h].count()), by_hit[h].mean()});
+  }
+  std::stable_sort(out.collisions_by_model_hit.begin(), out.collisions_by_model_hit.end(),
+                   [](const CollisionError& a, const CollisionError& b) { return a.moments > b.moments; });
   return out;
 }
 

@@ -30,6 +30,25 @@ TEST(PredictionError, TheTrueModelPredictsBetterThanAWrongOne) {
   EXPECT_EQ(right.free_moments, wrong.free_moments);  // chosen from the recording alone
   EXPECT_LT(right.free_mean_m, wrong.free_mean_m);
   EXPECT_LT(right.free_mean_m, 0.004);
+
+  // The collision moments, by what the model's ball hit first: every one counted once, most first.
+  std::size_t by_hit = 0;
+  for (std::size_t i = 0; i < right.collisions_by_model_hit.size(); ++i) {
+    const CollisionError& c = right.collisions_by_model_hit[i];
+    EXPECT_FALSE(c.model_hit.empty());
+    EXPECT_GT(c.moments, 0u);
+    if (i > 0) {
+      EXPECT_LE(c.moments, right.collisions_by_model_hit[i - 1].moments);
+    }
+    by_hit += c.moments;
+  }
+  EXPECT_EQ(by_hit, right.moments - right.free_moments);
+  double weighted_m = 0.0;
+  for (const CollisionError& c : right.collisions_by_model_hit) weighted_m += c.mean_m * static_cast<double>(c.moments);
+  EXPECT_NEAR(weighted_m / static_cast<double>(by_hit), right.collision_mean_m, 1e-12);
+  // In the true model a bounce the camera saw is one the model plays: mostly a wall or a flipper, not "nothing".
+  ASSERT_FALSE(right.collisions_by_model_hit.empty());
+  EXPECT_NE(right.collisions_by_model_hit.front().model_hit, "nothing");
 }
 
 TEST(PredictionError, NoMomentNearACoilCommandOrWithoutTheBall) {
@@ -50,6 +69,26 @@ TEST(PredictionError, NoMomentNearACoilCommandOrWithoutTheBall) {
   play.commands.clear();
   for (bus::RecordedFrame& f : play.frames) f.found = false;
   EXPECT_TRUE(prediction_starts(plays, options).empty());
+}
+
+TEST(PredictionError, NoMomentSpansTheJumpToAnotherBall) {
+  // A drain, then at once the next ball in the shooter lane: the ball seen at
+  // the horizon is not the ball of the moment, so no window may span the jump.
+  std::vector<bus::RecordedPlay> plays{pinball::testing::record_model_play(pinball::testing::thesis_board(), 2, 0.0005, 10)};
+  PredictionOptions options;
+  options.sigma_m = 0.0005;
+  bus::RecordedPlay& play = plays[0];
+  const std::size_t jump = play.frames.size() / 2;
+  const double t_jump = play.frames[jump].t_s;
+  const auto spans_jump = [&](const PredictionStart& s) {
+    const double t = play.frames[s.frame].t_s;
+    return t < t_jump && t_jump <= t + options.horizon_s + 0.01;
+  };
+  std::size_t spanning = 0;
+  for (const PredictionStart& s : prediction_starts(plays, options)) spanning += spans_jump(s) ? 1 : 0;
+  ASSERT_GT(spanning, 0u) << "the test needs moments around the jump";
+  for (std::size_t i = jump; i < play.frames.size(); ++i) play.frames[i].p_board += Vec2(0.3, 0.0);
+  for (const PredictionStart& s : prediction_starts(plays, options)) EXPECT_FALSE(spans_jump(s)) << s.frame;
 }
 
 }  // namespace

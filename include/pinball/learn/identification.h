@@ -98,6 +98,8 @@ struct IdentificationResult {
 /// The board's material groups: obstacles with the same ρ and kick, named by
 /// their obstacles' names (ball eaters left out: no ball comes back).
 std::vector<table::ObstacleGroupOverlay> material_groups(const table::Board& board);
+/// Each board obstacle's index into `groups` (-1: in none, e.g. a ball eater).
+std::vector<int> material_group_of(const table::Board& board, const std::vector<table::ObstacleGroupOverlay>& groups);
 
 /// Identifies what `recordings` show of the table `board` describes (the
 /// belief: its geometry must be the recorded table's). `progress(stage,

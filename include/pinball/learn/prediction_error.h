@@ -5,11 +5,15 @@
 // a horizon with the flippers down, and the predicted ball is compared with
 // where the camera saw it. The moments are chosen from the recording alone
 // (never from the belief), so two beliefs are judged on the same moments:
-// the ball was seen in every frame of the history and at the horizon, the
-// history fits one parabola, and no coil command falls near the window.
+// the ball was seen in every frame of the history and at the horizon and
+// was one ball all along, the history fits one parabola, and no coil
+// command falls near the window. A ball the model loses in the window flies
+// on under g from where it was lost (the model takes it off the table; the
+// camera still sees it).
 
 #include <cstddef>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "pinball/bus/recorded_play.h"
@@ -25,12 +29,30 @@ struct PredictionOptions {
   double sigma_m = 0.001;         ///< detector noise, for the history's χ² test (m)
   double command_margin_s = 0.3;  ///< no coil command this long before the moment, nor before the horizon (s)
   int stride_frames = 5;          ///< frames between moments (they overlap less)
+  /// A faster move between two frames is another ball (the next one launched
+  /// after a drain): no moment's window spans it (m/s).
+  double max_speed_mps = 10.0;
 };
 
 /// One moment to predict from.
 struct PredictionStart {
   std::size_t recording = 0;  ///< index into the recordings
   std::size_t frame = 0;      ///< the history's last frame: the moment
+};
+
+/// The error of the moments whose window held a collision, by what the
+/// model's ball hit first in it: where the model, not the start, is wrong.
+struct CollisionError {
+  std::string model_hit;    ///< a material group (identification's label), a flipper, "nothing" or "lost"
+  std::size_t moments = 0;  ///< moments
+  double mean_m = 0.0;      ///< mean error (m)
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(model_hit));
+    a->Visit(PINBALL_NVP(moments));
+    a->Visit(PINBALL_NVP(mean_m));
+  }
 };
 
 /// Prediction errors over moments.
@@ -45,6 +67,8 @@ struct PredictionError {
   std::size_t free_moments = 0;
   double free_mean_m = 0.0;       ///< mean error over them (m)
   double collision_mean_m = 0.0;  ///< mean error over the others: something was hit in the window (m)
+  /// The collision moments by what the model hit first, most moments first.
+  std::vector<CollisionError> collisions_by_model_hit;
 
   /// Every figure, for --json (core/json_write_archive.h).
   template <class Archive>
@@ -57,6 +81,7 @@ struct PredictionError {
     a->Visit(PINBALL_NVP(free_moments));
     a->Visit(PINBALL_NVP(free_mean_m));
     a->Visit(PINBALL_NVP(collision_mean_m));
+    a->Visit(PINBALL_NVP(collisions_by_model_hit));
   }
 };
 
