@@ -85,7 +85,9 @@ class FailingThread : public ::testing::TestWithParam<int> {};
 
 TEST_P(FailingThread, MakesTheCoilsSafeReportsAndEndsTheRun) {
   const int thread = GetParam();
-  Daemon d(sim_config(3, false));
+  // Enough balls that the run is still going when the fault lands 300 ms in
+  // (3 balls could all be played by then on an idle machine: no failure to report).
+  Daemon d(sim_config(200, false));
   std::thread tester([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     d.inject_fault(thread, 0.0, /*fail=*/true);
