@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "pinball/core/check.h"
+#include "pinball/track/flipper_geometry.h"
 
 namespace pinball::learn {
 
@@ -28,7 +29,8 @@ PlanningController::PlanningController(const table::Board& belief, const control
       delay_(belief.flippers.size(), settings.actuation_delay_s),
       idle_delay_(delay_) {
   check_input(check_planner_settings(settings), "planner");
-  check_input(belief.flippers.size() == 2, "planner", "the belief board must have two flippers");
+  check_input(belief.flippers.size() == 2 && belief.flippers[0].side != belief.flippers[1].side, "planner",
+              "the belief board must have a left and a right flipper");
   stepper_ = std::make_unique<const sim::ThesisStepper>(belief);
   const LookaheadConfig config = lookahead_config(settings, stepper_->dt_s());
   planner_ = std::make_unique<LookaheadPlanner>(*stepper_, config);
@@ -90,7 +92,7 @@ void PlanningController::update(const track::TrackerOutput& o, double now_s, std
     command_[static_cast<std::size_t>(held_)] = false;
     held_ = -1;
   }
-  energized = command_;
+  energized = energized_by_side();
   if (!place_ball(o, now_s)) return;
   state_.ball_in_play = true;
   const int f = planner_->decision_flipper(state_);
@@ -107,7 +109,16 @@ void PlanningController::update(const track::TrackerOutput& o, double now_s, std
     }
   }
   state_.ball_in_play = false;
-  energized = command_;
+  energized = energized_by_side();
+}
+
+std::array<bool, 2> PlanningController::energized_by_side() const {
+  std::array<bool, 2> out{false, false};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const bool left = belief_.flippers[i].side == table::Side::kLeft;
+    out[static_cast<std::size_t>(left ? track::kLeftFlipper : track::kRightFlipper)] = command_[i];
+  }
+  return out;
 }
 
 std::unique_ptr<control::FlipperController> make_controller(const control::ControllerSpec& spec,

@@ -53,6 +53,23 @@ TEST(PlanningController, SavesABallFallingOntoTheLeftFlipperAndReleasesAfterTheH
   EXPECT_TRUE(frames_up == 6 || frames_up == 20) << frames_up << " frames: one of the two holds";
 }
 
+TEST(PlanningController, FiresTheLeftFlipperOnABoardThatListsTheRightOneFirst) {
+  // A controller's commands are [left, right] whatever the board's order.
+  table::Board swapped = thesis_board();
+  std::swap(swapped.flippers[0], swapped.flippers[1]);
+  PlanningController c(swapped, short_planner());
+  std::array<bool, 2> energized{false, false};
+  double t = 1.0;
+  for (int frame = 0; frame < 10 && c.fires() == 0; ++frame, t += 0.005) {
+    c.update(seen(Vec2(0.235, 0.190), Vec2(0.5, -1.5), 1.0), t, energized);
+  }
+  ASSERT_EQ(c.fires(), 1);
+  EXPECT_TRUE(energized[track::kLeftFlipper]);
+  EXPECT_FALSE(energized[track::kRightFlipper]);
+  swapped.flippers[0].side = swapped.flippers[1].side;
+  EXPECT_THROW(PlanningController(swapped, short_planner()), std::invalid_argument) << "two left flippers";
+}
+
 TEST(PlanningController, NoDecisionSimulatesMoreThanItsStepBudget) {
   // Eight frames of the test ball, planned with the default horizon, then with
   // a budget a tenth of what that horizon needs: the same first decision

@@ -34,7 +34,8 @@ LookaheadConfig lookahead_config(const control::PlannerSettings& settings, doubl
 class PlanningController final : public control::FlipperController {
  public:
   /// Borrows `belief` (it must outlive the controller). Throws
-  /// std::invalid_argument for settings out of range or a board without two flippers.
+  /// std::invalid_argument for settings out of range or a board without a
+  /// left and a right flipper.
   PlanningController(const table::Board& belief, const control::PlannerSettings& settings);
 
   void update(const track::TrackerOutput& output, double now_s, std::array<bool, 2>& energized) override;
@@ -49,6 +50,8 @@ class PlanningController final : public control::FlipperController {
 
  private:
   void advance_bats_to(double now_s);
+  /// The commands (board order) as a controller gives them: [kLeftFlipper, kRightFlipper].
+  std::array<bool, 2> energized_by_side() const;
   bool place_ball(const track::TrackerOutput& output, double now_s);
 
   const table::Board& belief_;
@@ -58,7 +61,7 @@ class PlanningController final : public control::FlipperController {
   sim::GameState state_;      // the belief: bats as commanded, the ball as last estimated
   simlab::DelayLine delay_;   // the believed actuation delay on our own commands
   simlab::DelayLine idle_delay_;  // nothing in flight: reset() copies it (same size, no allocation)
-  std::array<bool, 2> command_{false, false};
+  std::array<bool, 2> command_{false, false};  // per board flipper, in the board's order
   bool started_ = false;
   int held_ = -1;
   double release_at_s_ = 0.0;
