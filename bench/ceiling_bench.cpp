@@ -9,6 +9,7 @@
 
 #include "pinball/learn/planning_controller.h"
 #include "pinball/core/progress.h"
+#include "pinball/core/rng.h"
 #include "pinball/control/spastic_controller.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
@@ -16,6 +17,7 @@
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/simlab/oracle_policy.h"
+#include "pinball/track/trajectory_fit.h"
 
 namespace pinball::bench {
 
@@ -59,6 +61,38 @@ CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper&
     r = learn::play_through_tracker(world, board, state, options.camera,
                                     track::default_tracker_config(board, options.camera), *controller,
                                     options.actuation_delay_s, limits, ball_seed, observer);
+  } else if (kind == CeilingPlayerKind::kControllerTrueState) {
+    // The controller as the tracker would drive it, but every frame's fit is
+    // the true ball (plus the feed's noise): no camera, no tracker.
+    const std::unique_ptr<control::FlipperController> controller = learn::make_controller(*options.controller, board);
+    limits.pull = options.controller->launcher_pull;
+    const CeilingBenchOptions::TrueStateFeed feed = *options.true_state_feed;
+    simlab::DelayLine delay(board.flippers.size(), options.actuation_delay_s);
+    Rng noise(learn::camera_seed(ball_seed));
+    const auto jitter = [&](double sd) { return Vec2(sd * noise.normal(), sd * noise.normal()); };
+    std::array<int, 2> board_index{};  // controller flipper (left, right) -> board flipper
+    for (std::size_t i = 0; i < 2; ++i)
+      board_index[board.flippers[i].side == table::Side::kLeft ? track::kLeftFlipper : track::kRightFlipper] =
+          static_cast<int>(i);
+    track::TrackerOutput seen;
+    seen.window = 24;
+    std::array<bool, 2> energized{false, false};
+    std::uint64_t step = 0;
+    r = sim::play_ball(
+        world, state, limits,
+        [&](sim::GameState& s) {
+          if (step++ % static_cast<std::uint64_t>(options.planner.frame_steps) == 0) {
+            seen.fit = track::exact_trajectory(s.ball.position_m + jitter(feed.position_noise_m),
+                                               s.ball.velocity_mps + jitter(feed.velocity_noise_mps),
+                                               board.gravity_mps2, s.time_s);
+            seen.fit.valid = s.ball_in_play;
+            controller->update(seen, s.time_s, energized);
+          }
+          for (std::size_t f = 0; f < 2; ++f)
+            s.flippers[static_cast<std::size_t>(board_index[f])].energized = energized[f];
+          delay.apply(s);
+        },
+        observer);
   } else {
     r = sim::play_ball(world, state, limits, [](sim::GameState&) {}, observer);
   }
@@ -75,6 +109,7 @@ const char* player_name(CeilingPlayerKind kind) {
     case CeilingPlayerKind::kNoFlipping: return "no_flipping";
     case CeilingPlayerKind::kTrackerSpastic: return "tracker_spastic";
     case CeilingPlayerKind::kController: return "controller";
+    case CeilingPlayerKind::kControllerTrueState: return "controller_true_state";
   }
   return "?";
 }
@@ -150,14 +185,25 @@ CeilingReport run_ceiling_bench(const table::Board& board, const CeilingBenchOpt
   report.spastic = run_player(*world_prototype, model, options, CeilingPlayerKind::kSpastic, progress);
   report.no_flipping = run_player(*world_prototype, model, options, CeilingPlayerKind::kNoFlipping, progress);
   report.tracker_spastic = run_player(*world_prototype, model, options, CeilingPlayerKind::kTrackerSpastic, progress);
+  if (options.true_state_feed && options.controller == nullptr)
+    throw std::invalid_argument("ceiling bench: the true-state feed needs a controller to feed");
+  if (options.true_state_feed && !(options.true_state_feed->position_noise_m >= 0.0 &&
+                                   options.true_state_feed->velocity_noise_mps >= 0.0))
+    throw std::invalid_argument("ceiling bench: the true-state feed's noise must be >= 0");
   if (options.controller != nullptr) {
     report.controller = run_player(*world_prototype, model, options, CeilingPlayerKind::kController, progress);
+  }
+  if (options.true_state_feed) {
+    report.controller_true_state =
+        run_player(*world_prototype, model, options, CeilingPlayerKind::kControllerTrueState, progress);
   }
   const auto ratio = [](double a, double b) { return b != 0.0 ? a / b : 0.0; };
   report.ceiling_over_spastic = ratio(report.ceiling.score.mean(), report.spastic.score.mean());
   const double ts = report.tracker_spastic.score.mean();
   report.ceiling_over_tracker_spastic = ratio(report.ceiling.score.mean(), ts);
   if (report.controller) report.controller_over_tracker_spastic = ratio(report.controller->score.mean(), ts);
+  if (report.controller_true_state)
+    report.controller_true_state_over_tracker_spastic = ratio(report.controller_true_state->score.mean(), ts);
   return report;
 }
 

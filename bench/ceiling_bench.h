@@ -60,6 +60,16 @@ struct CeilingBenchOptions {
   /// others (`--controller FILE`); null: none.
   const control::ControllerSpec* controller = nullptr;
   std::string controller_name;      ///< its file, for the report
+  /// Also play the controller fed the TRUE ball instead of the tracker's
+  /// estimate (`--true-state-noise MM,MPS`): every camera frame, a parabola
+  /// through the ball's true position and velocity, each coordinate plus
+  /// Gaussian noise of these standard deviations. How exact a start the
+  /// controller's plans need (docs/results.md); null: not played.
+  struct TrueStateFeed {
+    double position_noise_m = 0.0;     ///< standard deviation per coordinate (m)
+    double velocity_noise_mps = 0.0;   ///< standard deviation per coordinate (m/s)
+  };
+  std::optional<TrueStateFeed> true_state_feed;
 };
 
 /// A short run for tests and a first look: 10 balls.
@@ -68,7 +78,7 @@ CeilingBenchOptions quick_ceiling_bench_options();
 /// Who presses the buttons. The first three read the true state; the last two
 /// see only the tracker's output through the camera model, as the evaluator's
 /// controllers do (the 3x target's spastic baseline is kTrackerSpastic).
-enum class CeilingPlayerKind { kCeiling, kSpastic, kNoFlipping, kTrackerSpastic, kController };
+enum class CeilingPlayerKind { kCeiling, kSpastic, kNoFlipping, kTrackerSpastic, kController, kControllerTrueState };
 
 /// One ball's outcome, and the ceiling player's planning.
 struct CeilingBall : PlayedBall {
@@ -108,9 +118,11 @@ struct CeilingReport {
   CeilingPlayerReport no_flipping;///< flippers never move (baseline)
   CeilingPlayerReport tracker_spastic;  ///< the spastic flipper through the tracker (the learning tables' baseline)
   std::optional<CeilingPlayerReport> controller;  ///< options.controller, through the tracker
+  std::optional<CeilingPlayerReport> controller_true_state;  ///< options.controller fed options.true_state_feed
   double ceiling_over_spastic = 0.0;  ///< ratio of mean scores per ball
   double ceiling_over_tracker_spastic = 0.0;     ///< the same against the spastic flipper through the tracker
   double controller_over_tracker_spastic = 0.0;  ///< the controller's, when one was played
+  double controller_true_state_over_tracker_spastic = 0.0;  ///< the same fed the true state, when played
 };
 
 /// Runs the players; `progress` (may be empty) gets a line now and then, from

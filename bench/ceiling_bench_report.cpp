@@ -37,6 +37,7 @@ nlohmann::json to_json(const CeilingReport& r) {
                             {"no_flipping", player_json(r.no_flipping)},
                             {"tracker_spastic", player_json(r.tracker_spastic)}};
   if (r.controller) players["controller"] = player_json(*r.controller);
+  if (r.controller_true_state) players["controller_true_state"] = player_json(*r.controller_true_state);
   return {{"benchmark", "ceiling"},
           {"board", r.board},
           {"world_board", r.world_board},
@@ -60,7 +61,11 @@ nlohmann::json to_json(const CeilingReport& r) {
           {"controller", o.controller_name},
           {"ceiling_over_spastic", r.ceiling_over_spastic},
           {"ceiling_over_tracker_spastic", r.ceiling_over_tracker_spastic},
-          {"controller_over_tracker_spastic", r.controller_over_tracker_spastic}};
+          {"controller_over_tracker_spastic", r.controller_over_tracker_spastic},
+          {"true_state_feed", o.true_state_feed ? nlohmann::json{{"position_noise_m", o.true_state_feed->position_noise_m},
+                                                                 {"velocity_noise_mps", o.true_state_feed->velocity_noise_mps}}
+                                                : nlohmann::json(nullptr)},
+          {"controller_true_state_over_tracker_spastic", r.controller_true_state_over_tracker_spastic}};
 }
 
 std::string to_text(const CeilingReport& r) {
@@ -74,6 +79,7 @@ std::string to_text(const CeilingReport& r) {
          "controller\n";
   std::vector<const CeilingPlayerReport*> players = {&r.ceiling, &r.spastic, &r.no_flipping, &r.tracker_spastic};
   if (r.controller) players.push_back(&*r.controller);
+  if (r.controller_true_state) players.push_back(&*r.controller_true_state);
   for (const CeilingPlayerReport* p : players) {
     out << "  " << p->name << ": " << format_mean_ci(p->score.mean(), p->score.ci95_half_width())
         << " per ball (95 %), " << format_number(p->duration_s.mean()) << " s per ball, "
@@ -89,6 +95,11 @@ std::string to_text(const CeilingReport& r) {
   if (r.controller) {
     out << "controller (" << o.controller_name << ") / spastic through the tracker: "
         << format_number(r.controller_over_tracker_spastic) << "x\n";
+  }
+  if (r.controller_true_state) {
+    out << "controller fed the true state (noise " << format_number(o.true_state_feed->position_noise_m * 1e3)
+        << " mm, " << format_number(o.true_state_feed->velocity_noise_mps) << " m/s) / spastic through the tracker: "
+        << format_number(r.controller_true_state_over_tracker_spastic) << "x\n";
   }
   return out.str();
 }

@@ -77,6 +77,12 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
                   "(repeatable): play these instead of controllers/best.json, imitation.json and cem.json")
       ->transform(data_file())
       ->default_str("ceiling none, transfer controllers/best.json imitation.json cem.json");
+  cmd->add_option("--true-state-noise", a.true_state_noise,
+                  "ceiling: also play the --controller fed the TRUE ball every frame instead of the tracker's estimate, "
+                  "plus Gaussian noise of MM (position, mm) and MPS (velocity, m/s) per coordinate")
+      ->expected(2)
+      ->type_name("MM MPS")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--max-ball-time", a.max_ball_time_s,
                   "ceiling, transfer: seconds after which a ball still alive is cut")
       ->check(CLI::Range(1.0, 3600.0));
@@ -245,6 +251,10 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
     // tracker's view of the ball costs it, and nothing else.
     if (controller->planner) options.planner = learn::lookahead_config(*controller->planner, board.dt_s);
   }
+  if (!a.true_state_noise.empty()) {
+    if (!controller) throw std::invalid_argument("bench ceiling: --true-state-noise needs a --controller to feed");
+    options.true_state_feed = bench::CeilingBenchOptions::TrueStateFeed{a.true_state_noise[0] * 1e-3, a.true_state_noise[1]};
+  }
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
   options.actuation_delay_s = world_actuation_delay_s(std::nullopt, world_spec, a.identified);
   const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
@@ -378,6 +388,9 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   std::ostream& err = progress_wanted(a.progress) ? all_err : no_progress;
   if (a.which == "latency") return run_latency(a, out, err);
   if (a.which == "protocol") return run_protocol(a, out, err);
+  if (!a.true_state_noise.empty() && a.which != "ceiling") {
+    throw std::invalid_argument("bench " + a.which + ": --true-state-noise applies to ceiling only");
+  }
   if (!a.identified.empty() && a.which != "ceiling" && a.which != "transfer") {
     throw std::invalid_argument("bench " + a.which + ": --identified applies to ceiling and transfer only");
   }

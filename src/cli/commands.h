@@ -78,6 +78,7 @@ struct BenchArgs {
   int threads = 2;                                   ///< ceiling, transfer: worker threads (results do not depend on it)
   double max_ball_time_s = 60.0;                     ///< ceiling, transfer: a ball alive after this is cut
   std::vector<std::string> controllers;              ///< ceiling: one controller file; transfer: the controllers
+  std::vector<double> true_state_noise;              ///< ceiling: play the controller fed the true state, noise (mm, m/s); empty: not
   std::string csv;                                   ///< precision, transfer: CSV file to write, or empty
   std::string png;                                   ///< precision, transfer: plot to write, or empty
   simlab::WorldSpec world;                           ///< ceiling: the world (default: the model of `board`)

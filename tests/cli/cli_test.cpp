@@ -421,6 +421,15 @@ TEST_F(Cli, BenchCeilingWithThePlannerPlansWithItsSettingsOnTheTrueState) {
   EXPECT_EQ(planner.at("fire_frames"), 4) << "the file's settings, not the ceiling's own";
   EXPECT_EQ(planner.at("horizon_s"), 0.5);
   EXPECT_EQ(planner.at("step_budget"), 12000);
+
+  const CommandResult fed = run("bench ceiling --balls 1 --max-ball-time 2 --threads 1 --controller "
+                                "controllers/planner.json --true-state-noise 0.3 0.005 --json");
+  ASSERT_EQ(fed.exit_code, 0) << fed.err;
+  const auto k = nlohmann::json::parse(fed.out);
+  EXPECT_TRUE(k.at("players").contains("controller_true_state"));
+  EXPECT_DOUBLE_EQ(k.at("true_state_feed").at("position_noise_m").get<double>(), 0.0003);
+  EXPECT_NE(run("bench ceiling --balls 1 --true-state-noise 0.3 0.005").exit_code, 0) << "no controller to feed";
+  EXPECT_NE(run("bench speed --true-state-noise 0.3 0.005").exit_code, 0);
 }
 
 TEST_F(Cli, BenchPrecisionQuickWritesJsonCsvAndPng) {

@@ -94,5 +94,50 @@ TEST(CeilingBench, ReportCountsEveryBallAndPrintsOneJsonObject) {
   EXPECT_NE(to_text(r).find("controller (early.json) / spastic through the tracker"), std::string::npos);
 }
 
+TEST(CeilingBench, ThePlannerFedTheTrueStatePlaysBesideItAndItsNoiseMatters) {
+  control::ControllerSpec spec;
+  spec.planner = control::PlannerSettings{};
+  spec.planner->fire_frames = 3;
+  spec.planner->horizon_s = 1.0;
+  CeilingBenchOptions o = tiny_bench();
+  o.controller = &spec;
+  o.controller_name = "planner.json";
+  o.true_state_feed = CeilingBenchOptions::TrueStateFeed{};
+  const CeilingReport exact = run_ceiling_bench(thesis_board(), o, {});
+  ASSERT_TRUE(exact.controller_true_state.has_value());
+  EXPECT_EQ(exact.controller_true_state->score.count(), 3);
+  EXPECT_GT(exact.controller_true_state->flips.mean(), 0.0);
+  EXPECT_DOUBLE_EQ(exact.controller_true_state_over_tracker_spastic,
+                   exact.controller_true_state->score.mean() / exact.tracker_spastic.score.mean());
+  const nlohmann::json j = to_json(exact);
+  EXPECT_TRUE(j.at("players").contains("controller_true_state"));
+  EXPECT_EQ(j.at("true_state_feed").at("position_noise_m"), 0.0);
+  EXPECT_NE(to_text(exact).find("controller fed the true state"), std::string::npos);
+
+  // The same balls again: the same play; with 5 mm and 0.1 m/s of noise: another.
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
+  const sim::ThesisStepper model(thesis_board());
+  const CeilingBall a = play_ceiling_bench_ball(*world, model, o, CeilingPlayerKind::kControllerTrueState, 17);
+  const CeilingBall b = play_ceiling_bench_ball(*world->fork(), model, o, CeilingPlayerKind::kControllerTrueState, 17);
+  EXPECT_EQ(a.score, b.score);
+  EXPECT_EQ(a.duration_s, b.duration_s);
+  CeilingBenchOptions noisy = o;
+  noisy.true_state_feed = CeilingBenchOptions::TrueStateFeed{0.005, 0.1};
+  bool differs = false;
+  for (std::uint64_t seed = 17; seed < 27 && !differs; ++seed) {
+    const CeilingBall x = play_ceiling_bench_ball(*world->fork(), model, o, CeilingPlayerKind::kControllerTrueState, seed);
+    const CeilingBall y = play_ceiling_bench_ball(*world->fork(), model, noisy, CeilingPlayerKind::kControllerTrueState, seed);
+    differs = x.score != y.score || x.duration_s != y.duration_s || x.flips != y.flips;
+  }
+  EXPECT_TRUE(differs) << "the noise reached the controller";
+
+  CeilingBenchOptions bad = o;
+  bad.true_state_feed->velocity_noise_mps = -1.0;
+  EXPECT_THROW(run_ceiling_bench(thesis_board(), bad, {}), std::invalid_argument);
+  bad = o;
+  bad.controller = nullptr;
+  EXPECT_THROW(run_ceiling_bench(thesis_board(), bad, {}), std::invalid_argument) << "nothing to feed";
+}
+
 }  // namespace
 }  // namespace pinball::bench
