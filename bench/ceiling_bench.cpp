@@ -70,10 +70,7 @@ CeilingBall play_ceiling_bench_ball(sim::World& world, const sim::ThesisStepper&
     simlab::DelayLine delay(board.flippers.size(), options.actuation_delay_s);
     Rng noise(learn::camera_seed(ball_seed));
     const auto jitter = [&](double sd) { return Vec2(sd * noise.normal(), sd * noise.normal()); };
-    std::array<int, 2> board_index{};  // controller flipper (left, right) -> board flipper
-    for (std::size_t i = 0; i < 2; ++i)
-      board_index[board.flippers[i].side == table::Side::kLeft ? track::kLeftFlipper : track::kRightFlipper] =
-          static_cast<int>(i);
+    const std::array<int, 2> board_index = table::flippers_by_side(board);  // controller flipper -> board flipper
     track::TrackerOutput seen;
     seen.window = 24;
     std::array<bool, 2> energized{false, false};

@@ -187,9 +187,7 @@ ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, 
   ControllerStageOptions o;
   o.stall_timeout_s = config.camera.stall_timeout_s;
   o.recycle_s = config.coils.recycle_ms * 1e-3;
-  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    o.driver_of_flipper[board.flippers[i].side == table::Side::kLeft ? 0 : 1] = static_cast<int>(i);
-  }
+  o.driver_of_flipper = table::flippers_by_side(board);
   return o;
 }
 

@@ -27,9 +27,10 @@ PlanningController::PlanningController(const table::Board& belief, const control
       settings_(settings),
       state_(sim::make_game_state(belief, 0)),
       delay_(belief.flippers.size(), settings.actuation_delay_s),
-      idle_delay_(delay_) {
+      idle_delay_(delay_),
+      by_side_(table::flippers_by_side(belief)) {
   check_input(check_planner_settings(settings), "planner");
-  check_input(belief.flippers.size() == 2 && belief.flippers[0].side != belief.flippers[1].side, "planner",
+  check_input(belief.flippers.size() == 2 && by_side_[0] >= 0 && by_side_[1] >= 0, "planner",
               "the belief board must have a left and a right flipper");
   stepper_ = std::make_unique<const sim::ThesisStepper>(belief);
   const LookaheadConfig config = lookahead_config(settings, stepper_->dt_s());
@@ -113,12 +114,8 @@ void PlanningController::update(const track::TrackerOutput& o, double now_s, std
 }
 
 std::array<bool, 2> PlanningController::energized_by_side() const {
-  std::array<bool, 2> out{false, false};
-  for (std::size_t i = 0; i < 2; ++i) {
-    const bool left = belief_.flippers[i].side == table::Side::kLeft;
-    out[static_cast<std::size_t>(left ? track::kLeftFlipper : track::kRightFlipper)] = command_[i];
-  }
-  return out;
+  return {command_[static_cast<std::size_t>(by_side_[track::kLeftFlipper])],
+          command_[static_cast<std::size_t>(by_side_[track::kRightFlipper])]};
 }
 
 std::unique_ptr<control::FlipperController> make_controller(const control::ControllerSpec& spec,

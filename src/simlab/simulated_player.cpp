@@ -12,12 +12,8 @@ SimulatedPlayer::SimulatedPlayer(const table::Board& board, const track::CameraM
     : board_(board),
       camera_(camera, seed),
       tracker_(track::flipper_geometry_from_board(board), tracker),
-      controller_(controller) {
-  for (std::size_t i = 0; i < board.flippers.size(); ++i) {
-    board_index_[board.flippers[i].side == table::Side::kLeft ? track::kLeftFlipper : track::kRightFlipper] =
-        static_cast<int>(i);
-  }
-}
+      controller_(controller),
+      board_index_(table::flippers_by_side(board)) {}
 
 void SimulatedPlayer::act(sim::GameState& state) {
   if (!state.ball_in_play) {

@@ -30,6 +30,13 @@ double distance_to_shape(const Shape& shape, const Vec2& p) {
   return (p - shape.p0).norm() - shape.radius_m;
 }
 
+std::array<int, 2> flippers_by_side(const Board& board) {
+  std::array<int, 2> index{-1, -1};
+  for (std::size_t i = 0; i < board.flippers.size(); ++i)
+    index[board.flippers[i].side == Side::kLeft ? 0 : 1] = static_cast<int>(i);
+  return index;
+}
+
 std::string_view side_name(Side side) { return side == Side::kLeft ? "left" : "right"; }
 
 std::optional<Side> parse_side(std::string_view text) {

@@ -72,6 +72,15 @@ TEST(NearestFlipperAtRest, IsTheClosestRestSegment) {
   EXPECT_NEAR(right.second, 0.1, 1e-12);
 }
 
+TEST(FlippersBySide, LeftThenRightWhateverTheFileOrder) {
+  Board b = empty_board();
+  EXPECT_EQ(flippers_by_side(b), (std::array<int, 2>{-1, -1}));
+  add_flipper(b, Side::kRight, {0.4, 0.2}, 0.076, 0.0, 0.5, 33.0);
+  EXPECT_EQ(flippers_by_side(b), (std::array<int, 2>{-1, 0}));
+  add_flipper(b, Side::kLeft, {0.1, 0.2}, 0.076, 0.0, 0.5, 33.0);
+  EXPECT_EQ(flippers_by_side(b), (std::array<int, 2>{1, 0}));
+}
+
 TEST(MaxStableDt, FormulaAndSmallestOverFlippers) {
   Board b = empty_board();
   EXPECT_EQ(max_stable_dt_s(b), std::numeric_limits<double>::infinity());

@@ -61,6 +61,7 @@ class PlanningController final : public control::FlipperController {
   sim::GameState state_;      // the belief: bats as commanded, the ball as last estimated
   simlab::DelayLine delay_;   // the believed actuation delay on our own commands
   simlab::DelayLine idle_delay_;  // nothing in flight: reset() copies it (same size, no allocation)
+  std::array<int, 2> by_side_;    // board index of the left and the right flipper
   std::array<bool, 2> command_{false, false};  // per board flipper, in the board's order
   bool started_ = false;
   int held_ = -1;

@@ -5,6 +5,7 @@
 // GameState. Units: metres, seconds, radians, board frame (origin bottom-left
 // of the playfield, +x right, +y up the table).
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -172,6 +173,11 @@ Vec2 flipper_up_normal(const Flipper& f, double theta_rad);
 
 /// Tip position at theta_rad (m).
 Vec2 flipper_tip(const Flipper& f, double theta_rad);
+
+/// The board's index of its left and of its right flipper, in that order
+/// (the order controllers give commands in); -1 where the board has none.
+/// With two of one side, the last in the file.
+std::array<int, 2> flippers_by_side(const Board& board);
 
 /// The flipper whose rest segment (pivot to tip at θ_min) is nearest to `p`,
 /// and that distance (m): {-1, inf} on a board without flippers.
