@@ -61,7 +61,7 @@ struct CeilingBenchOptions {
   const control::ControllerSpec* controller = nullptr;
   std::string controller_name;      ///< its file, for the report
   /// Also play the controller fed the TRUE ball instead of the tracker's
-  /// estimate (`--true-state-noise MM,MPS`): every camera frame, a parabola
+  /// estimate (`--true-state-noise MM MPS`): every camera frame, a parabola
   /// through the ball's true position and velocity, each coordinate plus
   /// Gaussian noise of these standard deviations. How exact a start the
   /// controller's plans need (docs/results.md); null: not played.

@@ -43,7 +43,7 @@ struct PredictionStart {
 /// The error of the moments whose window held a collision, by what the
 /// model's ball hit first in it: where the model, not the start, is wrong.
 struct CollisionError {
-  std::string model_hit;    ///< a material group (identification's label), a flipper, "nothing" or "lost"
+  std::string model_hit;    ///< "obstacles <first> and N more" (a material group), "flipper <name>", "nothing" or "lost"
   std::size_t moments = 0;  ///< moments
   double mean_m = 0.0;      ///< mean error (m)
 
