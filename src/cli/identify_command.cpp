@@ -91,6 +91,7 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                    {"board_gravity_mps2", board.gravity_mps2},
                    {"gravity", to_json_value(r.gravity_no_drag)},
                    {"gravity_with_drag", to_json_value(r.gravity)},
+                   {"sliding_friction", to_json_value(r.sliding)},
                    {"obstacle_groups", groups},
                    {"rebounds", r.rebounds.size()},
                    {"launches", r.launch_speeds_mps.size()},
@@ -134,6 +135,14 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     out << "  drag               " << format_number(r.gravity.drag_per_s) << " ± "
         << format_number(r.gravity.drag_stderr_per_s, 2) << " 1/s, with g " << format_number(r.gravity.g_mps2)
         << " (diagnostic: the model has no drag; its speed clamp stands in)\n";
+  out << "  sliding friction   ";
+  if (r.sliding.skidding > 0)
+    out << format_number(r.sliding.decel_mps2) << " ± " << format_number(r.sliding.decel_stderr_mps2, 2)
+        << " m/s² (mu times g normal to the table)";
+  else
+    out << "none seen";
+  out << ": " << r.sliding.skidding << " of " << r.sliding.flights << " flights of "
+      << format_number(r.sliding.min_duration_s) << " s or more skid (diagnostic: the model's ball has no spin)\n";
   for (const learn::GroupResult& group : r.groups) {
     if (!group.identified) continue;
     out << "  rho " << format_number(group.overlay.board_rho);
@@ -168,6 +177,13 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     out << "  held out, ball " << format_number(learn::PredictionOptions{}.horizon_s * 1000.0) << " ms ahead ("
         << held_out->nominal.moments << " moments): board " << prediction_text(held_out->nominal) << "; identified "
         << prediction_text(held_out->identified) << "\n";
+    const learn::PredictionError& nominal = held_out->nominal;
+    const learn::PredictionError& fitted = held_out->identified;
+    out << "  held out, by what moved the ball in the history (mean error, board -> identified): g alone "
+        << fitted.under_g_moments << " moments, " << format_number(nominal.under_g_mean_m * 1000.0) << " -> "
+        << format_number(fitted.under_g_mean_m * 1000.0) << " mm; something more (a skid, a wall or flipper it "
+        << "rolled along) " << fitted.pushed_moments << " moments, " << format_number(nominal.pushed_mean_m * 1000.0)
+        << " -> " << format_number(fitted.pushed_mean_m * 1000.0) << " mm\n";
     out << "  held out, where the ball hit something, by what the identified model hit first (mean error, board -> "
            "identified):\n";
     for (const learn::CollisionError& c : held_out->identified.collisions_by_model_hit) {

@@ -9,6 +9,7 @@
 #include <unsupported/Eigen/NumericalDiff>
 
 #include "pinball/core/rng.h"
+#include "pinball/core/statistics.h"
 
 namespace pinball::learn {
 namespace {
@@ -306,6 +307,47 @@ FlightGravity fit_flight_gravity(std::span<const bus::RecordedPlay> recordings, 
     out.lateral_stderr_mps2 = sd(1);
     if (fit_drag) out.drag_stderr_per_s = sd(2);
     out.bootstrap_resamples = bootstrap;
+  }
+  return out;
+}
+
+SlidingFriction fit_sliding_friction(std::span<const bus::RecordedPlay> recordings,
+                                     std::span<const FreeFlight> flights, const FlightGravity& gravity,
+                                     double sigma_m, double min_duration_s) {
+  constexpr double kSlideOverRoll = 7.0 / 5.0;  // a solid ball rolls down a slope at 5/7 of its sliding acceleration
+  const Vec2 rolling{gravity.lateral_mps2, -gravity.g_mps2};
+  SlidingFriction out;
+  out.min_duration_s = min_duration_s;
+  std::vector<double> decel;
+  for (const FreeFlight& f : flights) {
+    if (f.t_last_s - f.t_first_s < min_duration_s) continue;
+    std::vector<track::Observation> seen;  // a flight may span a frame without the ball
+    for (std::size_t i = f.first; i <= f.last; ++i) {
+      const bus::RecordedFrame& frame = recordings[f.recording].frames[i];
+      if (frame.found) seen.push_back({frame.t_s, frame.p_board, 1.0, 0.0});
+    }
+    const track::AccelerationFit own = track::fit_free_acceleration(seen, sigma_m);
+    if (!own.valid) continue;
+    ++out.flights;
+    // χ² under the shared acceleration: the flight's residuals about it, each
+    // coordinate's start and velocity its own (a linear fit of p − a·τ²/2).
+    std::vector<track::Observation> shifted = seen;
+    for (track::Observation& o : shifted) {
+      const double tau = o.t_s - seen.back().t_s;
+      o.p_board -= 0.5 * tau * tau * rolling;
+    }
+    const double shared_chi2 = track::fit_fixed_gravity(shifted, 0.0, sigma_m).chi2;
+    if (shared_chi2 - own.chi2 <= track::chi2_threshold(2)) continue;
+    ++out.skidding;
+    decel.push_back((own.a_mps2 - kSlideOverRoll * rolling).norm());
+  }
+  if (decel.empty()) return out;
+  out.decel_mps2 = median(decel);
+  if (decel.size() >= 2) {
+    // The median's standard error, 1.2533·σ/√n, with σ the robust spread (1.4826 × the median absolute deviation).
+    std::vector<double> deviation;
+    for (double d : decel) deviation.push_back(std::abs(d - out.decel_mps2));
+    out.decel_stderr_mps2 = 1.2533 * 1.4826 * median(deviation) / std::sqrt(static_cast<double>(decel.size()));
   }
   return out;
 }

@@ -234,6 +234,7 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
   else
     result.gravity = result.gravity_no_drag;
   const FlightGravity& g = result.gravity_no_drag;
+  result.sliding = fit_sliding_friction(recordings, flights, g, options.flights.sigma_m);
   result.overlay.gravity_mps2 = table::IdentifiedValue{g.g_mps2, g.g_stderr_mps2, g.flights};
   identify_groups(board, flights, options, result);
   identify_launcher(board, recordings, flights, options, g.g_mps2, result);
@@ -246,6 +247,10 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
   result.not_identified.push_back(
       {"speed clamp", "the model's clamp stands in for friction; the drag the free flights show is reported "
                       "instead (the model cannot play it)"});
+  result.not_identified.push_back(
+      {"playfield sliding friction", "the model's ball has no spin, so it never skids after a bounce; the sliding "
+                                     "friction the skidding flights show is reported instead (the model cannot play "
+                                     "it)"});
   result.overlay.board = board.source;
   return result;
 }

@@ -87,6 +87,22 @@ std::vector<PredictionStart> prediction_starts(std::span<const bus::RecordedPlay
       starts.push_back({r, i});
     }
   }
+  // Under g or pushed: against the usual acceleration of these histories
+  // (most balls fly free), by how much χ² an acceleration of its own saves.
+  std::vector<track::AccelerationFit> own(starts.size());
+  std::vector<double> down_mps2;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    own[k] = track::fit_free_acceleration(history_of(recordings[starts[k].recording], starts[k].frame,
+                                                     o.history_frames), o.sigma_m);
+    if (own[k].valid) down_mps2.push_back(-own[k].a_mps2.y());
+  }
+  if (down_mps2.empty()) return starts;
+  const double usual_g_mps2 = median(down_mps2);
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const track::TrajectoryFit usual = track::fit_fixed_gravity(
+        history_of(recordings[starts[k].recording], starts[k].frame, o.history_frames), usual_g_mps2, o.sigma_m);
+    starts[k].pushed = own[k].valid && usual.chi2 - own[k].chi2 > track::chi2_threshold(2);
+  }
   return starts;
 }
 
@@ -97,7 +113,7 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   const auto steps = static_cast<std::uint64_t>(std::llround(o.horizon_s / world->dt_s()));
   std::vector<double> errors;
   errors.reserve(starts.size());
-  RunningStats free, collided;
+  RunningStats free, collided, under_g, pushed;
   // What the model's ball hit first: a material group, then the flippers, then nothing, then lost.
   const std::vector<table::ObstacleGroupOverlay> groups = material_groups(belief);
   const std::vector<int> group_of = material_group_of(belief, groups);
@@ -141,6 +157,7 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
       }
     }
     errors.push_back((predicted - seen).norm());
+    (s.pushed ? pushed : under_g).add(errors.back());
     if (flew_free(play, s.frame, fit.t_ref_s + o.horizon_s, o.sigma_m)) {
       free.add(errors.back());
     } else {
@@ -160,6 +177,10 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   out.free_moments = static_cast<std::size_t>(free.count());
   out.free_mean_m = free.mean();
   out.collision_mean_m = collided.mean();
+  out.under_g_moments = static_cast<std::size_t>(under_g.count());
+  out.under_g_mean_m = under_g.mean();
+  out.pushed_moments = static_cast<std::size_t>(pushed.count());
+  out.pushed_mean_m = pushed.mean();
   for (std::size_t h = 0; h < by_hit.size(); ++h) {
     if (by_hit[h].count() == 0) continue;
     const std::vector<std::string>& names = h < flipper_hit ? groups[h].obstacles : std::vector<std::string>{};

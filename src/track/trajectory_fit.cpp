@@ -102,6 +102,39 @@ TrajectoryFit fit_free_gravity(std::span<const Observation> obs, double sigma_m)
   return fit;
 }
 
+AccelerationFit fit_free_acceleration(std::span<const Observation> obs, double sigma_m) {
+  AccelerationFit fit;
+  if (!usable(obs)) return fit;
+  const double t_ref = obs.back().t_s;
+  // Both coordinates share the design matrix [1 τ τ²/2].
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 3, 2> atp = Eigen::Matrix<double, 3, 2>::Zero();
+  for (const Observation& o : obs) {
+    const double tau = o.t_s - t_ref;
+    const Eigen::Vector3d row{1.0, tau, 0.5 * tau * tau};
+    ata += row * row.transpose();
+    atp += row * o.p_board.transpose();
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(ata);
+  if (ldlt.info() != Eigen::Success || !(std::abs(ata.determinant()) > 0.0)) return fit;
+  const Eigen::Matrix<double, 3, 2> c = ldlt.solve(atp);
+  fit.valid = c.allFinite();
+  if (!fit.valid) return fit;
+  fit.t_ref_s = t_ref;
+  fit.p_ref = c.row(0).transpose();
+  fit.v_ref = c.row(1).transpose();
+  fit.a_mps2 = c.row(2).transpose();
+  fit.points = static_cast<int>(obs.size());
+  fit.dof = 2 * fit.points - 6;
+  double chi2 = 0.0;
+  for (const Observation& o : obs) {
+    const double tau = o.t_s - t_ref;
+    chi2 += (o.p_board - (fit.p_ref + fit.v_ref * tau + 0.5 * tau * tau * fit.a_mps2)).squaredNorm();
+  }
+  fit.chi2 = sigma_m > 0.0 ? chi2 / (sigma_m * sigma_m) : 0.0;
+  return fit;
+}
+
 double chi2_threshold(int dof) {
   if (dof <= 0) return INFINITY;
   // Wilson–Hilferty: (χ²/k)^(1/3) is nearly normal with mean 1 − 2/(9k) and

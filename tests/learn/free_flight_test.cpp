@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "common/thesis_board.h"
 #include "pinball/core/rng.h"
@@ -136,6 +137,64 @@ TEST(FreeFlight, BootstrapGivesAnUncertaintyNearTheCovariancesOnIndependentNoise
   EXPECT_GT(fit.g_stderr_mps2, fit.g_covariance_stderr_mps2 / 3.0);
   EXPECT_LT(fit.g_stderr_mps2, fit.g_covariance_stderr_mps2 * 3.0);
   EXPECT_NEAR(fit.g_mps2, 0.9, 4.0 * fit.g_stderr_mps2);
+}
+
+// Flights that roll under (0, −g_roll), then flights that skid: the slope's
+// full pull, 7/5 of the rolling one, less μ·g_n against a slip in a random
+// direction; then skids too short to judge.
+Flights rolling_and_skidding(double g_roll, double mu_g_n, double sigma_m, std::uint64_t seed) {
+  Flights out;
+  Rng rng(seed);
+  bus::RecordedPlay& play = out.recordings[0];
+  for (int k = 0; k < 70; ++k) {
+    const bool skids = k >= 30;
+    const double heading = rng.uniform(0.0, 2.0 * std::numbers::pi);
+    const Vec2 a = skids ? Vec2(1.4 * Vec2(0.0, -g_roll) - mu_g_n * Vec2(std::cos(heading), std::sin(heading)))
+                         : Vec2(0.0, -g_roll);
+    const std::size_t first = play.frames.size();
+    const Vec2 p0(rng.uniform(0.15, 0.35), rng.uniform(0.3, 0.4));
+    const Vec2 v0(rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 1.0));
+    const double duration_s = k >= 60 ? 0.05 : rng.uniform(0.15, 0.3);
+    fly(play, 2.0 * k, p0, v0, -a.y(), a.x(), 0.0, duration_s, sigma_m, rng);
+    out.flights.push_back({0, first, play.frames.size() - 1, play.frames[first].t_s, play.frames.back().t_s, {}});
+  }
+  return out;
+}
+
+TEST(SlidingFriction, NoiselessSkidsGiveMuTimesGExactly) {
+  const Flights data = rolling_and_skidding(0.79, 1.95, 0.0, 21);
+  FlightGravity rolling;
+  rolling.g_mps2 = 0.79;
+  const SlidingFriction friction = fit_sliding_friction(data.recordings, data.flights, rolling, 0.0005);
+  EXPECT_EQ(friction.flights, 60);  // the ten short skids are not judged
+  EXPECT_EQ(friction.skidding, 30);
+  EXPECT_NEAR(friction.decel_mps2, 1.95, 1e-6);
+  EXPECT_DOUBLE_EQ(friction.min_duration_s, 0.1);
+}
+
+TEST(SlidingFriction, NoisySkidsGiveMuTimesGWithinItsUncertainty) {
+  const Flights data = rolling_and_skidding(0.79, 1.95, 0.0005, 22);
+  FlightGravity rolling;
+  rolling.g_mps2 = 0.79;
+  const SlidingFriction friction = fit_sliding_friction(data.recordings, data.flights, rolling, 0.0005);
+  EXPECT_EQ(friction.flights, 60);
+  EXPECT_GE(friction.skidding, 30);  // every skid, and at most a false alarm among the 30 rolling flights
+  EXPECT_LE(friction.skidding, 31);
+  EXPECT_GT(friction.decel_stderr_mps2, 0.0);
+  EXPECT_LT(friction.decel_stderr_mps2, 0.1);
+  EXPECT_NEAR(friction.decel_mps2, 1.95, 4.0 * friction.decel_stderr_mps2);
+}
+
+TEST(SlidingFriction, RollingFlightsShowNone) {
+  const Flights data = many_flights(0.9, 0.0, 0.0, 0.0005, 23);
+  FlightGravity rolling;
+  rolling.g_mps2 = 0.9;
+  const SlidingFriction friction = fit_sliding_friction(data.recordings, data.flights, rolling, 0.0005);
+  EXPECT_GT(friction.flights, 20);
+  EXPECT_LE(friction.skidding, 1);
+  if (friction.skidding == 0) {
+    EXPECT_EQ(friction.decel_mps2, 0.0);
+  }
 }
 
 TEST(FreeFlight, RefusesFewerThanTwoFlights) {

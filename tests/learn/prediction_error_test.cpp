@@ -4,6 +4,7 @@
 
 #include "common/thesis_board.h"
 #include "model_recording.h"
+#include "pinball/learn/free_flight.h"
 
 namespace pinball::learn {
 namespace {
@@ -31,6 +32,30 @@ TEST(PredictionError, TheTrueModelPredictsBetterThanAWrongOne) {
   EXPECT_LT(right.free_mean_m, wrong.free_mean_m);
   EXPECT_LT(right.free_mean_m, 0.004);
 
+  // Under g or pushed split the moments, the same for both beliefs.
+  EXPECT_EQ(right.under_g_moments + right.pushed_moments, right.moments);
+  EXPECT_EQ(right.pushed_moments, wrong.pushed_moments);
+  EXPECT_NEAR((right.under_g_mean_m * static_cast<double>(right.under_g_moments) +
+               right.pushed_mean_m * static_cast<double>(right.pushed_moments)) /
+                  static_cast<double>(right.moments),
+              right.mean_m, 1e-12);
+  // The model's ball never skids: what pushes it in a history is something
+  // it rolls along (a wall, a resting flipper), so every pushed moment but a
+  // χ² false alarm or two (0.1 % each) has the ball touching something.
+  int pushed = 0;
+  int pushed_in_the_open = 0;
+  for (const PredictionStart& s : starts) {
+    if (!s.pushed) continue;
+    ++pushed;
+    bool touched = false;
+    for (int k = 0; k < options.history_frames; ++k)
+      touched = touched || !ball_is_clear(truth, plays[0].frames[s.frame - static_cast<std::size_t>(k)].p_board, 0.003);
+    if (!touched) ++pushed_in_the_open;
+  }
+  EXPECT_EQ(static_cast<std::size_t>(pushed), right.pushed_moments);
+  EXPECT_GT(pushed, 0);
+  EXPECT_LE(pushed_in_the_open, 3);
+
   // The collision moments, by what the model's ball hit first: every one counted once, most first.
   std::size_t by_hit = 0;
   for (std::size_t i = 0; i < right.collisions_by_model_hit.size(); ++i) {
@@ -49,6 +74,45 @@ TEST(PredictionError, TheTrueModelPredictsBetterThanAWrongOne) {
   // In the true model a bounce the camera saw is one the model plays: mostly a wall or a flipper, not "nothing".
   ASSERT_FALSE(right.collisions_by_model_hit.empty());
   EXPECT_NE(right.collisions_by_model_hit.front().model_hit, "nothing");
+}
+
+TEST(PredictionStarts, TellsAPushedBallByItsHistorysAcceleration) {
+  // 3 s at 200 frames/s of a ball under g = 1.11 m/s², except from 1.0 to
+  // 1.6 s, when sliding friction pushes it 2 m/s² more along −y (a ball
+  // skidding straight up the table after a bounce off the bottom).
+  constexpr double kG = 1.11, kSkid = 2.0, kSkidFrom = 1.0, kSkidTo = 1.6, kDt = 0.005;
+  bus::RecordedPlay play;
+  Vec2 p{0.25, 0.1};
+  Vec2 v{0.1, 1.6};
+  for (int i = 0; i <= 600; ++i) {
+    const double t = i * kDt;
+    play.frames.push_back({t, i, true, p, false, false});
+    const bool skidding = t >= kSkidFrom && t < kSkidTo;
+    const Vec2 a{0.0, -kG - (skidding ? kSkid : 0.0)};
+    p += v * kDt + 0.5 * a * kDt * kDt;
+    v += a * kDt;
+  }
+  const std::vector<bus::RecordedPlay> plays{play};
+  PredictionOptions options;
+  options.sigma_m = 0.0005;
+  const std::vector<PredictionStart> starts = prediction_starts(plays, options);
+  ASSERT_GT(starts.size(), 60u);
+  const double history_s = (options.history_frames - 1) * kDt;
+  int pushed = 0;
+  int under_g = 0;
+  for (const PredictionStart& s : starts) {
+    const double t = play.frames[s.frame].t_s;
+    const double from = t - history_s;
+    if (from >= kSkidFrom - 1e-9 && t < kSkidTo) {
+      EXPECT_TRUE(s.pushed) << t;
+      ++pushed;
+    } else if (t < kSkidFrom || from >= kSkidTo - 1e-9) {
+      EXPECT_FALSE(s.pushed) << t;
+      ++under_g;
+    }
+  }
+  EXPECT_GT(pushed, 10);
+  EXPECT_GT(under_g, 40);
 }
 
 TEST(PredictionError, NoMomentNearACoilCommandOrWithoutTheBall) {

@@ -87,13 +87,69 @@ TEST(FitFreeGravity, RecoversGravity) {
   }
 }
 
+TEST(FitFreeAcceleration, RecoversAnAccelerationInBothCoordinatesExactly) {
+  // A skidding ball: g along −y plus a sliding friction of 1.95 m/s² against
+  // its slip, at large absolute times (τ keeps the system well conditioned).
+  const Vec2 a{1.2, -1.11 - 1.5};
+  const Vec2 p{0.3, 0.2};
+  const Vec2 v{-0.4, 0.9};
+  std::vector<Observation> obs = parabola(24, 1e5, 0.005, p, v, 0.0);
+  for (Observation& o : obs) {
+    const double tau = o.t_s - 1e5;
+    o.p_board += 0.5 * tau * tau * a;
+  }
+  const AccelerationFit fit = fit_free_acceleration(obs, kSigma);
+  ASSERT_TRUE(fit.valid);
+  EXPECT_NEAR((fit.a_mps2 - a).norm(), 0.0, 1e-6);
+  EXPECT_NEAR((fit.p_ref - p).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((fit.v_ref - v).norm(), 0.0, 1e-8);
+  EXPECT_DOUBLE_EQ(fit.t_ref_s, 1e5);
+  EXPECT_EQ(fit.points, 24);
+  EXPECT_EQ(fit.dof, 42);
+  EXPECT_NEAR(fit.chi2, 0.0, 1e-6);
+}
+
+TEST(FitFreeAcceleration, TellsASkiddingBallFromARollingOneByItsChi2Drop) {
+  // The likelihood-ratio test a held-out prediction uses: the χ² the free
+  // acceleration saves over g alone is χ²(2) for a ball under g, so it stays
+  // under the 99.9 % point; a 2 m/s² push is far over it.
+  Rng rng(11);
+  constexpr int kTrials = 2000;
+  int rolling_flagged = 0;
+  int skidding_flagged = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const Vec2 p{rng.uniform(0.1, 0.4), rng.uniform(0.2, 0.8)};
+    const Vec2 v{rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)};
+    std::vector<Observation> rolling = parabola(24, 10.0 + trial, 0.005, p, v, kG);
+    std::vector<Observation> skidding = rolling;
+    const double heading = rng.uniform(0.0, 2.0 * std::numbers::pi);
+    for (Observation& o : skidding) {
+      const double tau = o.t_s - skidding.back().t_s;
+      o.p_board += 0.5 * tau * tau * 2.0 * Vec2{std::cos(heading), std::sin(heading)};
+    }
+    add_noise(rolling, rng, kSigma);
+    add_noise(skidding, rng, kSigma);
+    const auto drop = [](const std::vector<Observation>& obs) {
+      return fit_fixed_gravity(obs, kG, kSigma).chi2 - fit_free_acceleration(obs, kSigma).chi2;
+    };
+    if (drop(rolling) > chi2_threshold(2)) ++rolling_flagged;
+    if (drop(skidding) > chi2_threshold(2)) ++skidding_flagged;
+  }
+  EXPECT_LE(rolling_flagged, 10);  // about 2 false alarms in 2000
+  // 24 frames over 115 ms measure the acceleration to about 0.3 m/s² at this
+  // noise: the push is some 7 σ, missed in about 1 % of trials.
+  EXPECT_GE(skidding_flagged, kTrials * 97 / 100);
+}
+
 TEST(TrajectoryFit, TooFewPointsOrEqualTimesAreInvalid) {
   const std::vector<Observation> obs = parabola(5, 2.0, 0.005, {0.2, 0.3}, {0.1, -0.4}, kG);
   for (std::size_t n = 0; n < 3; ++n) {
     const std::span<const Observation> few(obs.data(), n);
     EXPECT_FALSE(fit_fixed_gravity(few, kG, kSigma).valid) << n;
     EXPECT_FALSE(fit_free_gravity(few, kSigma).valid) << n;
+    EXPECT_FALSE(fit_free_acceleration(few, kSigma).valid) << n;
   }
+  EXPECT_TRUE(fit_free_acceleration(std::span<const Observation>(obs.data(), 3), kSigma).valid);
   EXPECT_TRUE(fit_fixed_gravity(std::span<const Observation>(obs.data(), 3), kG, kSigma).valid);
   EXPECT_TRUE(fit_free_gravity(std::span<const Observation>(obs.data(), 3), kSigma).valid);
 
@@ -103,6 +159,7 @@ TEST(TrajectoryFit, TooFewPointsOrEqualTimesAreInvalid) {
   const TrajectoryFit free_g = fit_free_gravity(same, kSigma);
   EXPECT_FALSE(fixed.valid);
   EXPECT_FALSE(free_g.valid);
+  EXPECT_FALSE(fit_free_acceleration(same, kSigma).valid);
   EXPECT_TRUE(std::isfinite(fixed.p_ref.x()) && std::isfinite(fixed.v_ref.y()));
 }
 

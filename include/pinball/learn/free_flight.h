@@ -105,4 +105,38 @@ FlightGravity fit_flight_gravity(std::span<const bus::RecordedPlay> recordings, 
                                  double nominal_g_mps2, double sigma_m, bool fit_drag, int bootstrap,
                                  std::uint64_t seed, const std::function<void(int, int)>& progress = {});
 
+/// What the flights that skid say of the playfield's sliding friction. A
+/// ball that bounces keeps the spin it rolled with, so it skids until the
+/// playfield's friction, μ·g_n against the slip, has made it roll again; on
+/// the way its acceleration is the slope's plus that friction, where a
+/// rolling ball's is 5/7 of the slope's (a solid ball). So a skidding
+/// flight's own acceleration a gives μ·g_n = |a − (7/5)·a_rolling|, with
+/// a_rolling the shared acceleration of the flights (most roll). A
+/// diagnostic: the model's ball has no spin and never skids.
+struct SlidingFriction {
+  int flights = 0;                ///< flights long enough to judge (min_duration_s)
+  int skidding = 0;               ///< of them, flights whose own acceleration fits beyond the 99.9 % point of χ²(2)
+  double decel_mps2 = 0.0;        ///< μ·g_n: the median over the skidding flights (m/s²); 0 with none
+  double decel_stderr_mps2 = 0.0; ///< its standard uncertainty (the median's, from the spread; m/s²)
+  double min_duration_s = 0.0;    ///< the shortest flight judged (s)
+
+  /// Every figure, for --json (core/json_write_archive.h).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(PINBALL_NVP(flights));
+    a->Visit(PINBALL_NVP(skidding));
+    a->Visit(PINBALL_NVP(decel_mps2));
+    a->Visit(PINBALL_NVP(decel_stderr_mps2));
+    a->Visit(PINBALL_NVP(min_duration_s));
+  }
+};
+
+/// The sliding friction the skidding flights among `flights` show (see
+/// SlidingFriction), against the shared acceleration `gravity` (what
+/// fit_flight_gravity found). Only flights of at least `min_duration_s` are
+/// judged: a short one measures its acceleration too coarsely to tell.
+SlidingFriction fit_sliding_friction(std::span<const bus::RecordedPlay> recordings,
+                                     std::span<const FreeFlight> flights, const FlightGravity& gravity,
+                                     double sigma_m, double min_duration_s = 0.1);
+
 }  // namespace pinball::learn

@@ -3,8 +3,9 @@
 // recorded play (bus::RecordedPlay, what `lcm-logger` keeps of pinballd), so
 // the belief is the table that was recorded rather than the board file's
 // guesses. What each kind of event identifies:
-//  - free flights (free_flight.h): g along the table, with a sideways tilt
-//    and a drag reported as diagnostics the model cannot play;
+//  - free flights (free_flight.h): g along the table, with a sideways tilt,
+//    a drag and the playfield's sliding friction (from the flights that
+//    skid) reported as diagnostics the model cannot play;
 //  - rebounds, two free flights joined at a board obstacle: the normal speed
 //    out against the normal speed in gives ρ (and the kick, for obstacles the
 //    board gives one) of each material group: the obstacles the board file
@@ -82,6 +83,7 @@ struct IdentificationResult {
   table::BoardOverlay overlay;            ///< what the belief should lay over the board
   FlightGravity gravity;                  ///< shared acceleration, fitted with drag when asked (diagnostic)
   FlightGravity gravity_no_drag;          ///< the same without drag: what the model plays (the overlay's g)
+  SlidingFriction sliding;                ///< what the skidding flights show (diagnostic: the model's ball never skids)
   std::vector<GroupResult> groups;        ///< every material group of the board with obstacles
   std::vector<Rebound> rebounds;          ///< every rebound used
   std::vector<double> launch_speeds_mps;  ///< launch speed at the launcher of every launch seen

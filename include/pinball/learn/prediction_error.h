@@ -10,6 +10,14 @@
 // command falls near the window. A ball the model loses in the window flies
 // on under g from where it was lost (the model takes it off the table; the
 // camera still sees it).
+// The moments are also told apart by what moved the ball in the history,
+// again from the recording alone: g alone, when the history's acceleration
+// is the recording's usual one (the median over every moment's history), or
+// something more (pushed), when an acceleration of its own fits the history
+// better by more than the 99.9 % point of χ²(2). What pushes a ball is a
+// wall or a resting flipper it rolls along, or, on a real table, sliding
+// friction: a ball skids after a bounce until the playfield has made it
+// roll again, which a model without ball spin cannot know.
 
 #include <cstddef>
 #include <span>
@@ -38,6 +46,7 @@ struct PredictionOptions {
 struct PredictionStart {
   std::size_t recording = 0;  ///< index into the recordings
   std::size_t frame = 0;      ///< the history's last frame: the moment
+  bool pushed = false;        ///< the history's acceleration is not the recording's usual one (see the file comment)
 };
 
 /// The error of the moments whose window held a collision, by what the
@@ -67,6 +76,10 @@ struct PredictionError {
   std::size_t free_moments = 0;
   double free_mean_m = 0.0;       ///< mean error over them (m)
   double collision_mean_m = 0.0;  ///< mean error over the others: something was hit in the window (m)
+  std::size_t under_g_moments = 0;  ///< moments whose history g alone moved (PredictionStart::pushed false)
+  double under_g_mean_m = 0.0;       ///< mean error over them (m)
+  std::size_t pushed_moments = 0;   ///< moments whose history something more pushed (skid, a wall, a flipper)
+  double pushed_mean_m = 0.0;       ///< mean error over them (m)
   /// The collision moments by what the model hit first, most moments first.
   std::vector<CollisionError> collisions_by_model_hit;
 
@@ -81,6 +94,10 @@ struct PredictionError {
     a->Visit(PINBALL_NVP(free_moments));
     a->Visit(PINBALL_NVP(free_mean_m));
     a->Visit(PINBALL_NVP(collision_mean_m));
+    a->Visit(PINBALL_NVP(under_g_moments));
+    a->Visit(PINBALL_NVP(under_g_mean_m));
+    a->Visit(PINBALL_NVP(pushed_moments));
+    a->Visit(PINBALL_NVP(pushed_mean_m));
     a->Visit(PINBALL_NVP(collisions_by_model_hit));
   }
 };

@@ -43,6 +43,25 @@ TrajectoryFit fit_fixed_gravity(std::span<const Observation> observations, doubl
 /// Needs at least 3 points with distinct times.
 TrajectoryFit fit_free_gravity(std::span<const Observation> observations, double sigma_m);
 
+/// A parabola with an acceleration of its own in both coordinates: what a
+/// ball follows when something besides g pushes it, e.g. one that skids on
+/// the playfield (sliding friction against its slip), which the model's
+/// rolling ball never does.
+struct AccelerationFit {
+  bool valid = false;              ///< false: too few points or a singular system
+  double t_ref_s = 0.0;            ///< newest observation time: τ = 0 (s)
+  Vec2 p_ref = Vec2::Zero();       ///< fitted position at τ = 0 (m)
+  Vec2 v_ref = Vec2::Zero();       ///< fitted velocity at τ = 0 (m/s)
+  Vec2 a_mps2 = Vec2::Zero();      ///< fitted acceleration (m/s²); a ball under the board's g alone has (0, −g)
+  int points = 0;                  ///< observations used
+  double chi2 = 0.0;               ///< Σ |residual|² / σ² over both coordinates
+  int dof = 0;                     ///< degrees of freedom: 2·points − 6
+};
+
+/// Fits p + v·τ + a·τ²/2 with a free in both coordinates (6 parameters).
+/// Needs at least 3 points with distinct times.
+AccelerationFit fit_free_acceleration(std::span<const Observation> observations, double sigma_m);
+
 /// χ² above which `dof` degrees of freedom do not fit at the 99.9 % level
 /// (Wilson–Hilferty approximation of the χ² quantile).
 double chi2_threshold(int dof);
