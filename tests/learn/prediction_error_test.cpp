@@ -76,23 +76,38 @@ TEST(PredictionError, TheTrueModelPredictsBetterThanAWrongOne) {
   EXPECT_NE(right.collisions_by_model_hit.front().model_hit, "nothing");
 }
 
-TEST(PredictionStarts, TellsAPushedBallByItsHistorysAcceleration) {
-  // 3 s at 200 frames/s of a ball under g = 1.11 m/s², except from 1.0 to
-  // 1.6 s, when sliding friction pushes it 2 m/s² more along −y (a ball
-  // skidding straight up the table after a bounce off the bottom).
-  constexpr double kG = 1.11, kSkid = 2.0, kSkidFrom = 1.0, kSkidTo = 1.6, kDt = 0.005;
+// 3 s at 200 frames/s of a ball under g = 1.11 m/s², except from 1.0 to
+// 1.6 s, when sliding friction pushes it 2 m/s² more along −y (a ball
+// skidding straight up the table after a bounce off the bottom).
+constexpr double kG = 1.11, kSkid = 2.0, kSkidFrom = 1.0, kSkidTo = 1.6, kDt = 0.005;
+
+bus::RecordedPlay skid_recording() {
   bus::RecordedPlay play;
-  Vec2 p{0.25, 0.1};
+  Vec2 p{2.0, 2.0};
   Vec2 v{0.1, 1.6};
   for (int i = 0; i <= 600; ++i) {
     const double t = i * kDt;
     play.frames.push_back({t, i, true, p, false, false});
-    const bool skidding = t >= kSkidFrom && t < kSkidTo;
+    const bool skidding = t >= kSkidFrom - 1e-9 && t < kSkidTo - 1e-9;
     const Vec2 a{0.0, -kG - (skidding ? kSkid : 0.0)};
     p += v * kDt + 0.5 * a * kDt * kDt;
     v += a * kDt;
   }
-  const std::vector<bus::RecordedPlay> plays{play};
+  return play;
+}
+
+// A belief with nothing to hit: the ball flies under its g alone.
+table::Board open_board() {
+  table::Board board;
+  board.width_m = 10.0;
+  board.height_m = 10.0;
+  board.gravity_mps2 = kG;
+  board.launcher.position = {5.0, 0.5};
+  return board;
+}
+
+TEST(PredictionStarts, TellsAPushedBallByItsHistorysAcceleration) {
+  const std::vector<bus::RecordedPlay> plays{skid_recording()};
   PredictionOptions options;
   options.sigma_m = 0.0005;
   const std::vector<PredictionStart> starts = prediction_starts(plays, options);
@@ -101,7 +116,7 @@ TEST(PredictionStarts, TellsAPushedBallByItsHistorysAcceleration) {
   int pushed = 0;
   int under_g = 0;
   for (const PredictionStart& s : starts) {
-    const double t = play.frames[s.frame].t_s;
+    const double t = plays[0].frames[s.frame].t_s;
     const double from = t - history_s;
     if (from >= kSkidFrom - 1e-9 && t < kSkidTo) {
       EXPECT_TRUE(s.pushed) << t;
@@ -113,6 +128,32 @@ TEST(PredictionStarts, TellsAPushedBallByItsHistorysAcceleration) {
   }
   EXPECT_GT(pushed, 10);
   EXPECT_GT(under_g, 40);
+}
+
+TEST(PredictionError, APushedBallStartsFromItsOwnAcceleration) {
+  // Noiseless frames: a moment under g is predicted exactly; a pushed one
+  // whose push lasts through the window misses by the push alone,
+  // kSkid·h²/2 = 10 mm, the start being exact. Forced onto g, the start's
+  // velocity would be kSkid·(history)/2 = 0.115 m/s off: 21.5 mm in all.
+  const std::vector<bus::RecordedPlay> plays{skid_recording()};
+  PredictionOptions options;
+  options.sigma_m = 0.0005;
+  const double history_s = (options.history_frames - 1) * kDt;
+  std::vector<PredictionStart> in_skid, under_g;
+  for (const PredictionStart& s : prediction_starts(plays, options)) {
+    const double t = plays[0].frames[s.frame].t_s;
+    if (t - history_s >= kSkidFrom - 1e-9 && t + options.horizon_s < kSkidTo - 1e-9) in_skid.push_back(s);
+    if (t + options.horizon_s < kSkidFrom - 1e-9 || t - history_s >= kSkidTo - 1e-9) under_g.push_back(s);
+  }
+  ASSERT_GT(in_skid.size(), 5u);
+  ASSERT_GT(under_g.size(), 40u);
+  const PredictionError skid = prediction_error(open_board(), plays, in_skid, options);
+  EXPECT_EQ(skid.moments, in_skid.size());
+  EXPECT_EQ(skid.pushed_moments, in_skid.size());
+  EXPECT_NEAR(skid.pushed_mean_m, 0.5 * kSkid * options.horizon_s * options.horizon_s, 2e-4);
+  const PredictionError free = prediction_error(open_board(), plays, under_g, options);
+  EXPECT_EQ(free.under_g_moments, under_g.size());
+  EXPECT_LT(free.under_g_mean_m, 1e-4);  // the model's semi-implicit Euler steps alone
 }
 
 TEST(PredictionError, NoMomentNearACoilCommandOrWithoutTheBall) {

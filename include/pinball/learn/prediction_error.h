@@ -1,9 +1,9 @@
 #pragma once
 // How well a belief predicts recorded play (issue 20): from a moment of a
 // recording, the ball's state as the tracker would estimate it from the last
-// frames (a parabola under the belief's g), the belief's model plays on for
-// a horizon with the flippers down, and the predicted ball is compared with
-// where the camera saw it. The moments are chosen from the recording alone
+// frames (a parabola under the belief's g, unless the ball was pushed: see
+// below), the belief's model plays on for a horizon with the flippers down,
+// and the predicted ball is compared with where the camera saw it. The moments are chosen from the recording alone
 // (never from the belief), so two beliefs are judged on the same moments:
 // the ball was seen in every frame of the history and at the horizon and
 // was one ball all along, the history fits one parabola, and no coil
@@ -17,7 +17,10 @@
 // better by more than the 99.9 % point of χ²(2). What pushes a ball is a
 // wall or a resting flipper it rolls along, or, on a real table, sliding
 // friction: a ball skids after a bounce until the playfield has made it
-// roll again, which a model without ball spin cannot know.
+// roll again, which a model without ball spin cannot know. A pushed
+// moment starts from the history's own acceleration fit (the same for every
+// belief): forcing g on it would get the velocity wrong by the push times
+// half the history.
 
 #include <cstddef>
 #include <span>
