@@ -69,7 +69,8 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
     losses += o.launch.lost ? 1 : 0;
     if (a.json) {
       nlohmann::json j = {{"t", row.observation.t_s}, {"valid", p.valid}, {"reason", track::to_string(p.reason)},
-                          {"window", o.window},       {"flushed", o.flushed}, {"launched", o.launch.launched},
+                          {"window", o.window},       {"flushed", o.flushed}, {"pushed", o.pushed},
+                          {"launched", o.launch.launched},
                           {"lost", o.launch.lost}};
       if (p.valid) {
         j.update({{"flipper", side_name(p.flipper)}, {"speed_mps", p.speed_mps}, {"angle_rad", p.angle_rad},
@@ -89,7 +90,8 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
     }
   }
   err << "track: " << rows.size() << " observations, " << valid << " projections, " << launches << " launches, "
-      << losses << " losses, " << tracker.flushes() << " collision flushes\n";
+      << losses << " losses, " << tracker.flushes() << " collision flushes, " << tracker.pushes()
+      << " pushed fits\n";
   if (a.json) {
     out << nlohmann::json{{"board", a.board},
                           {"observations_file", a.observations},
@@ -101,6 +103,7 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
                           {"launches", launches},
                           {"losses", losses},
                           {"collision_flushes", tracker.flushes()},
+                          {"pushed_fits", tracker.pushes()},
                           {"projections", projections}}
                .dump(2)
         << "\n";

@@ -28,10 +28,11 @@ Tracker::Tracker(const FlipperGeometry& geometry, const TrackerConfig& config)
     : geometry_(geometry), config_(config), launch_(flipper_ellipse(geometry), config.launch) {
   if (!(config.window_distance_m > 0.0) || !(config.rolling_epsilon_m > 0.0) || !(config.sigma_m > 0.0) ||
       config.max_window < 3 || config.max_window > static_cast<int>(kHistory) || config.min_window < 0 ||
-      config.min_window > config.max_window || !std::isfinite(config.g_mps2)) {
+      config.min_window > config.max_window || !std::isfinite(config.g_mps2) || !(config.max_push_mps2 >= 0.0) ||
+      !std::isfinite(config.max_push_mps2)) {
     throw std::invalid_argument(
         "tracker: window distance, rolling epsilon and sigma must be > 0, max_window in [3, 512], "
-        "min_window in [0, max_window], g finite");
+        "min_window in [0, max_window], g finite, max push finite and >= 0");
   }
 }
 
@@ -114,8 +115,27 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
   }
 
   std::size_t n = window_length();
-  TrajectoryFit fit = fit_fixed_gravity(newest(n), config_.g_mps2, config_.sigma_m);
-  if (config_.chi2_flush && fit.valid && fit.chi2 > chi2_threshold(fit.dof)) {
+  const std::span<const Observation> fitted = newest(n);
+  TrajectoryFit fit = fit_fixed_gravity(fitted, config_.g_mps2, config_.sigma_m);
+  // A push shows as the χ² an acceleration of its own saves (a likelihood
+  // ratio test, far finer than g's χ² alone, which a skid can pass while its
+  // velocity is already off by the push times half the window). It saves at
+  // most all of g's χ².
+  const double push_chi2 = chi2_threshold(2);
+  if (fit.valid && config_.max_push_mps2 > 0.0 && fit.chi2 > push_chi2) {
+    const AccelerationFit own = fit_free_acceleration(fitted, config_.sigma_m);
+    if (own.valid && fit.chi2 - own.chi2 > push_chi2 && own.chi2 <= chi2_threshold(own.dof) &&
+        (own.a_mps2 - Vec2(0.0, -config_.g_mps2)).norm() <= config_.max_push_mps2) {
+      // One smooth path with a push: its own state, projected under g.
+      fit = exact_trajectory(own.p_ref, own.v_ref, config_.g_mps2, own.t_ref_s);
+      fit.points = own.points;
+      fit.dof = own.dof;
+      fit.chi2 = own.chi2;
+      out_.pushed = true;
+      ++pushes_;
+    }
+  }
+  if (config_.chi2_flush && !out_.pushed && fit.valid && fit.chi2 > chi2_threshold(fit.dof)) {
     // The newest points left the old parabola (thesis 4.1.1's proposal): find
     // the fewest newest points whose removal leaves the older ones fitting one
     // parabola; those are after the collision, so drop everything before them

@@ -1,5 +1,6 @@
 #include "pinball/track/trajectory_fit.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -106,32 +107,42 @@ AccelerationFit fit_free_acceleration(std::span<const Observation> obs, double s
   AccelerationFit fit;
   if (!usable(obs)) return fit;
   const double t_ref = obs.back().t_s;
-  // Both coordinates share the design matrix [1 τ τ²/2].
-  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-  Eigen::Matrix<double, 3, 2> atp = Eigen::Matrix<double, 3, 2>::Zero();
+  const Vec2 origin = obs.back().p_board;  // positions near zero: the closed-form χ² below cancels less
+  // Both coordinates share the design matrix [1 τ τ²/2]: accumulate the
+  // moments of τ and of q·τ^k once (the tracker calls this every frame).
+  double s1 = 0.0, s2 = 0.0, s3 = 0.0, s4 = 0.0;
+  Eigen::Matrix<double, 3, 2> atq = Eigen::Matrix<double, 3, 2>::Zero();
+  double qq = 0.0;
   for (const Observation& o : obs) {
     const double tau = o.t_s - t_ref;
-    const Eigen::Vector3d row{1.0, tau, 0.5 * tau * tau};
-    ata += row * row.transpose();
-    atp += row * o.p_board.transpose();
+    const double tau2 = tau * tau;
+    const Vec2 q = o.p_board - origin;
+    s1 += tau;
+    s2 += tau2;
+    s3 += tau2 * tau;
+    s4 += tau2 * tau2;
+    atq.row(0) += q.transpose();
+    atq.row(1) += tau * q.transpose();
+    atq.row(2) += 0.5 * tau2 * q.transpose();
+    qq += q.squaredNorm();
   }
+  const double n = static_cast<double>(obs.size());
+  Eigen::Matrix3d ata;
+  ata << n, s1, 0.5 * s2, s1, s2, 0.5 * s3, 0.5 * s2, 0.5 * s3, 0.25 * s4;
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(ata);
   if (ldlt.info() != Eigen::Success || !(std::abs(ata.determinant()) > 0.0)) return fit;
-  const Eigen::Matrix<double, 3, 2> c = ldlt.solve(atp);
+  const Eigen::Matrix<double, 3, 2> c = ldlt.solve(atq);
   fit.valid = c.allFinite();
   if (!fit.valid) return fit;
   fit.t_ref_s = t_ref;
-  fit.p_ref = c.row(0).transpose();
+  fit.p_ref = origin + Vec2(c.row(0).transpose());
   fit.v_ref = c.row(1).transpose();
   fit.a_mps2 = c.row(2).transpose();
   fit.points = static_cast<int>(obs.size());
   fit.dof = 2 * fit.points - 6;
-  double chi2 = 0.0;
-  for (const Observation& o : obs) {
-    const double tau = o.t_s - t_ref;
-    chi2 += (o.p_board - (fit.p_ref + fit.v_ref * tau + 0.5 * tau * tau * fit.a_mps2)).squaredNorm();
-  }
-  fit.chi2 = sigma_m > 0.0 ? chi2 / (sigma_m * sigma_m) : 0.0;
+  // At the least-squares solution Σ|q − A·c|² = Σ|q|² − Σ cᵀ(Aᵀq).
+  const double residual = std::max(0.0, qq - (c.array() * atq.array()).sum());
+  fit.chi2 = sigma_m > 0.0 ? residual / (sigma_m * sigma_m) : 0.0;
   return fit;
 }
 

@@ -473,6 +473,26 @@ TEST_F(Cli, TrackPrintsOneProjectionPerObservation) {
   EXPECT_NEAR(last_valid.at("angle_rad").get<double>(), -1.5707963267948966, 1e-9) << "a vertical fall";
 }
 
+TEST_F(Cli, TrackKeepsASkiddingBallsPathAsOnePushedFit) {
+  // A ball skidding down the table: 1.5 m/s² of sliding friction besides g.
+  const fs::path obs = dir_ / "skid.csv";
+  {
+    std::ofstream f(obs);
+    f << "t,x,y\n";
+    for (int i = 0; i < 40; ++i) {
+      const double t = i * 0.005;
+      f << t << "," << 0.21 + 0.3 * t << "," << 0.45 - 0.5 * t - 0.5 * (1.11 + 1.5) * t * t << "\n";
+    }
+  }
+  const CommandResult j = run("track --board boards/mit1993.board --json --observations " + obs.string());
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  const auto report = nlohmann::json::parse(j.out);
+  EXPECT_EQ(report.at("collision_flushes"), 0);
+  EXPECT_GT(report.at("pushed_fits").get<int>(), 10);
+  EXPECT_TRUE(report.at("projections").at(39).at("pushed").get<bool>());
+  EXPECT_NE(j.err.find(" pushed fits"), std::string::npos) << j.err;
+}
+
 TEST_F(Cli, TrackRejectsABadObservationFileNamingTheLine) {
   const fs::path obs = dir_ / "bad.csv";
   std::ofstream(obs) << "t,x,y\n0,0.1,0.2\n0.01,0.1,abc\n";

@@ -168,6 +168,8 @@ TEST(TrajectoryFit, Chi2AveragesItsDegreesOfFreedomOnNoisyData) {
   constexpr int kTrials = 4000;
   double sum_fixed = 0.0;
   double sum_free = 0.0;
+  double sum_own = 0.0;
+  int dof_own = 0;
   int over_fixed = 0;
   int dof_fixed = 0;
   int dof_free = 0;
@@ -178,9 +180,12 @@ TEST(TrajectoryFit, Chi2AveragesItsDegreesOfFreedomOnNoisyData) {
     add_noise(obs, rng, kSigma);
     const TrajectoryFit fixed = fit_fixed_gravity(obs, kG, kSigma);
     const TrajectoryFit free_g = fit_free_gravity(obs, kSigma);
-    ASSERT_TRUE(fixed.valid && free_g.valid);
+    const AccelerationFit own = fit_free_acceleration(obs, kSigma);
+    ASSERT_TRUE(fixed.valid && free_g.valid && own.valid);
     sum_fixed += fixed.chi2;
     sum_free += free_g.chi2;
+    sum_own += own.chi2;
+    dof_own = own.dof;
     dof_fixed = fixed.dof;
     dof_free = free_g.dof;
     if (fixed.chi2 > chi2_threshold(fixed.dof)) ++over_fixed;
@@ -189,6 +194,8 @@ TEST(TrajectoryFit, Chi2AveragesItsDegreesOfFreedomOnNoisyData) {
   EXPECT_EQ(dof_free, 15);
   EXPECT_NEAR(sum_fixed / kTrials / dof_fixed, 1.0, 0.2);
   EXPECT_NEAR(sum_free / kTrials / dof_free, 1.0, 0.2);
+  EXPECT_EQ(dof_own, 14);
+  EXPECT_NEAR(sum_own / kTrials / dof_own, 1.0, 0.2);
   // The threshold is the 99.9 % point: about 4 false alarms in 4000.
   EXPECT_LE(over_fixed, 20);
 }

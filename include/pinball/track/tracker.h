@@ -25,6 +25,17 @@ struct TrackerConfig {
   int min_window = 24;                ///< at least this many points when the trajectory has them (0: the thesis rule alone)
   int max_window = 64;                ///< at most this many points in a fit
   bool chi2_flush = true;             ///< drop the points before a collision at once (4.1.1)
+  /// A window that an acceleration of its own fits better than g (by more
+  /// than the 99.9 % point of χ²(2)), and within the camera's noise, no
+  /// further than this from g's (m/s²), is one smooth path with a push:
+  /// a ball skidding after a bounce (sliding friction μ·g_n, 1.9 m/s² on
+  /// the twin's waxed playfield, plus the slope's fuller pull on a sliding
+  /// ball) or rolling along a wall. Its state is that fit's, and nothing is
+  /// flushed; forcing g on it would get the velocity wrong by the push times
+  /// half the window. A kink (a collision) fits no parabola, or needs a far
+  /// larger acceleration, and is flushed as before. 0: g's fit always, and
+  /// every misfit flushes (the thesis's rule).
+  double max_push_mps2 = 3.5;
   LaunchDetectorConfig launch;        ///< launch detection
 };
 
@@ -39,6 +50,7 @@ struct TrackerOutput {
   LaunchEvent launch;               ///< launch / loss / entry events of this update
   int window = 0;                   ///< observations in the fit
   bool flushed = false;             ///< the χ² test dropped points from before a collision
+  bool pushed = false;              ///< the fit is the window's own acceleration's (TrackerConfig::max_push_mps2)
 };
 
 /// Stateful tracker for one ball at a time.
@@ -60,6 +72,8 @@ class Tracker {
   std::size_t history_size() const { return size_; }
   /// Collisions detected by the χ² test since construction.
   std::size_t flushes() const { return flushes_; }
+  /// Updates whose fit was a pushed ball's (TrackerOutput::pushed) since construction.
+  std::size_t pushes() const { return pushes_; }
 
  private:
   static constexpr std::size_t kHistory = 512;
@@ -79,6 +93,7 @@ class Tracker {
   std::array<Observation, kHistory> scratch_{};
   bool was_rolling_ = false;
   std::size_t flushes_ = 0;
+  std::size_t pushes_ = 0;
   TrackerOutput out_;
 };
 
