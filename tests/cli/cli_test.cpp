@@ -16,6 +16,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "common/command_test.h"
+#include "pinball/core/geometry.h"
 
 namespace {
 
@@ -446,17 +447,22 @@ TEST_F(Cli, BenchPrecisionQuickWritesJsonCsvAndPng) {
   EXPECT_GT(fs::file_size(png), 10'000u);
 }
 
+// 40 frames at 200 fps of the ball at `at(t)`, as an observations CSV.
+template <class Path>
+void write_observations(const fs::path& file, Path at) {
+  std::ofstream f(file);
+  f << "t,x,y\n";
+  for (int i = 0; i < 40; ++i) {
+    const double t = i * 0.005;
+    const pinball::Vec2 p = at(t);
+    f << t << "," << p.x() << "," << p.y() << "\n";
+  }
+}
+
 TEST_F(Cli, TrackPrintsOneProjectionPerObservation) {
   // A ball falling straight onto the left flipper of the thesis table, seen at 200 fps.
   const fs::path obs = dir_ / "obs.csv";
-  {
-    std::ofstream f(obs);
-    f << "t,x,y\n";
-    for (int i = 0; i < 40; ++i) {
-      const double t = i * 0.005;
-      f << t << "," << 0.21 << "," << 0.40 - 1.0 * t - 0.5 * 1.11 * t * t << "\n";
-    }
-  }
+  write_observations(obs, [](double t) { return pinball::Vec2(0.21, 0.40 - 1.0 * t - 0.5 * 1.11 * t * t); });
   const CommandResult r = run("track --board boards/mit1993.board --observations " + obs.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out.rfind("t,valid,flipper,speed,angle,h,d,t_impact,rolling\n", 0), 0u);
@@ -476,14 +482,9 @@ TEST_F(Cli, TrackPrintsOneProjectionPerObservation) {
 TEST_F(Cli, TrackKeepsASkiddingBallsPathAsOnePushedFit) {
   // A ball skidding down the table: 1.5 m/s² of sliding friction besides g.
   const fs::path obs = dir_ / "skid.csv";
-  {
-    std::ofstream f(obs);
-    f << "t,x,y\n";
-    for (int i = 0; i < 40; ++i) {
-      const double t = i * 0.005;
-      f << t << "," << 0.21 + 0.3 * t << "," << 0.45 - 0.5 * t - 0.5 * (1.11 + 1.5) * t * t << "\n";
-    }
-  }
+  write_observations(obs, [](double t) {
+    return pinball::Vec2(0.21 + 0.3 * t, 0.45 - 0.5 * t - 0.5 * (1.11 + 1.5) * t * t);
+  });
   const CommandResult j = run("track --board boards/mit1993.board --json --observations " + obs.string());
   ASSERT_EQ(j.exit_code, 0) << j.err;
   const auto report = nlohmann::json::parse(j.out);
