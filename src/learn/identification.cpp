@@ -49,14 +49,24 @@ bool find_rebound(const table::Board& board, const std::vector<int>& group_of, c
           table::distance_to_shape(board.shapes[k], p) < radius + 2.0 * o.contact_tolerance_m)
         return false;
     if (!ball_clear_of_flippers(board, p, o.contact_tolerance_m)) return false;
-    if ((b.fit.position_at(t) - p).norm() > o.join_tolerance_m) return false;
+    // The ball leaves where it arrived, at once; a kicker holds it until its
+    // coil fires and throws it from its ring's reach: flight out may join
+    // up to kick_dwell_s later and kick_join_tolerance_m away.
+    const bool kicker = board.obstacles[static_cast<std::size_t>(nearest)].action.kick_mps > 0.0;
+    double t_out = t;
+    double join = (b.fit.position_at(t) - p).norm();
+    for (double u = t; kicker && u <= std::min(t + o.kick_dwell_s, b.t_first_s); u += kContactStep_s) {
+      const double d = (b.fit.position_at(u) - p).norm();
+      if (d < join) join = d, t_out = u;
+    }
+    if (join > (kicker ? o.kick_join_tolerance_m : o.join_tolerance_m)) return false;
     const Vec2 n = surface_normal(board.shapes[static_cast<std::size_t>(nearest)], p);
     out.group = group_of[static_cast<std::size_t>(nearest)];
     out.obstacle = nearest;
     out.t_s = t;
     out.contact_m = p;
     out.speed_in_mps = -a.fit.velocity_at(t).dot(n);
-    out.speed_out_mps = b.fit.velocity_at(t).dot(n);
+    out.speed_out_mps = b.fit.velocity_at(t_out).dot(n);
     return out.speed_in_mps >= o.min_normal_speed_mps && out.speed_out_mps > 0.0;
   }
   return false;

@@ -92,6 +92,61 @@ TEST(Identification, RecoversTheRecordedTablesGravityRhoKickAndLaunch) {
   EXPECT_EQ(r.overlay.board, pinball::testing::thesis_board().source);
 }
 
+// A pop bumper that holds the ball 8 ms, then throws it from its ring's
+// 10 mm reach at ρ·(normal speed in) + kick: balls from below, 14 of them,
+// at 0.3 to 1.2 m/s, each seen at 200 fps for 60 ms in and 60 ms out.
+bus::RecordedPlay kicker_play(const table::Board& board, double rho, double kick_mps, double dwell_s,
+                              double reach_m) {
+  std::size_t bumper = 0;
+  while (board.obstacles[bumper].name != "bumper_low") ++bumper;
+  const table::Shape& circle = board.shapes[bumper];
+  const Vec2 g_vec(0.0, -board.gravity_mps2);
+  bus::RecordedPlay play;
+  play.source = "kicker";
+  std::int64_t seq = 0;
+  const auto see = [&](double t, const Vec2& p) { play.frames.push_back({t, seq++, true, p, false, false}); };
+  for (int k = 0; k < 14; ++k) {
+    const double angle = -1.2 + 0.05 * k;  // below the bumper, pointing down and sideways
+    const Vec2 n(std::sin(angle), -std::cos(angle));
+    const Vec2 tangent(-n.y(), n.x());
+    const Vec2 contact = circle.p0 + (circle.radius_m + board.ball.radius_m) * n;
+    const double speed_in = 0.3 + 0.07 * k;
+    const Vec2 v_in = -speed_in * n + 0.1 * tangent;
+    const Vec2 v_out = (rho * speed_in + kick_mps) * n + 0.1 * tangent;
+    const double t_contact = 2.0 * k + 1.0;
+    for (double tau = -0.06; tau < -1e-9; tau += 0.005)
+      see(t_contact + tau, contact + v_in * tau + 0.5 * tau * tau * g_vec);
+    for (double tau = 0.0; tau < dwell_s; tau += 0.005) see(t_contact + tau, contact);
+    const Vec2 thrown = contact + reach_m * n;
+    for (double tau = 0.0; tau <= 0.06 + 1e-9; tau += 0.005)
+      see(t_contact + dwell_s + tau, thrown + v_out * tau + 0.5 * tau * tau * g_vec);
+  }
+  return play;
+}
+
+TEST(Identification, AKickerThatHoldsTheBallAndThrowsItFromItsReachIsIdentified) {
+  const table::Board& board = pinball::testing::thesis_board();
+  const std::vector<bus::RecordedPlay> plays{kicker_play(board, 0.6, 1.0, 0.008, 0.010)};
+  IdentifyOptions options;
+  options.flights.sigma_m = 0.0005;
+  options.bootstrap = 0;
+  const IdentificationResult r = identify_table(board, plays, options);
+  const GroupResult* bumpers = group_with(r, 1.1, 0.8);
+  ASSERT_NE(bumpers, nullptr);
+  ASSERT_TRUE(bumpers->identified) << bumpers->why_not;
+  EXPECT_EQ(bumpers->rebounds, 14);
+  ASSERT_TRUE(bumpers->overlay.kick_mps.has_value());
+  EXPECT_NEAR(bumpers->overlay.rho.value, 0.6, 0.03);
+  EXPECT_NEAR(bumpers->overlay.kick_mps->value, 1.0, 0.03);
+
+  // Joined at the contact as a wall is, the thrown ball is 10 mm and more
+  // from where it arrived: no rebound.
+  options.kick_dwell_s = 0.0;
+  options.kick_join_tolerance_m = options.join_tolerance_m;
+  const IdentificationResult strict = identify_table(board, plays, options);
+  EXPECT_EQ(group_with(strict, 1.1, 0.8)->rebounds, 0);
+}
+
 TEST(Identification, SaysWhichParametersItCouldNotIdentifyAndWhy) {
   const table::Board world = recorded_table();
   const std::vector<bus::RecordedPlay> short_play{pinball::testing::record_model_play(world, 2, 0.0005, 5)};

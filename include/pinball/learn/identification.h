@@ -43,6 +43,11 @@ struct IdentifyOptions {
   double max_rebound_gap_s = 0.05;   ///< two flights further apart in time are not one rebound (s)
   double contact_tolerance_m = 0.002;///< the extrapolated ball reaches the obstacle within this of its radius (m)
   double join_tolerance_m = 0.006;   ///< both flights put the ball within this of each other at contact (m)
+  /// An obstacle with a kick (a pop bumper, a slingshot) holds the ball until
+  /// its coil fires and throws it from its ring's reach: the flight out may
+  /// pass this close to the contact (m), up to kick_dwell_s after it (s).
+  double kick_join_tolerance_m = 0.02;
+  double kick_dwell_s = 0.02;
   double min_normal_speed_mps = 0.15;///< a slower approach gives no usable ratio (m/s)
   int min_rebounds = 8;              ///< a group needs this many rebounds for ρ (and 2 more for a kick)
   int min_launches = 5;              ///< launches needed for the pull and the noise
