@@ -16,9 +16,7 @@ namespace {
 // median. Returns how many are kept, or -1 when nothing changed (or all agree).
 int trim(const std::vector<double>& r, double trim_mad, std::vector<char>& keep) {
   const double med = median(r);
-  std::vector<double> dev;
-  for (const double x : r) dev.push_back(std::abs(x - med));
-  const double sigma = 1.4826 * median(dev);
+  const double sigma = robust_sigma(r);
   if (!(sigma > 0.0)) return -1;
   bool changed = false;
   int kept = 0;

@@ -159,9 +159,7 @@ GravityCalibration calibrate_gravity(std::span<const GravityRoll> rolls, const G
   // Outliers by median/MAD, from 3 rolls on; the robust σ never falls below
   // what the rolls' own fits allow (identical rolls must not reject each other).
   const double med = median(a);
-  std::vector<double> dev;
-  for (const double x : a) dev.push_back(std::abs(x - med));
-  const double sigma = std::max(1.4826 * median(dev), 2.0 * median(se));
+  const double sigma = std::max(robust_sigma(a), 2.0 * median(se));
   GravityEstimate& e = out.estimate;
   e.confidence = o.confidence;
   double sum = 0.0;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace pinball {
 
@@ -36,6 +37,15 @@ double median(std::vector<double> values) {
   std::nth_element(values.begin(), mid, values.end());
   if (values.size() % 2 == 1) return *mid;
   return 0.5 * (*mid + *std::max_element(values.begin(), mid));
+}
+
+double robust_sigma(const std::vector<double>& values) {
+  constexpr double kMadToSigma = 1.4826;  // a normal's σ over its median absolute deviation
+  const double middle = median(values);
+  std::vector<double> deviation;
+  deviation.reserve(values.size());
+  for (const double x : values) deviation.push_back(std::abs(x - middle));
+  return kMadToSigma * median(std::move(deviation));
 }
 
 }  // namespace pinball

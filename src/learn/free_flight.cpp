@@ -344,10 +344,8 @@ SlidingFriction fit_sliding_friction(std::span<const bus::RecordedPlay> recordin
   if (decel.empty()) return out;
   out.decel_mps2 = median(decel);
   if (decel.size() >= 2) {
-    // The median's standard error, 1.2533·σ/√n, with σ the robust spread (1.4826 × the median absolute deviation).
-    std::vector<double> deviation;
-    for (double d : decel) deviation.push_back(std::abs(d - out.decel_mps2));
-    out.decel_stderr_mps2 = 1.2533 * 1.4826 * median(deviation) / std::sqrt(static_cast<double>(decel.size()));
+    // The median's standard error: 1.2533·σ/√n for a normal spread σ.
+    out.decel_stderr_mps2 = 1.2533 * robust_sigma(decel) / std::sqrt(static_cast<double>(decel.size()));
   }
   return out;
 }

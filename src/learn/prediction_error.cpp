@@ -65,6 +65,7 @@ bool flew_free(const bus::RecordedPlay& play, std::size_t from, double t_end, do
 std::vector<PredictionStart> prediction_starts(std::span<const bus::RecordedPlay> recordings,
                                                const PredictionOptions& o) {
   std::vector<PredictionStart> starts;
+  std::vector<track::AccelerationFit> own;  // each start's history with an acceleration of its own
   const auto history = static_cast<std::size_t>(o.history_frames);
   for (std::size_t r = 0; r < recordings.size(); ++r) {
     const bus::RecordedPlay& play = recordings[r];
@@ -85,17 +86,14 @@ std::vector<PredictionStart> prediction_starts(std::span<const bus::RecordedPlay
       const track::TrajectoryFit fit = track::fit_free_gravity(obs, o.sigma_m);
       if (!fit.valid || fit.chi2 > track::chi2_threshold(fit.dof)) continue;
       starts.push_back({r, i});
+      own.push_back(track::fit_free_acceleration(obs, o.sigma_m));
     }
   }
   // Under g or pushed: against the usual acceleration of these histories
   // (most balls fly free), by how much χ² an acceleration of its own saves.
-  std::vector<track::AccelerationFit> own(starts.size());
   std::vector<double> down_mps2;
-  for (std::size_t k = 0; k < starts.size(); ++k) {
-    own[k] = track::fit_free_acceleration(history_of(recordings[starts[k].recording], starts[k].frame,
-                                                     o.history_frames), o.sigma_m);
-    if (own[k].valid) down_mps2.push_back(-own[k].a_mps2.y());
-  }
+  for (const track::AccelerationFit& f : own)
+    if (f.valid) down_mps2.push_back(-f.a_mps2.y());
   if (down_mps2.empty()) return starts;
   const double usual_g_mps2 = median(down_mps2);
   for (std::size_t k = 0; k < starts.size(); ++k) {

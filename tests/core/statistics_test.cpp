@@ -55,6 +55,13 @@ TEST(RunningStats, TheIntervalOfTwoBallsUsesStudentsT) {
   EXPECT_GT(s.ci95_half_width() / (1.96 * 1000.0), 6.4);  // the normal approximation is 6.5x too narrow
 }
 
+TEST(Statistics, RobustSigmaIsTheScaledMedianAbsoluteDeviation) {
+  // Median 3, deviations {2, 1, 0, 1, 97}: their median 1.
+  EXPECT_DOUBLE_EQ(robust_sigma({1.0, 2.0, 3.0, 4.0, 100.0}), 1.4826);
+  EXPECT_DOUBLE_EQ(robust_sigma({5.0, 5.0, 5.0}), 0.0);
+  EXPECT_DOUBLE_EQ(robust_sigma({}), 0.0);
+}
+
 TEST(Statistics, TheMedianIsTheMiddleOrTheMeanOfTheTwoMiddleValues) {
   EXPECT_EQ(median({}), 0.0);
   EXPECT_EQ(median({3.0}), 3.0);

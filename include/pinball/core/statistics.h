@@ -29,6 +29,10 @@ double quantile(std::vector<T> values, double q) {
 /// values for an even count (0 for none). Takes its own copy.
 double median(std::vector<double> values);
 
+/// A normal's σ estimated robustly from `values`: 1.4826 × their median
+/// absolute deviation from their median (0 for none). Takes its own copy.
+double robust_sigma(const std::vector<double>& values);
+
 /// Two-sided 95 % critical value of Student's t with `dof` degrees of freedom:
 /// 12.71 for 1, 2.23 for 10, 1.96 in the limit. Infinite for dof < 1.
 double student_t95(std::int64_t dof);
