@@ -53,6 +53,29 @@ bool shape_time_of_impact(const table::Shape& shape, const Vec2& p, const Vec2& 
   return circle_time_of_impact(shape.p0, shape.radius_m, p, v, r, t_max, out);
 }
 
+double wall_friction_loss_mps(double tangential_mps, double normal_in_mps, double normal_change_mps, double mu) {
+  const double along = std::abs(tangential_mps);
+  const double slip = std::hypot(along, normal_in_mps);
+  if (!(mu > 0.0) || !(along > 0.0) || !(normal_change_mps > 0.0)) return 0.0;
+  // A solid sphere: a unit impulse changes the contact's slip by 1 + 5/2.
+  constexpr double kSlipPerImpulse = 3.5;
+  const double impulse = mu * normal_change_mps;
+  if (kSlipPerImpulse * impulse >= slip) return along / kSlipPerImpulse;  // the contact sticks
+  return impulse * along / slip;
+}
+
+Vec2 obstacle_response(const table::Obstacle& o, const Vec2& n, const Vec2& v) {
+  const double vn = v.dot(n);
+  Vec2 out = reflect(v, n, o.rho);
+  if (o.friction > 0.0 && vn < 0.0) {
+    const Vec2 tangential = v - vn * n;
+    const double speed = tangential.norm();
+    const double loss = wall_friction_loss_mps(speed, -vn, (1.0 + o.rho) * -vn + o.action.kick_mps, o.friction);
+    if (loss > 0.0) out -= (loss / speed) * tangential;
+  }
+  return out + o.action.kick_mps * n;
+}
+
 table::Shape flipper_face(const table::Flipper& f, double theta_rad, const Vec2& p) {
   table::Shape face;
   face.kind = table::ShapeKind::kLine;

@@ -31,9 +31,7 @@ void raise_flags(const table::Board& board, GameState& state, double clear_m) {
 void hit_obstacle(const table::Board& board, GameState& state, std::int32_t index, const Vec2& normal,
                   StepEvents& events, double clear_m) {
   const table::Obstacle& o = board.obstacles[index];
-  Vec2& v = state.ball.velocity_mps;
-  v = reflect(v, normal, o.rho);
-  v += o.action.kick_mps * normal;
+  state.ball.velocity_mps = obstacle_response(o, normal, state.ball.velocity_mps);
   score_obstacle_hit(board, state, index, events, clear_m);
 }
 

@@ -63,6 +63,7 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
     if (g.obstacles.empty()) r.fail(key + ".obstacles", "names no obstacle");
     check_value(g.rho, kZero, {3.0, false}, "", key + ".rho", r);
     if (g.kick_mps) check_value(*g.kick_mps, kZero, {10.0, false}, " m/s", key + ".kick_mps", r);
+    if (g.friction) check_value(*g.friction, kZero, {2.0, false}, "", key + ".friction", r);
   }
   for (std::size_t i = 0; i < o.flippers.size(); ++i) {
     const std::string key = "flippers[" + std::to_string(i) + "]";
@@ -148,6 +149,7 @@ void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, B
         if (o.name != g.obstacles[j]) continue;
         o.rho = g.rho.value;
         if (g.kick_mps) o.action.kick_mps = g.kick_mps->value;
+        if (g.friction) o.friction = g.friction->value;
         ++shapes;
       }
       if (shapes == 0) {

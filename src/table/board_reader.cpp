@@ -48,7 +48,7 @@ bool in_list(std::string_view list, std::string_view key) {
   return false;
 }
 
-constexpr std::string_view kValueAttributes = "rho score kick contact bank name pull noise mu kickout spread bonus";
+constexpr std::string_view kValueAttributes = "rho friction score kick contact bank name pull noise mu kickout spread bonus";
 constexpr std::string_view kFlagAttributes = "eat hidden two-sided";
 
 }  // namespace

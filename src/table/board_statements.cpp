@@ -13,7 +13,7 @@ namespace pinball::table::loader {
 
 namespace {
 
-constexpr std::string_view kObstacleAttributes = "rho score kick contact eat hidden bank name";
+constexpr std::string_view kObstacleAttributes = "rho friction score kick contact eat hidden bank name";
 
 // Physical bounds, SI. A table is about 0.5 m x 1 m, its ball 27 mm across and
 // at most a few m/s fast; the bounds are loose around that. They are here so
@@ -176,6 +176,8 @@ std::string default_name(const Reader& r) { return std::string(r.keyword()) + "@
 Obstacle obstacle_attributes(const LoadState& state, const Reader& r) {
   Obstacle o;
   o.rho = rho_attribute(r, state.default_rho);
+  o.friction = r.attribute("friction", 0.0);
+  r.require(o.friction >= 0, "attribute friction", ">= 0", o.friction);
   o.action.score = r.attribute("score", 0.0);
   const double kick = r.attribute("kick", 0.0);
   r.require(kick >= 0, "attribute kick", ">= 0", kick);
@@ -360,7 +362,7 @@ void hole(LoadState& state, const Reader& r) {
 }  // namespace
 
 const StatementKind* find_kind(std::string_view keyword) {
-  static constexpr std::string_view kObstacleTwoSided = "rho score kick contact eat hidden bank name two-sided";
+  static constexpr std::string_view kObstacleTwoSided = "rho friction score kick contact eat hidden bank name two-sided";
   static const StatementKind kKinds[] = {
       {"pinball-board", &header, true, false, ""},
       {"units", &units, true, false, ""},

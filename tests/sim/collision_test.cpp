@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "pinball/core/rng.h"
 #include "test_boards.h"
 
 namespace pinball::sim {
@@ -207,6 +208,74 @@ TEST(Reflect, NormalSpeedScaledByRhoTangentialUnchanged) {
     EXPECT_NEAR(out.dot(t), 0.7, 1e-14) << rho;
     // Kinetic energy: tangential part kept, normal part scaled by rho².
     EXPECT_NEAR(out.squaredNorm(), 0.49 + 4.0 * rho * rho, 1e-13) << rho;
+  }
+}
+
+TEST(WallFriction, SlidingLossIsMuTimesImpulseTimesTheSlipsTangentialShare) {
+  // Slip (0.6 along, 0.8 across): 3.5·μ·J = 0.35 < 1, so the contact slides
+  // all through the hit and the loss is μ·J·0.6/1.
+  EXPECT_NEAR(wall_friction_loss_mps(0.6, 0.8, 1.0, 0.1), 0.1 * 1.0 * 0.6, 1e-15);
+  // A grazing ball (little normal speed) loses the whole μ·J.
+  EXPECT_NEAR(wall_friction_loss_mps(2.0, 1e-9, 0.1, 0.2), 0.02, 1e-9);
+  // A head-on ball has no tangential speed to lose.
+  EXPECT_EQ(wall_friction_loss_mps(0.0, 1.0, 1.5, 0.3), 0.0);
+}
+
+TEST(WallFriction, StickingCapsTheLossAtATangential3Point5th) {
+  // 3.5·μ·J = 3.5·0.5·2 = 3.5 > slip 1: the contact sticks.
+  EXPECT_NEAR(wall_friction_loss_mps(0.6, 0.8, 2.0, 0.5), 0.6 / 3.5, 1e-15);
+  // The loss grows with μ up to the cap, continuously, and never past it.
+  double last = 0.0;
+  for (double mu = 0.0; mu <= 3.0; mu += 0.01) {
+    const double loss = wall_friction_loss_mps(0.6, 0.8, 2.0, mu);
+    EXPECT_GE(loss, last - 1e-15);
+    EXPECT_LE(loss, 0.6 / 3.5 + 1e-15);
+    EXPECT_LT(loss - last, 0.02);
+    last = loss;
+  }
+}
+
+TEST(WallFriction, NoFrictionNoImpulseOrNoSpeedIsNoLoss) {
+  EXPECT_EQ(wall_friction_loss_mps(1.0, 1.0, 1.0, 0.0), 0.0);
+  EXPECT_EQ(wall_friction_loss_mps(1.0, 1.0, 0.0, 0.4), 0.0);
+  EXPECT_EQ(wall_friction_loss_mps(0.0, 0.0, 1.0, 0.4), 0.0);
+}
+
+TEST(ObstacleResponse, FrictionlessIsTheThesisReflectionPlusKick) {
+  const Vec2 n = Vec2{1.0, 2.0}.normalized();
+  const Vec2 v = -1.5 * n + 0.4 * perp_left(n);
+  table::Obstacle o;
+  o.rho = 0.7;
+  o.action.kick_mps = 0.3;
+  const Vec2 out = obstacle_response(o, n, v);
+  EXPECT_NEAR((out - (reflect(v, n, 0.7) + 0.3 * n)).norm(), 0.0, 1e-15);
+}
+
+TEST(ObstacleResponse, FrictionTakesTangentialSpeedAndNeverAddsEnergy) {
+  const Vec2 n{0.0, 1.0};
+  const Vec2 t{1.0, 0.0};
+  table::Obstacle o;
+  o.rho = 0.5;
+  o.friction = 0.1;
+  const Vec2 v = 2.0 * t - 1.0 * n;  // fast along the wall, 1 m/s into it
+  const Vec2 out = obstacle_response(o, n, v);
+  const double impulse = 1.5;  // (1 + ρ)·1
+  EXPECT_NEAR(out.dot(n), 0.5, 1e-15);  // the normal part is the thesis's
+  EXPECT_NEAR(out.dot(t), 2.0 - 0.1 * impulse * 2.0 / std::sqrt(5.0), 1e-14);
+  // Turned round: the same loss against the other way along the wall.
+  const Vec2 back = obstacle_response(o, n, Vec2(-2.0 * t - 1.0 * n));
+  EXPECT_NEAR(back.dot(t), -out.dot(t), 1e-15);
+  // Random hits: never faster than the frictionless response, never turned back along the wall.
+  Rng rng(7);
+  for (int i = 0; i < 10000; ++i) {
+    o.rho = rng.uniform(0.0, 1.5);
+    o.friction = rng.uniform(0.0, 2.0);
+    const Vec2 in = rng.uniform(-2.0, 2.0) * t - rng.uniform(1e-6, 3.0) * n;
+    const Vec2 free = reflect(in, n, o.rho);
+    const Vec2 with = obstacle_response(o, n, in);
+    ASSERT_LE(with.squaredNorm(), free.squaredNorm() + 1e-15);
+    ASSERT_GE(with.dot(t) * in.dot(t), 0.0);
+    ASSERT_NEAR(with.dot(n), free.dot(n), 1e-15);
   }
 }
 

@@ -71,7 +71,7 @@ TEST(BoardLoader, ConvertsMillimetresAndDegreesToSi) {
       "dt 0.0005\n"
       "balls 2\n"
       "launcher 450 50 pull=0.5 noise=0.1\n"
-      "circle 100 200 30 kick=400\n"
+      "circle 100 200 30 kick=400 friction=0.15\n"
       "flipper right 300 150 76 -30 30 2000\n"
       "hole 250 800 20 kickout=100,-200\n",
       "mm.board");
@@ -88,6 +88,7 @@ TEST(BoardLoader, ConvertsMillimetresAndDegreesToSi) {
   EXPECT_TRUE(b.shapes[0].p0.isApprox(Vec2(0.1, 0.2)));
   EXPECT_DOUBLE_EQ(b.shapes[0].radius_m, 0.03);
   EXPECT_DOUBLE_EQ(b.obstacles[0].action.kick_mps, 0.4);
+  EXPECT_DOUBLE_EQ(b.obstacles[0].friction, 0.15);  // a coefficient, not a length
   ASSERT_EQ(b.flippers.size(), 1u);
   const Flipper& f = b.flippers[0];
   EXPECT_EQ(f.side, Side::kRight);
@@ -387,6 +388,7 @@ TEST(BoardLoaderErrors, AttributeMisuse) {
   expect_body_error("circle 0.1 0.5 rho=1 0.01\n", 8, "'0.01' after the attributes");
   expect_body_error("circle 0.1 0.5 0.01 rho=-1\n", 8, "circle: attribute rho must be >= 0, got -1");
   expect_body_error("circle 0.1 0.5 0.01 kick=-2\n", 8, "attribute kick must be >= 0, got -2");
+  expect_body_error("wall 0.1 0.5 0.2 0.5 friction=-0.1\n", 8, "wall: attribute friction must be >= 0, got -0.1");
   expect_body_error("circle 0.1 0.5 0.01 score=lots\n", 8, "attribute score is not a finite number: 'lots'");
   expect_error("pinball-board 1\nlauncher 1 1 pull=1.5\n", 2, "launcher: attribute pull must be in (0, 1], got 1.5");
   expect_error("pinball-board 1\nlauncher 1 1 noise=0.6\n", 2, "attribute noise must be in [0, 0.5], got 0.6");

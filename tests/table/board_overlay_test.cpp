@@ -29,6 +29,7 @@ BoardOverlay full() {
   arcs.board_rho = 0.6;
   arcs.obstacles = {"top_right_arc", "top_left_arc"};
   arcs.rho = value(0.55, 0.02, 37);
+  arcs.friction = value(0.11, 0.004, 35);
   ObstacleGroupOverlay bumpers;
   bumpers.board_rho = 1.1;
   bumpers.board_kick_mps = 0.8;
@@ -83,6 +84,10 @@ TEST(BoardOverlay, EveryFieldRoundTrips) {
   EXPECT_EQ(b.obstacle_groups[0].obstacles, a.obstacle_groups[0].obstacles);
   EXPECT_EQ(b.obstacle_groups[0].board_rho, 0.6);
   EXPECT_FALSE(b.obstacle_groups[0].kick_mps);
+  ASSERT_TRUE(b.obstacle_groups[0].friction);
+  EXPECT_EQ(b.obstacle_groups[0].friction->value, 0.11);
+  EXPECT_EQ(b.obstacle_groups[0].friction->events, 35);
+  EXPECT_FALSE(b.obstacle_groups[1].friction);
   EXPECT_EQ(b.obstacle_groups[1].board_kick_mps, 0.8);
   ASSERT_TRUE(b.obstacle_groups[1].kick_mps);
   EXPECT_EQ(b.obstacle_groups[1].kick_mps->value, 0.7);
@@ -155,6 +160,11 @@ TEST(BoardOverlay, EveryRangeIsChecked) {
   expect_key_error(group(3.01, {}), "obstacle_groups[1].rho.value", "must be in [0, 3]");
   expect_key_error(group(1.0, -0.5), "obstacle_groups[1].kick_mps.value", "must be in [0, 10] m/s");
   expect_key_error(group(1.0, 10.5), "obstacle_groups[1].kick_mps.value", "must be in [0, 10] m/s");
+  for (double friction : {-0.01, 2.01}) {
+    BoardOverlay f = full();
+    f.obstacle_groups[0].friction->value = friction;
+    expect_key_error(board_overlay_to_yaml(f), "obstacle_groups[0].friction.value", "must be in [0, 2]");
+  }
   BoardOverlay o = full();
   o.gravity_mps2->value = 0.0;
   expect_key_error(board_overlay_to_yaml(o), "gravity_mps2.value", "must be in (0, 20] m/s^2");
@@ -287,6 +297,7 @@ TEST(BoardOverlay, ApplyChangesExactlyTheNamedParameters) {
   arc.board_rho = 0.6;
   arc.obstacles = {"top_right_arc"};
   arc.rho = value(0.45, 0.02, 12);
+  arc.friction = value(0.12, 0.01, 11);
   ObstacleGroupOverlay bumpers;
   bumpers.board_rho = 1.1;
   bumpers.board_kick_mps = 0.8;
@@ -313,12 +324,15 @@ TEST(BoardOverlay, ApplyChangesExactlyTheNamedParameters) {
       ++arc_shapes;
       EXPECT_EQ(x.rho, 0.45);
       EXPECT_EQ(x.action.kick_mps, was.action.kick_mps);  // no kick identified: the file's
+      EXPECT_EQ(x.friction, 0.12);
     } else if (x.name == "bumper_left" || x.name == "bumper_low") {
       EXPECT_EQ(x.rho, 0.95);
       EXPECT_EQ(x.action.kick_mps, 0.65);
+      EXPECT_EQ(x.friction, was.friction);  // no friction identified: the file's
     } else {
       EXPECT_EQ(x.rho, was.rho);
       EXPECT_EQ(x.action.kick_mps, was.action.kick_mps);
+      EXPECT_EQ(x.friction, was.friction);
     }
   }
   int file_arc_shapes = 0;

@@ -34,6 +34,23 @@ bool shape_time_of_impact(const table::Shape& shape, const Vec2& p, const Vec2& 
 /// then scale the normal component: v − (1 + ρ)(v·n)n.
 inline Vec2 reflect(const Vec2& v, const Vec2& n, double rho) { return v - (1.0 + rho) * v.dot(n) * n; }
 
+/// Tangential speed (m/s) a rolling ball loses to Coulomb friction `mu` at a
+/// wall it hits at its equator. At that contact the ball slips along the
+/// wall at its tangential speed and across it (up or down the wall) at the
+/// normal speed it came in with, which its rolling spin carries; friction
+/// opposes that slip with mu times the normal impulse (per unit mass, the
+/// normal speed change), so a head-on ball keeps its little tangential speed
+/// and a grazing one loses mu times the impulse. A solid sphere's contact
+/// stops slipping after an impulse of slip / 3.5, which caps the loss at
+/// tangential / 3.5: friction never turns the ball back along the wall.
+double wall_friction_loss_mps(double tangential_mps, double normal_in_mps, double normal_change_mps, double mu);
+
+/// Ball velocity after hitting an obstacle with contact normal n: reflect
+/// with ρ (thesis 3.3.2), take the wall friction's tangential loss (0 when
+/// the obstacle's friction is 0, the thesis's frictionless wall), then add
+/// the kick along n.
+Vec2 obstacle_response(const table::Obstacle& o, const Vec2& n, const Vec2& v);
+
 /// The flipper as a two-sided segment at theta_rad: which face the ball at p
 /// is in front of, as a line shape from pivot to tip with that face's normal.
 table::Shape flipper_face(const table::Flipper& f, double theta_rad, const Vec2& p);

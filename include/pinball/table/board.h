@@ -43,6 +43,7 @@ struct Action {
 /// A reflecting obstacle: shape, reflectivity and action (thesis 3.2.3).
 struct Obstacle {
   double rho = 1.0;       ///< reflectivity: normal speed out = rho x normal speed in; > 1 kicks
+  double friction = 0.0;  ///< Coulomb friction at a hit (sim::wall_friction_loss_mps); 0: the thesis's frictionless wall
   Action action;          ///< score, kick, eat
   bool visible = true;    ///< visibility at the start of a game (thesis 3.4); hidden ones are not hit
   int bank = -1;          ///< index into Board::banks when it is a flag of a bank, else -1

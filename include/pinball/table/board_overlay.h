@@ -44,6 +44,7 @@ struct ObstacleGroupOverlay {
   std::vector<std::string> obstacles;   ///< the board's obstacle names in the group (every shape of each)
   IdentifiedValue rho;                  ///< identified reflectivity: normal speed out = ρ · normal speed in + kick
   std::optional<IdentifiedValue> kick_mps;  ///< identified kick (m/s); only for groups the board gives a kick
+  std::optional<IdentifiedValue> friction;  ///< identified wall friction (sim::wall_friction_loss_mps); absent: the board's
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -52,6 +53,7 @@ struct ObstacleGroupOverlay {
     a->Visit(PINBALL_NVP(obstacles));
     a->Visit(PINBALL_NVP(rho));
     a->Visit(PINBALL_NVP(kick_mps));
+    a->Visit(PINBALL_NVP(friction));
   }
 };
 
@@ -123,7 +125,7 @@ void write_board_overlay(const BoardOverlay& overlay, const std::string& path);
 
 /// Reads an overlay file. Throws KeyError "path:key: what is wrong" for a
 /// missing, unknown, repeated, mistyped or out-of-range key (ρ in [0, 3],
-/// kick in [0, 10] m/s, g in (0, 20] m/s², μ in [0, 10], ω in (0, 200] rad/s,
+/// kick in [0, 10] m/s, wall friction in [0, 2], g in (0, 20] m/s², μ in [0, 10], ω in (0, 200] rad/s,
 /// rise delay in [0, 0.1] s, pull in (0, 1],
 /// noise_max in [0, 1), stderr ≥ 0, events ≥ 0) or a wrong version;
 /// std::runtime_error naming the file when it cannot be read or parsed.
@@ -132,7 +134,7 @@ BoardOverlay read_board_overlay(const std::string& path);
 /// Parses YAML text; `name` stands for the file in messages.
 BoardOverlay parse_board_overlay(const std::string& text, const std::string& name);
 
-/// Lays the overlay over `board`: g, each group's obstacles' ρ and kick (by
+/// Lays the overlay over `board`: g, each group's obstacles' ρ, kick and friction (by
 /// name, every shape of a named obstacle), each flipper's μ (by name), the
 /// launcher's pull and noise, and each flipper's stroke speed where given (its
 /// rise delay is not the board's: identified_actuation_delay_s). All or nothing: throws KeyError "name:key: ..."
