@@ -59,7 +59,11 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                       {"rho", g.identified ? to_json_value(g.overlay.rho) : nlohmann::json(nullptr)},
                       {"kick_mps", g.overlay.kick_mps ? to_json_value(*g.overlay.kick_mps) : nlohmann::json(nullptr)},
                       {"rms_nominal_mps", g.rms_nominal_mps},
-                      {"rms_fitted_mps", g.rms_fitted_mps}});
+                      {"rms_fitted_mps", g.rms_fitted_mps},
+                      {"friction", g.overlay.friction ? to_json_value(*g.overlay.friction) : nlohmann::json(nullptr)},
+                      {"friction_outliers", g.friction.outliers},
+                      {"tangent_rms_frictionless_mps", g.friction.rms_frictionless_mps},
+                      {"tangent_rms_fitted_mps", g.friction.rms_fitted_mps}});
   }
   nlohmann::json strokes = nlohmann::json::array();
   for (const learn::FlipperStrokeFit& f : r.flipper_strokes) {
@@ -105,13 +109,14 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                    {"overlay", a.out.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.out)},
                    {"held_out", nullptr}};
   if (held_out) {
+    const learn::ErrorRatio ratio = learn::paired_error_ratio(held_out->identified, held_out->nominal);
     j["held_out"] = {{"recordings", a.held_out},
                      {"horizon_s", learn::PredictionOptions{}.horizon_s},
                      {"nominal", to_json_value(held_out->nominal)},
                      {"identified", to_json_value(held_out->identified)},
-                     {"error_ratio", held_out->nominal.mean_m > 0.0
-                                         ? held_out->identified.mean_m / held_out->nominal.mean_m
-                                         : 0.0}};
+                     {"error_ratio", ratio.ratio},
+                     {"error_ratio_ci95", ratio.ci95},
+                     {"error_ratio_moments", ratio.moments}};
   }
   return j;
 }
@@ -151,7 +156,12 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
         << (group.overlay.obstacles.size() > 1 ? ", ..." : "") << "): rho " << value_text(group.overlay.rho, "");
     if (group.overlay.kick_mps) out << ", kick " << value_text(*group.overlay.kick_mps, " m/s");
     out << " (" << group.rebounds << " rebounds, " << group.outliers << " outliers); residual "
-        << format_number(group.rms_nominal_mps) << " -> " << format_number(group.rms_fitted_mps) << " m/s\n";
+        << format_number(group.rms_nominal_mps) << " -> " << format_number(group.rms_fitted_mps) << " m/s";
+    if (group.overlay.friction)
+      out << "; friction " << value_text(*group.overlay.friction, "") << " (" << group.friction.outliers
+          << " outliers), tangential residual " << format_number(group.friction.rms_frictionless_mps) << " -> "
+          << format_number(group.friction.rms_fitted_mps) << " m/s";
+    out << "\n";
   }
   for (const learn::FlipperStrokeFit& f : r.flipper_strokes) {
     if (!f.identified) continue;
@@ -177,6 +187,9 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     out << "  held out, ball " << format_number(learn::PredictionOptions{}.horizon_s * 1000.0) << " ms ahead ("
         << held_out->nominal.moments << " moments): board " << prediction_text(held_out->nominal) << "; identified "
         << prediction_text(held_out->identified) << "\n";
+    const learn::ErrorRatio ratio = learn::paired_error_ratio(held_out->identified, held_out->nominal);
+    out << "  held out, identified / board mean error: " << format_number(ratio.ratio, 3) << " ± "
+        << format_number(ratio.ci95, 2) << " (95 %, paired over " << ratio.moments << " moments)\n";
     const learn::PredictionError& nominal = held_out->nominal;
     const learn::PredictionError& fitted = held_out->identified;
     out << "  held out, by what moved the ball in the history (mean error, board -> identified): g alone "

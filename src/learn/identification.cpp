@@ -6,6 +6,8 @@
 
 #include "pinball/core/format.h"
 #include "pinball/core/least_squares_line.h"
+#include "pinball/core/statistics.h"
+#include "pinball/sim/collision.h"
 
 namespace pinball::learn {
 namespace {
@@ -65,8 +67,13 @@ bool find_rebound(const table::Board& board, const std::vector<int>& group_of, c
     out.obstacle = nearest;
     out.t_s = t;
     out.contact_m = p;
-    out.speed_in_mps = -a.fit.velocity_at(t).dot(n);
-    out.speed_out_mps = b.fit.velocity_at(t_out).dot(n);
+    const Vec2 v_in = a.fit.velocity_at(t);
+    const Vec2 v_out = b.fit.velocity_at(t_out);
+    out.speed_in_mps = -v_in.dot(n);
+    out.speed_out_mps = v_out.dot(n);
+    const Vec2 along = v_in + out.speed_in_mps * n;
+    out.tangent_in_mps = along.norm();
+    out.tangent_out_mps = out.tangent_in_mps > 0.0 ? v_out.dot(along) / out.tangent_in_mps : 0.0;
     return out.speed_in_mps >= o.min_normal_speed_mps && out.speed_out_mps > 0.0;
   }
   return false;
@@ -112,6 +119,16 @@ void identify_groups(const table::Board& board, const std::vector<FreeFlight>& f
     group.overlay.rho = {fit.line.slope, fit.slope_stderr, fit.used};
     if (with_kick) group.overlay.kick_mps = table::IdentifiedValue{fit.line.intercept, fit.intercept_stderr, fit.used};
     group.rms_fitted_mps = rms_residual(in_out, fit.line);
+    std::vector<Rebound> own;
+    for (const Rebound& r : result.rebounds)
+      if (r.group == static_cast<int>(g)) own.push_back(r);
+    group.friction = fit_wall_friction(own, group.overlay.rho.value, group.overlay.kick_mps.value_or(table::IdentifiedValue{}).value);
+    if (std::isfinite(group.friction.stderr_)) {
+      group.overlay.friction = table::IdentifiedValue{group.friction.friction, group.friction.stderr_, group.friction.used};
+    } else {
+      result.not_identified.push_back({group_label(group.overlay) + ": wall friction",
+                                       "no rebound came in along the obstacle fast enough for friction to show"});
+    }
     result.overlay.obstacle_groups.push_back(group.overlay);
   }
 }
@@ -181,7 +198,73 @@ void identify_flippers(const table::Board& board, std::span<const bus::RecordedP
   }
 }
 
+// The tangential speed out that the model's response gives one rebound.
+double modelled_tangent_out_mps(const Rebound& r, double rho, double kick_mps, double friction) {
+  const double change_mps = (1.0 + rho) * r.speed_in_mps + kick_mps;
+  return r.tangent_in_mps - sim::wall_friction_loss_mps(r.tangent_in_mps, r.speed_in_mps, change_mps, friction);
+}
+
+double tangent_sse(std::span<const Rebound> rebounds, double rho, double kick_mps, double friction) {
+  double sse = 0.0;
+  for (const Rebound& r : rebounds) sse += std::pow(r.tangent_out_mps - modelled_tangent_out_mps(r, rho, kick_mps, friction), 2);
+  return sse;
+}
+
+// The friction in [0, kMaxFriction] with the least squared residual: a grid,
+// then golden sections around its best point (the loss is piecewise smooth
+// in the friction, so the sum is not convex everywhere, but its grid is fine).
+double best_friction(std::span<const Rebound> rebounds, double rho, double kick_mps) {
+  constexpr double kMaxFriction = 2.0;
+  constexpr int kGrid = 400;
+  constexpr double kStep = kMaxFriction / kGrid;
+  double best = 0.0, best_sse = INFINITY;
+  for (int i = 0; i <= kGrid; ++i) {
+    const double sse = tangent_sse(rebounds, rho, kick_mps, i * kStep);
+    if (sse < best_sse) best_sse = sse, best = i * kStep;
+  }
+  double lo = std::max(0.0, best - kStep), hi = std::min(kMaxFriction, best + kStep);
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int it = 0; it < 40; ++it) {
+    const double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo);
+    if (tangent_sse(rebounds, rho, kick_mps, a) <= tangent_sse(rebounds, rho, kick_mps, b)) hi = b; else lo = a;
+  }
+  const double found = 0.5 * (lo + hi);
+  return found < 1e-9 ? 0.0 : found;  // the search's rounding at the bound is no friction
+}
+
 }  // namespace
+
+WallFrictionFit fit_wall_friction(std::span<const Rebound> rebounds, double rho, double kick_mps) {
+  if (rebounds.size() < 2) throw std::invalid_argument("fit_wall_friction: need 2 rebounds");
+  const double first = best_friction(rebounds, rho, kick_mps);
+  std::vector<double> residuals;
+  for (const Rebound& r : rebounds) residuals.push_back(r.tangent_out_mps - modelled_tangent_out_mps(r, rho, kick_mps, first));
+  const double sigma = robust_sigma(residuals);
+  std::vector<Rebound> kept;
+  for (std::size_t i = 0; i < rebounds.size(); ++i)
+    if (sigma <= 0.0 || std::abs(residuals[i]) <= 3.5 * sigma) kept.push_back(rebounds[i]);
+  if (kept.size() < 2) kept.assign(rebounds.begin(), rebounds.end());
+  WallFrictionFit fit;
+  fit.friction = best_friction(kept, rho, kick_mps);
+  fit.used = static_cast<int>(kept.size());
+  fit.outliers = static_cast<int>(rebounds.size() - kept.size());
+  const double n = static_cast<double>(kept.size());
+  const double sse = tangent_sse(kept, rho, kick_mps, fit.friction);
+  fit.rms_fitted_mps = std::sqrt(sse / n);
+  fit.rms_frictionless_mps = std::sqrt(tangent_sse(kept, rho, kick_mps, 0.0) / n);
+  // Standard error from the curvature of the sum (Gauss–Newton: the
+  // residuals' derivative in the friction, by central differences).
+  constexpr double h = 1e-4;
+  double jtj = 0.0;
+  for (const Rebound& r : kept) {
+    const double d = (modelled_tangent_out_mps(r, rho, kick_mps, fit.friction + h) -
+                      modelled_tangent_out_mps(r, rho, kick_mps, std::max(0.0, fit.friction - h))) /
+                     (fit.friction + h - std::max(0.0, fit.friction - h));
+    jtj += d * d;
+  }
+  fit.stderr_ = jtj > 0.0 && n > 1.0 ? std::sqrt(sse / (n - 1.0) / jtj) : INFINITY;
+  return fit;
+}
 
 std::vector<int> material_group_of(const table::Board& board, const std::vector<table::ObstacleGroupOverlay>& groups) {
   std::vector<int> group_of(board.obstacles.size(), -1);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include "pinball/core/running_stats.h"
 #include "pinball/core/statistics.h"
@@ -104,6 +106,32 @@ std::vector<PredictionStart> prediction_starts(std::span<const bus::RecordedPlay
   return starts;
 }
 
+ErrorRatio paired_error_ratio(const PredictionError& model, const PredictionError& baseline) {
+  if (model.errors_m.size() != baseline.errors_m.size())
+    throw std::invalid_argument("paired_error_ratio: " + std::to_string(model.errors_m.size()) + " against " +
+                                std::to_string(baseline.errors_m.size()) + " starts");
+  double sum_model = 0.0, sum_baseline = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < model.errors_m.size(); ++i) {
+    if (std::isnan(model.errors_m[i]) || std::isnan(baseline.errors_m[i])) continue;
+    sum_model += model.errors_m[i];
+    sum_baseline += baseline.errors_m[i];
+    ++n;
+  }
+  ErrorRatio out;
+  out.moments = n;
+  if (n < 2 || !(sum_baseline > 0.0)) return out;
+  out.ratio = sum_model / sum_baseline;
+  // Delta method: R = mean(a)/mean(b), var R ≈ var(a − R·b) / (n·mean(b)²).
+  RunningStats d;
+  for (std::size_t i = 0; i < model.errors_m.size(); ++i)
+    if (!std::isnan(model.errors_m[i]) && !std::isnan(baseline.errors_m[i]))
+      d.add(model.errors_m[i] - out.ratio * baseline.errors_m[i]);
+  const double mean_baseline = sum_baseline / static_cast<double>(n);
+  out.ci95 = d.ci95_half_width() / mean_baseline;
+  return out;
+}
+
 PredictionError prediction_error(const table::Board& belief, std::span<const bus::RecordedPlay> recordings,
                                  std::span<const PredictionStart> starts, const PredictionOptions& o) {
   const std::unique_ptr<sim::World> world = sim::make_model_world(belief);
@@ -111,6 +139,7 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   const auto steps = static_cast<std::uint64_t>(std::llround(o.horizon_s / world->dt_s()));
   std::vector<double> errors;
   errors.reserve(starts.size());
+  std::vector<double> each(starts.size(), std::numeric_limits<double>::quiet_NaN());
   RunningStats free, collided, under_g, pushed;
   // What the model's ball hit first: a material group, then the flippers, then nothing, then lost.
   const std::vector<table::ObstacleGroupOverlay> groups = material_groups(belief);
@@ -119,7 +148,8 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   const std::size_t nothing_hit = flipper_hit + belief.flippers.size();
   const std::size_t lost = nothing_hit + 1;
   std::vector<RunningStats> by_hit(lost + 1);
-  for (const PredictionStart& s : starts) {
+  for (std::size_t index = 0; index < starts.size(); ++index) {
+    const PredictionStart& s = starts[index];
     const bus::RecordedPlay& play = recordings[s.recording];
     const std::vector<track::Observation> history = history_of(play, s.frame, o.history_frames);
     const track::TrajectoryFit fit = track::fit_fixed_gravity(history, belief.gravity_mps2, o.sigma_m);
@@ -163,6 +193,7 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
       }
     }
     errors.push_back((predicted - seen).norm());
+    each[index] = errors.back();
     (s.pushed ? pushed : under_g).add(errors.back());
     if (flew_free(play, s.frame, fit.t_ref_s + o.horizon_s, o.sigma_m)) {
       free.add(errors.back());
@@ -172,6 +203,7 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
     }
   }
   PredictionError out;
+  out.errors_m = std::move(each);
   out.moments = errors.size();
   if (errors.empty()) return out;
   RunningStats stats;

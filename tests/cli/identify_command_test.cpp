@@ -56,16 +56,35 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   EXPECT_TRUE(j["actuation_delay_s"].is_null());
   EXPECT_GT(j["held_out"]["nominal"]["moments"].get<int>(), 50);
   EXPECT_LT(j["held_out"]["identified"]["mean_m"].get<double>(), j["held_out"]["nominal"]["mean_m"].get<double>());
+  EXPECT_NEAR(j["held_out"]["error_ratio"].get<double>(),
+              j["held_out"]["identified"]["mean_m"].get<double>() / j["held_out"]["nominal"]["mean_m"].get<double>(), 1e-9);
+  EXPECT_GT(j["held_out"]["error_ratio_ci95"].get<double>(), 0.0);
+  EXPECT_EQ(j["held_out"]["error_ratio_moments"], j["held_out"]["nominal"]["moments"]);
   const table::BoardOverlay written = table::read_board_overlay(overlay);
   ASSERT_TRUE(written.gravity_mps2.has_value());
   EXPECT_DOUBLE_EQ(written.gravity_mps2->value, j["gravity"]["g_mps2"].get<double>());
   EXPECT_EQ(written.recordings, std::vector<std::string>{train});
+  // Each identified group's wall friction: in the JSON, in the overlay, the same figure.
+  bool friction_seen = false;
+  for (const nlohmann::json& g : j["obstacle_groups"]) {
+    if (!g["identified"].get<bool>() || g["friction"].is_null()) continue;
+    friction_seen = true;
+    EXPECT_GE(g["friction"]["value"].get<double>(), 0.0);
+    EXPECT_LE(g["tangent_rms_fitted_mps"].get<double>(), g["tangent_rms_frictionless_mps"].get<double>());
+    for (const table::ObstacleGroupOverlay& w : written.obstacle_groups)
+      if (w.board_rho == g["board_rho"].get<double>() && w.board_kick_mps == g["board_kick_mps"].get<double>()) {
+        ASSERT_TRUE(w.friction.has_value());
+        EXPECT_DOUBLE_EQ(w.friction->value, g["friction"]["value"].get<double>());
+      }
+  }
+  EXPECT_TRUE(friction_seen);
 
   // The text report says the same and where the overlay went.
   const pinball::testing::CommandResult text = run("identify " + train + " --bootstrap 0 --sigma-m 0.0005");
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("g along the table"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("not identified: camera latency"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("; friction "), std::string::npos) << text.out;
 }
 
 TEST_F(IdentifyCommand, BadLogsAreRefusedNamingTheFileAndNothingIsWritten) {

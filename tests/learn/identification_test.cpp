@@ -5,18 +5,20 @@
 #include <algorithm>
 
 #include "common/thesis_board.h"
+#include "pinball/core/rng.h"
+#include "pinball/sim/collision.h"
 #include "model_recording.h"
 
 namespace pinball::learn {
 namespace {
 
 // The thesis table as it "really" is in these tests: a flatter slope, deader
-// walls, weaker bumpers, a weaker launch.
+// walls with friction, weaker bumpers, a weaker launch.
 table::Board recorded_table() {
   table::Board world = pinball::testing::thesis_board();
   world.gravity_mps2 = 0.95;
   for (table::Obstacle& o : world.obstacles) {
-    if (o.rho == 0.6 && o.action.kick_mps == 0.0) o.rho = 0.5;
+    if (o.rho == 0.6 && o.action.kick_mps == 0.0) o.rho = 0.5, o.friction = 0.12;
     if (o.action.kick_mps == 0.8) o.action.kick_mps = 0.6;
   }
   world.launcher.pull = 0.9;
@@ -76,6 +78,10 @@ TEST(Identification, RecoversTheRecordedTablesGravityRhoKickAndLaunch) {
   EXPECT_NEAR(walls->overlay.rho.value, 0.5, std::max(4.0 * walls->overlay.rho.stderr_, 0.03));
   EXPECT_LT(walls->rms_fitted_mps, walls->rms_nominal_mps);
   EXPECT_FALSE(walls->overlay.kick_mps.has_value());
+  ASSERT_TRUE(walls->overlay.friction.has_value());
+  EXPECT_NEAR(walls->overlay.friction->value, 0.12, std::max(4.0 * walls->overlay.friction->stderr_, 0.03));
+  EXPECT_GT(walls->overlay.friction->stderr_, 0.0);
+  EXPECT_LT(walls->friction.rms_fitted_mps, walls->friction.rms_frictionless_mps);
 
   const GroupResult* bumpers = group_with(r, 1.1, 0.8);
   ASSERT_NE(bumpers, nullptr);
@@ -90,6 +96,50 @@ TEST(Identification, RecoversTheRecordedTablesGravityRhoKickAndLaunch) {
   EXPECT_NEAR(r.overlay.launcher->noise_max.value, 0.05, 0.02);
   EXPECT_EQ(r.overlay.recordings, std::vector<std::string>{"model"});
   EXPECT_EQ(r.overlay.board, pinball::testing::thesis_board().source);
+}
+
+// Rebounds whose tangential speed out is exactly the model's, plus noise.
+std::vector<Rebound> rebounds_with_friction(double rho, double kick_mps, double friction, double noise_mps, int count) {
+  Rng rng(5);
+  std::vector<Rebound> out;
+  for (int i = 0; i < count; ++i) {
+    Rebound r;
+    r.speed_in_mps = rng.uniform(0.2, 2.0);
+    r.tangent_in_mps = rng.uniform(0.0, 3.0);
+    r.speed_out_mps = rho * r.speed_in_mps + kick_mps;
+    const double loss = sim::wall_friction_loss_mps(r.tangent_in_mps, r.speed_in_mps,
+                                                    (1.0 + rho) * r.speed_in_mps + kick_mps, friction);
+    r.tangent_out_mps = r.tangent_in_mps - loss + noise_mps * rng.normal();
+    out.push_back(r);
+  }
+  return out;
+}
+
+TEST(WallFrictionFit, RecoversTheFrictionExactlyWithoutNoiseAndWithinItsUncertaintyWithNoise) {
+  for (double friction : {0.0, 0.05, 0.12, 0.4}) {
+    SCOPED_TRACE(friction);
+    const WallFrictionFit exact = fit_wall_friction(rebounds_with_friction(0.5, 0.0, friction, 0.0, 50), 0.5, 0.0);
+    EXPECT_NEAR(exact.friction, friction, 1e-6);
+    EXPECT_NEAR(exact.rms_fitted_mps, 0.0, 1e-6);
+    const WallFrictionFit noisy = fit_wall_friction(rebounds_with_friction(0.8, 0.9, friction, 0.05, 400), 0.8, 0.9);
+    EXPECT_NEAR(noisy.friction, friction, 4.0 * noisy.stderr_ + 1e-3);
+    EXPECT_GT(noisy.stderr_, 0.0);
+    EXPECT_LT(noisy.stderr_, 0.02);
+    EXPECT_GE(noisy.friction, 0.0);  // never a friction that adds speed
+    EXPECT_NEAR(noisy.rms_fitted_mps, 0.05, 0.01);
+  }
+}
+
+TEST(WallFrictionFit, TrimsOutliersAndNeedsTwoRebounds) {
+  std::vector<Rebound> rebounds = rebounds_with_friction(0.5, 0.0, 0.1, 0.01, 100);
+  for (int i = 0; i < 5; ++i) rebounds[static_cast<std::size_t>(i * 7)].tangent_out_mps = -3.0;  // joined wrongly
+  const WallFrictionFit fit = fit_wall_friction(rebounds, 0.5, 0.0);
+  // The five and perhaps a few the first, pulled fit put beyond the trim.
+  EXPECT_GE(fit.outliers, 5);
+  EXPECT_LE(fit.outliers, 8);
+  EXPECT_EQ(fit.used + fit.outliers, 100);
+  EXPECT_NEAR(fit.friction, 0.1, 0.01);
+  EXPECT_THROW(fit_wall_friction(std::span<const Rebound>(rebounds.data(), 1), 0.5, 0.0), std::invalid_argument);
 }
 
 // A pop bumper that holds the ball 8 ms, then throws it from its ring's

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "common/thesis_board.h"
 #include "model_recording.h"
 #include "pinball/learn/free_flight.h"
@@ -31,6 +34,14 @@ TEST(PredictionError, TheTrueModelPredictsBetterThanAWrongOne) {
   EXPECT_EQ(right.free_moments, wrong.free_moments);  // chosen from the recording alone
   EXPECT_LT(right.free_mean_m, wrong.free_mean_m);
   EXPECT_LT(right.free_mean_m, 0.004);
+
+  // The paired ratio: every start has its error, and the ratio is the means'.
+  ASSERT_EQ(right.errors_m.size(), starts.size());
+  const ErrorRatio ratio = paired_error_ratio(right, wrong);
+  EXPECT_EQ(ratio.moments, right.moments);
+  EXPECT_NEAR(ratio.ratio, right.mean_m / wrong.mean_m, 1e-12);
+  EXPECT_GT(ratio.ci95, 0.0);
+  EXPECT_LT(ratio.ratio + ratio.ci95, 1.0);  // the true model is better beyond the noise
 
   // Under g or pushed split the moments, the same for both beliefs.
   EXPECT_EQ(right.under_g_moments + right.pushed_moments, right.moments);
@@ -104,6 +115,30 @@ table::Board open_board() {
   board.gravity_mps2 = kG;
   board.launcher.position = {5.0, 0.5};
   return board;
+}
+
+TEST(PairedErrorRatio, ClosedFormsSkippedMomentsAndMismatchedRuns) {
+  PredictionError baseline, half, same;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  baseline.errors_m = {0.002, 0.004, nan, 0.006, 0.008};
+  half.errors_m = {0.001, 0.002, 0.5, 0.003, nan};
+  same.errors_m = baseline.errors_m;
+  const ErrorRatio exact = paired_error_ratio(half, baseline);
+  EXPECT_EQ(exact.moments, 3u);  // a NaN on either side drops the moment from both
+  EXPECT_NEAR(exact.ratio, 0.5, 1e-15);
+  EXPECT_NEAR(exact.ci95, 0.0, 1e-15);  // a = R·b exactly: no spread
+  EXPECT_NEAR(paired_error_ratio(same, baseline).ratio, 1.0, 1e-15);
+  // a − 0.5·b = ±0.001 about 0 (mean b 0.005): the interval is t(3)·s/√4 / 0.005.
+  PredictionError noisy;
+  baseline.errors_m = {0.004, 0.004, 0.006, 0.006};
+  noisy.errors_m = {0.003, 0.001, 0.004, 0.002};
+  const ErrorRatio r = paired_error_ratio(noisy, baseline);
+  EXPECT_NEAR(r.ratio, 0.5, 1e-15);
+  const double s = std::sqrt(4.0 * 1e-6 / 3.0);
+  EXPECT_NEAR(r.ci95, 3.182446305284263 * s / 2.0 / 0.005, 1e-3);
+  PredictionError shorter;
+  shorter.errors_m = {0.001};
+  EXPECT_THROW(paired_error_ratio(shorter, baseline), std::invalid_argument);
 }
 
 TEST(PredictionStarts, TellsAPushedBallByItsHistorysAcceleration) {

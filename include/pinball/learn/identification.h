@@ -9,7 +9,8 @@
 //  - rebounds, two free flights joined at a board obstacle: the normal speed
 //    out against the normal speed in gives ρ (and the kick, for obstacles the
 //    board gives one) of each material group: the obstacles the board file
-//    gives the same ρ and kick;
+//    gives the same ρ and kick; the tangential speed lost gives the group's
+//    wall friction (sim::wall_friction_loss_mps);
 //  - launches, flights that start at the launcher: the pull and noise;
 //  - flipper shots, a free flight into a rising bat and one out of it after
 //    the flipper's energize command (flipper_shots.h): each flipper's rise
@@ -64,7 +65,24 @@ struct Rebound {
   Vec2 contact_m = Vec2::Zero();  ///< ball centre at contact (m)
   double speed_in_mps = 0.0;      ///< normal speed towards the obstacle (m/s, > 0)
   double speed_out_mps = 0.0;     ///< normal speed away from it (m/s)
+  double tangent_in_mps = 0.0;    ///< speed along the obstacle coming in (m/s, >= 0)
+  double tangent_out_mps = 0.0;   ///< speed along it going out, in the same direction (m/s; < 0: turned back)
 };
+
+/// A group's wall friction as its rebounds show it.
+struct WallFrictionFit {
+  double friction = 0.0;              ///< Coulomb coefficient (sim::wall_friction_loss_mps)
+  double stderr_ = 0.0;               ///< its standard uncertainty (the fit's curvature)
+  int used = 0;                       ///< rebounds kept
+  int outliers = 0;                   ///< left out: residual beyond 3.5 robust σ
+  double rms_frictionless_mps = 0.0;  ///< RMS of tangential speed out − in, over the rebounds kept (m/s)
+  double rms_fitted_mps = 0.0;        ///< ... − the fitted friction's prediction (m/s)
+};
+
+/// Least squares over friction in [0, 2] of tangent out against what the
+/// model's response (ρ, kick) with that friction gives, trimmed once at 3.5
+/// robust σ. Needs at least 2 rebounds (throws std::invalid_argument).
+WallFrictionFit fit_wall_friction(std::span<const Rebound> rebounds, double rho, double kick_mps);
 
 /// One material group and what its rebounds say.
 struct GroupResult {
@@ -75,6 +93,7 @@ struct GroupResult {
   int outliers = 0;                     ///< left out: residual beyond 3.5 robust σ
   double rms_nominal_mps = 0.0;         ///< RMS of speed out − board prediction (m/s)
   double rms_fitted_mps = 0.0;          ///< ... − identified prediction (m/s)
+  WallFrictionFit friction;             ///< when identified: the tangential speeds' fit
 };
 
 /// A parameter the recordings could not identify, and why.

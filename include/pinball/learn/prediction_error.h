@@ -85,6 +85,9 @@ struct PredictionError {
   double pushed_mean_m = 0.0;       ///< mean error over them (m)
   /// The collision moments by what the model hit first, most moments first.
   std::vector<CollisionError> collisions_by_model_hit;
+  /// Each start's error (m), in the order of the starts; NaN where the
+  /// moment could not be predicted. Not in --json: the pairing is its use.
+  std::vector<double> errors_m;
 
   /// Every figure, for --json (core/json_write_archive.h).
   template <class Archive>
@@ -104,6 +107,18 @@ struct PredictionError {
     a->Visit(PINBALL_NVP(collisions_by_model_hit));
   }
 };
+
+/// One model's mean error over another's on the moments both predicted.
+struct ErrorRatio {
+  double ratio = 0.0;      ///< Σ errors of the first / Σ errors of the second
+  double ci95 = 0.0;       ///< half-width of its 95 % interval (delta method over the paired moments)
+  std::size_t moments = 0; ///< moments both predicted
+};
+
+/// The ratio of `model`'s mean error to `baseline`'s, paired moment by
+/// moment (both from prediction_error over the same starts). Throws
+/// std::invalid_argument when their starts differ in number.
+ErrorRatio paired_error_ratio(const PredictionError& model, const PredictionError& baseline);
 
 /// The moments of `recordings` to predict from (see the file comment).
 std::vector<PredictionStart> prediction_starts(std::span<const bus::RecordedPlay> recordings,
