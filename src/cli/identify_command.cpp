@@ -65,6 +65,17 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                       {"tangent_rms_frictionless_mps", g.friction.rms_frictionless_mps},
                       {"tangent_rms_fitted_mps", g.friction.rms_fitted_mps}});
   }
+  const learn::WallThicknessFit& t = r.wall_thickness;
+  nlohmann::json scan = nlohmann::json::array();
+  for (const auto& [thickness_m, error_m] : t.scan) scan.push_back({{"thickness_m", thickness_m}, {"mean_error_m", error_m}});
+  const nlohmann::json thickness = {{"identified", t.identified},
+                                    {"why_not", t.identified ? nlohmann::json(nullptr) : nlohmann::json(t.why_not)},
+                                    {"thickness_m", t.thickness_m},
+                                    {"stderr_m", t.stderr_m},
+                                    {"moments", t.moments},
+                                    {"error_at_zero_m", t.error_at_zero_m},
+                                    {"error_fitted_m", t.error_fitted_m},
+                                    {"scan", scan}};
   nlohmann::json strokes = nlohmann::json::array();
   for (const learn::FlipperStrokeFit& f : r.flipper_strokes) {
     strokes.push_back({{"name", f.name},
@@ -105,6 +116,7 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                                              ? nlohmann::json(*table::identified_actuation_delay_s(r.overlay))
                                              : nlohmann::json(nullptr)},
                    {"launcher", r.overlay.launcher ? to_json_value(*r.overlay.launcher) : nlohmann::json(nullptr)},
+                   {"wall_thickness", thickness},
                    {"not_identified", not_identified},
                    {"overlay", a.out.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.out)},
                    {"held_out", nullptr}};
@@ -181,6 +193,11 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
   if (r.overlay.launcher)
     out << "  launcher           pull " << value_text(r.overlay.launcher->pull, "") << ", noise "
         << value_text(r.overlay.launcher->noise_max, "") << " (" << r.launch_speeds_mps.size() << " launches)\n";
+  if (r.wall_thickness.identified)
+    out << "  wall thickness     " << format_number(r.wall_thickness.thickness_m * 1000.0) << " ± "
+        << format_number(r.wall_thickness.stderr_m * 1000.0, 2) << " mm, every two-sided wall (" << r.wall_thickness.moments
+        << " moments: the model's mean error 100 ms ahead " << format_number(r.wall_thickness.error_at_zero_m * 1000.0)
+        << " mm with the file's lines -> " << format_number(r.wall_thickness.error_fitted_m * 1000.0) << " mm)\n";
   for (const learn::NotIdentified& n : r.not_identified)
     out << "  not identified: " << n.parameter << ": " << n.why << "\n";
   if (held_out) {

@@ -6,6 +6,8 @@
 
 #include "pinball/core/format.h"
 #include "pinball/core/least_squares_line.h"
+#include "pinball/core/rng.h"
+#include "pinball/core/running_stats.h"
 #include "pinball/core/statistics.h"
 #include "pinball/sim/collision.h"
 
@@ -232,7 +234,93 @@ double best_friction(std::span<const Rebound> rebounds, double rho, double kick_
   return found < 1e-9 ? 0.0 : found;  // the search's rounding at the bound is no friction
 }
 
+// The vertex of the parabola through (x[k-1], y[k-1]), (x[k], y[k]),
+// (x[k+1], y[k+1]) on an even grid, kept within the neighbours; the grid
+// point itself at either end of the grid.
+double parabola_vertex(const std::vector<double>& x, const std::vector<double>& y, std::size_t k) {
+  if (k == 0 || k + 1 >= x.size()) return x[k];
+  const double step = x[k + 1] - x[k];
+  const double curvature = y[k - 1] - 2.0 * y[k] + y[k + 1];
+  if (!(curvature > 0.0)) return x[k];
+  return x[k] + std::clamp(0.5 * step * (y[k - 1] - y[k + 1]) / curvature, -step, step);
+}
+
+bool has_two_sided_wall(const table::Board& board) {
+  table::Board probe = board;
+  table::set_wall_thickness(probe, board.wall_thickness_m + 1e-3);
+  for (std::size_t i = 0; i < board.shapes.size(); ++i)
+    if ((probe.shapes[i].p0 - board.shapes[i].p0).norm() > 0.0) return true;
+  return false;
+}
+
 }  // namespace
+
+WallThicknessFit fit_wall_thickness(const table::Board& belief, std::span<const bus::RecordedPlay> recordings,
+                                    const PredictionOptions& options, int bootstrap, std::uint64_t seed,
+                                    const std::function<void(int, int)>& progress) {
+  constexpr int kSteps = 9;
+  constexpr double kStep_m = 0.0005;
+  constexpr std::size_t kMinMoments = 100;
+  WallThicknessFit fit;
+  if (!has_two_sided_wall(belief)) {
+    fit.why_not = "the board has no two-sided wall";
+    return fit;
+  }
+  const std::vector<PredictionStart> starts = prediction_starts(recordings, options);
+  std::vector<double> thickness;
+  std::vector<std::vector<double>> errors;  // per thickness, per start
+  for (int k = 0; k < kSteps; ++k) {
+    table::Board b = belief;
+    table::set_wall_thickness(b, k * kStep_m);
+    thickness.push_back(k * kStep_m);
+    errors.push_back(prediction_error(b, recordings, starts, options).errors_m);
+    if (progress) progress(k + 1, kSteps);
+  }
+  // The moments every thickness predicted (a start the fit refuses is refused at all).
+  std::vector<std::size_t> used;
+  for (std::size_t s = 0; s < starts.size(); ++s) {
+    bool all = true;
+    for (const std::vector<double>& e : errors) all = all && !std::isnan(e[s]);
+    if (all) used.push_back(s);
+  }
+  fit.moments = used.size();
+  if (used.size() < kMinMoments) {
+    fit.why_not = std::to_string(used.size()) + " moments to predict, needs " + std::to_string(kMinMoments);
+    return fit;
+  }
+  const auto means = [&](const std::vector<std::size_t>& moments) {
+    std::vector<double> m;
+    for (const std::vector<double>& e : errors) {
+      double sum = 0.0;
+      for (std::size_t s : moments) sum += e[s];
+      m.push_back(sum / static_cast<double>(moments.size()));
+    }
+    return m;
+  };
+  const auto best_of = [&](const std::vector<double>& m) {
+    return parabola_vertex(thickness, m, static_cast<std::size_t>(std::min_element(m.begin(), m.end()) - m.begin()));
+  };
+  const std::vector<double> m = means(used);
+  for (int k = 0; k < kSteps; ++k) fit.scan.emplace_back(thickness[static_cast<std::size_t>(k)], m[static_cast<std::size_t>(k)]);
+  fit.thickness_m = best_of(m);
+  fit.error_at_zero_m = m.front();
+  table::Board best = belief;
+  table::set_wall_thickness(best, fit.thickness_m);
+  const std::vector<double> at_best = prediction_error(best, recordings, starts, options).errors_m;
+  double sum = 0.0;
+  for (std::size_t s : used) sum += std::isnan(at_best[s]) ? 0.0 : at_best[s];
+  fit.error_fitted_m = sum / static_cast<double>(used.size());
+  RunningStats spread;
+  Rng rng(seed);
+  std::vector<std::size_t> resample(used.size());
+  for (int b = 0; b < bootstrap; ++b) {
+    for (std::size_t& s : resample) s = used[static_cast<std::size_t>(rng.uniform01() * static_cast<double>(used.size()))];
+    spread.add(best_of(means(resample)));
+  }
+  fit.stderr_m = bootstrap > 1 ? spread.stddev() : 0.0;
+  fit.identified = true;
+  return fit;
+}
 
 WallFrictionFit fit_wall_friction(std::span<const Rebound> rebounds, double rho, double kick_mps) {
   if (rebounds.size() < 2) throw std::invalid_argument("fit_wall_friction: need 2 rebounds");
@@ -332,6 +420,23 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
   identify_groups(board, flights, options, result);
   identify_launcher(board, recordings, flights, options, g.g_mps2, result);
   identify_flippers(board, recordings, flights, options, result);
+  {
+    // Last: the thickness is judged on the model with everything else identified.
+    table::Board belief = board;
+    table::apply_board_overlay(result.overlay, "(identified)", belief);
+    PredictionOptions prediction;
+    prediction.sigma_m = options.flights.sigma_m;
+    result.wall_thickness = fit_wall_thickness(belief, recordings, prediction, options.bootstrap, options.seed,
+                                               [&](int done, int total) {
+                                                 if (progress) progress("wall thickness", done, total);
+                                               });
+    const WallThicknessFit& t = result.wall_thickness;
+    if (t.identified)
+      result.overlay.wall_thickness_m =
+          table::IdentifiedValue{t.thickness_m, t.stderr_m, static_cast<int>(t.moments)};
+    else
+      result.not_identified.push_back({"two-sided wall thickness", t.why_not});
+  }
   result.not_identified.push_back(
       {"camera latency", "a constant error in it shifts the ball's frames against the commands by the same amount "
                          "as the coil's rise delay, so ball tracks cannot tell them apart (the identified rise delay "

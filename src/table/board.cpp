@@ -16,6 +16,38 @@ Shape make_line_shape(const Vec2& p0, const Vec2& p1) {
   return s;
 }
 
+void set_wall_thickness(Board& board, double thickness_m) {
+  if (!(thickness_m >= 0.0) || !std::isfinite(thickness_m))
+    throw std::invalid_argument("wall thickness must be a finite number >= 0 m, got " + std::to_string(thickness_m));
+  const double was = 0.5 * board.wall_thickness_m;
+  const double now = 0.5 * thickness_m;
+  constexpr double kSame_m = 1e-9;
+  // A face's centre-line end points, from its face and the thickness it had.
+  const auto centre = [was](const Shape& s) { return std::pair<Vec2, Vec2>{s.p0 - was * s.normal, s.p1 - was * s.normal}; };
+  std::vector<char> paired(board.shapes.size(), 0);
+  for (std::size_t i = 0; i < board.shapes.size(); ++i) {
+    const Shape& a = board.shapes[i];
+    if (a.kind != ShapeKind::kLine || paired[i]) continue;
+    const auto [a0, a1] = centre(a);
+    for (std::size_t j = i + 1; j < board.shapes.size(); ++j) {
+      const Shape& b = board.shapes[j];
+      if (b.kind != ShapeKind::kLine || paired[j]) continue;
+      const auto [b0, b1] = centre(b);
+      if ((a0 - b1).norm() > kSame_m || (a1 - b0).norm() > kSame_m) continue;
+      paired[i] = paired[j] = 1;
+      break;
+    }
+  }
+  for (std::size_t i = 0; i < board.shapes.size(); ++i) {
+    if (!paired[i]) continue;
+    Shape& s = board.shapes[i];
+    const auto [c0, c1] = centre(s);
+    s.p0 = c0 + now * s.normal;
+    s.p1 = c1 + now * s.normal;
+  }
+  board.wall_thickness_m = thickness_m;
+}
+
 Shape make_circle_shape(const Vec2& centre, double radius_m) {
   Shape s;
   s.kind = ShapeKind::kCircle;

@@ -55,6 +55,7 @@ constexpr Bound kAboveZero{0.0, true};
 // The checks a type cannot express, after reading (header: the ranges).
 void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
   if (o.gravity_mps2) check_value(*o.gravity_mps2, kAboveZero, {20.0, false}, " m/s^2", "gravity_mps2", r);
+  if (o.wall_thickness_m) check_value(*o.wall_thickness_m, kZero, {0.05, false}, " m", "wall_thickness_m", r);
   for (std::size_t i = 0; i < o.obstacle_groups.size(); ++i) {
     const ObstacleGroupOverlay& g = o.obstacle_groups[i];
     const std::string key = "obstacle_groups[" + std::to_string(i) + "]";
@@ -141,6 +142,7 @@ BoardOverlay read_board_overlay(const std::string& path) { return parse_board_ov
 void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, Board& board) {
   Board b = board;  // all or nothing: the board changes only when every name is found
   if (overlay.gravity_mps2) b.gravity_mps2 = overlay.gravity_mps2->value;
+  if (overlay.wall_thickness_m) set_wall_thickness(b, overlay.wall_thickness_m->value);
   for (std::size_t i = 0; i < overlay.obstacle_groups.size(); ++i) {
     const ObstacleGroupOverlay& g = overlay.obstacle_groups[i];
     for (std::size_t j = 0; j < g.obstacles.size(); ++j) {

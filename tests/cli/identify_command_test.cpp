@@ -78,6 +78,12 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
       }
   }
   EXPECT_TRUE(friction_seen);
+  // The walls' thickness: the scan behind it, and the overlay's value.
+  ASSERT_TRUE(j["wall_thickness"]["identified"].get<bool>()) << j["wall_thickness"].dump();
+  EXPECT_EQ(j["wall_thickness"]["scan"].size(), 9u);
+  EXPECT_LE(j["wall_thickness"]["error_fitted_m"].get<double>(), j["wall_thickness"]["error_at_zero_m"].get<double>());
+  ASSERT_TRUE(written.wall_thickness_m.has_value());
+  EXPECT_DOUBLE_EQ(written.wall_thickness_m->value, j["wall_thickness"]["thickness_m"].get<double>());
 
   // The text report says the same and where the overlay went.
   const pinball::testing::CommandResult text = run("identify " + train + " --bootstrap 0 --sigma-m 0.0005");
@@ -85,6 +91,7 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   EXPECT_NE(text.out.find("g along the table"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("not identified: camera latency"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("; friction "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("wall thickness "), std::string::npos) << text.out;
 }
 
 TEST_F(IdentifyCommand, BadLogsAreRefusedNamingTheFileAndNothingIsWritten) {

@@ -13,7 +13,7 @@ namespace pinball::learn {
 namespace {
 
 // The thesis table as it "really" is in these tests: a flatter slope, deader
-// walls with friction, weaker bumpers, a weaker launch.
+// walls with friction, 3 mm thick guides, weaker bumpers, a weaker launch.
 table::Board recorded_table() {
   table::Board world = pinball::testing::thesis_board();
   world.gravity_mps2 = 0.95;
@@ -23,6 +23,7 @@ table::Board recorded_table() {
   }
   world.launcher.pull = 0.9;
   world.launcher.noise_max = 0.05;
+  table::set_wall_thickness(world, 0.003);
   return world;
 }
 
@@ -89,6 +90,13 @@ TEST(Identification, RecoversTheRecordedTablesGravityRhoKickAndLaunch) {
     ASSERT_TRUE(bumpers->overlay.kick_mps.has_value());
     EXPECT_NEAR(bumpers->overlay.kick_mps->value, 0.6, std::max(4.0 * bumpers->overlay.kick_mps->stderr_, 0.1));
   }
+
+  // The guides' thickness, from the model's own predictions of the moments.
+  ASSERT_TRUE(r.wall_thickness.identified) << r.wall_thickness.why_not;
+  ASSERT_TRUE(r.overlay.wall_thickness_m.has_value());
+  EXPECT_NEAR(r.overlay.wall_thickness_m->value, 0.003, std::max(4.0 * r.overlay.wall_thickness_m->stderr_, 0.0005));
+  EXPECT_LT(r.wall_thickness.error_fitted_m, r.wall_thickness.error_at_zero_m);
+  EXPECT_EQ(r.wall_thickness.scan.size(), 9u);
 
   ASSERT_TRUE(r.overlay.launcher.has_value());
   EXPECT_EQ(r.overlay.launcher->pull.events, 60);

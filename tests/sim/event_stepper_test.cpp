@@ -224,6 +224,27 @@ TEST(EventStepper, BounceOffACircleIsTheReflectedRay) {
   EXPECT_EQ(s.events, 1u);
 }
 
+TEST(EventStepper, AThickWallAndWallFrictionAreTheClosedForm) {
+  // A 6 mm guide along y = 0.5 with friction 0.1: the ball, 0.5 m/s along it
+  // and 1 m/s into it, turns round one radius off the face, 3 mm from the
+  // line, and leaves along it at 0.5 − 0.1·2·0.5/√1.25 m/s.
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  add_wall(b, {0.1, 0.5}, {0.9, 0.5}, 1.0);
+  for (table::Obstacle& o : b.obstacles) o.friction = 0.1;
+  table::set_wall_thickness(b, 0.006);
+  const EventStepper stepper(b);
+  GameState s = state_with_ball(b, {0.3, 0.6}, {0.5, -1.0});
+  double closest_m = INFINITY;
+  for (int i = 0; i < 400; ++i) {
+    stepper.step(s);
+    closest_m = std::min(closest_m, s.ball.position_m.y() - 0.5);
+  }
+  EXPECT_NEAR(closest_m, 0.003 + kR, 1e-5);
+  EXPECT_NEAR(s.ball.velocity_mps.y(), 1.0, 1e-12);
+  EXPECT_NEAR(s.ball.velocity_mps.x(), 0.5 - 0.1 * 2.0 * 0.5 / std::sqrt(1.25), 1e-12);
+  EXPECT_EQ(s.events, 1u);
+}
+
 table::Board flipper_board() {
   table::Board b = empty_board(1.0, 1.0, 1.11, 5e-4);
   add_line(b, {-1.0, 0.0}, {2.0, 0.0}, 0.5);  // a floor far below

@@ -96,6 +96,24 @@ TEST(ThesisStepper, ReflectionOffHorizontalLineScalesNormalSpeedByRho) {
   }
 }
 
+TEST(ThesisStepper, AThickWallBouncesTheBallOffItsFaceOnBothSides) {
+  for (const double side : {1.0, -1.0}) {
+    table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+    add_wall(b, {0.1, 0.5}, {0.9, 0.5}, 1.0);
+    table::set_wall_thickness(b, 0.006);
+    const ThesisStepper stepper(b);
+    GameState s = state_with_ball(b, {0.5, 0.5 + side * 0.1}, {0.0, -side * 1.0});
+    double closest_m = INFINITY;
+    for (int i = 0; i < 400; ++i) {
+      stepper.step(s);
+      closest_m = std::min(closest_m, side * (s.ball.position_m.y() - 0.5));
+    }
+    // It turned round one radius off the face, 3 mm from the line, and kept its speed.
+    EXPECT_NEAR(closest_m, 0.003 + kR, 1e-5) << side;
+    EXPECT_NEAR(s.ball.velocity_mps.y(), side * 1.0, 1e-12);
+  }
+}
+
 TEST(ThesisStepper, ReflectionUsesVelocityAfterGravityUpdate) {
   const double g = 9.81;
   const double dt = 1e-3;

@@ -40,6 +40,7 @@ BoardOverlay full() {
   o.flippers = {{"left_flipper", value(1.4, 0.1, 55), value(40.0, 2.0, 54), value(0.012, 0.001, 54)},
                 {"right_flipper", value(1.7, 0.12, 48)}};
   o.launcher = LauncherOverlay{value(0.9, 0.01, 30), value(0.05, 0.01, 30)};
+  o.wall_thickness_m = value(0.00277, 0.00004, 32030);
   return o;
 }
 
@@ -102,6 +103,9 @@ TEST(BoardOverlay, EveryFieldRoundTrips) {
   ASSERT_TRUE(b.launcher);
   EXPECT_EQ(b.launcher->pull.value, 0.9);
   EXPECT_EQ(b.launcher->noise_max.stderr_, 0.01);
+  ASSERT_TRUE(b.wall_thickness_m);
+  EXPECT_EQ(b.wall_thickness_m->value, 0.00277);
+  EXPECT_EQ(b.wall_thickness_m->events, 32030);
 }
 
 TEST(BoardOverlay, OptionalSectionsMayBeAbsent) {
@@ -109,7 +113,7 @@ TEST(BoardOverlay, OptionalSectionsMayBeAbsent) {
   a.date = "2026-12-02T13:45:21Z";
   a.board = "boards/mit1993.board";
   const std::string text = board_overlay_to_yaml(a);
-  for (const char* section : {"gravity_mps2", "obstacle_groups", "flippers", "launcher"}) {
+  for (const char* section : {"gravity_mps2", "obstacle_groups", "flippers", "launcher", "wall_thickness_m"}) {
     EXPECT_EQ(text.find(section), std::string::npos) << section << " written though empty:\n" << text;
   }
   const BoardOverlay b = parse_board_overlay(text, "min.yaml");
@@ -197,6 +201,11 @@ TEST(BoardOverlay, EveryRangeIsChecked) {
   o = full();
   o.flippers[0].mu->events = -1;
   expect_key_error(board_overlay_to_yaml(o), "flippers[0].mu.events", "must be >= 0");
+  o = full();
+  o.wall_thickness_m->value = -0.001;
+  expect_key_error(board_overlay_to_yaml(o), "wall_thickness_m.value", "must be in [0, 0.05] m");
+  o.wall_thickness_m->value = 0.06;
+  expect_key_error(board_overlay_to_yaml(o), "wall_thickness_m.value", "must be in [0, 0.05] m");
   o = full();
   o.obstacle_groups[0].board_rho = -1.0;
   expect_key_error(board_overlay_to_yaml(o), "obstacle_groups[0].board_rho", "must be >= 0");
@@ -346,6 +355,25 @@ TEST(BoardOverlay, ApplyChangesExactlyTheNamedParameters) {
   // The rise delay is not the board's: the actuation delay, the flippers' mean.
   EXPECT_NEAR(*identified_actuation_delay_s(o), 0.017, 1e-15);
   EXPECT_FALSE(identified_actuation_delay_s(BoardOverlay{}));
+}
+
+TEST(BoardOverlay, AWallThicknessMovesTheTwoSidedWallsFacesOnly) {
+  const Board file = load_board(kBoard);
+  BoardOverlay o;
+  o.board = kBoard;
+  o.wall_thickness_m = value(0.003, 0.0001, 500);
+  Board b = file;
+  apply_board_overlay(o, "over.yaml", b);
+  Board expected = file;
+  set_wall_thickness(expected, 0.003);
+  EXPECT_EQ(b.wall_thickness_m, 0.003);
+  int moved = 0;
+  for (std::size_t i = 0; i < b.shapes.size(); ++i) {
+    EXPECT_EQ(b.shapes[i].p0, expected.shapes[i].p0) << i;
+    moved += b.shapes[i].p0 != file.shapes[i].p0 ? 1 : 0;
+  }
+  EXPECT_GT(moved, 20);  // the thesis table's walls, guides and sling backs
+  EXPECT_LT(moved, static_cast<int>(b.shapes.size()));  // not its outer arcs, points or posts
 }
 
 TEST(BoardOverlay, AnUnknownNameThrowsAndLeavesTheBoardUntouched) {

@@ -48,6 +48,41 @@ TEST(FlipperGeometry, DirectionAtZeroAndUpNormal) {
               1e-15);
 }
 
+TEST(WallThickness, MovesEachTwoSidedWallsFacesHalfOfItEitherSideOfItsLine) {
+  Board b = empty_board();
+  sim::testing::add_wall(b, {0.1, 0.5}, {0.4, 0.5});       // two faces, two end points
+  sim::testing::add_line(b, {0.0, 0.2}, {1.0, 0.2});       // one-sided: stays
+  b.shapes.push_back(make_circle_shape({0.7, 0.7}, 0.02)); // a post: stays
+  b.obstacles.push_back({});
+  const Board file = b;
+  set_wall_thickness(b, 0.004);
+  EXPECT_EQ(b.wall_thickness_m, 0.004);
+  // Faces: the line's normal side moved up 2 mm, the reverse down 2 mm, normals kept.
+  for (int face = 0; face < 2; ++face) {
+    const Shape& s = b.shapes[static_cast<std::size_t>(face)];
+    const Shape& was = file.shapes[static_cast<std::size_t>(face)];
+    EXPECT_TRUE(s.normal.isApprox(was.normal));
+    EXPECT_NEAR((s.p0 - was.p0).dot(was.normal), 0.002, 1e-15);
+    EXPECT_NEAR((s.p1 - was.p1).dot(was.normal), 0.002, 1e-15);
+    EXPECT_NEAR(cross(s.p1 - s.p0, was.normal), cross(was.p1 - was.p0, was.normal), 1e-15);  // same length
+  }
+  EXPECT_NEAR(distance_to_shape(b.shapes[0], {0.25, 0.5}), 0.002, 1e-15);
+  // End points stay on the centre line (a square end); the rest stays.
+  for (std::size_t i = 2; i < b.shapes.size(); ++i) {
+    EXPECT_EQ(b.shapes[i].p0, file.shapes[i].p0) << i;
+    EXPECT_EQ(b.shapes[i].p1, file.shapes[i].p1) << i;
+    EXPECT_EQ(b.shapes[i].radius_m, file.shapes[i].radius_m) << i;
+  }
+  // Set again: from the centre lines, not on top of the last thickness.
+  Board again = b;
+  set_wall_thickness(again, 0.001);
+  EXPECT_NEAR((again.shapes[0].p0 - file.shapes[0].p0).dot(file.shapes[0].normal), 0.0005, 1e-15);
+  set_wall_thickness(again, 0.0);
+  for (std::size_t i = 0; i < b.shapes.size(); ++i) EXPECT_LT((again.shapes[i].p0 - file.shapes[i].p0).norm(), 1e-15);
+  EXPECT_THROW(set_wall_thickness(b, -0.001), std::invalid_argument);
+  EXPECT_THROW(set_wall_thickness(b, std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+}
+
 TEST(Side, IsSpelledLeftOrRightBothWays) {
   EXPECT_EQ(side_name(Side::kLeft), "left");
   EXPECT_EQ(side_name(Side::kRight), "right");

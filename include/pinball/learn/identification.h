@@ -12,6 +12,11 @@
 //    gives the same ρ and kick; the tangential speed lost gives the group's
 //    wall friction (sim::wall_friction_loss_mps);
 //  - launches, flights that start at the launcher: the pull and noise;
+//  - the model itself, played from the recordings' moments 100 ms ahead
+//    (prediction_error.h) with everything above laid over the board: the
+//    two-sided walls' thickness, the one value that makes it predict best
+//    (rebounds cannot give it: their flights' fits put the meeting point
+//    a millimetre or more further out than the model wants the face);
 //  - flipper shots, a free flight into a rising bat and one out of it after
 //    the flipper's energize command (flipper_shots.h): each flipper's rise
 //    delay, stroke speed and μ.
@@ -30,6 +35,7 @@
 #include "pinball/firmware/flipper_actuation.h"
 #include "pinball/learn/flipper_shots.h"
 #include "pinball/learn/free_flight.h"
+#include "pinball/learn/prediction_error.h"
 #include "pinball/table/board.h"
 #include "pinball/table/board_overlay.h"
 
@@ -96,6 +102,29 @@ struct GroupResult {
   WallFrictionFit friction;             ///< when identified: the tangential speeds' fit
 };
 
+/// The two-sided walls' thickness that makes the model predict the
+/// recordings' moments best (table::set_wall_thickness).
+struct WallThicknessFit {
+  bool identified = false;
+  std::string why_not;                 ///< when not identified
+  double thickness_m = 0.0;            ///< the best thickness (m)
+  double stderr_m = 0.0;               ///< its standard uncertainty: bootstrap over the moments (m)
+  std::size_t moments = 0;             ///< moments predicted at every thickness tried
+  double error_at_zero_m = 0.0;        ///< mean 100 ms error with the walls the file's lines (m)
+  double error_fitted_m = 0.0;         ///< ... with the best thickness (m)
+  std::vector<std::pair<double, double>> scan;  ///< (thickness m, mean error m) at every thickness tried
+};
+
+/// Scans thicknesses 0 to 4 mm in steps of 0.5 mm, each the mean 100 ms
+/// prediction error over the moments of `recordings` of `belief` with that
+/// thickness, and takes the vertex of the parabola through the best and its
+/// neighbours; `bootstrap` resamples of the moments give the uncertainty.
+/// Not identified (why_not) when the board has no two-sided wall or the
+/// recordings hold fewer than 100 moments.
+WallThicknessFit fit_wall_thickness(const table::Board& belief, std::span<const bus::RecordedPlay> recordings,
+                                    const PredictionOptions& options, int bootstrap, std::uint64_t seed,
+                                    const std::function<void(int, int)>& progress = {});
+
 /// A parameter the recordings could not identify, and why.
 struct NotIdentified {
   std::string parameter;  ///< e.g. "flipper mu", "obstacle group rho=1.4 kick=0.6 m/s"
@@ -113,6 +142,7 @@ struct IdentificationResult {
   std::vector<double> launch_speeds_mps;  ///< launch speed at the launcher of every launch seen
   std::vector<FlipperShot> shots;         ///< every flipper shot found
   std::vector<FlipperStrokeFit> flipper_strokes;  ///< one per board flipper
+  WallThicknessFit wall_thickness;        ///< the two-sided walls' thickness
   std::vector<NotIdentified> not_identified;
   std::size_t frames = 0;                 ///< frames read
   std::size_t sightings = 0;              ///< frames that saw the ball

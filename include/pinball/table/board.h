@@ -147,6 +147,7 @@ struct Board {
   std::vector<Sensor> sensors;   ///< proximity sensors and holes
   std::vector<Flipper> flippers; ///< flippers, in file order
   std::vector<Bank> banks;       ///< banks of flags
+  double wall_thickness_m = 0.0; ///< every two-sided wall's thickness: its faces lie half of it either side of the file's line (set_wall_thickness)
 };
 
 /// A line shape from p0 to p1 whose normal points to the left of p0 -> p1.
@@ -154,6 +155,16 @@ Shape make_line_shape(const Vec2& p0, const Vec2& p1);
 
 /// A circle shape around `centre` (radius 0: a point).
 Shape make_circle_shape(const Vec2& centre, double radius_m);
+
+/// Gives every two-sided wall (a line and its exact reverse, whichever
+/// statements made them) the thickness `thickness_m`: its two faces move to
+/// half of it either side of the wall's centre line, the board file's line,
+/// so the ball bounces off a guide's faces rather than off its middle. The
+/// end points stay on the centre line (a guide's end is square, not round);
+/// one-sided lines and circles keep their place. Setting it again starts
+/// from the centre lines. Throws std::invalid_argument for a negative or
+/// non-finite thickness.
+void set_wall_thickness(Board& board, double thickness_m);
 
 /// Distance from a point p to a shape's surface (lines: to the segment,
 /// either side; circles: to the rim, negative inside).

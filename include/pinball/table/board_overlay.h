@@ -95,6 +95,7 @@ struct BoardOverlay {
   std::vector<ObstacleGroupOverlay> obstacle_groups;  ///< empty: none identified (section left out)
   std::vector<FlipperOverlay> flippers;        ///< empty: none identified (section left out)
   std::optional<LauncherOverlay> launcher;     ///< launch pull and noise
+  std::optional<IdentifiedValue> wall_thickness_m;  ///< every two-sided wall's thickness (m; table::set_wall_thickness)
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -113,6 +114,7 @@ struct BoardOverlay {
     a->Visit(make_name_value("flippers", &flips));
     flippers = flips.value_or(std::vector<FlipperOverlay>{});
     a->Visit(PINBALL_NVP(launcher));
+    a->Visit(PINBALL_NVP(wall_thickness_m));
   }
 };
 
@@ -125,7 +127,7 @@ void write_board_overlay(const BoardOverlay& overlay, const std::string& path);
 
 /// Reads an overlay file. Throws KeyError "path:key: what is wrong" for a
 /// missing, unknown, repeated, mistyped or out-of-range key (ρ in [0, 3],
-/// kick in [0, 10] m/s, wall friction in [0, 2], g in (0, 20] m/s², μ in [0, 10], ω in (0, 200] rad/s,
+/// kick in [0, 10] m/s, wall friction in [0, 2], wall thickness in [0, 0.05] m, g in (0, 20] m/s², μ in [0, 10], ω in (0, 200] rad/s,
 /// rise delay in [0, 0.1] s, pull in (0, 1],
 /// noise_max in [0, 1), stderr ≥ 0, events ≥ 0) or a wrong version;
 /// std::runtime_error naming the file when it cannot be read or parsed.
@@ -136,7 +138,7 @@ BoardOverlay parse_board_overlay(const std::string& text, const std::string& nam
 
 /// Lays the overlay over `board`: g, each group's obstacles' ρ, kick and friction (by
 /// name, every shape of a named obstacle), each flipper's μ (by name), the
-/// launcher's pull and noise, and each flipper's stroke speed where given (its
+/// launcher's pull and noise, the two-sided walls' thickness, and each flipper's stroke speed where given (its
 /// rise delay is not the board's: identified_actuation_delay_s). All or nothing: throws KeyError "name:key: ..."
 /// (`name` stands for the overlay file) for an obstacle or flipper name the
 /// board does not have, or for a pull, noise and g with which a launch could
