@@ -389,6 +389,7 @@ TEST(BoardLoaderErrors, AttributeMisuse) {
   expect_body_error("circle 0.1 0.5 0.01 rho=-1\n", 8, "circle: attribute rho must be >= 0, got -1");
   expect_body_error("circle 0.1 0.5 0.01 kick=-2\n", 8, "attribute kick must be >= 0, got -2");
   expect_body_error("wall 0.1 0.5 0.2 0.5 friction=-0.1\n", 8, "wall: attribute friction must be >= 0, got -0.1");
+  expect_body_error("wall 0.1 0.5 0.2 0.5 friction=2.5\n", 8, "wall: attribute friction must be at most 2, got 2.5");
   expect_body_error("circle 0.1 0.5 0.01 score=lots\n", 8, "attribute score is not a finite number: 'lots'");
   expect_error("pinball-board 1\nlauncher 1 1 pull=1.5\n", 2, "launcher: attribute pull must be in (0, 1], got 1.5");
   expect_error("pinball-board 1\nlauncher 1 1 noise=0.6\n", 2, "attribute noise must be in [0, 0.5], got 0.6");
