@@ -212,11 +212,11 @@ double tangent_sse(std::span<const Rebound> rebounds, double rho, double kick_mp
   return sse;
 }
 
-// The friction in [0, kMaxFriction] with the least squared residual: a grid,
+// The friction in [0, table::kMaxWallFriction] with the least squared residual: a grid,
 // then golden sections around its best point (the loss is piecewise smooth
 // in the friction, so the sum is not convex everywhere, but its grid is fine).
 double best_friction(std::span<const Rebound> rebounds, double rho, double kick_mps) {
-  constexpr double kMaxFriction = 2.0;
+  constexpr double kMaxFriction = table::kMaxWallFriction;
   constexpr int kGrid = 400;
   constexpr double kStep = kMaxFriction / kGrid;
   double best = 0.0, best_sse = INFINITY;

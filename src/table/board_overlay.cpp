@@ -64,7 +64,7 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
     if (g.obstacles.empty()) r.fail(key + ".obstacles", "names no obstacle");
     check_value(g.rho, kZero, {3.0, false}, "", key + ".rho", r);
     if (g.kick_mps) check_value(*g.kick_mps, kZero, {10.0, false}, " m/s", key + ".kick_mps", r);
-    if (g.friction) check_value(*g.friction, kZero, {2.0, false}, "", key + ".friction", r);
+    if (g.friction) check_value(*g.friction, kZero, {kMaxWallFriction, false}, "", key + ".friction", r);
   }
   for (std::size_t i = 0; i < o.flippers.size(); ++i) {
     const std::string key = "flippers[" + std::to_string(i) + "]";

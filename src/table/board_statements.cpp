@@ -26,7 +26,6 @@ constexpr double kMaxBallRadius_m = 0.1;     // a pinball is 13.5 mm
 constexpr double kMaxSpeed_mps = 100.0;      // SPEED_MAX, kick, kickout: twenty times a hard shot
 constexpr double kMaxGravity_mps2 = 10.0;    // along the table: at most g itself (9.81), with rounding
 constexpr double kMaxRho = 2.0;              // reflectivity: > 1 kicks; 2 already doubles the normal speed
-constexpr double kMaxFriction = 2.0;         // wall friction: no surface a ball rolls on has more (the overlay's bound too)
 // Below 1 µs a ball takes millions of steps a second of play (1e-12: never
 // ends); above 10 ms a 5 m/s ball jumps 5 cm, through any post.
 constexpr double kMinDt_s = 1e-6;
@@ -179,7 +178,7 @@ Obstacle obstacle_attributes(const LoadState& state, const Reader& r) {
   o.rho = rho_attribute(r, state.default_rho);
   o.friction = r.attribute("friction", 0.0);
   r.require(o.friction >= 0, "attribute friction", ">= 0", o.friction);
-  r.require(o.friction <= kMaxFriction, "attribute friction", "at most " + fmt(kMaxFriction), o.friction);
+  r.require(o.friction <= kMaxWallFriction, "attribute friction", "at most " + fmt(kMaxWallFriction), o.friction);
   o.action.score = r.attribute("score", 0.0);
   const double kick = r.attribute("kick", 0.0);
   r.require(kick >= 0, "attribute kick", ">= 0", kick);

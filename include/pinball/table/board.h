@@ -40,6 +40,9 @@ struct Action {
   bool eats_ball = false;            ///< ball eater: the ball is lost (drain, thesis 3.2.3)
 };
 
+/// The largest wall friction a board or an overlay may give: no surface a ball rolls on has more.
+inline constexpr double kMaxWallFriction = 2.0;
+
 /// A reflecting obstacle: shape, reflectivity and action (thesis 3.2.3).
 struct Obstacle {
   double rho = 1.0;       ///< reflectivity: normal speed out = rho x normal speed in; > 1 kicks
