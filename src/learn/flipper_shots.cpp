@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pinball/core/least_squares_line.h"
+#include "pinball/core/minimize.h"
 #include "pinball/core/statistics.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/model_world.h"
@@ -96,28 +97,7 @@ double shot_mu(sim::World& world, table::Board& board, sim::GameState& state, co
     mu = m;
     return replay_error(world, board, state, shot, delay_s);
   };
-  double best = 0.0, best_error = INFINITY;
-  for (int i = 0; i <= kMuGridSteps; ++i) {
-    const double m = kMuLimit * i / kMuGridSteps;
-    const double e = error_at(m);
-    if (e < best_error) best_error = e, best = m;
-  }
-  const double step = kMuLimit / kMuGridSteps;
-  double lo = std::max(0.0, best - step), hi = std::min(kMuLimit, best + step);
-  const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
-  double a = hi - ratio * (hi - lo), b = lo + ratio * (hi - lo);
-  double error_a = error_at(a), error_b = error_at(b);
-  for (int i = 0; i < kMuGoldenSteps; ++i) {
-    if (error_a < error_b) {
-      hi = b, b = a, error_b = error_a;
-      a = hi - ratio * (hi - lo), error_a = error_at(a);
-    } else {
-      lo = a, a = b, error_a = error_b;
-      b = lo + ratio * (hi - lo), error_b = error_at(b);
-    }
-  }
-  const double refined = 0.5 * (lo + hi);
-  return error_at(refined) <= best_error ? refined : best;
+  return minimize_on_interval(error_at, 0.0, kMuLimit, kMuGridSteps, kMuGoldenSteps);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "pinball/core/format.h"
 #include "pinball/core/least_squares_line.h"
+#include "pinball/core/minimize.h"
 #include "pinball/core/rng.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/core/statistics.h"
@@ -212,26 +213,13 @@ double tangent_sse(std::span<const Rebound> rebounds, double rho, double kick_mp
   return sse;
 }
 
-// The friction in [0, table::kMaxWallFriction] with the least squared residual: a grid,
-// then golden sections around its best point (the loss is piecewise smooth
-// in the friction, so the sum is not convex everywhere, but its grid is fine).
+// The friction in [0, table::kMaxWallFriction] with the least squared
+// residual (the loss is capped, so the sum is not smooth everywhere).
 double best_friction(std::span<const Rebound> rebounds, double rho, double kick_mps) {
-  constexpr double kMaxFriction = table::kMaxWallFriction;
-  constexpr int kGrid = 400;
-  constexpr double kStep = kMaxFriction / kGrid;
-  double best = 0.0, best_sse = INFINITY;
-  for (int i = 0; i <= kGrid; ++i) {
-    const double sse = tangent_sse(rebounds, rho, kick_mps, i * kStep);
-    if (sse < best_sse) best_sse = sse, best = i * kStep;
-  }
-  double lo = std::max(0.0, best - kStep), hi = std::min(kMaxFriction, best + kStep);
-  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
-  for (int it = 0; it < 40; ++it) {
-    const double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo);
-    if (tangent_sse(rebounds, rho, kick_mps, a) <= tangent_sse(rebounds, rho, kick_mps, b)) hi = b; else lo = a;
-  }
-  const double found = 0.5 * (lo + hi);
-  return found < 1e-9 ? 0.0 : found;  // the search's rounding at the bound is no friction
+  const double found = minimize_on_interval(
+      [&](double friction) { return tangent_sse(rebounds, rho, kick_mps, friction); }, 0.0, table::kMaxWallFriction,
+      400, 40);
+  return found < 1e-9 ? 0.0 : found;  // the sections' rounding at the bound is no friction
 }
 
 // The vertex of the parabola through (x[k-1], y[k-1]), (x[k], y[k]),
