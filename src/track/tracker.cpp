@@ -37,6 +37,7 @@ Tracker::Tracker(const FlipperGeometry& geometry, const TrackerConfig& config)
 }
 
 void Tracker::reset() {
+  noise_.restart_track();
   head_ = 0;
   size_ = 0;
   was_rolling_ = false;
@@ -84,6 +85,11 @@ double Tracker::rolling_speed() const {
   return 0.0;
 }
 
+double Tracker::sigma_m() const {
+  const std::optional<double> measured = config_.estimate_noise ? noise_.sigma_m() : std::nullopt;
+  return measured && *measured > kNoiseOverCalibration * config_.sigma_m ? *measured : config_.sigma_m;
+}
+
 const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensors& contacts) {
   if (size_ > 0 && !(obs.t_s > back(0).t_s)) {
     // Out of order or repeated frame: ignore it, keep the last answer.
@@ -93,6 +99,8 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
   if (size_ == kHistory) keep_newest(kHistory - 1);
   history_[(head_ + size_) % kHistory] = obs;
   ++size_;
+  if (config_.estimate_noise) noise_.add(obs);
+  const double sigma = sigma_m();
 
   out_ = TrackerOutput{};
   const bool rolling = contacts.left || contacts.right;
@@ -116,14 +124,14 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
 
   std::size_t n = window_length();
   const std::span<const Observation> fitted = newest(n);
-  TrajectoryFit fit = fit_fixed_gravity(fitted, config_.g_mps2, config_.sigma_m);
+  TrajectoryFit fit = fit_fixed_gravity(fitted, config_.g_mps2, sigma);
   // A push shows as the χ² an acceleration of its own saves (a likelihood
   // ratio test, far finer than g's χ² alone, which a skid can pass while its
   // velocity is already off by the push times half the window). It saves at
   // most all of g's χ².
   const double push_chi2 = chi2_threshold(2);
   if (fit.valid && config_.max_push_mps2 > 0.0 && fit.chi2 > push_chi2) {
-    const AccelerationFit own = fit_free_acceleration(fitted, config_.sigma_m);
+    const AccelerationFit own = fit_free_acceleration(fitted, sigma);
     if (own.valid && fit.chi2 - own.chi2 > push_chi2 && own.chi2 <= chi2_threshold(own.dof) &&
         (own.a_mps2 - Vec2(0.0, -config_.g_mps2)).norm() <= config_.max_push_mps2) {
       // One smooth path with a push: its own state, projected under g.
@@ -144,7 +152,7 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
     std::size_t good = 1;
     for (std::size_t m = 1; m + 3 <= n; ++m) {
       const std::span<const Observation> window = newest(n);
-      const TrajectoryFit older = fit_fixed_gravity(window.first(n - m), config_.g_mps2, config_.sigma_m);
+      const TrajectoryFit older = fit_fixed_gravity(window.first(n - m), config_.g_mps2, sigma);
       if (older.valid && older.chi2 <= chi2_threshold(older.dof)) {
         good = m;
         break;
@@ -154,7 +162,7 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
     out_.flushed = true;
     ++flushes_;
     n = good;
-    fit = fit_fixed_gravity(newest(n), config_.g_mps2, config_.sigma_m);
+    fit = fit_fixed_gravity(newest(n), config_.g_mps2, sigma);
   }
   out_.fit = fit;
   out_.window = static_cast<int>(std::min(n, size_));

@@ -2,10 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
+#include "pinball/control/spastic_controller.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board_loader.h"
@@ -147,6 +150,61 @@ TEST(SimulatedSpasticPlayer, BadSettingsThrow) {
   table::Board one = thesis_board();
   one.flippers.pop_back();
   EXPECT_THROW(SimulatedSpasticPlayer(one, track::CameraModelConfig{}, control::SpasticConfig{}, 1), std::invalid_argument);
+}
+
+
+// 20 balls of the tracked spastic flipper with the camera at `noise_px` and the
+// tracker calibrated for the default camera: the noise the tracker measured
+// (smallest and largest once it has one, after the first second of play) and
+// the σ its fits used at the end.
+struct MeasuredNoise {
+  double least_m = 1e9;
+  double most_m = 0.0;
+  double in_use_m = 0.0;
+  double calibrated_m = 0.0;
+};
+
+MeasuredNoise measure_camera_noise(double noise_px) {
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
+  const track::CameraModelConfig calibrated;
+  track::CameraModelConfig camera = calibrated;
+  camera.noise_px = noise_px;
+  const track::TrackerConfig believed = track::default_tracker_config(thesis_board(), calibrated);
+  control::SpasticController spastic;
+  SimulatedPlayer player(thesis_board(), camera, believed, spastic, 1);
+  MeasuredNoise m;
+  m.calibrated_m = believed.sigma_m;
+  for (int seed = 1; seed <= kBalls; ++seed) {
+    sim::GameState s = sim::make_game_state(thesis_board(), static_cast<std::uint64_t>(seed));
+    sim::play_ball(
+        *world, s, limits(), [&](sim::GameState& st) { player.act(st); },
+        [&](const sim::GameState& st, const sim::StepEvents&) {
+          const std::optional<double> sigma = player.tracker().measured_sigma_m();
+          if (!sigma || (seed == 1 && st.time_s < 1.0)) return;
+          m.least_m = std::min(m.least_m, *sigma);
+          m.most_m = std::max(m.most_m, *sigma);
+        });
+  }
+  m.in_use_m = player.tracker().sigma_m();
+  return m;
+}
+
+TEST(SimulatedPlayer, TheTrackerMeasuresTheCamerasNoiseInPlay) {
+  // As calibrated (0.3 px): the estimate stays within the 2x the tracker
+  // allows it before it replaces the calibration, so the fits are as before.
+  const MeasuredNoise as_calibrated = measure_camera_noise(0.3);
+  EXPECT_LT(as_calibrated.most_m, track::kNoiseOverCalibration * as_calibrated.calibrated_m);
+  EXPECT_GT(as_calibrated.least_m, 0.5 * as_calibrated.calibrated_m);
+  EXPECT_DOUBLE_EQ(as_calibrated.in_use_m, as_calibrated.calibrated_m);
+  // At 2 px (σ 4.04 mm with the pixel grid) the tracker weighs by what it measured.
+  const MeasuredNoise noisy = measure_camera_noise(2.0);
+  const double sigma_2px = track::observation_sigma_m([] {
+    track::CameraModelConfig c;
+    c.noise_px = 2.0;
+    return c;
+  }());
+  EXPECT_GT(noisy.least_m, track::kNoiseOverCalibration * noisy.calibrated_m);
+  EXPECT_NEAR(noisy.in_use_m, sigma_2px, 0.3 * sigma_2px);
 }
 
 }  // namespace

@@ -286,6 +286,47 @@ TEST(Tracker, Chi2FlushesThePointsBeforeACollision) {
   }
 }
 
+// Flushes over 4 s of a ball falling in the critical area, seen with noise
+// `noise_m` per coordinate, by a tracker calibrated for c.sigma_m.
+std::size_t flushes_with_noise(const TrackerConfig& c, double noise_m, Tracker& tracker) {
+  Rng rng(7);
+  for (int k = 0; k < 800; ++k) {
+    const double t = (k % 100) * kFrame_s;  // a fresh drop every 0.5 s
+    if (k % 100 == 0) tracker.reset();
+    const Flight f{0.0, {0.2, 0.45}, {0.05, 0.4}, c.g_mps2};
+    tracker.update(obs(k * kFrame_s, f.at(t) + noise_m * Vec2(rng.normal(), rng.normal())), kNoContact);
+  }
+  return tracker.flushes();
+}
+
+TEST(Tracker, ACameraNoisierThanItsCalibrationIsMeasuredAndFlushesFarLess) {
+  const TrackerConfig c = config();
+  TrackerConfig thesis = c;
+  thesis.estimate_noise = false;
+  Tracker measuring(geometry(), c);
+  Tracker believing(geometry(), thesis);
+  const double noise = 5.0 * c.sigma_m;
+  const std::size_t measured = flushes_with_noise(c, noise, measuring);
+  const std::size_t believed = flushes_with_noise(thesis, noise, believing);
+  ASSERT_TRUE(measuring.measured_sigma_m().has_value());
+  EXPECT_NEAR(measuring.sigma_m(), noise, 0.15 * noise);
+  EXPECT_DOUBLE_EQ(believing.sigma_m(), c.sigma_m);
+  // Believing its calibration, the tracker flushes at about one frame in five
+  // (a flush leaves 3 points, which pass for a while); measuring, it flushes
+  // while it learns (the first 34 frames) and seldom after.
+  EXPECT_GT(believed, 100u);
+  EXPECT_LT(measured, believed / 5);
+}
+
+TEST(Tracker, ACameraAsGoodAsItsCalibrationIsTrackedWithTheCalibration) {
+  const TrackerConfig c = config();
+  Tracker tracker(geometry(), c);
+  flushes_with_noise(c, c.sigma_m, tracker);
+  ASSERT_TRUE(tracker.measured_sigma_m().has_value());
+  EXPECT_NEAR(*tracker.measured_sigma_m(), c.sigma_m, 0.15 * c.sigma_m);
+  EXPECT_DOUBLE_EQ(tracker.sigma_m(), c.sigma_m);
+}
+
 TEST(Tracker, WithoutChi2FlushTheOldPointsLinger) {
   // The same collision with the test off: the first fits after it are wrong
   // (the thesis's "prediction may be incorrect for a few steps").

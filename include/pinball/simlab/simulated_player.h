@@ -36,6 +36,8 @@ class SimulatedPlayer {
   const track::TrackerOutput& last_output() const { return last_; }
   /// Observations processed.
   std::uint64_t observations() const { return observations_; }
+  /// The tracker (its counters and the noise it has measured, for reports and tests).
+  const track::Tracker& tracker() const { return tracker_; }
   /// Board flipper index of tracker flipper f (track::kLeftFlipper / kRightFlipper).
   int board_index(int f) const { return board_index_[static_cast<std::size_t>(f)]; }
 
