@@ -30,6 +30,7 @@
 #include "pinball/simlab/world_factory.h"
 #include "pinball/table/board_overlay.h"
 #include "pinball/track/flipper_geometry.h"
+#include "pinball/track/tracker.h"
 #include "pinball/vision/capture_source.h"
 #include "pinball/simlab/sim_camera_source.h"
 #include "pinball/learn/planning_controller.h"
@@ -424,6 +425,9 @@ DaemonReport Daemon::Impl::report() const {
   r.frames = cc.frames;
   r.detections = cc.detections;
   r.projections = cc.projections;
+  r.camera_noise_calibrated_m = tracker->config().sigma_m;
+  // The tracker belongs to the camera thread: its measurement is read once that thread is done.
+  if (threads_joined.load(std::memory_order_acquire)) r.camera_noise_measured_m = tracker->measured_sigma_m();
   r.commands = kc.commands;
   r.camera_stalls = kc.camera_stalls;
   r.ball_lost_releases = kc.ball_lost;
@@ -636,6 +640,10 @@ void Daemon::inject_fault(int thread, double freeze_s, bool fail) {
   f.fail.store(fail, std::memory_order_relaxed);
 }
 
+bool camera_noisier_than_calibrated(const DaemonReport& r) {
+  return r.camera_noise_measured_m && *r.camera_noise_measured_m > track::kNoiseOverCalibration * r.camera_noise_calibrated_m;
+}
+
 std::string recording_problems(const DaemonReport& r) {
   std::string lost;
   if (r.can_log && !r.can_log->complete()) {
@@ -689,6 +697,9 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["frames_dropped"] = r.frames_dropped;
   j["detections"] = r.detections;
   j["projections"] = r.projections;
+  j["camera_noise"] = {{"calibrated_m", r.camera_noise_calibrated_m},
+                       {"measured_m", r.camera_noise_measured_m ? nlohmann::json(*r.camera_noise_measured_m) : nlohmann::json()},
+                       {"over_calibration", camera_noisier_than_calibrated(r)}};
   j["commands"] = r.commands;
   j["camera_stalls"] = r.camera_stalls;
   j["ball_lost_releases"] = r.ball_lost_releases;
@@ -747,6 +758,14 @@ std::string report_to_text(const DaemonReport& r) {
   o << "frames " << r.frames << " (dropped " << r.frames_dropped << ")  ball seen " << r.detections
     << "  projections " << r.projections << "  commands " << r.commands << "  stalls " << r.camera_stalls
     << "  malformed LCM " << r.lcm.malformed << "\n";
+  if (r.camera_noise_measured_m) {
+    o << std::setprecision(2) << "camera noise " << *r.camera_noise_measured_m * 1e3 << " mm measured, "
+      << r.camera_noise_calibrated_m * 1e3 << " mm calibrated"
+      << (camera_noisier_than_calibrated(r)
+              ? ": the tracker weighs by the measured noise; calibrate the camera again (docs/calibration.md)"
+              : "")
+      << "\n" << std::setprecision(1);
+  }
   o << std::left << std::setw(24) << "latency (us)" << std::right << std::setw(10) << "count" << std::setw(10)
     << "p50" << std::setw(10) << "p99" << std::setw(10) << "max" << "\n";
   for (int s = 0; s < kStageCount; ++s) {

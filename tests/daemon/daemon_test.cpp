@@ -73,6 +73,31 @@ TEST(Daemon, LockstepRunsAreDeterminedByTheSeed) {
   EXPECT_EQ(a.board.watchdog_trips, 0u);
 }
 
+// The tracker measures the camera's noise as it plays; the report gives it
+// beside the calibration's, and says when the camera wants calibrating again.
+TEST(Daemon, TheReportGivesTheCameraNoiseTheTrackerMeasured) {
+  Daemon d(sim_config(1, 3));
+  const DaemonReport r = d.run();
+  ASSERT_GT(r.camera_noise_calibrated_m, 0.0);
+  ASSERT_TRUE(r.camera_noise_measured_m.has_value());
+  EXPECT_GT(*r.camera_noise_measured_m, 0.0);
+  EXPECT_FALSE(camera_noisier_than_calibrated(r));  // the embedded camera's rendered frames are cleaner than calibrated
+  const nlohmann::json j = report_to_json(r);
+  EXPECT_DOUBLE_EQ(j.at("camera_noise").at("measured_m").get<double>(), *r.camera_noise_measured_m);
+  EXPECT_DOUBLE_EQ(j.at("camera_noise").at("calibrated_m").get<double>(), r.camera_noise_calibrated_m);
+  EXPECT_NE(report_to_text(r).find("mm calibrated\n"), std::string::npos);
+
+  DaemonReport noisy = r;
+  noisy.camera_noise_measured_m = 3.0 * r.camera_noise_calibrated_m;
+  EXPECT_TRUE(camera_noisier_than_calibrated(noisy));
+  EXPECT_TRUE(report_to_json(noisy).at("camera_noise").at("over_calibration").get<bool>());
+  EXPECT_NE(report_to_text(noisy).find("calibrate the camera again"), std::string::npos);
+  DaemonReport unmeasured = r;
+  unmeasured.camera_noise_measured_m.reset();
+  EXPECT_TRUE(report_to_json(unmeasured).at("camera_noise").at("measured_m").is_null());
+  EXPECT_EQ(report_to_text(unmeasured).find("camera noise"), std::string::npos);
+}
+
 // The simulated table may be another board (or stepper) than the one the
 // tracker and the controller believe: the world is configured apart.
 TEST(Daemon, TheWorldIsConfiguredApartFromTheBelief) {

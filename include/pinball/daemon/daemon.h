@@ -63,6 +63,13 @@ struct DaemonReport {
   std::uint64_t frames_dropped = 0;          ///< frames lost before the camera thread
   std::uint64_t detections = 0;              ///< frames with a ball
   std::uint64_t projections = 0;             ///< valid projections
+  /// The camera's noise per coordinate (m): the calibration's, which the
+  /// tracker is given, and what the tracker measured from the ball's tracks
+  /// (docs/tracking.md; once the threads are done and it has enough frames).
+  /// Measured over track::kNoiseOverCalibration times the calibration, the
+  /// tracker weighs its fits by the measured one: the camera wants calibrating again.
+  double camera_noise_calibrated_m = 0.0;
+  std::optional<double> camera_noise_measured_m;
   std::uint64_t commands = 0;                ///< flipper commands given
   std::uint64_t camera_stalls = 0;           ///< releases because frames stopped
   std::uint64_t ball_lost_releases = 0;      ///< releases because the ball went out of sight
@@ -105,6 +112,10 @@ std::string recording_problems(const DaemonReport& report);
 /// simulation runs, tens of times real time, and an lcm-logger on udpm://
 /// loses messages it cannot keep up with, without a word.
 std::string lcm_pace_warning(const DaemonConfig& config);
+
+/// The tracker measured the camera noisier than track::kNoiseOverCalibration
+/// times its calibration (and so weighed its fits by the measured noise).
+bool camera_noisier_than_calibrated(const DaemonReport& report);
 
 /// The report as one JSON object (the --json output).
 nlohmann::json report_to_json(const DaemonReport& report);
