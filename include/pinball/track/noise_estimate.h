@@ -1,10 +1,10 @@
 #pragma once
 // The camera's noise, measured from the ball's own track (beyond the thesis).
 // The tracker weighs its fits and finds collisions by χ² against the noise it
-// was told (the calibration's σ). A camera noisier than that fails every χ²
-// test: the tracker flushes at almost every frame and fits 3 points, and a
-// planner playing from such fits drains balls down the middle (docs/results.md,
-// "Camera noise the tracker does not expect"). So the tracker also measures it.
+// was told (the calibration's σ). A camera noisier than that fails the χ²
+// tests: the tracker flushes often and fits 3 points, and a planner playing
+// from such fits drains balls down the middle (docs/results.md, "Camera noise
+// the tracker does not expect"). So the tracker also measures it.
 //
 // Any three frames in a row give one residual that no straight path has:
 // r = w0·p0 + w1·p1 + w2·p2 with w ∝ (1/Δt1, −1/Δt1 − 1/Δt2, 1/Δt2), scaled to
