@@ -641,7 +641,7 @@ void Daemon::inject_fault(int thread, double freeze_s, bool fail) {
 }
 
 bool camera_noisier_than_calibrated(const DaemonReport& r) {
-  return r.camera_noise_measured_m && *r.camera_noise_measured_m > track::kNoiseOverCalibration * r.camera_noise_calibrated_m;
+  return r.camera_noise_measured_m && track::measured_noise_overrides(*r.camera_noise_measured_m, r.camera_noise_calibrated_m);
 }
 
 std::string recording_problems(const DaemonReport& r) {

@@ -87,7 +87,7 @@ double Tracker::rolling_speed() const {
 
 double Tracker::sigma_m() const {
   const std::optional<double> measured = config_.estimate_noise ? noise_.sigma_m() : std::nullopt;
-  return measured && *measured > kNoiseOverCalibration * config_.sigma_m ? *measured : config_.sigma_m;
+  return measured && measured_noise_overrides(*measured, config_.sigma_m) ? *measured : config_.sigma_m;
 }
 
 const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensors& contacts) {

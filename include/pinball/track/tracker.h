@@ -53,6 +53,12 @@ struct TrackerConfig {
 /// rounding is not normal); at 1 px, 1.74 to 2.61 mm (docs/tracking.md).
 inline constexpr double kNoiseOverCalibration = 2.0;
 
+/// The rule both the tracker and its reports use: a measured noise replaces
+/// the calibrated one when it exceeds kNoiseOverCalibration times it.
+inline bool measured_noise_overrides(double measured_m, double calibrated_m) {
+  return measured_m > kNoiseOverCalibration * calibrated_m;
+}
+
 /// Defaults for a board and a camera: g from the board, d and ε from the
 /// flipper length, σ from the camera, the critical area 0.35 m above the pivots.
 TrackerConfig default_tracker_config(const table::Board& board, const CameraModelConfig& camera);
