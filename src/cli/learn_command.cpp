@@ -50,7 +50,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_option("board", a.board, "board file (docs/board-format.md)")->required()->transform(data_file());
   add_identified_option(*cmd, a.identified);
   cmd->add_option("--randomize", a.randomize,
-                  "searches and imitate's learner: play each ball in a world drawn from this file's ranges (g, wall "
+                  "searches and imitate (teacher and learner): play each ball in a world drawn from this file's ranges (g, wall "
                   "rho, flipper mu, pivots, delay, camera latency and noise, stepper) while the controller believes "
                   "the board (docs/learning.md); the final evaluation plays the board itself")
       ->check(CLI::ExistingFile);
@@ -338,7 +338,9 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     if (world_spec.kind != simlab::WorldKind::kModel || !world_spec.board_path.empty())
       throw std::invalid_argument("learn: --randomize draws its worlds around the belief's model; it cannot be "
                                   "combined with --world twin or --world-board");
-    if (!search) throw std::invalid_argument("learn: --randomize is for a search (tournament, relay, cem), not --method " + a.method);
+    if (!search && a.method != "imitate")
+      throw std::invalid_argument("learn: --randomize is for a search (tournament, relay, cem) or imitate, not --method " +
+                                  a.method);
   }
   if (a.lead && !search)
     throw std::invalid_argument("learn: --lead is for a search (tournament, relay, cem), not --method " + a.method);
@@ -347,7 +349,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   struct Objective final : learn::BallObjective {
     Objective(const table::Board& b, const learn::EvaluatorConfig& c, const sim::World& w, const LearnArgs& args)
         : ev(b, c, w.fork()), la(args) {
-      if (!args.randomize.empty())
+      if (!args.randomize.empty() && args.method != "imitate")  // imitate draws its own (learn::TeacherWorlds)
         randomized = std::make_unique<learn::RandomizedEvaluator>(b, c, learn::load_randomization(args.randomize));
     }
     learn::BallOutcome play(const control::ControllerSpec& s, std::uint64_t seed) const override {
@@ -443,6 +445,13 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     ic.demonstration.max_ball_time_s = a.max_ball_time_s;
     ic.demonstration.pull = a.pull;
     ic.rounds = a.rounds;
+    // With --randomize each ball plays a drawn world and the teacher plans in
+    // it; the final evaluation plays the belief's own world, as a search's does.
+    const learn::TeacherWorlds teacher_worlds =
+        a.randomize.empty() ? learn::TeacherWorlds(board, world.world.get())
+                            : learn::TeacherWorlds(board, learn::draw_worlds(board, ec, learn::load_randomization(a.randomize)),
+                                                   ec.dt_s);
+    if (!teacher_worlds.drawn().empty()) j["randomize"] = randomization_report(a.randomize, teacher_worlds.drawn());
     const std::string cycle_path = a.out + ".cycle.json";
     double cycle_score = -1e300;  // keep the highest-scoring cycle, as the searches do
     const learn::ImitationResult im = learn::learn_by_imitation(
@@ -460,7 +469,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
           if (writer) control::save_controller(s, cycle_path);
           err << "learn: cycle controller saved to " << cycle_path << "\n";
         },
-        world.world.get());
+        &teacher_worlds);
     const learn::SearchResult curve = learn::imitation_curve(im);
     if (writer && !a.curve.empty()) learn::write_curve_csv(curve, a.curve);
     if (writer && !a.plot.empty()) learn::plot_curve_png(curve, a.plot);

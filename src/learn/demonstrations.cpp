@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 
 #include "pinball/simlab/simulated_player.h"
@@ -111,6 +112,15 @@ void finish(DemonstrationBall& ball, ShotRecorder& recorder, const sim::BallResu
   ball.cut = r.cut;
 }
 
+// The camera model and tracker that watch a ball: the world's camera, the
+// belief's table and believed camera; the same seeds as the evaluator's, so
+// the examples see what a controller would.
+simlab::SimulatedPlayer make_watcher(const table::Board& belief, const DemonstrationConfig& config,
+                                     control::FlipperController& controller, std::uint64_t seed) {
+  return simlab::SimulatedPlayer(belief, config.world_camera.value_or(config.camera),
+                                 track::default_tracker_config(belief, config.camera), controller, camera_seed(seed));
+}
+
 sim::BallLimits limits_of(const DemonstrationConfig& config) {
   sim::BallLimits limits;
   limits.max_ball_time_s = config.max_ball_time_s;
@@ -122,19 +132,18 @@ sim::BallLimits limits_of(const DemonstrationConfig& config) {
 // teacher judges the true state: "fire now" labels the approach with this
 // frame's d; if the learner fires first, the teacher's best plan from that
 // frame labels it (fire k frames later: d less the ball's travel; no fire: a pass).
-DemonstrationBall record_correction(sim::World& world, const sim::ThesisStepper& model,
+DemonstrationBall record_correction(const table::Board& belief, sim::World& world, const sim::ThesisStepper& model,
                                     const DemonstrationConfig& config,
                                     const std::shared_ptr<const control::ShotTable>& learner_table,
                                     std::uint64_t seed) {
-  const table::Board& board = model.board();
   DemonstrationBall ball;
   ShotRecorder recorder(ball.shots);
   control::ImitationController learner(learner_table);
   Tee tee(learner, recorder);
-  simlab::SimulatedPlayer watcher(board, config.camera, tee, camera_seed(seed));
+  simlab::SimulatedPlayer watcher = make_watcher(belief, config, tee, seed);
   LookaheadPlanner teacher(model, config.teacher);
   const double frame_s = model.dt_s() * config.teacher.frame_steps;
-  simlab::DelayLine delay(board.flippers.size(), config.actuation_delay_s);
+  simlab::DelayLine delay(belief.flippers.size(), config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
   sim::GameState state = sim::make_game_state(world.board(), seed);
   bool held = false;  // a learner's flipper was commanded up before this step
@@ -175,13 +184,11 @@ DemonstrationBall record_correction(sim::World& world, const sim::ThesisStepper&
 
 }  // namespace
 
-DemonstrationBall record_demonstration(sim::World& world, const sim::ThesisStepper& model,
+DemonstrationBall record_demonstration(const table::Board& belief, sim::World& world, const sim::ThesisStepper& model,
                                        const DemonstrationConfig& config, std::uint64_t seed) {
-  const table::Board& board = model.board();
   DemonstrationBall ball;
   ShotRecorder recorder(ball.shots);
-  // The same camera and tracker seeds as the evaluator's, so the examples see what a controller would.
-  simlab::SimulatedPlayer watcher(board, config.camera, recorder, camera_seed(seed));
+  simlab::SimulatedPlayer watcher = make_watcher(belief, config, recorder, seed);
   LookaheadPlayer teacher(model, config.teacher, config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
   sim::GameState state = sim::make_game_state(world.board(), seed);
@@ -202,6 +209,38 @@ DemonstrationBall record_demonstration(sim::World& world, const sim::ThesisStepp
       [](const sim::GameState&, const sim::StepEvents&) {});
   finish(ball, recorder, r);
   return ball;
+}
+
+TeacherWorlds::TeacherWorlds(const table::Board& belief, const sim::World* world) : belief_(belief) {
+  Place home;
+  home.world = world != nullptr ? world->fork() : sim::make_model_world(belief);
+  sim::check_same_flippers(home.world->board(), belief);
+  home.teacher_model = std::make_unique<sim::ThesisStepper>(belief);
+  places_.push_back(std::move(home));
+}
+
+TeacherWorlds::TeacherWorlds(const table::Board& belief, std::vector<DrawnWorld> drawn, double dt_s)
+    : belief_(belief), drawn_(std::move(drawn)) {
+  if (drawn_.empty()) throw std::invalid_argument("teacher worlds: no drawn world");
+  for (const DrawnWorld& w : drawn_) {
+    Place p;
+    sim::ModelWorldOptions options;
+    options.stepper = w.stepper;
+    options.dt_s = dt_s;
+    p.world = sim::make_model_world(w.settings.board, options);
+    sim::check_same_flippers(p.world->board(), belief);
+    sim::ThesisStepperOptions model_options;
+    model_options.dt_s = dt_s;
+    p.teacher_model = std::make_unique<sim::ThesisStepper>(w.settings.board, model_options);
+    p.actuation_delay_s = w.settings.actuation_delay_s;
+    p.camera = w.settings.camera;
+    places_.push_back(std::move(p));
+  }
+}
+
+const TeacherWorlds::Place& TeacherWorlds::place_of(std::uint64_t ball_seed) const {
+  return places_.size() == 1 && drawn_.empty() ? places_.front()
+                                               : places_[drawn_world_index(ball_seed, places_.size())];
 }
 
 Blob to_blob(const DemonstrationBall& b) {
@@ -227,13 +266,13 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
                                      std::uint64_t seed, int threads,
                                      const std::function<void(const std::string&)>& progress,
                                      const std::shared_ptr<const control::ShotTable>& learner,
-                                     const sim::World* world) {
+                                     const TeacherWorlds* worlds) {
   if (balls < 1) throw std::invalid_argument("demonstrations: balls must be >= 1");
   if (board.flippers.size() != 2) throw std::invalid_argument("demonstrations: the board needs exactly two flippers");
-  const sim::ThesisStepper model(board);
-  const std::unique_ptr<sim::World> world_prototype =
-      world != nullptr ? world->fork() : sim::make_model_world(board);
-  sim::check_same_flippers(world_prototype->board(), board);
+  if (worlds != nullptr && &worlds->belief() != &board)
+    throw std::invalid_argument("demonstrations: the worlds must watch with the board given");
+  std::optional<TeacherWorlds> home;  // the belief's own model
+  if (worlds == nullptr) worlds = &home.emplace(board, nullptr);
   const auto n = static_cast<std::size_t>(balls);
   std::vector<DemonstrationBall> played(n);
   std::atomic<int> done{0};
@@ -243,10 +282,15 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
   const int share = std::max<int>(1, balls / team_size());
   const int every = std::max(1, share / 10);
   const std::vector<Blob> blobs = distributed_map(n, threads, [&](std::size_t i) {
-    const std::unique_ptr<sim::World> ball_world = world_prototype->fork();
+    const std::uint64_t b = ball_seed(seed, i);
+    const TeacherWorlds::Place& place = worlds->place_of(b);
+    DemonstrationConfig c = config;  // the world's own delay and camera, when it has them
+    if (place.actuation_delay_s) c.actuation_delay_s = *place.actuation_delay_s;
+    if (place.camera) c.world_camera = place.camera;
+    const std::unique_ptr<sim::World> ball_world = place.world->fork();
     const DemonstrationBall ball = learner != nullptr
-                                       ? record_correction(*ball_world, model, config, learner, ball_seed(seed, i))
-                                       : record_demonstration(*ball_world, model, config, ball_seed(seed, i));
+                                       ? record_correction(board, *ball_world, *place.teacher_model, c, learner, b)
+                                       : record_demonstration(board, *ball_world, *place.teacher_model, c, b);
     const int d = ++done;
     if (progress && (d % every == 0 || d == share)) {
       const std::lock_guard<std::mutex> lock(progress_mutex);
@@ -278,7 +322,7 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
 ImitationResult learn_by_imitation(const table::Board& board, const ImitationLearningConfig& config,
                                    std::uint64_t budget_balls, std::uint64_t seed, int threads,
                                    const std::function<void(const std::string&)>& progress,
-                                   const ImitationCycleHandler& on_cycle, const sim::World* world) {
+                                   const ImitationCycleHandler& on_cycle, const TeacherWorlds* worlds) {
   if (config.rounds < 1) throw std::invalid_argument("imitation: rounds must be >= 1");
   if (budget_balls < static_cast<std::uint64_t>(config.rounds)) {
     throw std::invalid_argument("imitation: the budget must give every round a ball");
@@ -296,7 +340,7 @@ ImitationResult learn_by_imitation(const table::Board& board, const ImitationLea
                                 if (progress) progress("round " + std::to_string(r + 1) + "/" +
                                                        std::to_string(config.rounds) + ": " + line);
                               },
-                              r == 0 ? nullptr : result.table, world);
+                              r == 0 ? nullptr : result.table, worlds);
     if (r > 0 && d.cut > 0 && on_cycle) on_cycle(*result.table, d.best_cut_score);  // the table that played it
     shots.insert(shots.end(), d.shots.begin(), d.shots.end());
     result.table = std::make_shared<const control::ShotTable>(shots, config.table);

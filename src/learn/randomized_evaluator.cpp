@@ -110,8 +110,12 @@ RandomizedEvaluator::RandomizedEvaluator(const table::Board& belief, const Evalu
   }
 }
 
+std::size_t drawn_world_index(std::uint64_t ball_seed, std::size_t variants) {
+  return static_cast<std::size_t>(mix(ball_seed) % variants);
+}
+
 std::size_t RandomizedEvaluator::world_of(std::uint64_t ball_seed) const {
-  return static_cast<std::size_t>(mix(ball_seed) % evaluators_.size());
+  return drawn_world_index(ball_seed, evaluators_.size());
 }
 
 BallOutcome RandomizedEvaluator::play(const control::ControllerSpec& spec, std::uint64_t ball_seed) const {

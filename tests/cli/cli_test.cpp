@@ -102,6 +102,21 @@ TEST_F(Cli, LearnRandomizeSearchesAcrossDrawnWorldsAndJudgesInTheHomeWorld) {
   EXPECT_EQ(nlohmann::json::parse(led.out).at("lead"), true);
   EXPECT_NE(pinball::testing::slurp(dir_ / "c.json").find("\"lead_actuation_delay_s\": 0.006"), std::string::npos);
 
+  // Imitation too: its teacher and learner play the drawn worlds, the evaluation the home world.
+  const std::string imitate = "learn boards/mit1993.board --method imitate --budget-balls 4 --rounds 2 --seed 3 "
+                              "--threads 1 --eval-balls 4 --max-ball-time 5 --json --out " + (dir_ / "i.json").string();
+  const CommandResult im = run(imitate + " --randomize " + ranges.string());
+  ASSERT_EQ(im.exit_code, 0) << im.err;
+  const auto ij = nlohmann::json::parse(im.out);
+  ASSERT_EQ(ij.at("randomize").at("worlds").size(), 4u);
+  EXPECT_EQ(ij.at("evaluation").at("balls"), 4);
+  EXPECT_EQ(ij.at("world"), "thesis");
+  EXPECT_NE(pinball::testing::slurp(dir_ / "i.json").find("--randomize " + ranges.string()), std::string::npos);
+  const CommandResult im_plain = run(imitate);
+  ASSERT_EQ(im_plain.exit_code, 0) << im_plain.err;
+  EXPECT_FALSE(nlohmann::json::parse(im_plain.out).contains("randomize"));
+  EXPECT_NE(nlohmann::json::parse(im_plain.out).at("rounds"), ij.at("rounds"));
+
   const CommandResult spastic = run("learn boards/mit1993.board --method spastic --eval-balls 2 --randomize " +
                                     ranges.string());
   EXPECT_EQ(spastic.exit_code, 1);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 #include <stdexcept>
 
 #include "common/thesis_board.h"
@@ -38,7 +39,7 @@ void expect_sane(const control::ShotExample& e) {
 TEST(Demonstrations, TheTeachersShotsAreRecordedOnePerApproach) {
   const sim::ThesisStepper model(thesis_board());
   const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
-  const DemonstrationBall b = record_demonstration(*world, model, short_config(), ball_seed(3, 0));
+  const DemonstrationBall b = record_demonstration(thesis_board(), *world, model, short_config(), ball_seed(3, 0));
   ASSERT_FALSE(b.shots.empty());
   int fired = 0;
   for (const control::ShotExample& e : b.shots) {
@@ -65,6 +66,88 @@ TEST(Demonstrations, SameSeedSameExamplesWhateverTheThreads) {
   }
   EXPECT_EQ(one.mean_teacher_score, two.mean_teacher_score);
   EXPECT_EQ(one.balls, 3);
+}
+
+// Three worlds around the thesis board, one of them on the event stepper,
+// with g, the solenoid's delay and the camera's latency drawn.
+std::vector<DrawnWorld> three_drawn_worlds() {
+  const Randomization r = parse_randomization(
+      "variants: 3\nseed: 4\nevent_stepper_share: 0.34\nranges:\n  gravity_pct: [-10, 10]\n"
+      "  actuation_delay_ms: [2, 20]\n  camera_latency_ms: [0, 10]\n",
+      "r.yaml");
+  return draw_worlds(thesis_board(), EvaluatorConfig{}, r);
+}
+
+// What a ball played in drawn world `w` alone gives: its table, stepper,
+// delay and camera, the teacher planning on that table.
+DemonstrationBall played_alone(const DrawnWorld& w, const DemonstrationConfig& config, std::uint64_t seed) {
+  sim::ModelWorldOptions options;
+  options.stepper = w.stepper;
+  const std::unique_ptr<sim::World> world = sim::make_model_world(w.settings.board, options);
+  const sim::ThesisStepper teacher_model(w.settings.board);
+  DemonstrationConfig c = config;
+  c.actuation_delay_s = w.settings.actuation_delay_s;
+  c.world_camera = w.settings.camera;
+  return record_demonstration(thesis_board(), *world, teacher_model, c, seed);
+}
+
+TEST(Demonstrations, RandomizedTheTeacherPlaysEachBallInTheDrawnWorldItsSeedPicks) {
+  const std::vector<DrawnWorld> drawn = three_drawn_worlds();
+  ASSERT_EQ(drawn.size(), 3u);
+  const TeacherWorlds worlds(thesis_board(), drawn);
+  ASSERT_EQ(worlds.drawn().size(), 3u);
+  const std::uint64_t seed = 13;
+  const int balls = 6;
+  const Demonstrations d = record_demonstrations(thesis_board(), short_config(), balls, seed, 2, {}, nullptr, &worlds);
+  std::vector<control::ShotExample> alone;
+  std::set<std::size_t> used;
+  double score = 0.0;
+  for (int i = 0; i < balls; ++i) {
+    const std::uint64_t b = ball_seed(seed, static_cast<std::uint64_t>(i));
+    used.insert(drawn_world_index(b, drawn.size()));
+    const DemonstrationBall ball = played_alone(drawn[drawn_world_index(b, drawn.size())], short_config(), b);
+    alone.insert(alone.end(), ball.shots.begin(), ball.shots.end());
+    score += ball.score;
+  }
+  EXPECT_GE(used.size(), 2u) << "the balls must visit more than one world";
+  ASSERT_EQ(d.shots.size(), alone.size());
+  for (std::size_t i = 0; i < alone.size(); ++i) {
+    EXPECT_EQ(d.shots[i].d_fire_m, alone[i].d_fire_m) << i;
+    EXPECT_EQ(d.shots[i].fired_flipper, alone[i].fired_flipper) << i;
+    EXPECT_EQ(d.shots[i].speed_mps, alone[i].speed_mps) << i;
+  }
+  EXPECT_DOUBLE_EQ(d.mean_teacher_score, score / balls);
+  // Not the belief's own world: the same balls there play otherwise.
+  const Demonstrations home = record_demonstrations(thesis_board(), short_config(), balls, seed, 2, {});
+  EXPECT_NE(home.mean_teacher_score, d.mean_teacher_score);
+}
+
+TEST(Demonstrations, RandomizedTheTeacherLabelsTheLearnerInTheDrawnWorld) {
+  // One drawn world only: every ball plays it, learner and teacher alike.
+  const std::vector<DrawnWorld> drawn = three_drawn_worlds();
+  const auto never = std::make_shared<const control::ShotTable>(
+      std::vector<control::ShotExample>{{0, false, 0.0, 0.5, 1.0, -1, 0.0, 0.0}, {1, false, 0.0, 0.5, 1.0, -1, 0.0, 0.0}},
+      control::ImitationConfig{});
+  for (const DrawnWorld& w : drawn) {
+    const TeacherWorlds one(thesis_board(), std::vector<DrawnWorld>{w});
+    const Demonstrations d = record_demonstrations(thesis_board(), short_config(), 2, 5, 1, {}, never, &one);
+    int fired = 0;
+    for (const control::ShotExample& e : d.shots) {
+      expect_sane(e);
+      fired += e.fired_flipper >= 0 ? 1 : 0;
+    }
+    EXPECT_GT(fired, 0) << "the teacher must want to flip where the learner did not";
+    // The learner's balls are played in that world: the same balls in the belief's model differ.
+    const Demonstrations home = record_demonstrations(thesis_board(), short_config(), 2, 5, 1, {}, never);
+    EXPECT_NE(home.mean_ball_time_s, d.mean_ball_time_s);
+  }
+}
+
+TEST(Demonstrations, TeacherWorldsRefuseNoWorldsAndAnotherBelief) {
+  EXPECT_THROW(TeacherWorlds(thesis_board(), std::vector<DrawnWorld>{}), std::invalid_argument);
+  const TeacherWorlds worlds(thesis_board(), three_drawn_worlds());
+  const table::Board other = thesis_board();  // equal, but not the board the worlds watch with
+  EXPECT_THROW(record_demonstrations(other, short_config(), 1, 1, 1, {}, nullptr, &worlds), std::invalid_argument);
 }
 
 TEST(Demonstrations, TheTeacherLabelsTheLearnersApproaches) {

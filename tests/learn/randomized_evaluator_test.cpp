@@ -90,7 +90,10 @@ TEST(RandomizedEvaluator, EachBallPlaysTheWorldItsSeedPicksBelievingTheBoard) {
   const Randomization r = parse_randomization(kRanges, "r.yaml");
   const RandomizedEvaluator randomized(belief, config, r);
   std::set<std::size_t> used;
-  for (std::uint64_t seed = 0; seed < 200; ++seed) used.insert(randomized.world_of(seed));
+  for (std::uint64_t seed = 0; seed < 200; ++seed) {
+    used.insert(randomized.world_of(seed));
+    EXPECT_EQ(randomized.world_of(seed), drawn_world_index(seed, 16));  // the rule imitation's teacher uses too
+  }
   EXPECT_EQ(used.size(), 16u);
   const control::ControllerSpec spec = randomized.prototype();
   for (std::uint64_t seed : {5u, 6u, 7u}) {

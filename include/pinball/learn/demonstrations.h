@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "pinball/firmware/flipper_actuation.h"
 #include "pinball/learn/blob.h"
 #include "pinball/learn/lookahead_player.h"
+#include "pinball/learn/randomized_evaluator.h"
 #include "pinball/learn/search.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "pinball/sim/world.h"
@@ -28,7 +30,10 @@ namespace pinball::learn {
 /// How the teacher plays and what watches it.
 struct DemonstrationConfig {
   LookaheadConfig teacher;           ///< the teacher's planner
-  track::CameraModelConfig camera;   ///< the camera the tracker sees through
+  track::CameraModelConfig camera;   ///< the camera the tracker believes it sees through
+  /// The camera the world really has (latency, noise) when it is not the
+  /// believed one (a drawn world of `learn --randomize`); empty: `camera`.
+  std::optional<track::CameraModelConfig> world_camera;
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< command to flipper motion (s), as in the evaluator
   double max_ball_time_s = 60.0;     ///< a teacher's ball alive after this is cut
   double pull = -1.0;                ///< launcher pull; negative: the board's
@@ -50,9 +55,49 @@ Blob to_blob(const DemonstrationBall& ball);
 DemonstrationBall demonstration_ball_from_blob(const Blob& blob);
 
 /// Plays ball `ball_seed` in `world` with the teacher, which plans on
-/// `model` (its board is the belief the tracker watches with), and records its shots.
-DemonstrationBall record_demonstration(sim::World& world, const sim::ThesisStepper& model,
-                                       const DemonstrationConfig& config, std::uint64_t ball_seed);
+/// `teacher_model`, while the tracker watches through the configured world
+/// camera believing `belief` and the configured camera; records the shots.
+DemonstrationBall record_demonstration(const table::Board& belief, sim::World& world,
+                                       const sim::ThesisStepper& teacher_model, const DemonstrationConfig& config,
+                                       std::uint64_t ball_seed);
+
+/// Where a teacher's balls are played, and on what the teacher plans. The
+/// teacher never looks into a world a controller is judged in: it plans on
+/// the belief's model, or on a world drawn from the belief's ranges.
+class TeacherWorlds {
+ public:
+  /// Every ball in a fork of `world` (null: the model of `belief`), the teacher
+  /// planning on the belief's model. Borrows `belief`. Throws
+  /// std::invalid_argument when the world's flippers are not the belief's.
+  TeacherWorlds(const table::Board& belief, const sim::World* world);
+  /// `learn --randomize`: each ball in the drawn world its seed picks
+  /// (drawn_world_index), with that world's stepper, delay and camera. The
+  /// teacher plans on that world's own table and delay: a drawn world is a
+  /// sample of the belief, so its labels say what is best in each world the
+  /// belief allows, and the learner, which cannot tell the worlds apart,
+  /// learns what does well across them. `dt_s`: the worlds' step (0: the
+  /// board's). Throws std::invalid_argument for no worlds.
+  TeacherWorlds(const table::Board& belief, std::vector<DrawnWorld> drawn, double dt_s = 0.0);
+
+  /// One place a ball can be played.
+  struct Place {
+    std::unique_ptr<sim::World> world;                   ///< forked for each ball
+    std::unique_ptr<sim::ThesisStepper> teacher_model;   ///< what the teacher plans on
+    std::optional<double> actuation_delay_s;             ///< the world's, when not the configured one
+    std::optional<track::CameraModelConfig> camera;      ///< the world's, when not the configured one
+  };
+  /// The place ball `ball_seed` plays in.
+  const Place& place_of(std::uint64_t ball_seed) const;
+  /// The belief the tracker watches with.
+  const table::Board& belief() const { return belief_; }
+  /// The drawn worlds (empty for one world).
+  const std::vector<DrawnWorld>& drawn() const { return drawn_; }
+
+ private:
+  const table::Board& belief_;
+  std::vector<DrawnWorld> drawn_;  // their boards outlive the places' worlds and models
+  std::vector<Place> places_;
+};
 
 /// Everything recorded over many balls.
 struct Demonstrations {
@@ -73,14 +118,13 @@ struct Demonstrations {
 /// that table plays and the teacher labels the approaches it reaches (DAgger:
 /// the learner's own mistakes get the teacher's answer; record_correction in
 /// the source). `progress` (may be empty) gets a line every tenth of the
-/// balls, never from two threads at once. `board` is the belief (the
-/// teacher's model and the tracker's table); the balls are played in forks of
-/// `world`, or in the model of `board` when it is null.
+/// balls, never from two threads at once. The balls are played in `worlds`
+/// (null: every ball in the model of `board`, the belief).
 Demonstrations record_demonstrations(const table::Board& board, const DemonstrationConfig& config, int balls,
                                      std::uint64_t seed, int threads,
                                      const std::function<void(const std::string&)>& progress,
                                      const std::shared_ptr<const control::ShotTable>& learner = nullptr,
-                                     const sim::World* world = nullptr);
+                                     const TeacherWorlds* worlds = nullptr);
 
 /// Settings of learning by imitation.
 struct ImitationLearningConfig {
@@ -117,13 +161,13 @@ using ImitationCycleHandler = std::function<void(const control::ShotTable& table
 /// round is trained on every example so far (DAgger). Round r's balls are
 /// ball_seed(ball_seed(seed, r), i). `on_cycle` (may be empty) hears of the
 /// highest-scoring cut ball of each learner round that had one, at the end of
-/// that round. `board` is the belief; balls play in forks of `world` (null:
-/// the model of `board`). Throws std::invalid_argument for fewer balls than
+/// that round. `board` is the belief; balls play in `worlds` (null: the
+/// model of `board`). Throws std::invalid_argument for fewer balls than
 /// rounds or rounds < 1.
 ImitationResult learn_by_imitation(const table::Board& board, const ImitationLearningConfig& config,
                                    std::uint64_t budget_balls, std::uint64_t seed, int threads,
                                    const std::function<void(const std::string&)>& progress,
-                                   const ImitationCycleHandler& on_cycle = {}, const sim::World* world = nullptr);
+                                   const ImitationCycleHandler& on_cycle = {}, const TeacherWorlds* worlds = nullptr);
 
 /// The rounds as a learning curve (one row per round; see docs/learning.md)
 /// for learn::write_curve_csv and plot_curve_png.

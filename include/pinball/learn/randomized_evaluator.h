@@ -84,6 +84,10 @@ struct DrawnWorld {
 std::vector<DrawnWorld> draw_worlds(const table::Board& belief, const EvaluatorConfig& config,
                                     const Randomization& randomization);
 
+/// Which of `variants` drawn worlds ball `ball_seed` plays (every learner of
+/// a randomization picks by this rule, so a ball's world depends only on its seed).
+std::size_t drawn_world_index(std::uint64_t ball_seed, std::size_t variants);
+
 /// Plays each ball in the drawn world its seed picks, believing the nominal table.
 class RandomizedEvaluator final : public BallObjective {
  public:
