@@ -13,13 +13,6 @@ RangeViolation check_planner_settings(const PlannerSettings& s) {
   if (!(std::isfinite(s.drain_penalty) && s.drain_penalty >= 0.0)) return {"drain_penalty", "must be finite and >= 0"};
   if (!(s.actuation_delay_s >= 0.0 && s.actuation_delay_s <= 0.1)) return {"actuation_delay_s", "must be in [0, 0.1] s"};
   if (!(s.step_budget >= 1000 && s.step_budget <= 10'000'000)) return {"step_budget", "must be in [1000, 10^7] steps"};
-  if (const std::optional<StartSampling>& z = s.start_sampling) {
-    if (!(z->samples >= 1 && z->samples <= 64)) return {"start_sampling.samples", "must be in [1, 64]"};
-    if (!(z->position_sigma_m >= 0.0 && z->position_sigma_m <= 0.05))
-      return {"start_sampling.position_sigma_m", "must be in [0, 0.05] m"};
-    if (!(z->velocity_sigma_mps >= 0.0 && z->velocity_sigma_mps <= 2.0))
-      return {"start_sampling.velocity_sigma_mps", "must be in [0, 2] m/s"};
-  }
   return {};
 }
 

@@ -9,10 +9,6 @@
 
 namespace pinball::learn {
 
-namespace {
-constexpr std::uint64_t kStartSamplingSeed = 12345;  // any fixed value: the same starts on every run
-}  // namespace
-
 LookaheadConfig lookahead_config(const control::PlannerSettings& s, double dt_s) {
   LookaheadConfig c;
   const double frame_s = dt_s * c.frame_steps;
@@ -40,8 +36,6 @@ PlanningController::PlanningController(const table::Board& belief, const control
   const LookaheadConfig config = lookahead_config(settings, stepper_->dt_s());
   planner_ = std::make_unique<LookaheadPlanner>(*stepper_, config);
   frame_s_ = stepper_->dt_s() * config.frame_steps;
-  plans_.reserve(1 + static_cast<std::size_t>(config.fire_frames + 1) * config.hold_frames.size());
-  start_rng_ = Rng(kStartSamplingSeed);
 }
 
 void PlanningController::reset(std::array<bool, 2>& energized) {
@@ -53,7 +47,6 @@ void PlanningController::reset(std::array<bool, 2>& energized) {
   for (sim::FlipperState& f : state_.flippers) f = sim::FlipperState{};
   for (std::size_t i = 0; i < state_.flippers.size(); ++i) state_.flippers[i].theta_rad = belief_.flippers[i].theta_min_rad;
   delay_ = idle_delay_;
-  start_rng_ = Rng(kStartSamplingSeed);  // a ball's decisions do not depend on the balls before it
 }
 
 void PlanningController::advance_bats_to(double now_s) {
@@ -107,7 +100,7 @@ void PlanningController::update(const track::TrackerOutput& o, double now_s, std
   if (f >= 0) {
     ++decisions_;
     const std::uint64_t steps_before = planner_->branch_steps();
-    const LookaheadCandidate& best = choose_plan(f);
+    const LookaheadCandidate& best = planner_->evaluate(state_, delay_, f)[planner_->best()];
     max_decision_steps_ = std::max(max_decision_steps_, planner_->branch_steps() - steps_before);
     if (best.fire_frame == 0) {
       command_[static_cast<std::size_t>(f)] = true;
@@ -118,31 +111,6 @@ void PlanningController::update(const track::TrackerOutput& o, double now_s, std
   }
   state_.ball_in_play = false;
   energized = energized_by_side();
-}
-
-const LookaheadCandidate& PlanningController::choose_plan(int flipper) {
-  const std::vector<LookaheadCandidate>& from_estimate = planner_->evaluate(state_, delay_, flipper);
-  if (!settings_.start_sampling || settings_.start_sampling->samples <= 1) return from_estimate[planner_->best()];
-  const control::StartSampling& z = *settings_.start_sampling;
-  plans_.assign(from_estimate.begin(), from_estimate.end());  // within the capacity reserved: no allocation
-  const sim::BallState estimate = state_.ball;
-  for (int k = 1; k < z.samples; ++k) {
-    // One draw per statement: the order of a call's arguments is the compiler's choice.
-    const double dx = start_rng_.normal();
-    const double dy = start_rng_.normal();
-    const double dvx = start_rng_.normal();
-    const double dvy = start_rng_.normal();
-    state_.ball.position_m = estimate.position_m + z.position_sigma_m * Vec2(dx, dy);
-    state_.ball.velocity_mps = estimate.velocity_mps + z.velocity_sigma_mps * Vec2(dvx, dvy);
-    const std::vector<LookaheadCandidate>& from_sample = planner_->evaluate(state_, delay_, flipper);
-    for (std::size_t i = 0; i < plans_.size(); ++i) plans_[i].value += from_sample[i].value;
-  }
-  state_.ball = estimate;
-  std::size_t best = 0;  // the first of equals, as LookaheadPlanner::best() picks
-  for (std::size_t i = 1; i < plans_.size(); ++i) {
-    if (plans_[i].value > plans_[best].value) best = i;
-  }
-  return plans_[best];
 }
 
 std::array<bool, 2> PlanningController::energized_by_side() const {

@@ -2,8 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include <limits>
-
 #include "pinball/control/controller_file.h"
 
 namespace pinball::control {
@@ -31,19 +29,6 @@ TEST(PlannerSettings, DefaultsAreInRangeAndEachBadSettingIsNamed) {
   EXPECT_EQ(check_planner_settings(s).key, "step_budget");
   s.step_budget = 10'000'001;
   EXPECT_EQ(check_planner_settings(s).key, "step_budget");
-  s = {};
-  s.start_sampling = StartSampling{};
-  EXPECT_FALSE(check_planner_settings(s)) << "the sampling defaults are in range";
-  s.start_sampling->samples = 0;
-  EXPECT_EQ(check_planner_settings(s).key, "start_sampling.samples");
-  s.start_sampling->samples = 65;
-  EXPECT_EQ(check_planner_settings(s).key, "start_sampling.samples");
-  s.start_sampling = StartSampling{};
-  s.start_sampling->position_sigma_m = -0.001;
-  EXPECT_EQ(check_planner_settings(s).key, "start_sampling.position_sigma_m");
-  s.start_sampling = StartSampling{};
-  s.start_sampling->velocity_sigma_mps = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(check_planner_settings(s).key, "start_sampling.velocity_sigma_mps");
 }
 
 TEST(PlannerSettings, AControllerFileKeepsThemAndRefusesABadOne) {
@@ -57,7 +42,6 @@ TEST(PlannerSettings, AControllerFileKeepsThemAndRefusesABadOne) {
   EXPECT_DOUBLE_EQ(back.planner->actuation_delay_s, 0.016);
   EXPECT_DOUBLE_EQ(back.planner->horizon_s, 2.0);
   EXPECT_EQ(back.planner->step_budget, 5000);
-  EXPECT_FALSE(back.planner->start_sampling.has_value()) << "absent unless a file asks for it";
   // Without the belief board the plain factory cannot build it, and says so.
   EXPECT_THROW(make_flipper_controller(back), std::invalid_argument);
 
@@ -68,26 +52,6 @@ TEST(PlannerSettings, AControllerFileKeepsThemAndRefusesABadOne) {
     FAIL() << "accepted a negative horizon";
   } catch (const ControllerFileError& e) {
     EXPECT_NE(std::string(e.what()).find("planner.horizon_s"), std::string::npos) << e.what();
-  }
-}
-
-TEST(PlannerSettings, AControllerFileKeepsTheStartSamplingAndRefusesABadOne) {
-  ControllerSpec spec;
-  spec.planner = PlannerSettings{};
-  spec.planner->start_sampling = StartSampling{5, 0.002, 0.03};
-  const std::string text = controller_to_json(spec);
-  const ControllerSpec back = controller_from_json(text, "p.json");
-  ASSERT_TRUE(back.planner && back.planner->start_sampling);
-  EXPECT_EQ(back.planner->start_sampling->samples, 5);
-  EXPECT_DOUBLE_EQ(back.planner->start_sampling->position_sigma_m, 0.002);
-  EXPECT_DOUBLE_EQ(back.planner->start_sampling->velocity_sigma_mps, 0.03);
-  std::string bad = text;
-  bad.replace(bad.find("\"samples\": 5"), 12, "\"samples\": 0");
-  try {
-    controller_from_json(bad, "p.json");
-    FAIL() << "accepted no samples";
-  } catch (const ControllerFileError& e) {
-    EXPECT_NE(std::string(e.what()).find("planner.start_sampling.samples"), std::string::npos) << e.what();
   }
 }
 

@@ -140,11 +140,5 @@ TEST(HotPath, TheOnlinePlannerAllocatesNothingPerFrame) {
   expect_no_allocation_per_frame(std::string(PINBALL_SOURCE_DIR) + "/controllers/planner.json");
 }
 
-TEST(HotPath, ThePlannerFromSampledStartsAllocatesNothingPerFrame) {
-  if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
-  // The summed plans live in a buffer reserved when the controller is made.
-  expect_no_allocation_per_frame(std::string(PINBALL_SOURCE_DIR) + "/controllers/planner_sampled.json");
-}
-
 }  // namespace
 }  // namespace pinball::daemon

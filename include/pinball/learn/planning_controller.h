@@ -13,12 +13,10 @@
 #include <array>
 #include <cstdint>
 #include <memory>
-#include <vector>
 
 #include "pinball/control/controller_file.h"
 #include "pinball/control/flipper_controller.h"
 #include "pinball/control/planner_settings.h"
-#include "pinball/core/rng.h"
 #include "pinball/learn/lookahead_player.h"
 #include "pinball/simlab/delay_line.h"
 #include "pinball/sim/game_state.h"
@@ -47,8 +45,7 @@ class PlanningController final : public control::FlipperController {
   long decisions() const { return decisions_; }
   long fires() const { return fires_; }
   std::uint64_t branch_steps() const { return planner_->branch_steps(); }
-  /// The most belief steps one decision simulated: never above the settings'
-  /// step_budget times the sampled starts (1 without start sampling).
+  /// The most belief steps one decision simulated: never above the settings' step_budget.
   std::uint64_t max_decision_steps() const { return max_decision_steps_; }
 
  private:
@@ -56,9 +53,6 @@ class PlanningController final : public control::FlipperController {
   /// The commands (board order) as a controller gives them: [kLeftFlipper, kRightFlipper].
   std::array<bool, 2> energized_by_side() const;
   bool place_ball(const track::TrackerOutput& output, double now_s);
-  // The plan to act on for `flipper`: the best from the estimate, or, with
-  // start sampling, the best summed over the sampled starts.
-  const LookaheadCandidate& choose_plan(int flipper);
 
   const table::Board& belief_;
   control::PlannerSettings settings_;
@@ -76,8 +70,6 @@ class PlanningController final : public control::FlipperController {
   long decisions_ = 0;
   long fires_ = 0;
   std::uint64_t max_decision_steps_ = 0;
-  Rng start_rng_;                          // the sampled starts' noise; reseeded every ball
-  std::vector<LookaheadCandidate> plans_;  // the estimate's plans, with values summed over the starts
 };
 
 /// The flipper controller a spec describes, every kind: the planner (which
