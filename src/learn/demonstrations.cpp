@@ -239,8 +239,7 @@ TeacherWorlds::TeacherWorlds(const table::Board& belief, std::vector<DrawnWorld>
 }
 
 const TeacherWorlds::Place& TeacherWorlds::place_of(std::uint64_t ball_seed) const {
-  return places_.size() == 1 && drawn_.empty() ? places_.front()
-                                               : places_[drawn_world_index(ball_seed, places_.size())];
+  return drawn_.empty() ? places_.front() : places_[drawn_world_index(ball_seed, places_.size())];
 }
 
 Blob to_blob(const DemonstrationBall& b) {
