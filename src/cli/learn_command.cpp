@@ -77,8 +77,9 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_flag("--partition-h", a.partition_by_h, "also partition by h (pivot-to-tip | tip-to-V-centre)");
   cmd->add_flag("--rolling", a.rolling, "a separate minicontroller for a ball rolling on each flipper");
   cmd->add_flag("--lead", a.lead,
-                "searches: the controller acts on each projection advanced by the frame's camera latency plus "
-                "--actuation-delay, to when its coil acts (docs/learning.md, \"Lead\"); written into the controller");
+                "searches and imitate: the controller acts on each projection advanced by the frame's camera latency "
+                "plus --actuation-delay, to when its coil acts (docs/learning.md, \"Lead\"); written into the "
+                "controller");
   cmd->add_flag("--randomise-launch", a.randomise_launch, "draw the launcher pull per ball from [0.5, 1]");
   cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")
       ->check(CLI::Range(0.01, 1.0))
@@ -342,8 +343,9 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
       throw std::invalid_argument("learn: --randomize is for a search (tournament, relay, cem) or imitate, not --method " +
                                   a.method);
   }
-  if (a.lead && !search)
-    throw std::invalid_argument("learn: --lead is for a search (tournament, relay, cem), not --method " + a.method);
+  if (a.lead && !search && a.method != "imitate")
+    throw std::invalid_argument("learn: --lead is for a search (tournament, relay, cem) or imitate, not --method " +
+                                a.method);
   // With --randomize the search plays the drawn worlds; the final evaluation
   // (objective.ev) plays the belief's own world, the home world.
   struct Objective final : learn::BallObjective {
@@ -377,7 +379,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
                       {"threads", a.threads}};
   j.update(identified_report(a.identified));
   if (objective.randomized) j["randomize"] = randomization_report(a.randomize, objective.randomized->worlds());
-  if (search) j["lead"] = a.lead;
+  if (search || a.method == "imitate") j["lead"] = a.lead;
   control::ControllerSpec result_spec;
   const control::ControllerSpec* eval_spec = nullptr;
   if (search) {
@@ -445,6 +447,10 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     ic.demonstration.max_ball_time_s = a.max_ball_time_s;
     ic.demonstration.pull = a.pull;
     ic.rounds = a.rounds;
+    if (a.lead) {  // the shots are keyed on the led projection the table will look up
+      ic.table.lead_actuation_delay_s = a.actuation_delay_s;
+      ic.demonstration.lead_actuation_delay_s = a.actuation_delay_s;
+    }
     // With --randomize each ball plays a drawn world and the teacher plans in
     // it; the final evaluation plays the belief's own world, as a search's does.
     const learn::TeacherWorlds teacher_worlds =

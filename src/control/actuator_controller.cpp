@@ -8,9 +8,7 @@ RangeViolation check_actuator_config(const ActuatorConfig& c) {
   if (!(c.max_hold_s >= 0.0 && c.max_hold_s <= kMaxHold_s))
     return {"max_hold_s", "must be in [0, " + std::to_string(firmware::kAbsMaxHoldMs / 1000) +
                               "] s (the driver board's hold cap; 0: no limit of its own)"};
-  if (c.lead_actuation_delay_s && !(*c.lead_actuation_delay_s >= 0.0 && *c.lead_actuation_delay_s <= 0.1))
-    return {"lead_actuation_delay_s", "must be in [0, 0.1] s"};
-  return {};
+  return check_lead_actuation_delay(c.lead_actuation_delay_s);
 }
 
 ActuatorController::ActuatorController(ActionFunction action_function, const ActuatorConfig& config)
@@ -38,10 +36,7 @@ void ActuatorController::update(const track::TrackerOutput& out, double now_s, s
       }
     }
   }
-  const track::TrajectoryProjection p =
-      config_.lead_actuation_delay_s
-          ? track::lead_projection(out.projection, out.fit, out.projection.latency_s + *config_.lead_actuation_delay_s)
-          : out.projection;
+  const track::TrajectoryProjection p = projection_to_act_on(out, config_.lead_actuation_delay_s);
   if (!p.valid || !p.hittable) return;
   const Action act = action_.action(p);
   responsible_ = act.partition;

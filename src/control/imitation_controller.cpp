@@ -86,7 +86,8 @@ RangeViolation check_imitation_config(const ImitationConfig& c) {
                    outside("h_scale", c.h_scale, kMinScale, kMaxHScale, " flipper lengths"),
                    outside("speed_scale_mps", c.speed_scale_mps, kMinScale, kMaxSpeedScale_mps, " m/s"),
                    outside("max_hold_s", c.max_hold_s, 0.0, kMaxHold_s, " s (0: no limit of its own)"),
-                   outside("lead_s", c.lead_s, 0.0, kMaxLead_s, " s")});
+                   outside("lead_s", c.lead_s, 0.0, kMaxLead_s, " s"),
+                   check_lead_actuation_delay(c.lead_actuation_delay_s)});
 }
 
 RangeViolation check_shot_example(const ShotExample& e) {
@@ -290,7 +291,7 @@ void ImitationController::update(const track::TrackerOutput& out, double now_s, 
     held_ = -1;
     return;
   }
-  const track::TrajectoryProjection& p = out.projection;
+  const track::TrajectoryProjection p = projection_to_act_on(out, table_->config().lead_actuation_delay_s);
   if (!p.valid || !p.hittable) return;
   const ImitationDecision act = table_->decide(p);
   if (!act.fire || p.d_m - p.speed_mps * table_->config().lead_s > act.d_critical_m) return;

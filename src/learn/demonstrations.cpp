@@ -21,16 +21,19 @@ namespace {
 // Watches the tracker and books one example per approach; never moves a flipper itself.
 class ShotRecorder final : public control::FlipperController {
  public:
-  explicit ShotRecorder(std::vector<control::ShotExample>& out) : out_(out) {}
+  // `lead_actuation_delay_s`: the examples hold the projection a table with this lead looks up.
+  ShotRecorder(std::vector<control::ShotExample>& out, std::optional<double> lead_actuation_delay_s)
+      : out_(out), lead_actuation_delay_s_(lead_actuation_delay_s) {}
 
   void update(const track::TrackerOutput& o, double now_s, std::array<bool, 2>&) override {
     if (o.launch.launched || o.launch.lost) {
       close();
       return;
     }
-    if (o.projection.valid && o.projection.hittable) {
+    const track::TrajectoryProjection p = control::projection_to_act_on(o, lead_actuation_delay_s_);
+    if (p.valid && p.hittable) {
       open_ = true;
-      last_ = o.projection;
+      last_ = p;
       last_time_s_ = now_s;
     }
   }
@@ -72,6 +75,7 @@ class ShotRecorder final : public control::FlipperController {
   }
 
   std::vector<control::ShotExample>& out_;
+  std::optional<double> lead_actuation_delay_s_;
   bool open_ = false;
   bool fired_ = false;  // labelled (fired or passed) in this approach
   track::TrajectoryProjection last_;
@@ -137,7 +141,7 @@ DemonstrationBall record_correction(const table::Board& belief, sim::World& worl
                                     const std::shared_ptr<const control::ShotTable>& learner_table,
                                     std::uint64_t seed) {
   DemonstrationBall ball;
-  ShotRecorder recorder(ball.shots);
+  ShotRecorder recorder(ball.shots, config.lead_actuation_delay_s);
   control::ImitationController learner(learner_table);
   Tee tee(learner, recorder);
   simlab::SimulatedPlayer watcher = make_watcher(belief, config, tee, seed);
@@ -187,7 +191,7 @@ DemonstrationBall record_correction(const table::Board& belief, sim::World& worl
 DemonstrationBall record_demonstration(const table::Board& belief, sim::World& world, const sim::ThesisStepper& model,
                                        const DemonstrationConfig& config, std::uint64_t seed) {
   DemonstrationBall ball;
-  ShotRecorder recorder(ball.shots);
+  ShotRecorder recorder(ball.shots, config.lead_actuation_delay_s);
   simlab::SimulatedPlayer watcher = make_watcher(belief, config, recorder, seed);
   LookaheadPlayer teacher(model, config.teacher, config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
@@ -270,6 +274,8 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
   if (board.flippers.size() != 2) throw std::invalid_argument("demonstrations: the board needs exactly two flippers");
   if (worlds != nullptr && &worlds->belief() != &board)
     throw std::invalid_argument("demonstrations: the worlds must watch with the board given");
+  if (learner != nullptr && learner->config().lead_actuation_delay_s != config.lead_actuation_delay_s)
+    throw std::invalid_argument("demonstrations: the learner's lead must be the one the shots are keyed with");
   std::optional<TeacherWorlds> home;  // the belief's own model
   if (worlds == nullptr) worlds = &home.emplace(board, nullptr);
   const auto n = static_cast<std::size_t>(balls);
@@ -323,6 +329,8 @@ ImitationResult learn_by_imitation(const table::Board& board, const ImitationLea
                                    const std::function<void(const std::string&)>& progress,
                                    const ImitationCycleHandler& on_cycle, const TeacherWorlds* worlds) {
   if (config.rounds < 1) throw std::invalid_argument("imitation: rounds must be >= 1");
+  if (config.table.lead_actuation_delay_s != config.demonstration.lead_actuation_delay_s)
+    throw std::invalid_argument("imitation: the table's lead must be the one its demonstrations are keyed with");
   if (budget_balls < static_cast<std::uint64_t>(config.rounds)) {
     throw std::invalid_argument("imitation: the budget must give every round a ball");
   }

@@ -116,6 +116,17 @@ TEST_F(Cli, LearnRandomizeSearchesAcrossDrawnWorldsAndJudgesInTheHomeWorld) {
   ASSERT_EQ(im_plain.exit_code, 0) << im_plain.err;
   EXPECT_FALSE(nlohmann::json::parse(im_plain.out).contains("randomize"));
   EXPECT_NE(nlohmann::json::parse(im_plain.out).at("rounds"), ij.at("rounds"));
+  EXPECT_EQ(nlohmann::json::parse(im_plain.out).at("lead"), false);
+  // --lead keys the shot table on the led projection and writes its delay into the table.
+  const CommandResult im_led = run(imitate + " --lead --actuation-delay 0.006");
+  ASSERT_EQ(im_led.exit_code, 0) << im_led.err;
+  EXPECT_EQ(nlohmann::json::parse(im_led.out).at("lead"), true);
+  const nlohmann::json led_table = nlohmann::json::parse(pinball::testing::slurp(dir_ / "i.json")).at("imitation");
+  EXPECT_EQ(led_table.at("lead_actuation_delay_s"), 0.006);
+  const CommandResult spastic_led = run("learn boards/mit1993.board --method spastic --eval-balls 2 --lead");
+  EXPECT_EQ(spastic_led.exit_code, 1);
+  EXPECT_NE(spastic_led.err.find("--lead is for a search (tournament, relay, cem) or imitate"), std::string::npos)
+      << spastic_led.err;
 
   const CommandResult spastic = run("learn boards/mit1993.board --method spastic --eval-balls 2 --randomize " +
                                     ranges.string());

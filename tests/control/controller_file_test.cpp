@@ -149,6 +149,20 @@ TEST(ControllerFile, ShotTableSettingsHaveSaneRanges) {
                "imitation.speed_scale_mps: must be in [0.001, 100] m/s");
   expect_error(with(good, "\"max_hold_s\": 0.8", "\"max_hold_s\": 60"), "imitation.max_hold_s: must be in [0, 10] s");
   expect_error(with(good, "\"lead_s\": 0.001", "\"lead_s\": 0.5"), "imitation.lead_s: must be in [0, 0.1] s");
+  expect_error(with(good, "\"lead_s\": 0.001", "\"lead_s\": 0.001, \"lead_actuation_delay_s\": 0.2"),
+               "imitation.lead_actuation_delay_s: must be in [0, 0.1] s");
+}
+
+TEST(ControllerFile, AShotTablesLeadRoundTripsAndATableWithoutOneLoadsWithout) {
+  ControllerSpec s = with_shots();
+  const std::string plain = controller_to_json(s);
+  EXPECT_EQ(plain.find("lead_actuation_delay_s"), std::string::npos) << "no lead, no key: older tables load as before";
+  EXPECT_FALSE(controller_from_json(plain, "old.json").shot_table->config().lead_actuation_delay_s.has_value());
+  ImitationConfig c = s.shot_table->config();
+  c.lead_actuation_delay_s = 0.004;
+  s.shot_table = std::make_shared<const ShotTable>(s.shot_table->examples(), c);
+  const ControllerSpec r = controller_from_json(controller_to_json(s), "led.json");
+  EXPECT_EQ(r.shot_table->config().lead_actuation_delay_s, 0.004);
 }
 
 TEST(ControllerFile, ShotsOutOfRangeAreRefusedBeforeAnyCast) {

@@ -228,6 +228,29 @@ TEST(ImitationController, FiresOnceDWithItsLeadReachesDCriticalAndReleasesAfterT
   EXPECT_FALSE(e[1]);
 }
 
+TEST(ImitationController, WithALeadItLooksUpAndFiresWhereTheBallWillBeWhenTheCoilActs) {
+  // d_critical 50 mm; a ball rolling at 2 m/s, seen 10 ms late; the lead adds
+  // 5 ms of actuation delay: the coil acts 30 mm further on.
+  ImitationConfig led_config = k_of(1);
+  led_config.lead_actuation_delay_s = 0.005;
+  track::TrackerOutput o = update_of(hittable_projection(1, -1.0, 0.5, 2.0, 0.075));
+  o.projection.rolling = true;  // advances at its speed (no fit needed)
+  o.projection.t_impact_s = 0.075 / 2.0;
+  o.projection.latency_s = 0.010;
+  const ShotExample rolling_shot{1, true, -1.0, 0.5, 2.0, 1, 0.050, 0.030};  // on the rolling line
+  ImitationController led(ShotTable({rolling_shot}, led_config));
+  ImitationController plain(ShotTable({rolling_shot}, k_of(1)));
+  std::array<bool, 2> e_led{}, e_plain{};
+  led.update(o, 0.0, e_led);
+  plain.update(o, 0.0, e_plain);
+  EXPECT_TRUE(e_led[1]) << "75 - 30 = 45 mm <= 50 mm";
+  EXPECT_FALSE(e_plain[1]) << "75 mm > 50 mm";
+  // The same table with a lead out of range is refused.
+  led_config.lead_actuation_delay_s = 0.5;
+  EXPECT_EQ(check_imitation_config(led_config).key, "lead_actuation_delay_s");
+  EXPECT_THROW(ShotTable({}, led_config), std::invalid_argument);
+}
+
 TEST(ImitationController, ReleasesOnLaunchAndLossAndIgnoresUnhittable) {
   ImitationController c(ShotTable({fire(0, -1.0, 0.5, 2.0, 0.5, 0, 10.0)}, k_of(1)));
   std::array<bool, 2> e{};

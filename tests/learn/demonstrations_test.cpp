@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -148,6 +149,46 @@ TEST(Demonstrations, TeacherWorldsRefuseNoWorldsAndAnotherBelief) {
   const TeacherWorlds worlds(thesis_board(), three_drawn_worlds());
   const table::Board other = thesis_board();  // equal, but not the board the worlds watch with
   EXPECT_THROW(record_demonstrations(other, short_config(), 1, 1, 1, {}, nullptr, &worlds), std::invalid_argument);
+}
+
+TEST(Demonstrations, WithALeadEachShotHoldsTheLedProjection) {
+  // The same ball, recorded with and without a lead: the teacher plays the
+  // same, the approaches and θ, h, s are the same; d is where the ball will be
+  // when a command given at the frame acts, nearer the impact.
+  const sim::ThesisStepper model(thesis_board());
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
+  DemonstrationConfig led_config = short_config();
+  led_config.lead_actuation_delay_s = 0.004;
+  const DemonstrationBall plain = record_demonstration(thesis_board(), *world, model, short_config(), ball_seed(3, 0));
+  const DemonstrationBall led = record_demonstration(thesis_board(), *world, model, led_config, ball_seed(3, 0));
+  ASSERT_EQ(led.shots.size(), plain.shots.size());
+  EXPECT_EQ(led.score, plain.score);
+  int nearer = 0;
+  for (std::size_t i = 0; i < led.shots.size(); ++i) {
+    const control::ShotExample& a = led.shots[i];
+    const control::ShotExample& b = plain.shots[i];
+    EXPECT_EQ(a.angle_rad, b.angle_rad);
+    EXPECT_EQ(a.h, b.h);
+    EXPECT_EQ(a.speed_mps, b.speed_mps);
+    EXPECT_EQ(a.fired_flipper, b.fired_flipper);
+    if (b.fired_flipper < 0) continue;
+    // 5 ms of camera latency + 4 ms of delay at under 5 m/s: at most 45 mm nearer.
+    EXPECT_LE(a.d_fire_m, b.d_fire_m);
+    EXPECT_GE(a.d_fire_m, std::max(0.0, b.d_fire_m - 0.045) - 1e-12);
+    nearer += a.d_fire_m < b.d_fire_m ? 1 : 0;
+  }
+  EXPECT_GT(nearer, 0);
+}
+
+TEST(Demonstrations, ALearnerMustLeadAsItsShotsAreKeyed) {
+  control::ImitationConfig led;
+  led.lead_actuation_delay_s = 0.004;
+  const auto learner = std::make_shared<const control::ShotTable>(std::vector<control::ShotExample>{}, led);
+  EXPECT_THROW(record_demonstrations(thesis_board(), short_config(), 1, 1, 1, {}, learner), std::invalid_argument);
+  ImitationLearningConfig c;
+  c.demonstration = short_config();
+  c.table = led;  // the demonstrations' lead is none
+  EXPECT_THROW(learn_by_imitation(thesis_board(), c, 2, 9, 1, {}), std::invalid_argument);
 }
 
 TEST(Demonstrations, TheTeacherLabelsTheLearnersApproaches) {

@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "pinball/control/flipper_controller.h"
@@ -48,6 +49,13 @@ struct ImitationConfig {
   /// was nearest its choice, so firing at the first frame with d <= d_critical
   /// would be half a frame late on average. Half a 200 fps frame by default; 0..0.1 s.
   double lead_s = 0.0025;
+  /// Lead (issue 20): the shots are keyed, and looked up, on the projection
+  /// advanced by the newest frame's camera latency plus this actuation delay
+  /// (s; projection_to_act_on), so d_critical means the same whatever the
+  /// latency. θ, h and s do not move; d does. A table recorded with a lead is
+  /// only right with the same lead. Absent: the projection from the newest
+  /// frame, as every table before the lead. 0..0.1 s.
+  std::optional<double> lead_actuation_delay_s;
 
   /// The keys of a controller file (docs/learning.md).
   template <class Archive>
@@ -58,6 +66,7 @@ struct ImitationConfig {
     a->Visit(PINBALL_NVP(speed_scale_mps));
     a->Visit(PINBALL_NVP(max_hold_s));
     a->Visit(PINBALL_NVP(lead_s));
+    a->Visit(PINBALL_NVP(lead_actuation_delay_s));
   }
 };
 

@@ -35,6 +35,9 @@ struct DemonstrationConfig {
   /// believed one (a drawn world of `learn --randomize`); empty: `camera`.
   std::optional<track::CameraModelConfig> world_camera;
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< command to flipper motion (s), as in the evaluator
+  /// The lead the shots are keyed with (control::ImitationConfig::lead_actuation_delay_s):
+  /// each example holds the projection a table with this lead will look up. Empty: none.
+  std::optional<double> lead_actuation_delay_s;
   double max_ball_time_s = 60.0;     ///< a teacher's ball alive after this is cut
   double pull = -1.0;                ///< launcher pull; negative: the board's
 };
@@ -119,7 +122,8 @@ struct Demonstrations {
 /// the learner's own mistakes get the teacher's answer; record_correction in
 /// the source). `progress` (may be empty) gets a line every tenth of the
 /// balls, never from two threads at once. The balls are played in `worlds`
-/// (null: every ball in the model of `board`, the belief).
+/// (null: every ball in the model of `board`, the belief). Throws
+/// std::invalid_argument when the learner's lead is not `config`'s.
 Demonstrations record_demonstrations(const table::Board& board, const DemonstrationConfig& config, int balls,
                                      std::uint64_t seed, int threads,
                                      const std::function<void(const std::string&)>& progress,
@@ -163,7 +167,7 @@ using ImitationCycleHandler = std::function<void(const control::ShotTable& table
 /// highest-scoring cut ball of each learner round that had one, at the end of
 /// that round. `board` is the belief; balls play in `worlds` (null: the
 /// model of `board`). Throws std::invalid_argument for fewer balls than
-/// rounds or rounds < 1.
+/// rounds, rounds < 1, or a table lead that is not the demonstrations'.
 ImitationResult learn_by_imitation(const table::Board& board, const ImitationLearningConfig& config,
                                    std::uint64_t budget_balls, std::uint64_t seed, int threads,
                                    const std::function<void(const std::string&)>& progress,
