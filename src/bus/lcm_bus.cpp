@@ -128,7 +128,8 @@ void LcmBus::on_observation(const void* data, int size) {
   bool found = false;
   track::Observation o;
   track::ContactSensors c;
-  if (m.decode(data, 0, size) < 0 || !from_lcm_observation(m, found, o, c)) {
+  if (decode_observation(data, static_cast<std::size_t>(size), m) == ObservationLayout::kMalformed ||
+      !from_lcm_observation(m, found, o, c)) {
     malformed_.fetch_add(1, std::memory_order_relaxed);
     return;
   }

@@ -1,16 +1,20 @@
 #include "pinball/bus/message_convert.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "pinball/core/utime.h"
+#include "pinball_lcm/lcmt_pinball_observation_v1.hpp"
 
 namespace pinball::bus {
 
-pinball_lcm::lcmt_pinball_observation to_lcm_observation(std::int64_t utime, std::int64_t seq, bool found,
+pinball_lcm::lcmt_pinball_observation to_lcm_observation(std::int64_t utime, std::int64_t delivered_utime,
+                                                          std::int64_t seq, bool found,
                                                           const track::Observation& observation, double u_px,
                                                           double v_px, const track::ContactSensors& contacts) {
   pinball_lcm::lcmt_pinball_observation m{};
   m.utime = utime;
+  m.delivered_utime = delivered_utime;
   m.seq = seq;
   m.found = found;
   if (found) {
@@ -135,13 +139,35 @@ pinball_lcm::lcmt_pinball_daemon_stats to_lcm_daemon_stats(std::int64_t utime, s
   return m;
 }
 
+ObservationLayout decode_observation(const void* data, std::size_t size, pinball_lcm::lcmt_pinball_observation& out) {
+  if (size > 0x7fffffffu) return ObservationLayout::kMalformed;
+  const int n = static_cast<int>(size);
+  if (out.decode(data, 0, n) == n) return ObservationLayout::kCurrent;
+  pinball_lcm::lcmt_pinball_observation_v1 old{};
+  if (old.decode(data, 0, n) != n) return ObservationLayout::kMalformed;
+  out = pinball_lcm::lcmt_pinball_observation{};
+  out.utime = old.utime;
+  out.delivered_utime = old.utime;
+  out.seq = old.seq;
+  out.found = old.found;
+  out.x_m = old.x_m;
+  out.y_m = old.y_m;
+  out.u_px = old.u_px;
+  out.v_px = old.v_px;
+  out.confidence = old.confidence;
+  out.contact_left = old.contact_left;
+  out.contact_right = old.contact_right;
+  return ObservationLayout::kBeforeDelivery;
+}
+
 bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& found, track::Observation& out,
                           track::ContactSensors& contacts) {
-  if (m.utime < 0 || m.seq < 0) return false;
+  if (m.utime < 0 || m.delivered_utime < 0 || m.seq < 0) return false;
   found = m.found;
   contacts.left = m.contact_left;
   contacts.right = m.contact_right;
   out.t_s = from_utime(m.utime);
+  out.latency_s = std::max(0.0, from_utime(m.delivered_utime) - out.t_s);
   if (!found) return true;
   if (!std::isfinite(m.x_m) || !std::isfinite(m.y_m) || !(m.confidence >= 0.0 && m.confidence <= 1.0)) return false;
   out.p_board = Vec2(m.x_m, m.y_m);

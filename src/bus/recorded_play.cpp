@@ -46,7 +46,8 @@ RecordedPlay read_recorded_play(const std::string& path) {
       bool found = false;
       track::Observation o;
       track::ContactSensors contacts;
-      if (!decode(e, m) || !from_lcm_observation(m, found, o, contacts)) {
+      if (decode_observation(e.data.data(), e.data.size(), m) == ObservationLayout::kMalformed ||
+          !from_lcm_observation(m, found, o, contacts)) {
         ++play.malformed;
         continue;
       }
@@ -92,7 +93,8 @@ std::string recorded_play_log(const RecordedPlay& play) {
     if (frame_next) {
       const RecordedFrame& r = play.frames[f++];
       track::Observation o{r.t_s, r.p_board, r.found ? 1.0 : 0.0, 0.0};
-      auto m = to_lcm_observation(to_utime(r.t_s), r.seq, r.found, o, 0.0, 0.0, {r.contact_left, r.contact_right});
+      auto m = to_lcm_observation(to_utime(r.t_s), to_utime(r.t_s), r.seq, r.found, o, 0.0, 0.0,
+                                  {r.contact_left, r.contact_right});
       const std::vector<std::uint8_t> data = encode_message(m);
       append_lcm_event(log, event++, m.utime, kObservationChannel, data.data(), data.size());
     } else {

@@ -38,6 +38,7 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
   if (a.json) {
     out << nlohmann::json{{"events", r.events},
                           {"observations", r.observations},
+                          {"observations_without_latency", r.observations_without_latency},
                           {"malformed", r.malformed},
                           {"recorded_commands", r.recorded_commands},
                           {"replayed_commands", r.replayed_commands},
@@ -57,6 +58,10 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
       out << "reproduced: every recorded decision came out again, in order\n";
     } else {
       out << "NOT reproduced: first difference at decision " << r.first_mismatch << ": " << r.mismatch << "\n";
+    }
+    if (r.observations_without_latency > 0) {
+      out << r.observations_without_latency << " observations were recorded before the delivery stamp: their camera "
+          << "latency is unknown (replayed as 0), so a leading controller's decisions may differ\n";
     }
   }
   return r.reproduced ? 0 : 3;

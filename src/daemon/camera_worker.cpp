@@ -73,7 +73,7 @@ void CameraWorker::process() {
     track::ContactSensors c;
     bus::from_lcm_observation(incoming_, found, o, c);
     const double now = steady_now_s();
-    stage_.track(found, o, o.t_s, c, now, record_);
+    stage_.track(found, o, from_utime(incoming_.delivered_utime), c, now, record_);
     record_.detected_wall_s = now;
   }
   record_.projected_wall_s = steady_now_s();
@@ -83,10 +83,12 @@ void CameraWorker::process() {
   h_.latency[kDetectionToProjection].record((record_.projected_wall_s - record_.detected_wall_s) * 1e6);
   if (!h_.records.try_push(record_)) h_.ring_overflows.fetch_add(1, std::memory_order_relaxed);
   h_.controller_bell.ring();
-  const std::int64_t utime = to_utime(record_.t_s);
+  // Dated as the tracker saw it: the ball's exposure, and the frame's stamp.
+  const std::int64_t utime = to_utime(record_.found ? record_.observation.t_s : record_.t_s);
   if (from_frames) {
-    lcm_.try_publish(bus::to_lcm_observation(utime, static_cast<std::int64_t>(record_.frame_seq), record_.found,
-                                             record_.observation, record_.u_px, record_.v_px, record_.contacts));
+    lcm_.try_publish(bus::to_lcm_observation(utime, to_utime(record_.t_s), static_cast<std::int64_t>(record_.frame_seq),
+                                             record_.found, record_.observation, record_.u_px, record_.v_px,
+                                             record_.contacts));
   }
   lcm_.try_publish(bus::to_lcm_projection(utime, static_cast<std::int64_t>(record_.seq),
                                           static_cast<std::int64_t>(record_.frame_seq), record_.output));

@@ -1,5 +1,7 @@
 #include "pinball/daemon/pipeline.h"
 
+#include <algorithm>
+
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/core/utime.h"
 #include "pinball/core/clock.h"
@@ -35,7 +37,11 @@ void CameraStage::track(bool found, const track::Observation& observation, doubl
   if (found) {
     detections_.add();
     out.observation = observation;
-    out.observation.t_s = t_s;
+    // The tracker fits the detector's exposure dates (calibrated latency,
+    // rolling shutter, the camera's steady clock); the stamp less that date
+    // is the latency a leading controller adds to its lead.
+    out.observation.t_s = utime_rounded(observation.t_s);
+    out.observation.latency_s = std::max(0.0, t_s - out.observation.t_s);
     last_seen_t_s_ = t_s;
     tracking_ = true;
     out.output = tracker_.update(out.observation, contacts);

@@ -12,6 +12,7 @@
 #include "pinball/bus/message_convert.h"
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/controller_file.h"
+#include "pinball/core/utime.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/firmware/stream_transport.h"
 #include "pinball/table/board_overlay.h"
@@ -21,10 +22,13 @@
 namespace pinball::daemon {
 namespace {
 
+// A decision and the frame it was made on (its projection's number: one per
+// frame, live and replayed alike while the log lost no observation).
 struct Decision {
   int flipper;
   bool energize;
   int cause;
+  std::int64_t projection_seq;
   bool operator==(const Decision&) const = default;
 };
 
@@ -72,17 +76,19 @@ ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
       bool found = false;
       track::Observation o;
       track::ContactSensors c;
-      if (m.decode(e->data, 0, static_cast<int>(e->datalen)) < 0 || !bus::from_lcm_observation(m, found, o, c)) {
+      const bus::ObservationLayout layout = bus::decode_observation(e->data, static_cast<std::size_t>(e->datalen), m);
+      if (layout == bus::ObservationLayout::kMalformed || !bus::from_lcm_observation(m, found, o, c)) {
         ++r.malformed;
         continue;
       }
       ++r.observations;
-      camera.track(found, o, o.t_s, c, 0.0, record);
+      if (layout == bus::ObservationLayout::kBeforeDelivery) ++r.observations_without_latency;
+      camera.track(found, o, from_utime(m.delivered_utime), c, 0.0, record);
       const int n = stage.on_record(record, record.t_s, 0.0, cmds);
       for (int i = 0; i < n; ++i) {
         const CommandRecord& k = cmds[static_cast<std::size_t>(i)];
         if (decided_by_observations(static_cast<int>(k.cause))) {
-          replayed.push_back({k.flipper, k.energize, static_cast<int>(k.cause)});
+          replayed.push_back({k.flipper, k.energize, static_cast<int>(k.cause), k.projection_seq});
         }
       }
       bus.poll_once(record.t_s);  // keeps its queue empty
@@ -96,7 +102,7 @@ ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
         continue;
       }
       if (decided_by_observations(m.cause)) {
-        recorded.push_back({m.flipper, m.energize != 0, m.cause});
+        recorded.push_back({m.flipper, m.energize != 0, m.cause, m.projection_seq});
       } else {
         ++r.skipped_timing;
       }
@@ -111,7 +117,8 @@ ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
     auto show = [](const std::vector<Decision>& v, std::size_t k) {
       if (k >= v.size()) return std::string("none");
       return std::string(v[k].flipper < 0 ? "all" : v[k].flipper == 0 ? "left" : "right") +
-             (v[k].energize ? " fire" : " release") + " (cause " + std::to_string(v[k].cause) + ")";
+             (v[k].energize ? " fire" : " release") + " (cause " + std::to_string(v[k].cause) + ", frame " +
+             std::to_string(v[k].projection_seq) + ")";
     };
     r.mismatch = "recorded " + show(recorded, r.matched) + ", replayed " + show(replayed, r.matched);
   }

@@ -90,7 +90,8 @@ void ViewState::on_observation(const void* data, std::size_t size, double t_s, b
   bool found = false;
   track::Observation o;
   track::ContactSensors contacts;
-  ok = decode(data, size, m) && bus::from_lcm_observation(m, found, o, contacts);
+  ok = bus::decode_observation(data, size, m) != bus::ObservationLayout::kMalformed &&
+       bus::from_lcm_observation(m, found, o, contacts);
   if (!ok) return;
   ++observations_;
   if (last_seq_ >= 0 && m.seq > last_seq_ + 1) seq_gaps_ += m.seq - last_seq_ - 1;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "pinball_lcm/lcmt_pinball_observation_v1.hpp"
+
 namespace pinball::bus {
 namespace {
 
@@ -22,8 +24,9 @@ TEST(MessageConvert, ObservationRoundTrip) {
   o.t_s = 1.25;
   o.p_board = Vec2(0.2, 0.7);
   o.confidence = 0.9;
-  const auto m = round_trip(to_lcm_observation(1250000, 7, true, o, 100.5, 200.25, {true, false}));
+  const auto m = round_trip(to_lcm_observation(1250000, 1258000, 7, true, o, 100.5, 200.25, {true, false}));
   EXPECT_EQ(m.utime, 1250000);
+  EXPECT_EQ(m.delivered_utime, 1258000);
   EXPECT_EQ(m.seq, 7);
   bool found = false;
   track::Observation back;
@@ -31,6 +34,7 @@ TEST(MessageConvert, ObservationRoundTrip) {
   ASSERT_TRUE(from_lcm_observation(m, found, back, c));
   EXPECT_TRUE(found);
   EXPECT_DOUBLE_EQ(back.t_s, 1.25);
+  EXPECT_DOUBLE_EQ(back.latency_s, 0.008) << "delivered 8 ms after the exposure";
   EXPECT_EQ(back.p_board, o.p_board);
   EXPECT_DOUBLE_EQ(back.confidence, 0.9);
   EXPECT_TRUE(c.left);
@@ -125,6 +129,48 @@ TEST(MessageConvert, MalformedObservationsAreRefused) {
   EXPECT_FALSE(from_lcm_observation(m, found, o, c));
   m.utime = 5;
   EXPECT_TRUE(from_lcm_observation(m, found, o, c));
+  m.delivered_utime = -1;
+  EXPECT_FALSE(from_lcm_observation(m, found, o, c));
+  m.delivered_utime = 2;  // stamped before its exposure (a miscalibrated latency): no negative lead
+  ASSERT_TRUE(from_lcm_observation(m, found, o, c));
+  EXPECT_EQ(o.latency_s, 0.0);
+}
+
+TEST(MessageConvert, LogsFromBeforeTheDeliveryStampStillDecode) {
+  // Every PINBALL_OBSERVATION recorded before 2026-12-03 carries this fingerprint.
+  EXPECT_EQ(pinball_lcm::lcmt_pinball_observation_v1::getHash(), static_cast<std::int64_t>(0x88dcd76b0973ee6dULL));
+  EXPECT_NE(pinball_lcm::lcmt_pinball_observation::getHash(), pinball_lcm::lcmt_pinball_observation_v1::getHash());
+  pinball_lcm::lcmt_pinball_observation_v1 old{};
+  old.utime = 2'000'000;
+  old.seq = 9;
+  old.found = true;
+  old.x_m = 0.3;
+  old.y_m = 0.4;
+  old.confidence = 0.75;
+  old.contact_right = true;
+  const std::vector<std::uint8_t> old_bytes = encode_message(old);
+  pinball_lcm::lcmt_pinball_observation m{};
+  ASSERT_EQ(decode_observation(old_bytes.data(), old_bytes.size(), m), ObservationLayout::kBeforeDelivery);
+  EXPECT_EQ(m.utime, 2'000'000);
+  EXPECT_EQ(m.delivered_utime, 2'000'000) << "delivered at its stamp: latency unknown, 0";
+  EXPECT_EQ(m.seq, 9);
+  EXPECT_EQ(m.x_m, 0.3);
+  EXPECT_EQ(m.y_m, 0.4);
+  EXPECT_EQ(m.confidence, 0.75);
+  EXPECT_TRUE(m.found);
+  EXPECT_TRUE(m.contact_right);
+  EXPECT_FALSE(m.contact_left);
+
+  track::Observation o;
+  o.p_board = Vec2(0.1, 0.2);
+  const std::vector<std::uint8_t> bytes = encode_message(to_lcm_observation(5, 7, 1, true, o, 0, 0, {}));
+  ASSERT_EQ(decode_observation(bytes.data(), bytes.size(), m), ObservationLayout::kCurrent);
+  EXPECT_EQ(m.delivered_utime, 7);
+  std::vector<std::uint8_t> longer = bytes;
+  longer.push_back(0);
+  EXPECT_EQ(decode_observation(longer.data(), longer.size(), m), ObservationLayout::kMalformed) << "trailing bytes";
+  const std::vector<std::uint8_t> garbage(bytes.size(), 0xab);
+  EXPECT_EQ(decode_observation(garbage.data(), garbage.size(), m), ObservationLayout::kMalformed);
 }
 
 TEST(MessageConvert, DriverStatusNamesTheCoilsThatAreOn) {

@@ -364,8 +364,8 @@ TEST(Daemon, SimModeTakesObservationsFromLcm) {
     track::Observation o;
     o.t_s = t_s;
     o.p_board = Vec2(x_m, 1.0 - 0.5 * t_s);
-    const pinball_lcm::lcmt_pinball_observation m =
-        bus::to_lcm_observation(static_cast<std::int64_t>(t_s * 1e6), i, true, o, 0.0, 0.0, {});
+    const auto utime = static_cast<std::int64_t>(t_s * 1e6);
+    const pinball_lcm::lcmt_pinball_observation m = bus::to_lcm_observation(utime, utime, i, true, o, 0.0, 0.0, {});
     d.lcm_bus().lcm().publish(bus::kObservationChannel, &m);
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }

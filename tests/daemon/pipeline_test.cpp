@@ -211,6 +211,30 @@ TEST(CameraStage, ForgetsABallOutOfSightAndSaysSo) {
   EXPECT_EQ(stage.counters().track_resets, 1u);
 }
 
+TEST(CameraStage, TheTrackerFitsTheExposureDatesAndTheStampGivesTheLatency) {
+  // The detector dates each sighting 7 ms before its frame's stamp (the
+  // calibrated latency): the tracker must fit those dates, and the record
+  // keeps the stamp (lockstep's now) and the 7 ms as the observation's latency.
+  const table::Board board = table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  track::Tracker tracker(track::flipper_geometry_from_board(board), track::TrackerConfig{});
+  CameraStage stage(nullptr, tracker, 0.5);
+  ProjectionRecord r;
+  const double g = track::TrackerConfig{}.g_mps2;
+  for (int i = 0; i < 10; ++i) {
+    track::Observation o;
+    o.t_s = 1.0 + i * 0.005;
+    const double tau = i * 0.005;
+    o.p_board = Vec2(0.25 + 0.5 * tau, 0.3 - 2.0 * tau - 0.5 * g * tau * tau);  // free flight
+    stage.track(true, o, o.t_s + 0.007, {}, 0.0, r);
+    EXPECT_DOUBLE_EQ(r.observation.t_s, o.t_s);
+    EXPECT_NEAR(r.observation.latency_s, 0.007, 1e-9);
+    EXPECT_DOUBLE_EQ(r.t_s, o.t_s + 0.007);
+  }
+  ASSERT_TRUE(r.output.fit.valid);
+  EXPECT_NEAR(r.output.fit.t_ref_s, 1.045, 1e-9) << "the fit is dated at the exposures, not the stamps";
+  EXPECT_NEAR(r.output.projection.latency_s, 0.007, 1e-9);
+}
+
 TEST(TrackingSetup, TheCalibrationsLensAndTimingReachTheDetector) {
   const table::Board board = table::load_board(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
   calibration::Calibration c;

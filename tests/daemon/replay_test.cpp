@@ -19,8 +19,11 @@
 #include <vector>
 
 #include "pinball/bus/channels.h"
+#include "pinball/bus/message_convert.h"
+#include "pinball/control/controller_file.h"
 #include "pinball/daemon/daemon.h"
 #include "pinball_lcm/lcmt_pinball_flipper_command.hpp"
+#include "pinball_lcm/lcmt_pinball_observation_v1.hpp"
 
 namespace pinball::daemon {
 namespace {
@@ -96,6 +99,74 @@ TEST(Replay, AnAlteredDecisionIsFoundAndBadMessagesAreSkipped) {
   EXPECT_EQ(r.first_mismatch, 1);
   EXPECT_EQ(r.malformed, 1u);
   EXPECT_NE(r.mismatch.find("recorded"), std::string::npos);
+}
+
+// `from` with every observation rewritten in the layout logs had before the
+// delivery stamp (lcmt_pinball_observation_v1), dated at its exposure.
+std::string rewritten_as_v1(const std::string& from, const std::string& name) {
+  const std::string to = ::testing::TempDir() + "/" + name + "_" + std::to_string(getpid()) + ".lcmlog";
+  lcm::LogFile in(from, "r");
+  lcm::LogFile out(to, "w");
+  EXPECT_TRUE(in.good() && out.good());
+  for (const lcm::LogEvent* e = in.readNextEvent(); e != nullptr; e = in.readNextEvent()) {
+    lcm::LogEvent copy = *e;
+    std::vector<std::uint8_t> data;
+    if (e->channel == bus::kObservationChannel) {
+      pinball_lcm::lcmt_pinball_observation m{};
+      EXPECT_EQ(bus::decode_observation(e->data, static_cast<std::size_t>(e->datalen), m),
+                bus::ObservationLayout::kCurrent);
+      const pinball_lcm::lcmt_pinball_observation_v1 old{m.utime, m.seq,  m.found,      m.x_m,        m.y_m,
+                                                         m.u_px,  m.v_px, m.confidence, m.contact_left, m.contact_right};
+      data = bus::encode_message(old);
+      copy.data = data.data();
+      copy.datalen = static_cast<std::int32_t>(data.size());
+    }
+    out.writeEvent(&copy);
+  }
+  return to;
+}
+
+TEST(Replay, ALogFromBeforeTheDeliveryStampStillReplays) {
+  // The ideal camera stamps at exposure: nothing is lost in the old layout.
+  const std::string old = rewritten_as_v1(recorded_log(), "pinballd_replay_v1");
+  const ReplayReport r = replay_log(old, config_for_test());
+  EXPECT_GT(r.observations, 1000u);
+  EXPECT_EQ(r.observations_without_latency, r.observations);
+  EXPECT_EQ(r.malformed, 0u);
+  EXPECT_TRUE(r.reproduced) << r.mismatch;
+  std::remove(old.c_str());
+}
+
+// A leading controller adds each frame's camera latency to its lead: through
+// the typical camera (8 ms and more) its replay is exact only because the log
+// carries the delivery stamp; without it, its decisions come on other frames.
+TEST(Replay, ALeadingControllerBehindALateCameraReplaysFrameForFrame) {
+  control::ControllerSpec led = control::load_controller(kSource + "/controllers/best.json");
+  led.actuator.lead_actuation_delay_s = 0.004;
+  DaemonConfig c = config_for_test();
+  c.controller = ::testing::TempDir() + "/pinballd_replay_led_" + std::to_string(getpid()) + ".json";
+  control::save_controller(led, c.controller);
+  c.sim.camera = "typical";
+  c.sim.balls = 6;
+  c.sim.max_ball_time_s = 10.0;
+  const std::string log = ::testing::TempDir() + "/pinballd_replay_led_" + std::to_string(getpid()) + ".lcmlog";
+  std::remove(log.c_str());
+  {
+    DaemonConfig recording = c;
+    recording.lcm_url = "file://" + log + "?mode=w";
+    Daemon d(recording);
+    d.run();
+  }
+  const ReplayReport r = replay_log(log, c);
+  EXPECT_GT(r.recorded_commands, 2u);
+  EXPECT_EQ(r.observations_without_latency, 0u);
+  EXPECT_TRUE(r.reproduced) << r.mismatch;
+
+  const std::string old = rewritten_as_v1(log, "pinballd_replay_led_v1");
+  const ReplayReport without = replay_log(old, c);
+  EXPECT_EQ(without.observations_without_latency, without.observations);
+  EXPECT_FALSE(without.reproduced) << "the latency was not needed: the test proves nothing";
+  for (const std::string& f : {log, old, c.controller}) std::remove(f.c_str());
 }
 
 TEST(Replay, AFileThatIsNoLcmLogIsRefusedNamingIt) {

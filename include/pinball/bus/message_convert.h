@@ -22,10 +22,25 @@
 
 namespace pinball::bus {
 
-/// An observation message. `found` false leaves the position fields zero.
-pinball_lcm::lcmt_pinball_observation to_lcm_observation(std::int64_t utime, std::int64_t seq, bool found,
+/// An observation message: `utime` the ball's exposure date (the frame's
+/// stamp when not found), `delivered_utime` the frame's stamp. `found` false
+/// leaves the position fields zero.
+pinball_lcm::lcmt_pinball_observation to_lcm_observation(std::int64_t utime, std::int64_t delivered_utime,
+                                                          std::int64_t seq, bool found,
                                                           const track::Observation& observation, double u_px,
                                                           double v_px, const track::ContactSensors& contacts);
+
+/// The layout a PINBALL_OBSERVATION message was recorded in.
+enum class ObservationLayout {
+  kMalformed,       ///< neither layout decodes the whole message
+  kCurrent,         ///< lcmt_pinball_observation
+  kBeforeDelivery,  ///< lcmt_pinball_observation_v1 (logs from before 2026-12-03): no delivery stamp
+};
+
+/// Decodes a PINBALL_OBSERVATION message of either layout into the current
+/// one; an old message is delivered at its own utime (latency unknown: 0).
+/// The message must fill `size` exactly.
+ObservationLayout decode_observation(const void* data, std::size_t size, pinball_lcm::lcmt_pinball_observation& out);
 
 /// A projection message from one tracker update.
 pinball_lcm::lcmt_pinball_projection to_lcm_projection(std::int64_t utime, std::int64_t seq,
@@ -70,7 +85,8 @@ pinball_lcm::lcmt_pinball_daemon_stats to_lcm_daemon_stats(std::int64_t utime, s
                                                             std::span<const StageLatency> stages,
                                                             const DaemonStatsCounts& counts);
 
-/// The observation inside a message; false when the message is malformed
+/// The observation inside a message: t_s the exposure date, latency_s the
+/// delivery stamp less it (never below 0); false when the message is malformed
 /// (non-finite or out-of-range fields, a found ball without a position).
 bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& found, track::Observation& out,
                           track::ContactSensors& contacts);

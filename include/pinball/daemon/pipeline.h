@@ -30,7 +30,8 @@ namespace pinball::daemon {
 struct ProjectionRecord {
   std::uint64_t seq = 0;           ///< projection number (one per frame)
   std::uint64_t frame_seq = 0;     ///< the frame's sequence number
-  double t_s = 0.0;                ///< exposure time on the pipeline's clock (s)
+  double t_s = 0.0;                ///< the frame's stamp on the pipeline's clock (s): when it was had
+                                   ///< (lockstep's now); the ball's exposure date is observation.t_s
   bool found = false;              ///< the detector saw the ball
   track::Observation observation;  ///< where (valid when found)
   double u_px = 0.0;               ///< image position (valid when found)
@@ -83,8 +84,10 @@ class CameraStage {
   /// Detects and tracks one frame; fills `out` (seq, times, detection, output).
   void process(const vision::Frame& frame, const track::ContactSensors& contacts, double capture_wall_s,
                ProjectionRecord& out);
-  /// Tracks one observation made elsewhere (LCM, a replayed log): `found`
-  /// false is a frame without the ball at `t_s`.
+  /// Tracks one observation made elsewhere (LCM, a replayed log). `t_s` is
+  /// the frame's stamp, when the pipeline had it; the observation's own t_s
+  /// is the ball's exposure date, which the tracker fits, and the stamp less
+  /// it becomes its latency_s. `found` false is a frame without the ball.
   void track(bool found, const track::Observation& observation, double t_s, const track::ContactSensors& contacts,
              double capture_wall_s, ProjectionRecord& out);
   /// Counters so far (from any thread).

@@ -16,10 +16,14 @@ namespace pinball::daemon {
 struct ReplayReport {
   std::uint64_t events = 0;             ///< log events read
   std::uint64_t observations = 0;       ///< PINBALL_OBSERVATION messages replayed
+  /// Of them, recorded before the delivery stamp (lcmt_pinball_observation_v1):
+  /// their latency is unknown and replayed as 0, so a leading controller's
+  /// decisions may differ from the recorded ones.
+  std::uint64_t observations_without_latency = 0;
   std::uint64_t malformed = 0;          ///< messages that failed to decode or check, skipped
   std::uint64_t recorded_commands = 0;  ///< PINBALL_FLIPPER_CMD messages from projections, launches and losses
   std::uint64_t replayed_commands = 0;  ///< commands the replay gave for the same causes
-  std::uint64_t matched = 0;            ///< leading commands equal in flipper, direction and cause
+  std::uint64_t matched = 0;            ///< leading commands equal in flipper, direction, cause and frame
   std::int64_t first_mismatch = -1;     ///< index of the first difference, -1 when none
   std::string mismatch;                 ///< the two decisions at first_mismatch, for people
   std::uint64_t skipped_timing = 0;     ///< recorded commands caused by timing alone (stall, shutdown, bus)
