@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
@@ -206,6 +207,17 @@ TEST(ControllerFile, IntegersAreNotTruncatedNorKeysRepeated) {
   expect_error(with(good, "\"version\": 1", "\"version\": 4294967297"), "bad.json: version: unsupported");
   expect_error(with(good, "\"version\": 1", "\"version\": 1, \"version\": 1"), "bad.json: version: duplicate key");
   expect_error(with(good, "\"max_hold_s\": 1.0", "\"max_hold_s\": 1e400"), "bad.json: (file): not valid JSON");
+}
+
+// docs/results.md quotes every file under controllers/: each must load as shipped.
+TEST(ControllerFile, EveryShippedControllerLoads) {
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(PINBALL_SOURCE_DIR "/controllers")) {
+    if (entry.path().extension() != ".json") continue;
+    EXPECT_NO_THROW(load_controller(entry.path().string())) << entry.path();
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 12);
 }
 
 }  // namespace

@@ -437,5 +437,17 @@ TEST(BoardOverlay, TheBeliefIsTheBoardFileWithTheOverlay) {
   std::filesystem::remove(path);
 }
 
+// The overlays under config/ that docs/results.md's figures rest on lay over the board they name.
+TEST(BoardOverlay, EveryShippedOverlayLaysOverItsBoard) {
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(PINBALL_SOURCE_DIR "/config")) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("twin.identified", 0) != 0) continue;
+    EXPECT_NO_THROW(load_belief_board(kBoard, entry.path().string())) << name;
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 3);
+}
+
 }  // namespace
 }  // namespace pinball::table
