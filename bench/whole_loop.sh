@@ -32,6 +32,10 @@ threads=2
 json=false
 while [ $# -gt 0 ]; do
   case "$1" in
+    --json|-h|--help) ;;
+    *) [ $# -ge 2 ] || { echo "whole_loop: $1 needs a value (try --help)" >&2; exit 2; } ;;
+  esac
+  case "$1" in
     --dir) dir="$2"; shift 2 ;;
     --minutes) minutes_list="$2"; shift 2 ;;
     --twin-balls) twin_balls="$2"; shift 2 ;;
