@@ -33,7 +33,8 @@ json=false
 while [ $# -gt 0 ]; do
   case "$1" in
     --json|-h|--help) ;;
-    *) [ $# -ge 2 ] || { echo "whole_loop: $1 needs a value (try --help)" >&2; exit 2; } ;;
+    --dir|--minutes|--twin-balls|--home-balls|--cem-budgets|--imitate-budget|--imitate-rounds|--threads)
+      [ $# -ge 2 ] || { echo "whole_loop: $1 needs a value (try --help)" >&2; exit 2; } ;;
   esac
   case "$1" in
     --dir) dir="$2"; shift 2 ;;
