@@ -47,6 +47,17 @@ TransferBall play_transfer_ball(sim::World& world, const WorldSettings& settings
   return b;
 }
 
+void set_ratios_to_spastic(std::vector<TransferCell>& cells) {
+  if (cells.empty()) return;
+  const RunningStats spastic = cells.front().score;
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    TransferCell& cell = cells[i];
+    cell.ratio_to_spastic = spastic.mean() != 0.0 ? cell.score.mean() / spastic.mean() : 0.0;
+    // The spastic flipper against its own games is 1 exactly: no interval.
+    cell.ratio_interval = i == 0 ? std::nullopt : ratio_of_means_ci95(cell.score, spastic);
+  }
+}
+
 namespace {
 
 // A world to play, with the board it borrows and its world-side settings.
@@ -169,8 +180,7 @@ void play_world(PlannedWorld& w, const table::Board& belief, const TransferBench
     }
     w.row.cells.push_back(cell);
   }
-  const double spastic = w.row.cells.front().score.mean();
-  for (TransferCell& cell : w.row.cells) cell.ratio_to_spastic = spastic != 0.0 ? cell.score.mean() / spastic : 0.0;
+  set_ratios_to_spastic(w.row.cells);
   w.row.world_warnings = w.world->warnings().total();
 }
 

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -114,8 +115,16 @@ struct TransferCell {
   int cut = 0;              ///< balls cut at the time limit
   DrainCounts drains;       ///< lost balls by cause
   double ratio_to_spastic = 0.0;  ///< mean score / the spastic flipper's in the same world (0 when that is 0)
+  /// ratio_to_spastic with its 95 % interval (ratio_of_means_ci95: the two
+  /// players' games are independent); none for the spastic flipper itself,
+  /// or without two balls each and positive means.
+  std::optional<RatioInterval> ratio_interval;
   double wall_s = 0.0;      ///< wall time of this cell's balls, summed over their threads (its cost)
 };
+
+/// Sets every cell's ratio_to_spastic and ratio_interval against the first
+/// cell, the spastic flipper's.
+void set_ratios_to_spastic(std::vector<TransferCell>& cells);
 
 /// One world (a row of the table).
 struct TransferWorld {

@@ -11,8 +11,9 @@
 namespace pinball::bench {
 namespace {
 
-// Ratios of two means get no interval: the project has none for a ratio.
-constexpr const char* kRatioInterval = "none: the project has no interval for a ratio of means";
+constexpr const char* kRatioInterval =
+    "95 %, delta method on log(ratio) with Welch-Satterthwaite's degrees of freedom, the two players' balls taken "
+    "as independent games";
 constexpr const char* kPivotAxis = "y: both pivots moved up (+) or down (-) the table by the same amount";
 constexpr const char* kWallRhoRule =
     "added to every obstacle with rho <= 1 that eats no ball, clamped to [0, 1]; kickers and flippers keep theirs";
@@ -28,6 +29,8 @@ nlohmann::json cell_json(const TransferCell& c) {
           {"score_stddev", c.score.stddev()},
           {"balls", c.score.count()},
           {"ratio_to_spastic", c.ratio_to_spastic},
+          {"ratio_ci95_low", c.ratio_interval ? nlohmann::json(c.ratio_interval->low) : nlohmann::json()},
+          {"ratio_ci95_high", c.ratio_interval ? nlohmann::json(c.ratio_interval->high) : nlohmann::json()},
           {"mean_ball_time_s", c.duration_s.mean()},
           {"flips_per_ball", c.flips.mean()},
           {"balls_cut_at_time_limit", c.cut},
@@ -42,7 +45,11 @@ nlohmann::json cell_json(const TransferCell& c) {
 // "9325 ± 700": a mean and its interval, or the ratio, as the text tables show them.
 std::string score_text(const TransferCell& c, bool with_ratio) {
   std::string s = format_mean_ci(c.score.mean(), c.score.ci95_half_width());
-  if (with_ratio) s += ", " + format_number(c.ratio_to_spastic, 3) + "x";
+  if (with_ratio) {
+    s += ", " + format_number(c.ratio_to_spastic, 3) + "x";
+    if (c.ratio_interval)
+      s += " (" + format_number(c.ratio_interval->low, 3) + "–" + format_number(c.ratio_interval->high, 3) + ")";
+  }
   if (c.cut > 0) s += ", " + std::to_string(c.cut) + " cut";
   return s;
 }
@@ -198,7 +205,8 @@ std::string to_csv(const TransferReport& r) {
   out.precision(10);
   out << "world,family,value,stepper,controller,status,balls,mean_score_per_ball,score_ci95_half_width,"
          "ratio_to_spastic,balls_cut_at_time_limit,max_ball_time_s,mean_ball_time_s,flips_per_ball,"
-         "drains_left_outlane,drains_right_outlane,drains_centre,drains_other,drains_left_table,wall_s\n";
+         "drains_left_outlane,drains_right_outlane,drains_centre,drains_other,drains_left_table,wall_s,"
+         "ratio_ci95_low,ratio_ci95_high\n";
   const std::vector<std::string> names = player_names(r);
   for (const TransferWorld& w : r.worlds) {
     std::ostringstream value;
@@ -207,7 +215,7 @@ std::string to_csv(const TransferReport& r) {
     if (!w.played) {
       for (const std::string& n : names) {
         out << head << n << ',' << csv_text("skipped: " + w.skipped_reason) << ",0,,,,," << r.options.max_ball_time_s
-            << ",,,,,,,,\n";
+            << ",,,,,,,,,,\n";
       }
       continue;
     }
@@ -216,7 +224,10 @@ std::string to_csv(const TransferReport& r) {
           << c.score.ci95_half_width() << ',' << c.ratio_to_spastic << ',' << c.cut << ',' << r.options.max_ball_time_s
           << ',' << c.duration_s.mean() << ',' << c.flips.mean() << ',' << c.drains.left_outlane << ','
           << c.drains.right_outlane << ',' << c.drains.centre << ',' << c.drains.other << ',' << c.drains.left_table
-          << ',' << c.wall_s << '\n';
+          << ',' << c.wall_s << ',';
+      if (c.ratio_interval) out << c.ratio_interval->low << ',' << c.ratio_interval->high;
+      else out << ',';
+      out << '\n';
     }
   }
   return out.str();

@@ -44,4 +44,26 @@ double RunningStats::ci95_half_width() const {
   return student_t95(n_ - 1) * stddev() / std::sqrt(static_cast<double>(n_));
 }
 
+std::optional<RatioInterval> ratio_of_means_ci95(const RunningStats& a, const RunningStats& b) {
+  if (a.count() < 2 || b.count() < 2 || !(a.mean() > 0.0) || !(b.mean() > 0.0)) return std::nullopt;
+  // Squared relative standard errors of each mean: the variances of log(ā) and log(b̄) to first order.
+  const auto relative_variance = [](const RunningStats& s) {
+    return s.variance() / (static_cast<double>(s.count()) * s.mean() * s.mean());
+  };
+  const double ua = relative_variance(a);
+  const double ub = relative_variance(b);
+  const double u = ua + ub;
+  RatioInterval out;
+  out.ratio = a.mean() / b.mean();
+  if (u == 0.0) {
+    out.low = out.high = out.ratio;
+    return out;
+  }
+  const double dof = u * u / (ua * ua / static_cast<double>(a.count() - 1) + ub * ub / static_cast<double>(b.count() - 1));
+  const double half_width_log = student_t95(static_cast<std::int64_t>(std::floor(dof))) * std::sqrt(u);
+  out.low = out.ratio * std::exp(-half_width_log);
+  out.high = out.ratio * std::exp(half_width_log);
+  return out;
+}
+
 }  // namespace pinball

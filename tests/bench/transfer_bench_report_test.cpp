@@ -36,6 +36,10 @@ TEST(TransferReport, JsonHasTheOptionsEveryCellAndTheSameKeysAsEveryCommand) {
       }
     }
     EXPECT_EQ(w.at("cells").at("spastic").at("ratio_to_spastic"), 1.0);
+    EXPECT_TRUE(w.at("cells").at("spastic").at("ratio_ci95_low").is_null()) << "no interval for itself";
+    const auto& learned = w.at("cells").at("learned");
+    EXPECT_LT(learned.at("ratio_ci95_low").get<double>(), learned.at("ratio_to_spastic").get<double>());
+    EXPECT_GT(learned.at("ratio_ci95_high").get<double>(), learned.at("ratio_to_spastic").get<double>());
   }
   const auto& pivot = j.at("sensitivity").at("pivot_y_mm");
   EXPECT_EQ(pivot.at("unit"), "mm");
@@ -67,13 +71,23 @@ TEST(TransferReport, CsvHasAHeaderAndOneRowPerWorldAndController) {
             std::string::npos)
       << csv;
   EXPECT_NE(csv.find("pivot_y_mm=+3,pivot_y_mm,3,thesis,learned,played,4,1850,"), std::string::npos) << csv;
+  EXPECT_NE(header.find(",ratio_ci95_low,ratio_ci95_high"), std::string::npos) << header;
+  // The model row: 2000 ± 100 against 1000 ± 100 over 4 balls each.
+  const auto interval = ratio_of_means_ci95(made_report().worlds[0].cells[1].score,
+                                            made_report().worlds[0].cells[0].score);
+  ASSERT_TRUE(interval.has_value());
+  std::ostringstream tail;
+  tail.precision(10);
+  tail << ',' << interval->low << ',' << interval->high << '\n';
+  EXPECT_NE(csv.find(tail.str()), std::string::npos) << tail.str() << csv;
+  EXPECT_NE(csv.find("model,nominal,0,thesis,spastic,played,4,1000,"), std::string::npos) << csv;
 }
 
 TEST(TransferReport, TextRoundsAndSaysWhatWasSkipped) {
   const std::string text = to_text(made_report());
   EXPECT_NE(text.find("| world | spastic | learned |"), std::string::npos) << text;
   EXPECT_NE(text.find("| model (thesis) | 1000 ± "), std::string::npos) << text;
-  EXPECT_NE(text.find("2x"), std::string::npos) << "learned / spastic in the model world\n" << text;
+  EXPECT_NE(text.find("2x ("), std::string::npos) << "learned / spastic in the model world, with its interval\n" << text;
   EXPECT_NE(text.find("| twin | skipped: this build has no MuJoCo twin"), std::string::npos) << text;
   EXPECT_NE(text.find("balls cut at 60 s"), std::string::npos) << "the cap in every output\n" << text;
   EXPECT_NE(text.find("| pivot_y_mm | mm | 10 ± "), std::string::npos) << text;

@@ -77,11 +77,37 @@ TEST(TransferBench, EveryWorldHasEveryControllerOnTheSameBalls) {
     }
     EXPECT_EQ(w.cells[0].ratio_to_spastic, 1.0) << "the spastic flipper against itself";
     EXPECT_DOUBLE_EQ(w.cells[1].ratio_to_spastic, w.cells[1].score.mean() / w.cells[0].score.mean());
+    EXPECT_FALSE(w.cells[0].ratio_interval.has_value()) << "the spastic flipper against itself";
+    const auto expected = ratio_of_means_ci95(w.cells[1].score, w.cells[0].score);
+    ASSERT_EQ(w.cells[1].ratio_interval.has_value(), expected.has_value()) << w.name;
+    if (expected) {
+      EXPECT_EQ(w.cells[1].ratio_interval->low, expected->low) << w.name;
+      EXPECT_EQ(w.cells[1].ratio_interval->high, expected->high) << w.name;
+    }
   }
   EXPECT_GE(lines, 1);
   EXPECT_EQ(last.rfind("transfer: ", 0), 0u) << last;
   EXPECT_NE(last.find("(100 %)"), std::string::npos) << last;
   EXPECT_FALSE(r.sensitivities.empty()) << "g is an offset family";
+}
+
+TEST(TransferBench, RatiosAreAgainstTheFirstCellTheSpasticFlippers) {
+  std::vector<TransferCell> cells(3);
+  for (const double x : {900.0, 1100.0, 1000.0}) cells[0].score.add(x);
+  for (const double x : {2500.0, 1500.0, 2000.0}) cells[1].score.add(x);
+  cells[2].score.add(3000.0);  // one ball: a ratio, no interval
+  set_ratios_to_spastic(cells);
+  EXPECT_EQ(cells[0].ratio_to_spastic, 1.0);
+  EXPECT_FALSE(cells[0].ratio_interval.has_value());
+  EXPECT_DOUBLE_EQ(cells[1].ratio_to_spastic, 2.0);
+  ASSERT_TRUE(cells[1].ratio_interval.has_value());
+  EXPECT_LT(cells[1].ratio_interval->low, 2.0);
+  EXPECT_GT(cells[1].ratio_interval->high, 2.0);
+  EXPECT_DOUBLE_EQ(cells[2].ratio_to_spastic, 3.0);
+  EXPECT_FALSE(cells[2].ratio_interval.has_value());
+  std::vector<TransferCell> none;
+  set_ratios_to_spastic(none);  // no cells, nothing to do
+  EXPECT_TRUE(none.empty());
 }
 
 TEST(TransferBench, SameSeedSameCellsWhateverTheThreads) {

@@ -43,7 +43,7 @@ inline bench::TransferReport made_report() {
     w.world = name == "event" ? "event" : "thesis";
     w.played = true;
     w.cells = {made_cell("spastic", 1000.0 - 10.0 * std::fabs(v), 4), made_cell("learned", 2000.0 - 50.0 * std::fabs(v), 4)};
-    for (bench::TransferCell& c : w.cells) c.ratio_to_spastic = c.score.mean() / w.cells[0].score.mean();
+    bench::set_ratios_to_spastic(w.cells);
     return w;
   };
   r.worlds.push_back(world("model", "nominal", 0.0));

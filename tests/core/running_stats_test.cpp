@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <vector>
 
 #include "pinball/core/rng.h"
@@ -119,6 +120,58 @@ TEST(RunningStats, Ci95CoversTheTrueMeanAboutNinetyFivePercent) {
   }
   // Binomial SE of the coverage: sqrt(0.95 * 0.05 / 2000) = 4.9e-3.
   EXPECT_NEAR(covered / static_cast<double>(kTrials), 0.95, 0.02);
+}
+
+RunningStats stats_of(std::initializer_list<double> xs) {
+  RunningStats s;
+  for (const double x : xs) s.add(x);
+  return s;
+}
+
+TEST(RatioOfMeans, ClosedForm) {
+  // ā = 3, var 2.5; b̄ = 6, var 10; five each: both relative variances 1/18,
+  // Welch-Satterthwaite gives 8 degrees of freedom (t = 2.306004).
+  const auto r = ratio_of_means_ci95(stats_of({1, 2, 3, 4, 5}), stats_of({2, 4, 6, 8, 10}));
+  ASSERT_TRUE(r.has_value());
+  const double half_width_log = 2.306004 * std::sqrt(1.0 / 9.0);
+  EXPECT_DOUBLE_EQ(r->ratio, 0.5);
+  EXPECT_NEAR(r->low, 0.5 * std::exp(-half_width_log), 1e-12);
+  EXPECT_NEAR(r->high, 0.5 * std::exp(half_width_log), 1e-12);
+  EXPECT_NEAR(r->low * r->high, 0.25, 1e-12);  // as wide each way in log terms
+}
+
+TEST(RatioOfMeans, NoSpreadIsNoInterval) {
+  const auto r = ratio_of_means_ci95(stats_of({4, 4, 4}), stats_of({2, 2}));
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->ratio, 2.0);
+  EXPECT_EQ(r->low, 2.0);
+  EXPECT_EQ(r->high, 2.0);
+}
+
+TEST(RatioOfMeans, NoneWithoutTwoSamplesEachOrPositiveMeans) {
+  EXPECT_FALSE(ratio_of_means_ci95(stats_of({1}), stats_of({1, 2})).has_value());
+  EXPECT_FALSE(ratio_of_means_ci95(stats_of({1, 2}), stats_of({3})).has_value());
+  EXPECT_FALSE(ratio_of_means_ci95(stats_of({1, 2}), stats_of({0, 0})).has_value());
+  EXPECT_FALSE(ratio_of_means_ci95(stats_of({0, 0}), stats_of({1, 2})).has_value());
+  EXPECT_FALSE(ratio_of_means_ci95(RunningStats{}, RunningStats{}).has_value());
+}
+
+TEST(RatioOfMeans, CoversTheTrueRatioOfSkewedScoresAboutNinetyFivePercent) {
+  // Scores per ball are skewed like exponentials (a few long balls): means
+  // 12000 and 5000, 300 and 150 balls, true ratio 2.4.
+  Rng rng(91);
+  const auto exponential = [&](double mean) { return -mean * std::log(1.0 - rng.uniform01()); };
+  int covered = 0;
+  constexpr int kTrials = 2000;
+  for (int t = 0; t < kTrials; ++t) {
+    RunningStats a, b;
+    for (int i = 0; i < 300; ++i) a.add(exponential(12000.0));
+    for (int i = 0; i < 150; ++i) b.add(exponential(5000.0));
+    const auto r = ratio_of_means_ci95(a, b);
+    ASSERT_TRUE(r.has_value());
+    covered += r->low <= 2.4 && 2.4 <= r->high ? 1 : 0;
+  }
+  EXPECT_NEAR(covered / static_cast<double>(kTrials), 0.95, 0.02);  // binomial SE 4.9e-3
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // Incremental mean and variance (Welford's update, thesis App. A done stably).
 
 #include <cstdint>
+#include <optional>
 
 namespace pinball {
 
@@ -35,5 +36,21 @@ class RunningStats {
   double min_ = 0.0;
   double max_ = 0.0;
 };
+
+/// A ratio of two means and its 95 % interval.
+struct RatioInterval {
+  double ratio = 0.0;  ///< mean of the numerator / mean of the denominator
+  double low = 0.0;    ///< lower end of the 95 % interval
+  double high = 0.0;   ///< upper end
+};
+
+/// The ratio of the means of two independent samples (a controller's scores
+/// over the spastic flipper's, each from its own games) with a 95 % interval
+/// from the delta method on log(ratio): var ≈ var(a)/(n_a·ā²) + var(b)/(n_b·b̄²),
+/// Student's t with Welch–Satterthwaite's degrees of freedom. The interval is
+/// R·exp(±t·σ), so it stays positive and is as wide each way in log terms,
+/// as a ratio's noise is. None unless both have two or more samples and
+/// positive means (no log, no interval).
+std::optional<RatioInterval> ratio_of_means_ci95(const RunningStats& numerator, const RunningStats& denominator);
 
 }  // namespace pinball
