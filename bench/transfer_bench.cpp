@@ -12,6 +12,7 @@
 #include "pinball/control/spastic_controller.h"
 #include "pinball/core/progress.h"
 #include "pinball/core/rng.h"
+#include "pinball/core/statistics.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/learn/team.h"
@@ -56,6 +57,34 @@ void set_ratios_to_spastic(std::vector<TransferCell>& cells) {
     // The spastic flipper against its own games is 1 exactly: no interval.
     cell.ratio_interval = i == 0 ? std::nullopt : ratio_of_means_ci95(cell.score, spastic);
   }
+}
+
+std::vector<TransferSummary> transfer_summaries(const std::vector<TransferWorld>& worlds, double target_ratio) {
+  std::vector<TransferSummary> out;
+  std::vector<std::vector<double>> ratios;
+  for (const TransferWorld& w : worlds) {
+    if (!w.played) continue;
+    for (std::size_t i = 1; i < w.cells.size(); ++i) {
+      const TransferCell& c = w.cells[i];
+      if (out.size() < i) {
+        out.resize(i);
+        ratios.resize(i);
+        out[i - 1].controller = c.controller;
+      }
+      TransferSummary& s = out[i - 1];
+      if (s.worlds == 0 || c.ratio_to_spastic < s.lowest_ratio) {
+        s.lowest_ratio = c.ratio_to_spastic;
+        s.lowest_world = w.name;
+        s.lowest_interval = c.ratio_interval;
+      }
+      ++s.worlds;
+      if (c.ratio_to_spastic >= target_ratio) ++s.worlds_at_target;
+      if (c.ratio_interval && c.ratio_interval->high < target_ratio) ++s.worlds_below_target;
+      ratios[i - 1].push_back(c.ratio_to_spastic);
+    }
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].median_ratio = median(ratios[i]);
+  return out;
 }
 
 namespace {
@@ -189,6 +218,8 @@ void check_options(const TransferBenchOptions& o) {
   if (o.twin_balls < 1) throw std::invalid_argument("transfer bench: twin balls must be >= 1");
   if (o.threads < 1) throw std::invalid_argument("transfer bench: threads must be >= 1");
   if (!(o.max_ball_time_s > 0.0)) throw std::invalid_argument("transfer bench: max ball time must be > 0");
+  if (!(o.target_ratio > 0.0) || !std::isfinite(o.target_ratio))
+    throw std::invalid_argument("transfer bench: target ratio must be finite and > 0");
   for (const TransferController& c : o.controllers) {
     if (c.spec == nullptr) throw std::invalid_argument("transfer bench: controller " + c.name + " has no spec");
     if (c.name == "spastic") throw std::invalid_argument("transfer bench: 'spastic' names the baseline; rename " + c.file);
@@ -224,6 +255,7 @@ TransferReport run_transfer_bench(const table::Board& belief, const TransferBenc
     report.worlds.push_back(std::move(w.row));
   }
   report.sensitivities = transfer_sensitivities(report.worlds, options);
+  report.summaries = transfer_summaries(report.worlds, options.target_ratio);
   report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }

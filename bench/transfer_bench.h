@@ -85,6 +85,9 @@ struct TransferBenchOptions {
   /// The identified overlay laid over the belief ("": none): the model worlds
   /// play it, the twin plays the board file (simlab::world_for_belief).
   std::string identified;
+  /// The ratio to the spastic flipper each cell is held to in the summary
+  /// (issue 20's sweep target: 2.5x in every world).
+  double target_ratio = 2.5;
 };
 
 /// The value of `p` in the nominal (`model`) world: 0 for an offset, the
@@ -154,12 +157,28 @@ struct TransferSensitivity {
   int worlds = 0;              ///< points in the fit
 };
 
+/// One controller's ratios to the spastic flipper over every played world
+/// (the nominal ones and the sweep): what the sweep's targets are judged on.
+struct TransferSummary {
+  std::string controller;        ///< whose
+  int worlds = 0;                ///< played worlds
+  double median_ratio = 0.0;     ///< the median world's ratio
+  double lowest_ratio = 0.0;     ///< the lowest world's ratio
+  std::string lowest_world;      ///< its name
+  std::optional<RatioInterval> lowest_interval;  ///< its interval
+  int worlds_at_target = 0;      ///< worlds with ratio >= target_ratio
+  /// Worlds whose whole interval lies below target_ratio: short of it beyond
+  /// the noise of their balls (the others may be short by chance).
+  int worlds_below_target = 0;
+};
+
 /// The whole measurement.
 struct TransferReport {
   std::string board;                 ///< the belief's board file
   TransferBenchOptions options;      ///< what was run (controllers' specs not owned)
   std::vector<TransferWorld> worlds; ///< model, event, twin, then the sweep in order
   std::vector<TransferSensitivity> sensitivities;  ///< per offset family and controller
+  std::vector<TransferSummary> summaries;          ///< per controller after the spastic flipper
   double wall_s = 0.0;               ///< the whole run
 };
 
@@ -173,6 +192,10 @@ TransferReport run_transfer_bench(const table::Board& belief, const TransferBenc
 /// The sensitivities of a report's worlds (run_transfer_bench fills them).
 std::vector<TransferSensitivity> transfer_sensitivities(const std::vector<TransferWorld>& worlds,
                                                         const TransferBenchOptions& options);
+
+/// Each controller's summary over `worlds` against `target_ratio`
+/// (run_transfer_bench fills them); none for the spastic flipper.
+std::vector<TransferSummary> transfer_summaries(const std::vector<TransferWorld>& worlds, double target_ratio);
 
 // The report (transfer_bench_report.cpp).
 

@@ -98,6 +98,18 @@ nlohmann::json to_json(const TransferReport& r) {
                                            {"ci95_half_width", s.ci95_half_width},
                                            {"worlds", s.worlds}};
   }
+  nlohmann::json summary = nlohmann::json::array();
+  for (const TransferSummary& m : r.summaries) {
+    summary.push_back({{"controller", m.controller},
+                       {"worlds", m.worlds},
+                       {"median_ratio", m.median_ratio},
+                       {"lowest_ratio", m.lowest_ratio},
+                       {"lowest_world", m.lowest_world},
+                       {"lowest_ratio_ci95_low", m.lowest_interval ? nlohmann::json(m.lowest_interval->low) : nlohmann::json()},
+                       {"lowest_ratio_ci95_high", m.lowest_interval ? nlohmann::json(m.lowest_interval->high) : nlohmann::json()},
+                       {"worlds_at_target", m.worlds_at_target},
+                       {"worlds_below_target", m.worlds_below_target}});
+  }
   std::int64_t balls = 0;
   for (const TransferWorld& w : r.worlds) {
     for (const TransferCell& c : w.cells) balls += c.score.count();
@@ -121,6 +133,8 @@ nlohmann::json to_json(const TransferReport& r) {
           {"controllers", controllers},
           {"sweep", sweep},
           {"worlds", worlds},
+          {"target_ratio", o.target_ratio},
+          {"summary", summary},
           {"sensitivity", sensitivity},
           {"balls_played", balls},
           {"wall_s", r.wall_s}};
@@ -154,6 +168,19 @@ std::string to_text(const TransferReport& r) {
     }
     for (const TransferCell& c : w.cells) out << ' ' << score_text(c, c.controller != "spastic") << " |";
     out << '\n';
+  }
+  if (!r.summaries.empty()) {
+    out << "\nover the " << r.summaries.front().worlds << " worlds played, against " << format_number(o.target_ratio)
+        << "x the spastic flipper (below it: worlds whose whole 95 % interval lies under it):\n\n"
+        << "| controller | median world | lowest world | at " << format_number(o.target_ratio) << "x or more | below it |\n"
+        << "|---|---:|---|---:|---:|\n";
+    for (const TransferSummary& m : r.summaries) {
+      out << "| " << m.controller << " | " << format_number(m.median_ratio, 3) << "x | " << format_number(m.lowest_ratio, 3)
+          << "x";
+      if (m.lowest_interval)
+        out << " (" << format_number(m.lowest_interval->low, 3) << "–" << format_number(m.lowest_interval->high, 3) << ")";
+      out << ", " << m.lowest_world << " | " << m.worlds_at_target << " | " << m.worlds_below_target << " |\n";
+    }
   }
   out << "\ndrains: left outlane / right outlane / centre / other; of them left the table (" << kDrainRule
       << "):\n\n"

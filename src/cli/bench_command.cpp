@@ -86,6 +86,11 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--max-ball-time", a.max_ball_time_s,
                   "ceiling, transfer: seconds after which a ball still alive is cut")
       ->check(CLI::Range(1.0, 3600.0));
+  cmd->add_option("--target-ratio", a.target_ratio,
+                  "transfer: the ratio to the spastic flipper the summary holds every world to (counts the worlds at "
+                  "it and those whose interval lies below it)")
+      ->check(CLI::Range(0.01, 1000.0))
+      ->default_str(format_number(bench::TransferBenchOptions{}.target_ratio));
   cmd->add_option("--frames", a.frames, "protocol: random and mutated frames per seed")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
   cmd->add_option("--seeds", a.seeds, "protocol: seeds to run, from --seed on")->check(CLI::Range(1, 1000));
@@ -290,6 +295,7 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
   options.seed = a.seed;
   options.threads = a.threads;
   options.max_ball_time_s = a.max_ball_time_s;
+  options.target_ratio = a.target_ratio;
   options.camera = a.camera;
   options.twin_params_path = a.world.twin_params_path;
   options.identified = a.identified;

@@ -77,6 +77,7 @@ struct BenchArgs {
   int twin_balls = 0;                                ///< transfer: per cell in the twin (0: the bench's)
   int threads = 2;                                   ///< ceiling, transfer: worker threads (results do not depend on it)
   double max_ball_time_s = 60.0;                     ///< ceiling, transfer: a ball alive after this is cut
+  double target_ratio = 2.5;                         ///< transfer: the ratio to the spastic flipper the summary holds each world to
   std::vector<std::string> controllers;              ///< ceiling: one controller file; transfer: the controllers
   std::vector<double> true_state_noise;              ///< ceiling: play the controller fed the true state, noise (mm, m/s); empty: not
   std::string csv;                                   ///< precision, transfer: CSV file to write, or empty

@@ -46,6 +46,35 @@ TEST(TransferReport, JsonHasTheOptionsEveryCellAndTheSameKeysAsEveryCommand) {
   EXPECT_NEAR(pivot.at("controllers").at("learned").at("points_per_ball_lost_per_unit").get<double>(), 50.0, 1e-9);
 }
 
+TEST(TransferReport, SummaryHasEachControllersMedianAndLowestWorldAgainstTheTarget) {
+  // learned / spastic: 2 in model and event, 1950/990 at pivots ±1 mm, 1850/970 at ±3, 1750/950 at g +5 %.
+  const TransferReport r = made_report();
+  ASSERT_EQ(r.summaries.size(), 1u) << "none for the spastic flipper";
+  const TransferSummary& m = r.summaries[0];
+  EXPECT_EQ(m.controller, "learned");
+  EXPECT_EQ(m.worlds, 7) << "the skipped twin is no world";
+  EXPECT_DOUBLE_EQ(m.median_ratio, 1950.0 / 990.0);
+  EXPECT_DOUBLE_EQ(m.lowest_ratio, 1750.0 / 950.0);
+  EXPECT_EQ(m.lowest_world, "gravity_pct=+5");
+  ASSERT_TRUE(m.lowest_interval.has_value());
+  EXPECT_EQ(m.lowest_interval->high, r.worlds.back().cells[1].ratio_interval->high);
+  EXPECT_EQ(m.worlds_at_target, 0);
+  EXPECT_EQ(m.worlds_below_target, 7) << "4 balls of ±100 each: every interval ends under 2.5";
+  // At 1.95 the four worlds at 1.97x or more reach it, and no interval lies wholly below it.
+  const std::vector<TransferSummary> lower = transfer_summaries(r.worlds, 1.95);
+  EXPECT_EQ(lower[0].worlds_at_target, 4);
+  EXPECT_EQ(lower[0].worlds_below_target, 0);
+
+  const nlohmann::json j = to_json(r);
+  EXPECT_EQ(j.at("target_ratio"), 2.5);
+  ASSERT_EQ(j.at("summary").size(), 1u);
+  EXPECT_EQ(j.at("summary")[0].at("lowest_world"), "gravity_pct=+5");
+  EXPECT_EQ(j.at("summary")[0].at("worlds_below_target"), 7);
+  const std::string text = to_text(r);
+  EXPECT_NE(text.find("| learned | 1.97x | 1.84x ("), std::string::npos) << text;
+  EXPECT_NE(text.find(", gravity_pct=+5 | 0 | 7 |"), std::string::npos) << text;
+}
+
 TEST(TransferReport, CsvHasAHeaderAndOneRowPerWorldAndController) {
   const std::string csv = to_csv(made_report());
   std::istringstream in(csv);

@@ -1,5 +1,6 @@
 #include "transfer_bench.h"
 
+#include <limits>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -164,6 +165,11 @@ TEST(TransferBench, BadOptionsAreRefused) {
   o = tiny();
   o.max_ball_time_s = 0.0;
   EXPECT_THROW(run_transfer_bench(thesis_board(), o, {}), std::invalid_argument);
+  for (const double target : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    o = tiny();
+    o.target_ratio = target;
+    EXPECT_THROW(run_transfer_bench(thesis_board(), o, {}), std::invalid_argument) << target;
+  }
   o = tiny();
   o.controllers.push_back(o.controllers.front());
   EXPECT_THROW(run_transfer_bench(thesis_board(), o, {}), std::invalid_argument) << "two named best";

@@ -52,6 +52,12 @@ TEST_F(TransferCommand, QuickRunGivesEveryCellAndWritesItsFiles) {
     }
     EXPECT_EQ(w.at("cells").at("spastic").at("ratio_to_spastic"), 1.0) << w.at("name");
   }
+  EXPECT_EQ(j.at("target_ratio"), 2.5) << "issue 20's target by default";
+  ASSERT_EQ(j.at("summary").size(), 3u) << "best, imitation, cem";
+  EXPECT_EQ(j.at("summary")[0].at("controller"), "best");
+  std::size_t played = 0;
+  for (const auto& w : j.at("worlds")) played += w.at("played").get<bool>() ? 1 : 0;
+  EXPECT_EQ(j.at("summary")[0].at("worlds"), played) << "every world played, the skipped twin none";
   EXPECT_TRUE(j.at("sensitivity").contains("pivot_y_mm"));
   EXPECT_TRUE(j.at("sensitivity").contains("theta_min_deg"));
   EXPECT_TRUE(j.at("sensitivity").contains("gravity_pct"));
@@ -114,6 +120,7 @@ TEST_F(TransferCommand, BadInputSaysWhatIsWrongInOneLineAndWritesNothing) {
                         Case{"--balls many", 2, "--balls"},
                         Case{"--max-ball-time -1", 2, "--max-ball-time"},
                         Case{"--threads 0", 2, "--threads"},
+                        Case{"--target-ratio 0", 2, "--target-ratio"},
                         Case{"--world twin", 1, "--world"},
                         Case{"--png " + png.string() + " --csv " + (dir_ / "no_such_folder" / "x.csv").string(), 1,
                              "no_such_folder"}}) {

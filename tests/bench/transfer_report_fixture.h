@@ -60,6 +60,7 @@ inline bench::TransferReport made_report() {
   }
   r.worlds.push_back(world("gravity_pct=+5", "gravity_pct", 5.0));
   r.sensitivities = bench::transfer_sensitivities(r.worlds, r.options);
+  r.summaries = bench::transfer_summaries(r.worlds, r.options.target_ratio);
   r.wall_s = 1.5;
   return r;
 }
