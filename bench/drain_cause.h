@@ -63,31 +63,45 @@ struct DrainCounts {
 };
 
 /// A ball runner's observer (sim::play_ball) that keeps the x at which the
-/// ball last went down past the pivot line since its launch.
+/// ball last went down past the pivot line since its launch, and how long
+/// before that a flipper last touched it: an outlane drain decided seconds
+/// and many bounces after the last shot is one no flipper could prevent.
 class DrainWatch {
  public:
   /// Watches the ball of `start` against `zones`' pivot line.
   DrainWatch(const sim::GameState& start, const DrainZones& zones)
       : line_y_m_(zones.line_y_m), last_(start.ball.position_m) {}
   void operator()(const sim::GameState& s, const sim::StepEvents& e) {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     const Vec2& p = s.ball.position_m;
     if (e.has(sim::StepEvents::kLaunch)) {
-      crossing_x_m_ = std::numeric_limits<double>::quiet_NaN();  // the chute lies below the line too
+      crossing_x_m_ = kNaN;  // the chute lies below the line too
+      crossing_after_flipper_s_ = kNaN;
+      flipper_touch_s_ = kNaN;
     } else if (e.has(sim::StepEvents::kBallLost)) {
       return;  // a lost ball is moved back to the launcher: keep what was seen before
-    } else if (last_.y() >= line_y_m_ && p.y() < line_y_m_) {
-      const double f = (last_.y() - line_y_m_) / (last_.y() - p.y());
-      crossing_x_m_ = last_.x() + f * (p.x() - last_.x());
+    } else {
+      if (e.has(sim::StepEvents::kHitFlipper) || e.has(sim::StepEvents::kFlipperPush)) flipper_touch_s_ = s.time_s;
+      if (last_.y() >= line_y_m_ && p.y() < line_y_m_) {
+        const double f = (last_.y() - line_y_m_) / (last_.y() - p.y());
+        crossing_x_m_ = last_.x() + f * (p.x() - last_.x());
+        crossing_after_flipper_s_ = s.time_s - flipper_touch_s_;  // NaN when no flipper has touched it
+      }
     }
     last_ = p;
   }
   /// Where the ball last went down past the line (NaN: it has not).
   double crossing_x_m() const { return crossing_x_m_; }
+  /// Seconds from the last flipper touch before that crossing to the
+  /// crossing (NaN: no crossing, or no flipper touched the ball before it).
+  double crossing_after_flipper_s() const { return crossing_after_flipper_s_; }
 
  private:
   double line_y_m_;
   Vec2 last_;
   double crossing_x_m_ = std::numeric_limits<double>::quiet_NaN();
+  double flipper_touch_s_ = std::numeric_limits<double>::quiet_NaN();
+  double crossing_after_flipper_s_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// What a bench keeps of one played ball: the ball runner's result and where
@@ -99,11 +113,13 @@ struct PlayedBall {
   bool cut = false;          ///< alive at the time limit
   bool left_table = false;   ///< lost by leaving the table's bounds
   double drain_x_m = 0.0;    ///< where it last went down past the flippers' pivot line (DrainWatch; NaN: never)
+  /// Seconds from the last flipper touch to that crossing (DrainWatch; NaN: none).
+  double drain_after_flipper_s = 0.0;
 };
 
 /// The ball `r` that `watch` saw.
 inline PlayedBall played_ball(const sim::BallResult& r, const DrainWatch& watch) {
-  return {r.score, r.duration_s, r.flips, r.cut, r.left_table, watch.crossing_x_m()};
+  return {r.score, r.duration_s, r.flips, r.cut, r.left_table, watch.crossing_x_m(), watch.crossing_after_flipper_s()};
 }
 
 }  // namespace pinball::bench

@@ -204,7 +204,10 @@ void play_world(PlannedWorld& w, const table::Board& belief, const TransferBench
       if (b.cut) {
         ++cell.cut;
       } else {
-        cell.drains.add(classify_drain(zones, b.drain_x_m), b.left_table);
+        const DrainCause cause = classify_drain(zones, b.drain_x_m);
+        cell.drains.add(cause, b.left_table);
+        const bool outlane = cause == DrainCause::kLeftOutlane || cause == DrainCause::kRightOutlane;
+        if (outlane && !std::isnan(b.drain_after_flipper_s)) cell.outlane_after_flipper_s.add(b.drain_after_flipper_s);
       }
     }
     w.row.cells.push_back(cell);

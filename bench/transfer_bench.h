@@ -117,6 +117,10 @@ struct TransferCell {
   RunningStats flips;       ///< per ball
   int cut = 0;              ///< balls cut at the time limit
   DrainCounts drains;       ///< lost balls by cause
+  /// Seconds from the last flipper touch to each outlane drain (those a
+  /// flipper touched since the launch): how long after its last shot a ball
+  /// took the drain no flipper guards.
+  RunningStats outlane_after_flipper_s;
   double ratio_to_spastic = 0.0;  ///< mean score / the spastic flipper's in the same world (0 when that is 0)
   /// ratio_to_spastic with its 95 % interval (ratio_of_means_ci95: the two
   /// players' games are independent); none for the spastic flipper itself,

@@ -39,6 +39,8 @@ nlohmann::json cell_json(const TransferCell& c) {
           {"drains_centre", c.drains.centre},
           {"drains_other", c.drains.other},
           {"drains_left_table", c.drains.left_table},
+          {"outlane_drain_after_flipper_s_mean",
+           c.outlane_after_flipper_s.count() > 0 ? nlohmann::json(c.outlane_after_flipper_s.mean()) : nlohmann::json()},
           {"wall_s", c.wall_s}};
 }
 
@@ -182,8 +184,8 @@ std::string to_text(const TransferReport& r) {
       out << ", " << m.lowest_world << " | " << m.worlds_at_target << " | " << m.worlds_below_target << " |\n";
     }
   }
-  out << "\ndrains: left outlane / right outlane / centre / other; of them left the table (" << kDrainRule
-      << "):\n\n"
+  out << "\ndrains: left outlane / right outlane / centre / other; of them left the table; mean s from the last "
+         "flipper touch to an outlane drain (" << kDrainRule << "):\n\n"
       << "| world |";
   for (const std::string& n : names) out << ' ' << n << " |";
   out << "\n|---|";
@@ -194,7 +196,9 @@ std::string to_text(const TransferReport& r) {
     out << "| " << w.name << " |";
     for (const TransferCell& c : w.cells) {
       out << ' ' << c.drains.left_outlane << " / " << c.drains.right_outlane << " / " << c.drains.centre << " / "
-          << c.drains.other << "; " << c.drains.left_table << " |";
+          << c.drains.other << "; " << c.drains.left_table;
+      if (c.outlane_after_flipper_s.count() > 0) out << "; " << format_number(c.outlane_after_flipper_s.mean(), 2) << " s";
+      out << " |";
     }
     out << '\n';
   }
@@ -233,7 +237,7 @@ std::string to_csv(const TransferReport& r) {
   out << "world,family,value,stepper,controller,status,balls,mean_score_per_ball,score_ci95_half_width,"
          "ratio_to_spastic,balls_cut_at_time_limit,max_ball_time_s,mean_ball_time_s,flips_per_ball,"
          "drains_left_outlane,drains_right_outlane,drains_centre,drains_other,drains_left_table,wall_s,"
-         "ratio_ci95_low,ratio_ci95_high\n";
+         "ratio_ci95_low,ratio_ci95_high,outlane_drain_after_flipper_s_mean\n";
   const std::vector<std::string> names = player_names(r);
   for (const TransferWorld& w : r.worlds) {
     std::ostringstream value;
@@ -242,7 +246,7 @@ std::string to_csv(const TransferReport& r) {
     if (!w.played) {
       for (const std::string& n : names) {
         out << head << n << ',' << csv_text("skipped: " + w.skipped_reason) << ",0,,,,," << r.options.max_ball_time_s
-            << ",,,,,,,,,,\n";
+            << ",,,,,,,,,,,\n";
       }
       continue;
     }
@@ -254,6 +258,8 @@ std::string to_csv(const TransferReport& r) {
           << ',' << c.wall_s << ',';
       if (c.ratio_interval) out << c.ratio_interval->low << ',' << c.ratio_interval->high;
       else out << ',';
+      out << ',';
+      if (c.outlane_after_flipper_s.count() > 0) out << c.outlane_after_flipper_s.mean();
       out << '\n';
     }
   }

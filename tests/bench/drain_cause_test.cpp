@@ -55,6 +55,38 @@ TEST(DrainCause, WatchKeepsTheLastDownwardCrossingSinceTheLaunch) {
   EXPECT_TRUE(std::isnan(w.crossing_x_m())) << "a new launch forgets the old crossing";
 }
 
+sim::GameState at_time(double x_m, double y_m, double t_s) {
+  sim::GameState s = at(x_m, y_m);
+  s.time_s = t_s;
+  return s;
+}
+
+TEST(DrainCause, WatchKeepsTheTimeFromTheLastFlipperTouchToTheCrossing) {
+  const DrainZones z = drain_zones(thesis_board());
+  sim::StepEvents touch;
+  touch.flags = sim::StepEvents::kHitFlipper;
+  sim::StepEvents push;
+  push.flags = sim::StepEvents::kFlipperPush;
+  DrainWatch w(at(0.49, 0.054), z);
+  w(at_time(0.49, 0.054, 0.0), sim::StepEvents{sim::StepEvents::kLaunch});
+  w(at_time(0.30, 0.17, 1.0), {});
+  w(at_time(0.30, 0.15, 1.1), {});  // down past the line with no flipper touch since the launch
+  EXPECT_NEAR(w.crossing_x_m(), 0.30, 1e-12);
+  EXPECT_TRUE(std::isnan(w.crossing_after_flipper_s())) << "no flipper touched it";
+  w(at_time(0.25, 0.18, 2.0), touch);
+  w(at_time(0.25, 0.30, 2.5), push);  // the last touch: a push at 2.5 s
+  w(at_time(0.02, 0.17, 5.0), {});
+  w(at_time(0.02, 0.15, 5.2), {});
+  EXPECT_NEAR(w.crossing_after_flipper_s(), 5.2 - 2.5, 1e-12);
+  w(at_time(0.49, 0.054, 5.3), sim::StepEvents{sim::StepEvents::kBallLost});
+  EXPECT_NEAR(w.crossing_after_flipper_s(), 2.7, 1e-12) << "kept past the loss";
+  w(at_time(0.49, 0.054, 5.4), sim::StepEvents{sim::StepEvents::kLaunch});
+  EXPECT_TRUE(std::isnan(w.crossing_after_flipper_s())) << "a new launch forgets it";
+  w(at_time(0.02, 0.17, 6.0), {});
+  w(at_time(0.02, 0.15, 6.1), {});
+  EXPECT_TRUE(std::isnan(w.crossing_after_flipper_s())) << "and the old ball's touches";
+}
+
 TEST(DrainCause, CountsAddUp) {
   DrainCounts c;
   c.add(DrainCause::kLeftOutlane, false);

@@ -31,7 +31,7 @@ TEST(TransferReport, JsonHasTheOptionsEveryCellAndTheSameKeysAsEveryCommand) {
     for (const char* c : {"spastic", "learned"}) {
       for (const char* k : {"mean_score_per_ball", "score_ci95_half_width", "balls_cut_at_time_limit", "wall_s",
                             "ratio_to_spastic", "drains_left_outlane", "drains_right_outlane", "drains_centre",
-                            "drains_other", "drains_left_table"}) {
+                            "drains_other", "drains_left_table", "outlane_drain_after_flipper_s_mean"}) {
         EXPECT_TRUE(w.at("cells").at(c).contains(k)) << w.at("name") << " " << c << " " << k;
       }
     }
@@ -107,7 +107,7 @@ TEST(TransferReport, CsvHasAHeaderAndOneRowPerWorldAndController) {
   ASSERT_TRUE(interval.has_value());
   std::ostringstream tail;
   tail.precision(10);
-  tail << ',' << interval->low << ',' << interval->high << '\n';
+  tail << ',' << interval->low << ',' << interval->high << ",2.5\n";
   EXPECT_NE(csv.find(tail.str()), std::string::npos) << tail.str() << csv;
   EXPECT_NE(csv.find("model,nominal,0,thesis,spastic,played,4,1000,"), std::string::npos) << csv;
 }
@@ -121,6 +121,9 @@ TEST(TransferReport, TextRoundsAndSaysWhatWasSkipped) {
   EXPECT_NE(text.find("balls cut at 60 s"), std::string::npos) << "the cap in every output\n" << text;
   EXPECT_NE(text.find("| pivot_y_mm | mm | 10 ± "), std::string::npos) << text;
   EXPECT_EQ(text.find("1849.999"), std::string::npos) << "rounded\n" << text;
+  EXPECT_NE(text.find("| model | 1 / 0 / 1 / 0; 0; 2.5 s |"), std::string::npos) << "the drains with the time from the last "
+                                                                                   "flipper touch\n"
+                                                                                << text;
 }
 
 }  // namespace

@@ -73,6 +73,11 @@ TEST(TransferBench, EveryWorldHasEveryControllerOnTheSameBalls) {
     for (const TransferCell& c : w.cells) {
       EXPECT_EQ(c.score.count(), balls) << w.name << " " << c.controller;
       EXPECT_EQ(c.cut + c.drains.total(), balls) << w.name << " " << c.controller;
+      EXPECT_LE(c.outlane_after_flipper_s.count(), c.drains.left_outlane + c.drains.right_outlane);
+      if (c.outlane_after_flipper_s.count() > 0) {
+        EXPECT_GT(c.outlane_after_flipper_s.min(), 0.0) << w.name << " " << c.controller;
+        EXPECT_LE(c.outlane_after_flipper_s.max(), c.duration_s.max()) << w.name << " " << c.controller;
+      }
       EXPECT_LE(c.duration_s.max(), 8.0 + 1e-9);
       EXPECT_GT(c.wall_s, 0.0);
     }

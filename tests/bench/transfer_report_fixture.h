@@ -20,6 +20,7 @@ inline bench::TransferCell made_cell(const std::string& controller, double mean,
     c.flips.add(3.0);
   }
   c.drains.add(bench::DrainCause::kLeftOutlane, false);
+  c.outlane_after_flipper_s.add(2.5);  // the outlane drain, 2.5 s after the last flipper touch
   c.drains.add(bench::DrainCause::kCentre, false);
   c.cut = balls - 2;
   c.wall_s = 0.01 * balls;
