@@ -147,6 +147,20 @@ std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const Transfer
       out.push_back(std::move(w));
     }
   }
+  for (const CombinedWorld& c : o.combined) {
+    PlannedWorld w{{}, nominal, {}};
+    for (const auto& [kind, change] : c.changes) w.settings = perturb(w.settings, kind, nominal_value(kind, o) + change);
+    w.row.family = "combined";
+    w.row.name = c.name;
+    w.row.world = std::string(sim::stepper_kind_name(c.stepper));
+    w.row.balls = o.balls;
+    w.row.played = true;
+    w.world.board = std::make_unique<const table::Board>(w.settings.board);
+    sim::ModelWorldOptions world_options;
+    world_options.stepper = c.stepper;
+    w.world.world = sim::make_model_world(*w.world.board, world_options);
+    out.push_back(std::move(w));
+  }
   return out;
 }
 

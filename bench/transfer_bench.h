@@ -57,6 +57,21 @@ std::vector<SweepFamily> default_transfer_sweep();
 /// One value per family, for tests and a first look.
 std::vector<SweepFamily> quick_transfer_sweep();
 
+/// Several perturbations at once (issue 20's "combined" cell: a real table
+/// differs from the model in many ways together), played on `stepper`.
+struct CombinedWorld {
+  std::string name;                                  ///< its row ("combined_mu-20")
+  sim::StepperKind stepper = sim::StepperKind::kEvent;  ///< the world's integrator
+  /// What changes, each relative to the nominal world in its family's unit:
+  /// offsets as in the sweep; delay, latency and noise added to the nominal setting.
+  std::vector<std::pair<Perturbation, double>> changes;
+};
+
+/// The differences the learned controllers were first measured to fail
+/// under together: the event stepper, flipper μ −20 % (and +20 %), g −3 %,
+/// and 5 ms more camera latency; two worlds.
+std::vector<CombinedWorld> default_combined_worlds();
+
 /// A player: the spastic baseline (spec null) or a controller file.
 struct TransferController {
   std::string name;                                ///< "spastic", or the file's stem
@@ -79,6 +94,7 @@ struct TransferBenchOptions {
   double twin_actuation_delay_s = firmware::kDefaultActuationDelay_s;
   track::CameraModelConfig camera;  ///< the nominal camera (the tracker's belief in every world)
   std::vector<SweepFamily> sweep = default_transfer_sweep();  ///< the perturbations
+  std::vector<CombinedWorld> combined = default_combined_worlds();  ///< played after the sweep
   /// The players after the spastic baseline, which always plays first (the ratios' denominator).
   std::vector<TransferController> controllers;
   std::string twin_params_path;     ///< the twin's parameters ("" : the shipped config/twin.yaml)
@@ -136,7 +152,7 @@ void set_ratios_to_spastic(std::vector<TransferCell>& cells);
 /// One world (a row of the table).
 struct TransferWorld {
   std::string name;           ///< "model", "event", "twin", or "<perturbation>=<value>" ("gravity_pct=+10")
-  std::string family;         ///< "nominal" for model, event and twin; otherwise perturbation_name
+  std::string family;         ///< "nominal" for model, event and twin, "combined" for a CombinedWorld; otherwise perturbation_name
   double value = 0.0;         ///< the perturbation's value (0 for the nominal worlds)
   std::string world;          ///< what played: thesis, event or twin
   int balls = 0;              ///< balls per cell in this world

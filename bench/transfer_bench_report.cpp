@@ -56,6 +56,13 @@ std::string score_text(const TransferCell& c, bool with_ratio) {
   return s;
 }
 
+// "+5", "-20": a change with its sign.
+std::string value_text_signed(double v) {
+  std::ostringstream out;
+  out << (v > 0 ? "+" : "") << v;
+  return out.str();
+}
+
 std::string csv_text(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string q = "\"";
@@ -80,6 +87,13 @@ nlohmann::json to_json(const TransferReport& r) {
   for (const SweepFamily& f : o.sweep) {
     sweep.push_back({{"family", perturbation_name(f.kind)}, {"label", perturbation_label(f.kind)},
                      {"offset", is_offset(f.kind)}, {"values", f.values}});
+  }
+  nlohmann::json combined = nlohmann::json::array();
+  for (const CombinedWorld& c : o.combined) {
+    nlohmann::json changes = nlohmann::json::array();
+    for (const auto& [kind, change] : c.changes)
+      changes.push_back({{"family", perturbation_name(kind)}, {"change", change}});
+    combined.push_back({{"name", c.name}, {"stepper", sim::stepper_kind_name(c.stepper)}, {"changes", changes}});
   }
   nlohmann::json worlds = nlohmann::json::array();
   for (const TransferWorld& w : r.worlds) {
@@ -134,6 +148,7 @@ nlohmann::json to_json(const TransferReport& r) {
           {"ratio_interval", kRatioInterval},
           {"controllers", controllers},
           {"sweep", sweep},
+          {"combined", combined},
           {"worlds", worlds},
           {"target_ratio", o.target_ratio},
           {"summary", summary},
@@ -150,8 +165,13 @@ std::string to_text(const TransferReport& r) {
       << o.balls << " balls per cell (seed " << o.seed << ", the same balls in every cell), balls cut at "
       << format_number(o.max_ball_time_s) << " s; wall " << format_duration(r.wall_s) << "\n"
       << "belief: " << kBelief << (o.identified.empty() ? "" : ", " + o.identified + " laid over it")
-      << "; pivots along " << kPivotAxis << "; wall rho " << kWallRhoRule << "\n"
-      << "mean score per ball (95 %), ratio to the spastic flipper in the same world (ratio interval: "
+      << "; pivots along " << kPivotAxis << "; wall rho " << kWallRhoRule << "\n";
+  for (const CombinedWorld& c : o.combined) {
+    out << c.name << ": the " << sim::stepper_kind_name(c.stepper) << " stepper";
+    for (const auto& [kind, change] : c.changes) out << ", " << perturbation_name(kind) << " " << value_text_signed(change);
+    out << " (each relative to the model world)\n";
+  }
+  out << "mean score per ball (95 %), ratio to the spastic flipper in the same world (ratio interval: "
       << kRatioInterval << "), balls cut at " << format_number(o.max_ball_time_s) << " s:\n\n| world |";
   for (const std::string& n : names) out << ' ' << n << " |";
   out << "\n|---|";
@@ -159,7 +179,7 @@ std::string to_text(const TransferReport& r) {
   out << '\n';
   for (const TransferWorld& w : r.worlds) {
     std::string label = w.name;
-    if (w.family == "nominal" && w.played) {
+    if ((w.family == "nominal" || w.family == "combined") && w.played) {
       const bool fewer = w.balls > 0 && w.balls != o.balls;
       label += " (" + w.world + (fewer ? ", " + std::to_string(w.balls) + " balls" : "") + ")";
     }

@@ -30,6 +30,18 @@ std::vector<SweepFamily> default_transfer_sweep() {
           {Perturbation::kCameraNoise_px, {1, 2}}};
 }
 
+std::vector<CombinedWorld> default_combined_worlds() {
+  std::vector<CombinedWorld> out;
+  for (const double mu_pct : {-20.0, 20.0}) {
+    out.push_back({std::string("combined_mu") + (mu_pct > 0 ? "+" : "") + std::to_string(static_cast<int>(mu_pct)),
+                   sim::StepperKind::kEvent,
+                   {{Perturbation::kFlipperMu_pct, mu_pct},
+                    {Perturbation::kGravity_pct, -3.0},
+                    {Perturbation::kCameraLatency_ms, 5.0}}});
+  }
+  return out;
+}
+
 std::vector<SweepFamily> quick_transfer_sweep() {
   return {{Perturbation::kPivotY_mm, {3}},         {Perturbation::kThetaMin_deg, {-1}},
           {Perturbation::kFlipperMu_pct, {20}},    {Perturbation::kWallRho, {-0.1}},

@@ -30,6 +30,7 @@ TransferBenchOptions tiny() {
   o.threads = 2;
   o.max_ball_time_s = 8.0;
   o.sweep = {{Perturbation::kGravity_pct, {10}}, {Perturbation::kActuationDelay_ms, {4, 20}}};
+  o.combined = {{"combined_test", sim::StepperKind::kEvent, {{Perturbation::kGravity_pct, -3.0}}}};
   o.controllers = {{"best", "controllers/best.json", &best()}};
   return o;
 }
@@ -48,12 +49,15 @@ TEST(TransferBench, EveryWorldHasEveryControllerOnTheSameBalls) {
     ++lines;
     last = l;
   });
-  // model, event, twin; the nominal 4 ms delay is the model world, not played twice.
-  ASSERT_EQ(r.worlds.size(), 5u);
+  // model, event, twin; the nominal 4 ms delay is the model world, not played twice; the combined world last.
+  ASSERT_EQ(r.worlds.size(), 6u);
   EXPECT_EQ(r.worlds[0].name, "model");
   EXPECT_EQ(r.worlds[1].world, "event");
   EXPECT_EQ(r.worlds[3].name, "gravity_pct=+10");
   EXPECT_EQ(r.worlds[4].name, "actuation_delay_ms=20");
+  EXPECT_EQ(r.worlds[5].name, "combined_test");
+  EXPECT_EQ(r.worlds[5].family, "combined");
+  EXPECT_EQ(r.worlds[5].world, "event");
   const TransferWorld& twin = world_named(r, "twin");
   EXPECT_EQ(twin.played, simlab::twin_available());
   if (!twin.played) {
@@ -114,6 +118,48 @@ TEST(TransferBench, RatiosAreAgainstTheFirstCellTheSpasticFlippers) {
   std::vector<TransferCell> none;
   set_ratios_to_spastic(none);  // no cells, nothing to do
   EXPECT_TRUE(none.empty());
+}
+
+TEST(TransferBench, ACombinedWorldAppliesEachChangeToTheNominalWorld) {
+  // On the thesis stepper, g +10 % alone is the sweep's g +10 % world, and 5 ms
+  // more latency than the nominal 5 ms is its 10 ms world: the same balls, bit for bit.
+  TransferBenchOptions o = tiny();
+  o.sweep = {{Perturbation::kGravity_pct, {10}}, {Perturbation::kCameraLatency_ms, {10}}};
+  o.combined = {{"g", sim::StepperKind::kThesis, {{Perturbation::kGravity_pct, 10.0}}},
+                {"latency", sim::StepperKind::kThesis, {{Perturbation::kCameraLatency_ms, 5.0}}},
+                {"both", sim::StepperKind::kThesis,
+                 {{Perturbation::kGravity_pct, 10.0}, {Perturbation::kCameraLatency_ms, 5.0}}}};
+  const TransferReport r = run_transfer_bench(thesis_board(), o, {});
+  const auto same = [&](const std::string& a, const std::string& b) {
+    const TransferWorld& p = world_named(r, a);
+    const TransferWorld& q = world_named(r, b);
+    ASSERT_EQ(p.cells.size(), q.cells.size());
+    for (std::size_t k = 0; k < p.cells.size(); ++k) {
+      EXPECT_EQ(p.cells[k].score.mean(), q.cells[k].score.mean()) << a << " " << b << " " << p.cells[k].controller;
+      EXPECT_EQ(p.cells[k].duration_s.mean(), q.cells[k].duration_s.mean()) << a << " " << b;
+    }
+  };
+  same("g", "gravity_pct=+10");
+  same("latency", "camera_latency_ms=10");
+  const TransferWorld& both = world_named(r, "both");
+  EXPECT_NE(both.cells[0].duration_s.mean(), world_named(r, "g").cells[0].duration_s.mean())
+      << "the latency moves the tracker-side spastic flipper too";
+  EXPECT_EQ(both.world, "thesis");
+}
+
+TEST(TransferBench, TheDefaultCombinedWorldsAreTheIssuesDifferencesTogether) {
+  const std::vector<CombinedWorld> c = default_combined_worlds();
+  ASSERT_EQ(c.size(), 2u);
+  for (const CombinedWorld& w : c) {
+    EXPECT_EQ(w.stepper, sim::StepperKind::kEvent) << w.name;
+    ASSERT_EQ(w.changes.size(), 3u) << w.name;
+    EXPECT_EQ(w.changes[1], std::make_pair(Perturbation::kGravity_pct, -3.0));
+    EXPECT_EQ(w.changes[2], std::make_pair(Perturbation::kCameraLatency_ms, 5.0));
+  }
+  EXPECT_EQ(c[0].name, "combined_mu-20");
+  EXPECT_EQ(c[0].changes[0], std::make_pair(Perturbation::kFlipperMu_pct, -20.0));
+  EXPECT_EQ(c[1].name, "combined_mu+20");
+  EXPECT_EQ(c[1].changes[0], std::make_pair(Perturbation::kFlipperMu_pct, 20.0));
 }
 
 TEST(TransferBench, SameSeedSameCellsWhateverTheThreads) {

@@ -38,7 +38,10 @@ TEST_F(TransferCommand, QuickRunGivesEveryCellAndWritesItsFiles) {
   EXPECT_EQ(j.at("twin_balls"), 2) << "the twin plays fewer of the same balls";
   EXPECT_EQ(j.at("max_ball_time_s"), 60.0);
   ASSERT_EQ(j.at("controllers").size(), 4u) << "spastic, best, imitation, cem";
-  ASSERT_EQ(j.at("worlds").size(), 3u + 8u) << "model, event, twin and one world per family";
+  ASSERT_EQ(j.at("worlds").size(), 3u + 8u + 2u) << "model, event, twin, one world per family, two combined";
+  ASSERT_EQ(j.at("combined").size(), 2u);
+  EXPECT_EQ(j.at("combined")[0].at("stepper"), "event");
+  EXPECT_EQ(j.at("worlds").back().at("family"), "combined");
   for (const auto& w : j.at("worlds")) {
     if (!w.at("played").get<bool>()) {
       EXPECT_EQ(w.at("name"), "twin") << "only the twin may be missing";
@@ -66,7 +69,7 @@ TEST_F(TransferCommand, QuickRunGivesEveryCellAndWritesItsFiles) {
   EXPECT_NE(r.err.find("ETA"), std::string::npos) << r.err;
   const std::string table = slurp(csv);
   EXPECT_EQ(table.rfind("world,family,value,stepper,controller,status,", 0), 0u) << table;
-  EXPECT_EQ(count_lines(table), 1 + 11 * 4);
+  EXPECT_EQ(count_lines(table), 1 + 13 * 4);
   const std::string picture = slurp(png);
   ASSERT_GT(picture.size(), 1000u);
   EXPECT_EQ(picture.substr(1, 3), "PNG");
