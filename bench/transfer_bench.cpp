@@ -48,6 +48,12 @@ TransferBall play_transfer_ball(sim::World& world, const WorldSettings& settings
   return b;
 }
 
+std::string value_text(double v, bool sign) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), sign ? "%+g" : "%g", v);
+  return buf;
+}
+
 void set_ratios_to_spastic(std::vector<TransferCell>& cells) {
   if (cells.empty()) return;
   const RunningStats spastic = cells.front().score;
@@ -95,12 +101,6 @@ struct PlannedWorld {
   WorldSettings settings;
   simlab::OwnedWorld world;  // empty when skipped
 };
-
-std::string value_text(double v, bool sign) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), sign ? "%+g" : "%g", v);
-  return buf;
-}
 
 // The nominal worlds, then the sweep in order; a value equal to the nominal
 // setting is the `model` world and is not played twice.

@@ -145,6 +145,10 @@ struct TransferCell {
   double wall_s = 0.0;      ///< wall time of this cell's balls, summed over their threads (its cost)
 };
 
+/// A perturbation's value as a row name shows it: "%g", with its sign
+/// ("+10") when `sign` (an offset, or a combined world's change).
+std::string value_text(double v, bool sign);
+
 /// Sets every cell's ratio_to_spastic and ratio_interval against the first
 /// cell, the spastic flipper's.
 void set_ratios_to_spastic(std::vector<TransferCell>& cells);

@@ -56,13 +56,6 @@ std::string score_text(const TransferCell& c, bool with_ratio) {
   return s;
 }
 
-// "+5", "-20": a change with its sign.
-std::string value_text_signed(double v) {
-  std::ostringstream out;
-  out << (v > 0 ? "+" : "") << v;
-  return out.str();
-}
-
 std::string csv_text(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string q = "\"";
@@ -168,7 +161,7 @@ std::string to_text(const TransferReport& r) {
       << "; pivots along " << kPivotAxis << "; wall rho " << kWallRhoRule << "\n";
   for (const CombinedWorld& c : o.combined) {
     out << c.name << ": the " << sim::stepper_kind_name(c.stepper) << " stepper";
-    for (const auto& [kind, change] : c.changes) out << ", " << perturbation_name(kind) << " " << value_text_signed(change);
+    for (const auto& [kind, change] : c.changes) out << ", " << perturbation_name(kind) << " " << value_text(change, true);
     out << " (each relative to the model world)\n";
   }
   out << "mean score per ball (95 %), ratio to the spastic flipper in the same world (ratio interval: "
