@@ -1,0 +1,66 @@
+#!/usr/bin/env python3
+"""bench/outlane_routes.py on a hand-made trace: one ball down the left
+passage into the outlane 2.5 s after a flipper push, one down the middle;
+and the refusals of a missing file and of a file that is no trace."""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+SCRIPT = sys.argv[1]
+
+
+def run(*args):
+    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
+
+
+def check(condition, what):
+    if not condition:
+        print("FAILED:", what, file=sys.stderr)
+        sys.exit(1)
+
+
+rows = [
+    # ball 1: pushed at 1.0 s, two obstacles, down the passage, past the pivot line at x 0.02 at 3.5 s
+    (0.0, 0.49, 0.054, 0, 4.6, "launch"),
+    (1.0, 0.20, 0.17, -1, 2, "push:left_flipper"),
+    (1.5, 0.17, 0.79, 0, 1, "hit:bumper_left"),
+    (1.6, 0.15, 0.80, 0, 1, "hit:bumper_left"),  # the same contact, one step on: not counted again
+    (2.0, 0.05, 1.00, -1, 0, "hit:top_left_arc"),
+    (2.5, 0.03, 0.70, 0, -1, ""),
+    (3.0, 0.03, 0.50, 0, -1, ""),
+    (3.4, 0.02, 0.17, 0, -1, ""),
+    (3.5, 0.02, 0.15, 0, -1, ""),
+    (3.6, 0.03, 0.02, 0, -1, "hit:drain|lost"),
+    # ball 2: pushed at 5.0 s, down the middle at 6.1 s
+    (4.0, 0.49, 0.054, 0, 4.6, "launch"),
+    (5.0, 0.30, 0.20, 0, 1, "push:right_flipper"),
+    (6.0, 0.25, 0.17, 0, -1, ""),
+    (6.1, 0.25, 0.15, 0, -1, ""),
+    (6.2, 0.25, 0.02, 0, -1, "hit:drain|lost"),
+]
+with tempfile.TemporaryDirectory() as d:
+    trace = os.path.join(d, "trace.csv")
+    with open(trace, "w") as f:
+        f.write("t,x,y,vx,vy,event\n")
+        for r in rows:
+            f.write(",".join(str(v) for v in r) + "\n")
+    r = run(trace, "--json")
+    check(r.returncode == 0, "exit 0 on a trace: " + r.stderr)
+    j = json.loads(r.stdout)
+    check(j["drains"] == 2 and j["left_outlane"] == 1 and j["centre_or_right"] == 1, f"the causes: {j}")
+    check(j["left_outlane_via_passage"] == 1, f"down the passage: {j}")
+    check(abs(j["s_from_last_flipper_touch"]["median"] - 2.5) < 1e-9, f"2.5 s from the push: {j}")
+    check(j["contacts_from_last_flipper_touch"]["median"] == 2, f"two contacts: {j}")
+    text = run(trace)
+    check(text.returncode == 0 and "1 left outlane (1 down the left passage" in text.stdout, text.stdout)
+
+    missing = run(os.path.join(d, "no_such.csv"))
+    check(missing.returncode == 1 and "no_such.csv" in missing.stderr and not missing.stdout, "a missing file")
+    other = os.path.join(d, "other.csv")
+    with open(other, "w") as f:
+        f.write("a,b\n1,2\n")
+    wrong = run(other)
+    check(wrong.returncode == 1 and "other.csv" in wrong.stderr and "header" in wrong.stderr, "not a trace")
+print("outlane_routes: all checks passed")
