@@ -18,7 +18,7 @@ packages=(
   libyaml-cpp-dev
   nlohmann-json3-dev libcli11-dev
   can-utils libsocketcan-dev
-  python3-minimal   # runs the test of the generated Python LCM bindings
+  python3           # runs the tests of the generated Python LCM bindings and bench/outlane_routes.py (json, statistics)
   # The driver board's firmware (firmware_interface/stm32f446/): the Arm cross compiler
   # and newlib for the image, QEMU to boot it (ctest label firmware).
   gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm
