@@ -102,6 +102,17 @@ struct PlannedWorld {
   simlab::OwnedWorld world;  // empty when skipped
 };
 
+// Makes `w` a model world of its own settings' board on `stepper`, played with `balls` balls.
+void play_model_world(PlannedWorld& w, sim::StepperKind stepper, int balls) {
+  w.row.world = std::string(sim::stepper_kind_name(stepper));
+  w.row.balls = balls;
+  w.row.played = true;
+  w.world.board = std::make_unique<const table::Board>(w.settings.board);
+  sim::ModelWorldOptions options;
+  options.stepper = stepper;
+  w.world.world = sim::make_model_world(*w.world.board, options);
+}
+
 // The nominal worlds, then the sweep in order; a value equal to the nominal
 // setting is the `model` world and is not played twice.
 std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const TransferBenchOptions& o) {
@@ -139,11 +150,7 @@ std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const Transfer
       w.row.family = std::string(perturbation_name(family.kind));
       w.row.name = w.row.family + "=" + value_text(v, is_offset(family.kind));
       w.row.value = v;
-      w.row.world = "thesis";
-      w.row.balls = o.balls;
-      w.row.played = true;
-      w.world.board = std::make_unique<const table::Board>(w.settings.board);
-      w.world.world = sim::make_model_world(*w.world.board);
+      play_model_world(w, sim::StepperKind::kThesis, o.balls);
       out.push_back(std::move(w));
     }
   }
@@ -152,13 +159,7 @@ std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const Transfer
     for (const auto& [kind, change] : c.changes) w.settings = perturb(w.settings, kind, nominal_value(kind, o) + change);
     w.row.family = "combined";
     w.row.name = c.name;
-    w.row.world = std::string(sim::stepper_kind_name(c.stepper));
-    w.row.balls = o.balls;
-    w.row.played = true;
-    w.world.board = std::make_unique<const table::Board>(w.settings.board);
-    sim::ModelWorldOptions world_options;
-    world_options.stepper = c.stepper;
-    w.world.world = sim::make_model_world(*w.world.board, world_options);
+    play_model_world(w, c.stepper, o.balls);
     out.push_back(std::move(w));
   }
   return out;
