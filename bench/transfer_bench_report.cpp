@@ -44,14 +44,16 @@ nlohmann::json cell_json(const TransferCell& c) {
           {"wall_s", c.wall_s}};
 }
 
+// " (1.96–2.31)": a ratio's interval as the text tables show it; "" for none.
+std::string interval_text(const std::optional<RatioInterval>& interval) {
+  if (!interval) return "";
+  return " (" + format_number(interval->low, 3) + "–" + format_number(interval->high, 3) + ")";
+}
+
 // "9325 ± 700": a mean and its interval, or the ratio, as the text tables show them.
 std::string score_text(const TransferCell& c, bool with_ratio) {
   std::string s = format_mean_ci(c.score.mean(), c.score.ci95_half_width());
-  if (with_ratio) {
-    s += ", " + format_number(c.ratio_to_spastic, 3) + "x";
-    if (c.ratio_interval)
-      s += " (" + format_number(c.ratio_interval->low, 3) + "–" + format_number(c.ratio_interval->high, 3) + ")";
-  }
+  if (with_ratio) s += ", " + format_number(c.ratio_to_spastic, 3) + "x" + interval_text(c.ratio_interval);
   if (c.cut > 0) s += ", " + std::to_string(c.cut) + " cut";
   return s;
 }
@@ -191,10 +193,7 @@ std::string to_text(const TransferReport& r) {
         << "|---|---:|---|---:|---:|\n";
     for (const TransferSummary& m : r.summaries) {
       out << "| " << m.controller << " | " << format_number(m.median_ratio, 3) << "x | " << format_number(m.lowest_ratio, 3)
-          << "x";
-      if (m.lowest_interval)
-        out << " (" << format_number(m.lowest_interval->low, 3) << "–" << format_number(m.lowest_interval->high, 3) << ")";
-      out << ", " << m.lowest_world << " | " << m.worlds_at_target << " | " << m.worlds_below_target << " |\n";
+          << "x" << interval_text(m.lowest_interval) << ", " << m.lowest_world << " | " << m.worlds_at_target << " | " << m.worlds_below_target << " |\n";
     }
   }
   out << "\ndrains: left outlane / right outlane / centre / other; of them left the table; mean s from the last "
