@@ -52,7 +52,14 @@ def main() -> int:
     since_touch_s = []
     contacts_since = []
     for r in rows:
-        t, x, y, vy, event = float(r[0]), float(r[1]), float(r[2]), float(r[4]), r[5]
+        try:
+            if len(r) != 6:
+                raise ValueError(f"{len(r)} fields, not 6")
+            t, x, y, vy, event = float(r[0]), float(r[1]), float(r[2]), float(r[4]), r[5]
+        except ValueError as e:
+            print(f"outlane_routes: {a.trace}:{rows.line_num}: not a trace row ({e}); nothing printed",
+                  file=sys.stderr)
+            return 1
         if event == "launch":
             crossing_x, touched_s, contacts, prev = None, None, 0, None
             steps.clear()

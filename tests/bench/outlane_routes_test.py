@@ -63,4 +63,9 @@ with tempfile.TemporaryDirectory() as d:
         f.write("a,b\n1,2\n")
     wrong = run(other)
     check(wrong.returncode == 1 and "other.csv" in wrong.stderr and "header" in wrong.stderr, "not a trace")
+    truncated = os.path.join(d, "truncated.csv")
+    with open(truncated, "w") as f:
+        f.write("t,x,y,vx,vy,event\n0,0.49,0.054,0,4.6,launch\n0.5,0.4\n")
+    cut = run(truncated, "--json")
+    check(cut.returncode == 1 and "truncated.csv:3" in cut.stderr and not cut.stdout, "a truncated row: " + cut.stderr)
 print("outlane_routes: all checks passed")
