@@ -17,6 +17,7 @@
 #include "calibration_bench.h"
 #include <optional>
 
+#include "aim_bench.h"
 #include "ceiling_bench.h"
 #include "transfer_bench.h"
 #include "pinball/control/controller_file.h"
@@ -34,18 +35,20 @@
 namespace pinball::cli {
 
 CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
+  const bench::AimBenchOptions aim_defaults;
   CLI::App* cmd = app.add_subcommand(
       "bench",
-      "run a benchmark (speed, tracker, latency, detector, camera, calibration, precision, ceiling, transfer, protocol, "
-      "draw)");
+      "run a benchmark (speed, tracker, latency, detector, camera, calibration, precision, ceiling, aim, transfer, "
+      "protocol, draw)");
   cmd->add_option("kind", a.which,
                   "which benchmark: speed, tracker, latency, detector, camera (a real camera's faults, uncorrected and "
-                  "corrected), calibration, precision, ceiling, transfer "
+                  "corrected), calibration, precision, ceiling, aim (how exactly a shot's direction follows from a noisy "
+                  "ball), transfer "
                   "(every controller in several worlds and a sweep of world errors, the belief nominal), protocol, "
                   "draw (the pictures of pinball play and pinball view)")
       ->required()
       ->check(CLI::IsMember(
-          {"speed", "tracker", "latency", "detector", "camera", "calibration", "precision", "ceiling", "transfer",
+          {"speed", "tracker", "latency", "detector", "camera", "calibration", "precision", "ceiling", "aim", "transfer",
            "protocol", "draw"}));
   cmd->add_option("--board", a.board, "board file (ceiling, transfer: the belief)")->transform(data_file());
   add_identified_option(*cmd, a.identified);
@@ -58,13 +61,14 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
                   "tracker, detector, camera, calibration, ceiling, transfer: seed for play, camera noise, placements and "
                   "balls");
   cmd->add_flag("--quick", a.quick,
-                "tracker, detector, camera, calibration, latency, precision, ceiling, transfer: a short run (fewer "
+                "tracker, detector, camera, calibration, latency, precision, ceiling, aim, transfer: a short run (fewer "
                 "approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one value per family)");
   cmd->add_option("--balls", a.balls,
-                  "ceiling: balls per player; transfer: balls per world and controller (the same ball seeds for "
-                  "every player)")
+                  "ceiling: balls per player; aim: ceiling balls whose fires are replayed; transfer: balls per world "
+                  "and controller (the same ball seeds for every player)")
       ->check(CLI::Range(1, 1'000'000))
-      ->default_str("ceiling 200, transfer " + std::to_string(bench::TransferBenchOptions{}.balls));
+      ->default_str("ceiling 200, aim " + std::to_string(aim_defaults.balls) + ", transfer " +
+                    std::to_string(bench::TransferBenchOptions{}.balls));
   cmd->add_option("--twin-balls", a.twin_balls,
                   "transfer: balls per controller in the MuJoCo twin, the first of the same seeds (it plays about "
                   "100x slower than the model)")
@@ -73,18 +77,19 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--threads", a.threads, "ceiling, transfer: worker threads (results do not depend on it)")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--controller", a.controllers,
-                  "ceiling: also play this controller file through the camera model and tracker (a planner file: the ceiling plans with its settings); transfer "
+                  "ceiling: also play this controller file through the camera model and tracker (a planner file: the ceiling plans with its settings); aim: a planner file whose settings the ceiling player plans with; transfer "
                   "(repeatable): play these instead of controllers/best.json, imitation.json and cem.json")
       ->transform(data_file())
       ->default_str("ceiling none, transfer controllers/best.json imitation.json cem.json");
   cmd->add_option("--true-state-noise", a.true_state_noise,
                   "ceiling: also play the --controller fed the TRUE ball every frame instead of the tracker's estimate, "
-                  "plus Gaussian noise of MM (position, mm) and MPS (velocity, m/s) per coordinate")
+                  "plus Gaussian noise of MM (position, mm) and MPS (velocity, m/s) per coordinate; aim: replay the "
+                  "shots from a ball with this noise only (default: 0.3 mm 0.005, 1 mm 0.02 and 3 mm 0.1 m/s)")
       ->expected(2)
       ->type_name("MM MPS")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--max-ball-time", a.max_ball_time_s,
-                  "ceiling, transfer: seconds after which a ball still alive is cut")
+                  "ceiling, aim, transfer: seconds after which a ball still alive is cut")
       ->check(CLI::Range(1.0, 3600.0));
   cmd->add_option("--target-ratio", a.target_ratio,
                   "transfer: the ratio to the spastic flipper the summary holds every world to (counts the worlds at "
@@ -278,10 +283,44 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
   return 0;
 }
 
-int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
+// Whether any of --world, --world-board, --stepper and --dt was given: the
+// benches that choose their own worlds refuse them.
+bool world_options_given(const simlab::WorldSpec& world) {
   const simlab::WorldSpec model_world;
-  if (a.world.kind != model_world.kind || !a.world.board_path.empty() || a.world.stepper != model_world.stepper ||
-      a.world.dt_s != model_world.dt_s) {
+  return world.kind != model_world.kind || !world.board_path.empty() || world.stepper != model_world.stepper ||
+         world.dt_s != model_world.dt_s;
+}
+
+int run_aim(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
+  bench::AimBenchOptions options;
+  options.balls = a.quick ? 3 : (a.balls > 0 ? a.balls : options.balls);
+  options.seed = a.seed;
+  options.max_ball_time_s = a.max_ball_time_s;
+  if (a.controllers.size() > 1) throw std::invalid_argument("bench aim: one --controller at most");
+  if (!a.controllers.empty()) {
+    const control::ControllerSpec planner = control::load_controller(a.controllers.front());
+    if (!planner.planner) throw std::invalid_argument("bench aim: " + a.controllers.front() + ": not a planner file");
+    options.planner = learn::lookahead_config(*planner.planner, board.dt_s);
+  }
+  if (!a.true_state_noise.empty()) options.noise = {{a.true_state_noise[0] * 1e-3, a.true_state_noise[1]}};
+  if (world_options_given(a.world)) {
+    throw std::invalid_argument("bench aim: it plays the belief's model only; --world, --world-board, --stepper and --dt do not apply");
+  }
+  options.actuation_delay_s = world_actuation_delay_s(std::nullopt, simlab::WorldSpec{}, a.identified);
+  const bench::AimReport report =
+      bench::run_aim_bench(board, options, [&](const std::string& line) { err << "bench " << line << "\n"; });
+  if (a.json) {
+    nlohmann::json j = bench::to_json(report);
+    j.update(identified_report(a.identified));
+    out << j.dump(2) << "\n";
+  } else {
+    out << bench::to_text(report) << identified_text_line(a.identified);
+  }
+  return 0;
+}
+
+int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
+  if (world_options_given(a.world)) {
     throw std::invalid_argument(
         "bench transfer: its worlds are its rows (model, event, twin and the sweep); --world, --world-board, "
         "--stepper and --dt do not apply");
@@ -394,11 +433,11 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   std::ostream& err = progress_wanted(a.progress) ? all_err : no_progress;
   if (a.which == "latency") return run_latency(a, out, err);
   if (a.which == "protocol") return run_protocol(a, out, err);
-  if (!a.true_state_noise.empty() && a.which != "ceiling") {
-    throw std::invalid_argument("bench " + a.which + ": --true-state-noise applies to ceiling only");
+  if (!a.true_state_noise.empty() && a.which != "ceiling" && a.which != "aim") {
+    throw std::invalid_argument("bench " + a.which + ": --true-state-noise applies to ceiling and aim only");
   }
-  if (!a.identified.empty() && a.which != "ceiling" && a.which != "transfer") {
-    throw std::invalid_argument("bench " + a.which + ": --identified applies to ceiling and transfer only");
+  if (!a.identified.empty() && a.which != "ceiling" && a.which != "aim" && a.which != "transfer") {
+    throw std::invalid_argument("bench " + a.which + ": --identified applies to ceiling, aim and transfer only");
   }
   const table::Board board = table::load_belief_board(a.board, a.identified);  // the belief of ceiling and transfer
   if (a.which == "tracker") return run_tracker(a, board, out, err);
@@ -407,6 +446,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   if (a.which == "calibration") return run_calibration(a, board, out, err);
   if (a.which == "precision") return run_precision(a, board, out, err);
   if (a.which == "ceiling") return run_ceiling(a, board, out, err);
+  if (a.which == "aim") return run_aim(a, board, out, err);
   if (a.which == "transfer") return run_transfer(a, board, out, err);
   if (a.which == "draw") return run_draw(a, board, out, err);
   bench::SpeedBenchOptions options;
