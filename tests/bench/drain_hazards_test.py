@@ -6,23 +6,12 @@ and a malformed row."""
 import json
 import math
 import os
-import subprocess
-import sys
 import tempfile
 
-SCRIPT = sys.argv[1]
+from script_test import check, run
+
 HEADER = ("world,family,value,stepper,controller,status,balls,mean_score_per_ball,ratio_to_spastic,"
           "mean_ball_time_s,drains_left_outlane,drains_right_outlane,drains_centre,drains_other,drains_left_table")
-
-
-def run(*args):
-    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
-
-
-def check(condition, what):
-    if not condition:
-        print("FAILED:", what, file=sys.stderr)
-        sys.exit(1)
 
 
 def write(d, name, lines):

@@ -6,22 +6,9 @@ outlane, one from the right bat that comes back, one too slow to count);
 and the refusals of a missing file and of a file that is no trace."""
 import json
 import os
-import subprocess
-import sys
 import tempfile
 
-SCRIPT = sys.argv[1]
-
-
-def run(*args):
-    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
-
-
-def check(condition, what):
-    if not condition:
-        print("FAILED:", what, file=sys.stderr)
-        sys.exit(1)
-
+from script_test import check, run
 
 rows = [
     # ball 1: pushed at 1.0 s, two obstacles, down the passage, past the pivot line at x 0.02 at 3.5 s
