@@ -48,6 +48,14 @@ struct Fire {
   double hold_s = 0.0;
 };
 
+// The share of `of` copies whose miss is at most `limit_deg` (a copy with no
+// shot has no miss and is not counted in).
+double share_within(const std::vector<double>& misses_deg, double limit_deg, std::size_t of) {
+  if (of == 0) return 0.0;
+  const auto n = std::count_if(misses_deg.begin(), misses_deg.end(), [&](double e) { return e <= limit_deg; });
+  return static_cast<double>(n) / static_cast<double>(of);
+}
+
 void check_options(const AimBenchOptions& o) {
   if (o.balls < 1) throw std::invalid_argument("aim bench: balls must be >= 1");
   if (o.copies < 1) throw std::invalid_argument("aim bench: copies must be >= 1");
@@ -114,18 +122,13 @@ AimReport run_aim_bench(const table::Board& belief, const AimBenchOptions& optio
     for (const double d : shots) bat_only_errors_deg.push_back(std::abs(d - centre));
   }
   report.bat_only_median_error_deg = quantile(bat_only_errors_deg, 0.5);
-  if (!bat_only_errors_deg.empty()) {
-    report.bat_only_within_10_deg =
-        std::count_if(bat_only_errors_deg.begin(), bat_only_errors_deg.end(), [](double e) { return e <= 10.0; }) /
-        static_cast<double>(bat_only_errors_deg.size());
-  }
+  report.bat_only_within_10_deg = share_within(bat_only_errors_deg, 10.0, bat_only_errors_deg.size());
 
   Rng rng(ball_seed(options.seed, 0x61696d));  // "aim": its own stream, apart from the balls'
   for (const StateNoise& noise : options.noise) {
     AimNoiseResult r;
     r.noise = noise;
     std::vector<double> errors_deg;
-    int within_5 = 0, within_10 = 0;
     for (std::size_t i = 0; i < fires.size(); ++i) {
       if (!exact[i]) continue;
       for (int k = 0; k < options.copies; ++k) {
@@ -139,19 +142,13 @@ AimReport run_aim_bench(const table::Board& belief, const AimBenchOptions& optio
           ++r.no_shot;
           continue;
         }
-        const double e = std::abs(*d - *exact[i]);
-        const double error_deg = std::min(e, 360.0 - e);
-        errors_deg.push_back(error_deg);
-        within_5 += error_deg <= 5.0;
-        within_10 += error_deg <= 10.0;
+        errors_deg.push_back(std::abs(*d - *exact[i]));  // both upward, in (0°, 180°): no wrap
       }
     }
     r.median_error_deg = quantile(errors_deg, 0.5);
     r.p90_error_deg = quantile(errors_deg, 0.9);
-    if (r.copies > 0) {
-      r.within_5_deg = within_5 / static_cast<double>(r.copies);
-      r.within_10_deg = within_10 / static_cast<double>(r.copies);
-    }
+    r.within_5_deg = share_within(errors_deg, 5.0, static_cast<std::size_t>(r.copies));
+    r.within_10_deg = share_within(errors_deg, 10.0, static_cast<std::size_t>(r.copies));
     report.results.push_back(r);
   }
   report.wall_s = elapsed_s();

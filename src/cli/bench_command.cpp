@@ -58,7 +58,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
       ->check(CLI::Range(10, 1'000'000));
   cmd->add_option("--seed", a.seed,
-                  "tracker, detector, camera, calibration, ceiling, transfer: seed for play, camera noise, placements and "
+                  "tracker, detector, camera, calibration, ceiling, aim, transfer: seed for play, camera noise, placements and "
                   "balls");
   cmd->add_flag("--quick", a.quick,
                 "tracker, detector, camera, calibration, latency, precision, ceiling, aim, transfer: a short run (fewer "
