@@ -31,8 +31,14 @@ void raise_flags(const table::Board& board, GameState& state, double clear_m) {
 void hit_obstacle(const table::Board& board, GameState& state, std::int32_t index, const Vec2& normal,
                   StepEvents& events, double clear_m) {
   const table::Obstacle& o = board.obstacles[index];
+  const double strike_mps = -state.ball.velocity_mps.dot(normal);
   state.ball.velocity_mps = obstacle_response(o, normal, state.ball.velocity_mps);
-  score_obstacle_hit(board, state, index, events, clear_m);
+  if (strike_mps >= kMinStrikeSpeed_mps || o.action.eats_ball) {
+    score_obstacle_hit(board, state, index, events, clear_m);
+  } else {
+    events.flags |= StepEvents::kHitObstacle;  // touched: the physics above, no score and no flag
+    events.obstacle = index;
+  }
 }
 
 void score_obstacle_hit(const table::Board& board, GameState& state, std::int32_t index, StepEvents& events,

@@ -5,6 +5,7 @@
 
 #include "pinball/sim/model_world.h"
 #include "pinball/sim/event_stepper.h"
+#include "pinball/sim/game_rules.h"
 
 #include <gtest/gtest.h>
 
@@ -105,6 +106,21 @@ TEST(EventStepper, BouncesOnAFloorFollowTheGeometricSeriesThenRest) {
   EXPECT_EQ(s.events, events) << "a resting ball has no more events";
   EXPECT_NEAR(s.ball.position_m.y(), kR, 1e-9);
   EXPECT_EQ(s.ball.velocity_mps.norm(), 0.0);
+}
+
+// The event stepper scores by the same rule: strikes, not rest.
+TEST(EventStepper, ARestingBallScoresOnlyItsStrikes) {
+  const double g = 1.11, rho = 0.8, h0 = 0.3;
+  table::Board b = empty_board(1.0, 1.0, g, 5e-4);
+  table::Action a;
+  a.score = 200.0;
+  add_line(b, {-1.0, 0.0}, {2.0, 0.0}, rho, a);
+  const EventStepper stepper(b);
+  GameState s = state_with_ball(b, {0.5, kR + h0}, Vec2::Zero());
+  int strikes = 0;
+  for (double v = std::sqrt(2.0 * g * h0); v >= sim::rules::kMinStrikeSpeed_mps; v *= rho) ++strikes;
+  for (int i = 0; i < 40000; ++i) stepper.step(s);  // 20 s: at rest for most of it
+  EXPECT_EQ(s.score, 200.0 * strikes);
 }
 
 TEST(EventStepper, LooseTolerancesCostPrecisionNotPhysics) {

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "pinball/sim/game_rules.h"
 #include "pinball/sim/collision.h"
 #include "pinball/sim/penetration.h"
 #include "test_boards.h"
@@ -314,6 +315,42 @@ TEST(ThesisStepperActions, ScoreEachHit) {
   EXPECT_EQ(hits, 4);
   EXPECT_EQ(s.score, 50.0 * hits);
   EXPECT_EQ(gained, s.score);
+}
+
+// A hit scores when the ball strikes, not while it rests or rolls on the
+// obstacle: a ball dropped on a scoring floor scores its bounces down to the
+// strike speed, then nothing while it rolls along it for 5 s.
+TEST(ThesisStepperActions, ARestingOrRollingBallScoresNothing) {
+  const double g = 1.11, rho = 0.5, h0 = 0.05;
+  table::Board b = empty_board(4.0, 1.0, g, 5e-4);
+  table::Action a;
+  a.score = 200.0;
+  add_line(b, {-1.0, 0.1}, {5.0, 0.1}, rho, a);
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.5, 0.1 + kR + h0}, {0.2, 0.0});
+  // Impact k comes at sqrt(2 g h0)·ρ^(k−1): the strikes at 0.02 m/s or more.
+  int strikes = 0;
+  for (double v = std::sqrt(2.0 * g * h0); v >= sim::rules::kMinStrikeSpeed_mps; v *= rho) ++strikes;
+  int touches = 0;
+  for (int i = 0; i < 10000; ++i) touches += stepper.step(s).has(StepEvents::kHitObstacle) ? 1 : 0;
+  EXPECT_EQ(s.score, 200.0 * strikes);
+  EXPECT_GT(touches, 100) << "the rolling ball keeps touching the floor";
+  EXPECT_NEAR(s.ball.position_m.y(), 0.1 + kR, 1e-3);
+  EXPECT_GT(s.ball.position_m.x(), 1.0) << "and rolls on";
+}
+
+// An eating obstacle eats a ball that only rolls onto it.
+TEST(ThesisStepperActions, AnEaterEatsARollingBall) {
+  table::Board b = empty_board(2.0, 1.0, 1.11, 5e-4);
+  add_line(b, {-1.0, 0.1}, {3.0, 0.1}, 0.5);  // a floor
+  table::Action eat;
+  eat.eats_ball = true;
+  add_line(b, {1.0, 0.1}, {1.0, 0.3}, 0.0, eat);  // a wall across it, facing the ball (normal -x)
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.8, 0.1 + kR + 1e-6}, {0.01, 0.0});
+  bool lost = false;
+  for (int i = 0; i < 100000 && !lost; ++i) lost = stepper.step(s).has(StepEvents::kBallLost);
+  EXPECT_TRUE(lost);
 }
 
 TEST(ThesisStepperActions, EatsBallEndsIt) {

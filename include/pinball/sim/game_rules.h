@@ -27,8 +27,19 @@ void raise_flags(const table::Board& board, GameState& state, double clear_m);
 void score_obstacle_hit(const table::Board& board, GameState& state, std::int32_t index, StepEvents& events,
                         double clear_m);
 
+/// Slower than this along the contact normal, the ball rests or rolls on an
+/// obstacle rather than striking it (m/s): a real switch does not close, and
+/// the twin, which scores a contact only when it begins, never scores it.
+/// The steppers meet a resting ball every step or two (gravity feeds it
+/// about g·dt, 0.6 mm/s, between contacts), so without this a ball balanced
+/// on the caret's apex scored 200 points a contact, 185 000 a second. The
+/// speed a ball gains falling 0.2 mm.
+inline constexpr double kMinStrikeSpeed_mps = 0.02;
+
 /// The ball strikes obstacle `index` with contact normal `normal`: reflection
-/// with ρ, the kick, then score_obstacle_hit. clear_m as for raise_flags.
+/// with ρ, the kick, then score_obstacle_hit if it struck at
+/// kMinStrikeSpeed_mps or more (an eating obstacle eats at any speed).
+/// clear_m as for raise_flags.
 void hit_obstacle(const table::Board& board, GameState& state, std::int32_t index, const Vec2& normal,
                   StepEvents& events, double clear_m);
 
