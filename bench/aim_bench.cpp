@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -11,6 +10,7 @@
 #include "pinball/core/progress.h"
 #include "pinball/core/rng.h"
 #include "pinball/core/statistics.h"
+#include "pinball/learn/shot_values.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/model_world.h"
 #include "pinball/simlab/delay_line.h"
@@ -22,19 +22,14 @@ std::optional<double> shot_direction_deg(const sim::ThesisStepper& stepper, sim:
                                          double shot_time_s) {
   simlab::DelayLine delay(state.flippers.size(), actuation_delay_s);
   const double t0 = state.time_s;
-  bool touched = false;
+  int touched = -1;
   while (state.time_s - t0 < shot_time_s) {
     for (std::size_t i = 0; i < state.flippers.size(); ++i) {
       state.flippers[i].energized = static_cast<int>(i) == flipper && state.time_s - t0 < hold_s;
     }
     delay.apply(state);
     if (stepper.step(state).has(sim::StepEvents::kBallLost)) return std::nullopt;
-    touched = touched || std::any_of(state.flippers.begin(), state.flippers.end(),
-                                     [](const sim::FlipperState& f) { return f.ball_contact; });
-    const Vec2& v = state.ball.velocity_mps;
-    if (touched && state.ball.position_m.y() >= exit_y_m && v.y() > 0.0) {
-      return std::atan2(v.y(), v.x()) * 180.0 / std::numbers::pi;
-    }
+    if (const std::optional<learn::Shot> shot = learn::read_shot(state, exit_y_m, touched)) return shot->direction_deg;
   }
   return std::nullopt;
 }
@@ -80,9 +75,7 @@ AimReport run_aim_bench(const table::Board& belief, const AimBenchOptions& optio
   const auto elapsed_s = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   const sim::ThesisStepper stepper(belief);
   const std::unique_ptr<sim::World> world = sim::make_model_world(belief);
-  double pivot_y_m = -1e300;
-  for (const table::Flipper& f : belief.flippers) pivot_y_m = std::max(pivot_y_m, f.pivot.y());
-  const double exit_y_m = pivot_y_m + options.exit_height_m;
+  const double exit_y_m = learn::shot_line_y_m(belief, options.exit_height_m);
 
   std::vector<Fire> fires;
   sim::BallLimits limits;

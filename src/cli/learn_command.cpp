@@ -23,6 +23,8 @@
 #include "world_options.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/control/imitation_controller.h"
+#include "pinball/learn/shot_value_collection.h"
+#include "pinball/learn/shot_values.h"
 #include "pinball/learn/demonstrations.h"
 #include <functional>
 #include <optional>
@@ -54,12 +56,17 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
                   "rho, flipper mu, pivots, delay, camera latency and noise, stepper) while the controller believes "
                   "the board (docs/learning.md); the final evaluation plays the board itself")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--shot-values", a.shot_values,
+                  "imitate: the teacher values each plan at its shot by this table of what shots are worth "
+                  "(learn/shot_values.h, docs/learning.md) rather than by the branch played past it")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--method", a.method,
                   "tournament (thesis 6.2), relay (Hoeffding relay race, 6.3), cem (cross-entropy with common "
                   "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller); "
-                  "launcher: the launcher controller's search (20 pulls x 10 launches, thesis 5.1)")
+                  "launcher: the launcher controller's search (20 pulls x 10 launches, thesis 5.1); shot-values: what "
+                  "shots are worth in the belief, for a planner's or imitate's --shot-values (--budget-balls balls, --out)")
       ->required()
-      ->check(CLI::IsMember({"tournament", "relay", "cem", "imitate", "none", "spastic", "evaluate", "launcher"}));
+      ->check(CLI::IsMember({"tournament", "relay", "cem", "imitate", "none", "spastic", "evaluate", "launcher", "shot-values"}));
   cmd->add_option("--budget-balls", a.budget_balls, "simulated balls the search may play")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
   cmd->add_option("--seed", a.seed, "random seed; same seed, same result, whatever --threads");
@@ -307,12 +314,54 @@ int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err
   return 0;
 }
 
+// Gathers what shots are worth in the belief's model (learn/shot_value_collection.h)
+// and writes the table a planner's or imitate's teacher values its plans by.
+int run_shot_values(const LearnArgs& a, std::ostream& out, std::ostream& err) {
+  if (a.out.empty()) throw std::invalid_argument("learn: --method shot-values needs --out TABLE");
+  const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
+  if (world_spec.kind != simlab::WorldKind::kModel || !world_spec.board_path.empty() || !a.randomize.empty()) {
+    throw std::invalid_argument("learn: --method shot-values plays the belief's own model; not --world twin, "
+                                "--world-board or --randomize");
+  }
+  const table::Board board = table::load_belief_board(a.board, a.identified);
+  learn::ShotValueCollectionConfig config;
+  config.actuation_delay_s = a.actuation_delay_s;
+  config.max_ball_time_s = a.max_ball_time_s;
+  config.pull = a.pull;
+  const auto start = std::chrono::steady_clock::now();
+  const learn::ShotValueTable table = learn::collect_shot_values(
+      board, config, static_cast<int>(a.budget_balls), a.seed, a.threads, [&](const std::string& line) {
+        if (progress_wanted(a.progress)) err << "learn " << line << "\n";
+      });
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (learn::team_root()) learn::write_shot_value_table(table, a.out);
+  int valued_bins = 0;
+  for (const double v : table.smoothed) valued_bins += std::isnan(v) ? 0 : 1;
+  if (a.json) {
+    nlohmann::json j = {{"board", a.board},         {"method", "shot-values"},
+                        {"seed", a.seed},           {"balls", a.budget_balls},
+                        {"out", a.out},             {"shots", learn::shots_in(table)},
+                        {"valued_bins", valued_bins}, {"bins", table.smoothed.size()},
+                        {"horizon_s", config.player.horizon_s}, {"actuation_delay_s", config.actuation_delay_s},
+                        {"max_ball_time_s", config.max_ball_time_s}, {"wall_s", wall_s}};
+    j.update(identified_report(a.identified));
+    out << j.dump(2) << "\n";
+    return 0;
+  }
+  out << "shot values on " << a.board << " (seed " << a.seed << ", " << a.budget_balls << " balls of the looking-ahead "
+      << "player on the true state): " << learn::shots_in(table) << " shots, " << valued_bins << " of "
+      << table.smoothed.size() << " bins valued, " << format_duration(wall_s) << "\n"
+      << identified_text_line(a.identified) << "written to " << a.out << "\n";
+  return 0;
+}
+
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   LearnArgs a = args;
   a.actuation_delay_s = world_actuation_delay_s(
       args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,
       args.identified);
   if (a.method == "launcher") return run_launcher_search(a, out, err);
+  if (a.method == "shot-values") return run_shot_values(a, out, err);
   const bool search = a.method == "tournament" || a.method == "relay" || a.method == "cem";
   if ((search || a.method == "imitate") && a.out.empty()) {
     throw std::invalid_argument("learn: --out CONTROLLER is required for a search");
@@ -343,6 +392,8 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
       throw std::invalid_argument("learn: --randomize is for a search (tournament, relay, cem) or imitate, not --method " +
                                   a.method);
   }
+  if (!a.shot_values.empty() && a.method != "imitate")
+    throw std::invalid_argument("learn: --shot-values is for imitate (its teacher), not --method " + a.method);
   if (a.lead && !search && a.method != "imitate")
     throw std::invalid_argument("learn: --lead is for a search (tournament, relay, cem) or imitate, not --method " +
                                 a.method);
@@ -447,6 +498,11 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     ic.demonstration.max_ball_time_s = a.max_ball_time_s;
     ic.demonstration.pull = a.pull;
     ic.rounds = a.rounds;
+    if (!a.shot_values.empty()) {
+      ic.demonstration.teacher.shot_values =
+          std::make_shared<const learn::ShotValueTable>(learn::read_shot_value_table(a.shot_values));
+      j["shot_values"] = a.shot_values;
+    }
     if (a.lead) {  // the shots are keyed on the led projection the table will look up
       ic.table.lead_actuation_delay_s = a.actuation_delay_s;
       ic.demonstration.lead_actuation_delay_s = a.actuation_delay_s;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -244,7 +245,13 @@ ControllerSpec load_controller(const std::string& path) {
   if (!f) throw ControllerFileError(path + ": cannot open");
   std::ostringstream ss;
   ss << f.rdbuf();
-  return controller_from_json(ss.str(), path);
+  ControllerSpec spec = controller_from_json(ss.str(), path);
+  // A planner's shot-value table is named relative to the controller file, so
+  // that the two travel together.
+  if (spec.planner && spec.planner->shot_values && std::filesystem::path(*spec.planner->shot_values).is_relative()) {
+    spec.planner->shot_values = (std::filesystem::path(path).parent_path() / *spec.planner->shot_values).string();
+  }
+  return spec;
 }
 
 }  // namespace pinball::control

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -35,6 +36,8 @@ LookaheadPlanner::LookaheadPlanner(const sim::ThesisStepper& stepper, const Look
     if (share < 1) throw std::invalid_argument("ceiling planner: step budget is less than one step per candidate");
     max_branch_steps_ = std::min(max_branch_steps_, share);
   }
+  shot_y_m_ = shot_line_y_m(stepper.board(),
+                            config.shot_values ? config.shot_values->exit_height_m : config.shot_exit_height_m);
 }
 
 namespace {
@@ -75,7 +78,10 @@ void LookaheadPlanner::play_branch(LookaheadCandidate& c, int flipper) {
   const double t0 = scratch_.time_s;
   bool on = false;
   bool left_zone = false;
+  int touched = -1;  // the bat the ball last touched
   c.lost = false;
+  c.shot_flipper = -1;
+  c.valued_by_table = false;
   for (std::uint64_t j = 0;; ++j) {
     // Same frame clock as the real player: commands change only at frame starts.
     if (j % static_cast<std::uint64_t>(config_.frame_steps) == 0) {
@@ -92,6 +98,25 @@ void LookaheadPlanner::play_branch(LookaheadCandidate& c, int flipper) {
     if (events.has(sim::StepEvents::kBallLost)) {
       c.lost = true;
       break;
+    }
+    if (c.shot_flipper < 0) {
+      if (const std::optional<Shot> shot = read_shot(scratch_, shot_y_m_, touched)) {
+        c.shot_flipper = shot->flipper;
+        c.shot_direction_deg = shot->direction_deg;
+        c.shot_speed_mps = shot->speed_mps;
+        c.score_at_shot = scratch_.score - score0;
+        if (config_.shot_values) {
+          const std::optional<double> after =
+              shot_value(*config_.shot_values, shot->flipper, shot->direction_deg, shot->speed_mps);
+          if (after) {
+            c.valued_by_table = true;
+            c.score = c.score_at_shot;
+            c.value = c.score_at_shot + *after;
+            c.length_s = scratch_.time_s - t0;
+            return;
+          }
+        }
+      }
     }
     if (j + 1 >= max_branch_steps_) break;  // the horizon or the budget's share
     if (!in_zone(scratch_)) {

@@ -19,6 +19,7 @@ LookaheadConfig lookahead_config(const control::PlannerSettings& s, double dt_s)
   c.horizon_s = s.horizon_s;
   c.drain_penalty = s.drain_penalty;
   c.step_budget = s.step_budget;
+  if (s.shot_values) c.shot_values = std::make_shared<const ShotValueTable>(read_shot_value_table(*s.shot_values));
   return c;
 }
 

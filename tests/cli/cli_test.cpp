@@ -296,6 +296,54 @@ TEST_F(Cli, LearnImitateWritesAShotTableThatEvaluateAndSimPlay) {
   EXPECT_NE(run("learn boards/mit1993.board --method imitate --budget-balls 2").exit_code, 0);
 }
 
+// What shots are worth: `learn --method shot-values` writes a table that the
+// imitate teacher and a planner file value their plans by; the same seed gives
+// the same table whatever the threads.
+TEST_F(Cli, LearnShotValuesWritesATableThatImitateAndThePlannerUse) {
+  const std::string table = (dir_ / "shots.json").string();
+  const std::string common = " --seed 3 --max-ball-time 4 --json";
+  const CommandResult r = run("learn boards/mit1993.board --method shot-values --budget-balls 3 --threads 2 --out " +
+                              table + common + " --progress");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("method"), "shot-values");
+  EXPECT_GT(j.at("shots").get<double>(), 100.0);
+  EXPECT_GT(j.at("valued_bins").get<int>(), 0);
+  EXPECT_NE(r.err.find("3/3 balls"), std::string::npos) << "progress goes to stderr";
+  const std::string one = (dir_ / "shots1.json").string();
+  ASSERT_EQ(run("learn boards/mit1993.board --method shot-values --budget-balls 3 --threads 1 --out " + one + common)
+                .exit_code, 0);
+  EXPECT_EQ(slurp(one), slurp(table));
+  // The imitate teacher values its plans by it.
+  const std::string learned = (dir_ / "imitate.json").string();
+  const CommandResult im = run("learn boards/mit1993.board --method imitate --budget-balls 2 --rounds 1 --eval-balls 2 --out " +
+                               learned + " --shot-values " + table + common);
+  ASSERT_EQ(im.exit_code, 0) << im.err;
+  EXPECT_EQ(nlohmann::json::parse(im.out).at("shot_values"), table);
+  // A planner file names it.
+  auto planner = nlohmann::json::parse(slurp(PINBALL_SOURCE_DIR "/controllers/planner.json"));
+  planner["planner"]["shot_values"] = table;
+  const std::string planner_file = (dir_ / "planner_sv.json").string();
+  std::ofstream(planner_file) << planner.dump(1);
+  EXPECT_EQ(run("learn boards/mit1993.board --method evaluate --controller " + planner_file + " --eval-balls 2" + common)
+                .exit_code, 0);
+  // Refused in one line: no --out; another world; --shot-values outside imitate; a file that is no table.
+  const CommandResult no_out = run("learn boards/mit1993.board --method shot-values --budget-balls 1");
+  EXPECT_NE(no_out.exit_code, 0);
+  EXPECT_NE(no_out.err.find("--out"), std::string::npos) << no_out.err;
+  const CommandResult twin = run("learn boards/mit1993.board --method shot-values --budget-balls 1 --world twin --out " + one);
+  EXPECT_NE(twin.exit_code, 0);
+  EXPECT_NE(twin.err.find("belief's own model"), std::string::npos) << twin.err;
+  const CommandResult outside = run("learn boards/mit1993.board --method cem --budget-balls 2 --out " + learned +
+                                    " --shot-values " + table);
+  EXPECT_NE(outside.exit_code, 0);
+  EXPECT_NE(outside.err.find("--shot-values is for imitate"), std::string::npos) << outside.err;
+  const CommandResult wrong = run("learn boards/mit1993.board --method imitate --budget-balls 2 --rounds 1 --out " + learned +
+                                  " --shot-values " + planner_file);
+  EXPECT_NE(wrong.exit_code, 0);
+  EXPECT_NE(wrong.err.find("not a shot-value table"), std::string::npos) << wrong.err;
+}
+
 // The overlay `pinball identify` writes (docs/identification.md) is part of
 // the belief: the report names it, and a bad one is refused naming file:key.
 TEST_F(Cli, SimNamesTheIdentifiedOverlayAndRefusesABadOne) {

@@ -67,6 +67,51 @@ TEST(LookaheadPlanner, UnflippedBallOnTheFlipperDrainsAndTheBestPlanSavesIt) {
   EXPECT_GT(planner.branch_steps(), 0u);
 }
 
+// Each fire plan reads its shot where the ball rises off the bat through the
+// shot line; with a shot-value table, a plan is worth its points to the shot
+// plus the table's value there, and the best plan is the one whose shot the
+// table prefers.
+TEST(LookaheadPlanner, ReadsEachPlansShotAndValuesItByTheTable) {
+  const sim::ThesisStepper stepper(thesis_board());
+  LookaheadPlanner plain(stepper, short_planner());
+  const sim::GameState s = ball_on_left_flipper(thesis_board());
+  const simlab::DelayLine delay(s.flippers.size(), 0.004);
+  const std::vector<LookaheadCandidate> c = plain.evaluate(s, delay, 0);
+  std::vector<std::size_t> shots;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (c[i].shot_flipper < 0) continue;
+    shots.push_back(i);
+    EXPECT_EQ(c[i].shot_flipper, 0) << "the left bat shot";
+    EXPECT_GT(c[i].shot_direction_deg, 0.0);
+    EXPECT_LT(c[i].shot_direction_deg, 180.0);
+    EXPECT_GT(c[i].shot_speed_mps, 0.0);
+    EXPECT_LE(c[i].score_at_shot, c[i].score);
+    EXPECT_FALSE(c[i].valued_by_table);
+  }
+  ASSERT_GE(shots.size(), 2u) << "several fire plans shoot";
+  // The table likes only the last shooting plan's direction (within a bin).
+  const LookaheadCandidate& liked = c[shots.back()];
+  auto table = std::make_shared<ShotValueTable>(make_shot_value_table(2));
+  table->min_weight = 1e-9;
+  table->kernel_direction_deg = 0.5;
+  for (double d = 1.0; d < 180.0; d += 2.0) {
+    const bool near_liked = std::abs(d - liked.shot_direction_deg) < 1.0;
+    add_shot(*table, 0, d, liked.shot_speed_mps, near_liked ? 100000.0 : -100000.0);
+  }
+  add_shot(*table, 0, liked.shot_direction_deg, liked.shot_speed_mps, 100000.0);
+  smooth(*table);
+  LookaheadConfig config = short_planner();
+  config.shot_values = table;
+  LookaheadPlanner valued(stepper, config);
+  const auto& v = valued.evaluate(s, delay, 0);
+  const LookaheadCandidate& best = v[valued.best()];
+  EXPECT_TRUE(best.valued_by_table);
+  EXPECT_NEAR(best.shot_direction_deg, liked.shot_direction_deg, 2.0);
+  EXPECT_GT(best.value, 50000.0);
+  EXPECT_DOUBLE_EQ(best.score, best.score_at_shot) << "a valued branch ends at its shot";
+  EXPECT_LT(best.length_s, liked.length_s);
+}
+
 TEST(LookaheadPlanner, NoDecisionForARisingOrFarBall) {
   const sim::ThesisStepper stepper(thesis_board());
   const LookaheadPlanner planner(stepper, short_planner());

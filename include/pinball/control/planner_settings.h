@@ -6,6 +6,9 @@
 // file holds them under "planner" (docs/learning.md); the planner itself lives
 // in learn, which has the simulator.
 
+#include <optional>
+#include <string>
+
 #include "pinball/core/check.h"
 #include "pinball/core/name_value.h"
 #include "pinball/firmware/flipper_actuation.h"
@@ -29,6 +32,11 @@ struct PlannerSettings {
   /// to 0.29 us in pinballd (docs/results.md), so 12000 steps is 3.5 ms of the
   /// 5 ms frame; the defaults (11 plans of 0.5 s) need 11000.
   int step_budget = 12000;
+  /// A shot-value table (learn/shot_values.h, `pinball learn --method
+  /// shot-values`) that values each plan at its shot rather than by the
+  /// branch played past it; a relative path is from the controller file's
+  /// folder. None by default.
+  std::optional<std::string> shot_values;
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -40,6 +48,7 @@ struct PlannerSettings {
     a->Visit(PINBALL_NVP(drain_penalty));
     a->Visit(PINBALL_NVP(actuation_delay_s));
     a->Visit(PINBALL_NVP(step_budget));
+    a->Visit(PINBALL_NVP(shot_values));
   }
 };
 

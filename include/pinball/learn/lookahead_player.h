@@ -15,8 +15,10 @@
 // the branches as in the real play.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "pinball/learn/shot_values.h"
 #include "pinball/simlab/delay_line.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -38,6 +40,13 @@ struct LookaheadConfig {
   /// it ends as one cut by the horizon. What bounds a decision's time on the
   /// controller thread, deterministically (the same plans on every machine).
   std::int64_t step_budget = 0;
+  /// Where a branch's shot is read: the ball, having touched a bat, rises
+  /// through this height above the highest pivot (m).
+  double shot_exit_height_m = 0.10;
+  /// What shots are worth (none: every branch is valued by what it played).
+  /// With a table, a branch ends at its shot and is worth its points so far
+  /// plus the table's value of the shot, where the table has one.
+  std::shared_ptr<const ShotValueTable> shot_values;
 };
 
 /// One candidate plan and its branch's outcome.
@@ -48,6 +57,12 @@ struct LookaheadCandidate {
   double score = 0.0;       ///< score gained in the branch
   bool lost = false;        ///< the ball was lost within the branch
   double length_s = 0.0;    ///< simulated length of the branch
+  /// The branch's shot, if the ball rose off a bat through the shot line in it.
+  int shot_flipper = -1;            ///< the bat it last touched; -1: no shot
+  double shot_direction_deg = 0.0;  ///< direction of travel there (atan2 of the velocity)
+  double shot_speed_mps = 0.0;
+  double score_at_shot = 0.0;       ///< points gained before the shot
+  bool valued_by_table = false;     ///< value is score_at_shot plus the shot-value table's
 };
 
 /// Plays candidate plans ahead on copies of the state. Holds scratch copies
@@ -73,6 +88,8 @@ class LookaheadPlanner {
   std::uint64_t branch_steps() const { return branch_steps_; }
   /// The settings.
   const LookaheadConfig& config() const { return config_; }
+  /// The candidates of the last evaluate().
+  const std::vector<LookaheadCandidate>& candidates() const { return candidates_; }
 
  private:
   bool in_zone(const sim::GameState& state) const;
@@ -87,6 +104,7 @@ class LookaheadPlanner {
   const simlab::DelayLine* origin_delay_ = nullptr;
   std::uint64_t branch_steps_ = 0;
   std::uint64_t max_branch_steps_ = 0;
+  double shot_y_m_ = 0.0;  // the shot line
 };
 
 /// The looking-ahead player on the true state: plans every frame while no flip
@@ -107,6 +125,8 @@ class LookaheadPlayer {
   /// Frames at which candidates were evaluated, and lookahead steps simulated.
   int decisions() const { return decisions_; }
   std::uint64_t branch_steps() const { return planner_.branch_steps(); }
+  /// The planner, for its last candidates.
+  const LookaheadPlanner& planner() const { return planner_; }
 
  private:
   void decide(const sim::GameState& s);
