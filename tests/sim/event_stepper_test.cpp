@@ -117,8 +117,7 @@ TEST(EventStepper, ARestingBallScoresOnlyItsStrikes) {
   add_line(b, {-1.0, 0.0}, {2.0, 0.0}, rho, a);
   const EventStepper stepper(b);
   GameState s = state_with_ball(b, {0.5, kR + h0}, Vec2::Zero());
-  int strikes = 0;
-  for (double v = std::sqrt(2.0 * g * h0); v >= sim::rules::kMinStrikeSpeed_mps; v *= rho) ++strikes;
+  const int strikes = scoring_bounces(g, h0, rho, sim::rules::kMinStrikeSpeed_mps);
   for (int i = 0; i < 40000; ++i) stepper.step(s);  // 20 s: at rest for most of it
   EXPECT_EQ(s.score, 200.0 * strikes);
 }

@@ -14,6 +14,15 @@
 
 namespace pinball::sim::testing {
 
+/// How many of a ball's bounces score when it falls h0_m onto a floor of
+/// reflectivity rho under g: impact k comes at sqrt(2 g h0)·ρ^(k−1), and
+/// only strikes of at least `min_strike_mps` score.
+inline int scoring_bounces(double g_mps2, double h0_m, double rho, double min_strike_mps) {
+  int n = 0;
+  for (double v = std::sqrt(2.0 * g_mps2 * h0_m); v >= min_strike_mps; v *= rho) ++n;
+  return n;
+}
+
 /// Obstacle attributes with reflectivity rho and everything else default.
 inline table::Obstacle obstacle_with_rho(double rho) {
   table::Obstacle o;

@@ -328,9 +328,7 @@ TEST(ThesisStepperActions, ARestingOrRollingBallScoresNothing) {
   add_line(b, {-1.0, 0.1}, {5.0, 0.1}, rho, a);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.5, 0.1 + kR + h0}, {0.2, 0.0});
-  // Impact k comes at sqrt(2 g h0)·ρ^(k−1): the strikes at 0.02 m/s or more.
-  int strikes = 0;
-  for (double v = std::sqrt(2.0 * g * h0); v >= sim::rules::kMinStrikeSpeed_mps; v *= rho) ++strikes;
+  const int strikes = scoring_bounces(g, h0, rho, sim::rules::kMinStrikeSpeed_mps);
   int touches = 0;
   for (int i = 0; i < 10000; ++i) touches += stepper.step(s).has(StepEvents::kHitObstacle) ? 1 : 0;
   EXPECT_EQ(s.score, 200.0 * strikes);
