@@ -76,6 +76,17 @@ void smooth(ShotValueTable& t) {
   // Bins within three kernel widths count.
   const int rd = static_cast<int>(std::ceil(3.0 * t.kernel_direction_deg / t.direction_bin_deg));
   const int rs = static_cast<int>(std::ceil(3.0 * t.kernel_speed_mps / t.speed_bin_mps));
+  // The kernel's weight at each bin offset, computed once (a table is smoothed
+  // whenever a planner is built, once a ball in an evaluation).
+  const int wd = 2 * rd + 1;
+  std::vector<double> weight(static_cast<std::size_t>(wd * (2 * rs + 1)));
+  for (int od = -rd; od <= rd; ++od) {
+    const double ed = od * t.direction_bin_deg / t.kernel_direction_deg;
+    for (int os = -rs; os <= rs; ++os) {
+      const double es = os * t.speed_bin_mps / t.kernel_speed_mps;
+      weight[static_cast<std::size_t>((os + rs) * wd + od + rd)] = std::exp(-0.5 * (ed * ed + es * es));
+    }
+  }
   t.smoothed.assign(cells(t), std::numeric_limits<double>::quiet_NaN());
   for (int f = 0; f < t.flippers; ++f) {
     for (int d = 0; d < nd; ++d) {
@@ -83,10 +94,8 @@ void smooth(ShotValueTable& t) {
         double w_sum = 0.0;
         double v_sum = 0.0;
         for (int dd = std::max(0, d - rd); dd <= std::min(nd - 1, d + rd); ++dd) {
-          const double ed = (dd - d) * t.direction_bin_deg / t.kernel_direction_deg;
           for (int ss = std::max(0, s - rs); ss <= std::min(t.speed_bins - 1, s + rs); ++ss) {
-            const double es = (ss - s) * t.speed_bin_mps / t.kernel_speed_mps;
-            const double k = std::exp(-0.5 * (ed * ed + es * es));
+            const double k = weight[static_cast<std::size_t>((ss - s + rs) * wd + dd - d + rd)];
             const std::size_t i = index(t, f, dd, ss);
             w_sum += k * t.count[i];
             v_sum += k * t.sum[i];
