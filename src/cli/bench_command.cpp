@@ -18,6 +18,7 @@
 #include <optional>
 
 #include "aim_bench.h"
+#include "cradle_bench.h"
 #include "ceiling_bench.h"
 #include "transfer_bench.h"
 #include "pinball/control/controller_file.h"
@@ -38,18 +39,18 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   const bench::AimBenchOptions aim_defaults;
   CLI::App* cmd = app.add_subcommand(
       "bench",
-      "run a benchmark (speed, tracker, latency, detector, camera, calibration, precision, ceiling, aim, transfer, "
-      "protocol, draw)");
+      "run a benchmark (speed, tracker, latency, detector, camera, calibration, precision, ceiling, aim, cradle, "
+      "transfer, protocol, draw)");
   cmd->add_option("kind", a.which,
                   "which benchmark: speed, tracker, latency, detector, camera (a real camera's faults, uncorrected and "
                   "corrected), calibration, precision, ceiling, aim (how exactly a shot's direction follows from a noisy "
-                  "ball), transfer "
+                  "ball), cradle (how long a cycle shot from a ball at rest on a raised bat keeps it alive), transfer "
                   "(every controller in several worlds and a sweep of world errors, the belief nominal), protocol, "
                   "draw (the pictures of pinball play and pinball view)")
       ->required()
       ->check(CLI::IsMember(
-          {"speed", "tracker", "latency", "detector", "camera", "calibration", "precision", "ceiling", "aim", "transfer",
-           "protocol", "draw"}));
+          {"speed", "tracker", "latency", "detector", "camera", "calibration", "precision", "ceiling", "aim", "cradle",
+           "transfer", "protocol", "draw"}));
   cmd->add_option("--board", a.board, "board file (ceiling, transfer: the belief)")->transform(data_file());
   add_identified_option(*cmd, a.identified);
   cmd->add_option("--steps", a.steps, "speed: steps per timed run (the MuJoCo twin's runs: a tenth)")
@@ -58,23 +59,25 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
       ->check(CLI::Range(10, 1'000'000));
   cmd->add_option("--seed", a.seed,
-                  "tracker, detector, camera, calibration, ceiling, aim, transfer: seed for play, camera noise, placements and "
-                  "balls");
+                  "tracker, detector, camera, calibration, ceiling, aim, cradle, transfer: seed for play, camera noise, "
+                  "placements and balls");
   cmd->add_flag("--quick", a.quick,
-                "tracker, detector, camera, calibration, latency, precision, ceiling, aim, transfer: a short run (fewer "
-                "approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one value per family)");
+                "tracker, detector, camera, calibration, latency, precision, ceiling, aim, cradle, transfer: a short run (fewer "
+                "approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one value per family; "
+                "cradle: 2 balls, 3 drops, 60 s)");
   cmd->add_option("--balls", a.balls,
-                  "ceiling: balls per player; aim: ceiling balls whose fires are replayed; transfer: balls per world "
-                  "and controller (the same ball seeds for every player)")
+                  "ceiling: balls per player; aim: ceiling balls whose fires are replayed; cradle: balls per drop "
+                  "duration; transfer: balls per world and controller (the same ball seeds for every player)")
       ->check(CLI::Range(1, 1'000'000))
-      ->default_str("ceiling 200, aim " + std::to_string(aim_defaults.balls) + ", transfer " +
+      ->default_str("ceiling 200, aim " + std::to_string(aim_defaults.balls) + ", cradle " +
+                    std::to_string(bench::CradleBenchOptions{}.balls) + ", transfer " +
                     std::to_string(bench::TransferBenchOptions{}.balls));
   cmd->add_option("--twin-balls", a.twin_balls,
                   "transfer: balls per controller in the MuJoCo twin, the first of the same seeds (it plays about "
                   "100x slower than the model)")
       ->check(CLI::Range(1, 1'000'000))
       ->default_str(std::to_string(bench::TransferBenchOptions{}.twin_balls));
-  cmd->add_option("--threads", a.threads, "ceiling, transfer: worker threads (results do not depend on it)")
+  cmd->add_option("--threads", a.threads, "ceiling, cradle, transfer: worker threads (results do not depend on it)")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--controller", a.controllers,
                   "ceiling: also play this controller file through the camera model and tracker (a planner file: the ceiling plans with its settings); aim: a planner file whose settings the ceiling player plans with; transfer "
@@ -89,8 +92,16 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
       ->type_name("MM MPS")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--max-ball-time", a.max_ball_time_s,
-                  "ceiling, aim, transfer: seconds after which a ball still alive is cut")
-      ->check(CLI::Range(1.0, 3600.0));
+                  "ceiling, aim, cradle, transfer: seconds after which a ball still alive is cut")
+      ->check(CLI::Range(1.0, 3600.0))
+      ->default_str("60; cradle 600");
+  cmd->add_option("--drop-ms", a.drop_ms,
+                  "cradle: the drop durations to try, FROM TO STEP in ms: how long the bat a ball rests on is "
+                  "dropped before it shoots")
+      ->expected(3)
+      ->type_name("FROM TO STEP")
+      ->check(CLI::PositiveNumber)
+      ->default_str("230 250 1");
   cmd->add_option("--target-ratio", a.target_ratio,
                   "transfer: the ratio to the spastic flipper the summary holds every world to (counts the worlds at "
                   "it and those whose interval lies below it)")
@@ -249,7 +260,7 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
   if (!a.quick && a.balls > 0) options.balls = a.balls;
   options.seed = a.seed;
   options.threads = a.threads;
-  options.max_ball_time_s = a.max_ball_time_s;
+  if (a.max_ball_time_s > 0.0) options.max_ball_time_s = a.max_ball_time_s;
   options.camera = a.camera;
   if (a.controllers.size() > 1) throw std::invalid_argument("bench ceiling: one --controller at most");
   std::optional<control::ControllerSpec> controller;
@@ -291,11 +302,42 @@ bool world_options_given(const simlab::WorldSpec& world) {
          world.dt_s != model_world.dt_s;
 }
 
+int run_cradle(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
+  bench::CradleBenchOptions options;
+  if (a.quick) {
+    options.balls = 2;
+    options.drop_to_s = options.drop_from_s + 2.0 * options.drop_step_s;
+    options.max_ball_time_s = 60.0;
+  }
+  if (a.balls > 0) options.balls = a.balls;
+  if (a.max_ball_time_s > 0.0) options.max_ball_time_s = a.max_ball_time_s;
+  if (!a.drop_ms.empty()) {
+    options.drop_from_s = a.drop_ms[0] * 1e-3;
+    options.drop_to_s = a.drop_ms[1] * 1e-3;
+    options.drop_step_s = a.drop_ms[2] * 1e-3;
+  }
+  options.seed = a.seed;
+  options.threads = a.threads;
+  const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
+  const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
+  const bench::CradleReport report =
+      bench::run_cradle_bench(*world.world, options, [&](const std::string& line) { err << "bench " << line << "\n"; });
+  if (a.json) {
+    nlohmann::json j = bench::to_json(report);
+    j.update(world_report(world_spec, a.board, *world.world));
+    j.update(identified_report(a.identified));
+    out << j.dump(2) << "\n";
+  } else {
+    out << bench::to_text(report) << identified_text_line(a.identified);
+  }
+  return 0;
+}
+
 int run_aim(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::AimBenchOptions options;
   options.balls = a.quick ? 3 : (a.balls > 0 ? a.balls : options.balls);
   options.seed = a.seed;
-  options.max_ball_time_s = a.max_ball_time_s;
+  if (a.max_ball_time_s > 0.0) options.max_ball_time_s = a.max_ball_time_s;
   if (a.controllers.size() > 1) throw std::invalid_argument("bench aim: one --controller at most");
   if (!a.controllers.empty()) {
     const control::ControllerSpec planner = control::load_controller(a.controllers.front());
@@ -333,7 +375,7 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
   if (a.twin_balls > 0) options.twin_balls = a.twin_balls;
   options.seed = a.seed;
   options.threads = a.threads;
-  options.max_ball_time_s = a.max_ball_time_s;
+  if (a.max_ball_time_s > 0.0) options.max_ball_time_s = a.max_ball_time_s;
   options.target_ratio = a.target_ratio;
   options.camera = a.camera;
   options.twin_params_path = a.world.twin_params_path;
@@ -436,8 +478,12 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   if (!a.true_state_noise.empty() && a.which != "ceiling" && a.which != "aim") {
     throw std::invalid_argument("bench " + a.which + ": --true-state-noise applies to ceiling and aim only");
   }
-  if (!a.identified.empty() && a.which != "ceiling" && a.which != "aim" && a.which != "transfer") {
-    throw std::invalid_argument("bench " + a.which + ": --identified applies to ceiling, aim and transfer only");
+  if (!a.identified.empty() && a.which != "ceiling" && a.which != "aim" && a.which != "cradle" &&
+      a.which != "transfer") {
+    throw std::invalid_argument("bench " + a.which + ": --identified applies to ceiling, aim, cradle and transfer only");
+  }
+  if (!a.drop_ms.empty() && a.which != "cradle") {
+    throw std::invalid_argument("bench " + a.which + ": --drop-ms applies to cradle only");
   }
   const table::Board board = table::load_belief_board(a.board, a.identified);  // the belief of ceiling and transfer
   if (a.which == "tracker") return run_tracker(a, board, out, err);
@@ -447,6 +493,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   if (a.which == "precision") return run_precision(a, board, out, err);
   if (a.which == "ceiling") return run_ceiling(a, board, out, err);
   if (a.which == "aim") return run_aim(a, board, out, err);
+  if (a.which == "cradle") return run_cradle(a, board, out, err);
   if (a.which == "transfer") return run_transfer(a, board, out, err);
   if (a.which == "draw") return run_draw(a, board, out, err);
   bench::SpeedBenchOptions options;

@@ -65,7 +65,7 @@ int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 
 /// `pinball bench`
 struct BenchArgs {
-  std::string which;                                 ///< speed | tracker | latency | detector | camera | calibration | precision | ceiling | transfer | protocol | draw
+  std::string which;                                 ///< speed | tracker | latency | detector | camera | calibration | precision | ceiling | aim | cradle | transfer | protocol | draw
   std::string board = "boards/mit1993.board";        ///< board to measure on
   std::string identified;                            ///< ceiling, transfer: overlay laid over the belief; empty: none
   std::uint64_t steps = 2'000'000;                   ///< steps per timed run
@@ -76,7 +76,8 @@ struct BenchArgs {
   int balls = 0;                                     ///< ceiling: balls per player; transfer: per cell (0: the bench's)
   int twin_balls = 0;                                ///< transfer: per cell in the twin (0: the bench's)
   int threads = 2;                                   ///< ceiling, transfer: worker threads (results do not depend on it)
-  double max_ball_time_s = 60.0;                     ///< ceiling, transfer: a ball alive after this is cut
+  double max_ball_time_s = 0.0;                      ///< ceiling, aim, transfer, cradle: a ball alive after this is cut (0: the bench's, 60 s; cradle 600 s)
+  std::vector<double> drop_ms;                       ///< cradle: drop durations FROM TO STEP (ms); empty: the bench's
   double target_ratio = 2.5;                         ///< transfer: the ratio to the spastic flipper the summary holds each world to
   std::vector<std::string> controllers;              ///< ceiling: one controller file; transfer: the controllers
   std::vector<double> true_state_noise;              ///< ceiling: play the controller fed the true state, noise (mm, m/s); empty: not

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace pinball {
@@ -46,6 +48,20 @@ double robust_sigma(const std::vector<double>& values) {
   deviation.reserve(values.size());
   for (const double x : values) deviation.push_back(std::abs(x - middle));
   return kMadToSigma * median(std::move(deviation));
+}
+
+ShareInterval wilson_ci95(std::int64_t successes, std::int64_t trials) {
+  if (successes < 0 || successes > trials) {
+    throw std::invalid_argument("wilson_ci95: " + std::to_string(successes) + " successes of " +
+                                std::to_string(trials) + " trials");
+  }
+  if (trials == 0) return {};
+  constexpr double z = 1.959963984540054;
+  const double n = static_cast<double>(trials);
+  const double p = static_cast<double>(successes) / n;
+  const double centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
+  const double half = z / (1.0 + z * z / n) * std::sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n));
+  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
 }
 
 }  // namespace pinball

@@ -3,6 +3,8 @@
 // every p50 and p99 (benches, latency histograms, detector errors) is the
 // nearest-rank quantile below, and every 95 % interval of a mean uses
 // Student's t, which a handful of balls needs (1.96 is 6.5x too narrow for 2).
+// A share (k of n) gets Wilson's interval, which stays inside [0, 1] and
+// does not collapse to a point at 0 or n as the normal one does.
 
 #include <algorithm>
 #include <cstddef>
@@ -36,5 +38,15 @@ double robust_sigma(const std::vector<double>& values);
 /// Two-sided 95 % critical value of Student's t with `dof` degrees of freedom:
 /// 12.71 for 1, 2.23 for 10, 1.96 in the limit. Infinite for dof < 1.
 double student_t95(std::int64_t dof);
+
+/// A 95 % interval of a share.
+struct ShareInterval {
+  double low = 0.0;
+  double high = 1.0;
+};
+
+/// Wilson's 95 % score interval of the share `successes` / `trials`; [0, 1]
+/// for no trials. Throws std::invalid_argument for successes outside [0, trials].
+ShareInterval wilson_ci95(std::int64_t successes, std::int64_t trials);
 
 }  // namespace pinball

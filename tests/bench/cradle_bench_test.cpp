@@ -1,0 +1,119 @@
+#include "cradle_bench.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "common/thesis_board.h"
+#include "pinball/core/rng.h"
+#include "pinball/sim/model_world.h"
+#include "pinball/simlab/world_factory.h"
+
+namespace pinball::bench {
+namespace {
+
+using pinball::testing::thesis_board;
+
+// The twin, where a ball held on raised bats comes to rest in a crook
+// (mit1993.board: 17 of 20 launches).
+simlab::OwnedWorld twin() {
+  simlab::WorldSpec spec;
+  spec.kind = simlab::WorldKind::kTwin;
+  return simlab::make_world(spec, thesis_board());
+}
+
+CradleBenchOptions short_run(double drop_s, double cap_s) {
+  CradleBenchOptions o;
+  o.balls = 1;
+  o.drop_from_s = drop_s;
+  o.drop_to_s = drop_s;
+  o.max_ball_time_s = cap_s;
+  o.cycling_gap_s = cap_s;
+  return o;
+}
+
+TEST(CradleBench, ABriefDropOnlyRocksTheBallInTheCrookAndIsNoCycle) {
+  if (!simlab::twin_available()) GTEST_SKIP() << "built without the MuJoCo twin";
+  const simlab::OwnedWorld world = twin();
+  // 10 ms down: the bat hardly moves, the ball stays, and is cradled again.
+  const CradleBall b = play_cradle_ball(*world, ball_seed(1, 0), 0.010, short_run(0.010, 15.0));
+  EXPECT_TRUE(b.cradled);
+  EXPECT_GT(b.duds, 3);
+  EXPECT_EQ(b.returns, 0);
+  EXPECT_EQ(b.shots, 0) << "a dud neither returns nor loses the ball";
+  EXPECT_TRUE(b.cut);
+  EXPECT_FALSE(b.cycling_at_cut) << "a ball rocking in the crook is not a cycle";
+  EXPECT_FALSE(b.lost_after_drop);
+}
+
+TEST(CradleBench, ALongerDropShootsTheBallUpAndItComesBackToTheCradle) {
+  if (!simlab::twin_available()) GTEST_SKIP() << "built without the MuJoCo twin";
+  const simlab::OwnedWorld world = twin();
+  const CradleReport r = run_cradle_bench(*world, short_run(0.241, 30.0));
+  ASSERT_EQ(r.drops.size(), 1u);
+  const CradleDropResult& d = r.drops[0];
+  EXPECT_EQ(d.cradled, 1);
+  EXPECT_GE(d.returns, 3);
+  EXPECT_GT(d.mean_period_s, 1.0) << "up the table and back";
+  EXPECT_LT(d.mean_period_s, 10.0);
+  EXPECT_GT(d.points_per_cycle, 0.0);
+  EXPECT_EQ(d.shots, d.returns + d.drains.total());
+  EXPECT_EQ(r.world, "twin");
+}
+
+TEST(CradleBench, ResultsDoNotDependOnTheThreadCount) {
+  if (!simlab::twin_available()) GTEST_SKIP() << "built without the MuJoCo twin";
+  const simlab::OwnedWorld world = twin();
+  CradleBenchOptions o = short_run(0.240, 12.0);
+  o.balls = 2;
+  o.drop_to_s = 0.242;
+  o.drop_step_s = 0.002;
+  const CradleReport one = run_cradle_bench(*world, o);
+  o.threads = 2;
+  const CradleReport two = run_cradle_bench(*world, o);
+  EXPECT_EQ(to_json(one).at("drops"), to_json(two).at("drops"));
+  EXPECT_EQ(one.drops.size(), 2u);
+}
+
+TEST(CradleBench, TenMinutesAtOnePercentNeedsTheReturnShareToThePowerOfTheCycles) {
+  CradleDropResult r;
+  r.shots = 10;
+  r.returns = 9;
+  r.mean_period_s = 3.0;  // 200 cycles in 10 minutes
+  EXPECT_DOUBLE_EQ(r.return_share(), 0.9);
+  EXPECT_NEAR(r.return_share_needed(), std::pow(0.01, 1.0 / 200.0), 1e-12);
+  EXPECT_NEAR(r.return_share_needed(), 0.97724, 1e-5);
+  EXPECT_NEAR(r.projected_share_at_10_min(), std::pow(0.9, 200.0), 1e-15);
+  const CradleDropResult none;
+  EXPECT_EQ(none.return_share(), 0.0);
+  EXPECT_EQ(none.return_share_needed(), 1.0);
+  EXPECT_EQ(none.projected_share_at_10_min(), 0.0);
+}
+
+TEST(CradleBench, RefusesOptionsItCannotUse) {
+  const std::unique_ptr<sim::World> world = sim::make_model_world(thesis_board());
+  const auto refuses = [&](CradleBenchOptions o) {
+    EXPECT_THROW(run_cradle_bench(*world, o), std::invalid_argument);
+  };
+  CradleBenchOptions o;
+  o.balls = 0;
+  refuses(o);
+  o = {};
+  o.drop_to_s = o.drop_from_s - 0.001;
+  refuses(o);
+  o = {};
+  o.drop_step_s = 0.0;
+  refuses(o);
+  o = {};
+  o.drop_from_s = 0.001;
+  o.drop_to_s = 2.0;
+  o.drop_step_s = 0.001;  // 2000 durations
+  refuses(o);
+  o = {};
+  o.rest_s = 0.0;
+  refuses(o);
+}
+
+}  // namespace
+}  // namespace pinball::bench
