@@ -73,7 +73,7 @@ struct CradleDropResult {
   int returns = 0;
   int duds = 0;
   DrainCounts drains;          ///< balls lost after a drop, by route
-  ShareInterval return_interval;  ///< Wilson 95 % of returns / shots
+  Interval return_interval;  ///< Wilson 95 % of returns / shots
   double mean_period_s = 0.0;  ///< cradle to cradle over the returns
   double points_per_cycle = 0.0;
   double mean_ball_time_s = 0.0;

@@ -50,12 +50,12 @@ double robust_sigma(const std::vector<double>& values) {
   return kMadToSigma * median(std::move(deviation));
 }
 
-ShareInterval wilson_ci95(std::int64_t successes, std::int64_t trials) {
+Interval wilson_ci95(std::int64_t successes, std::int64_t trials) {
   if (successes < 0 || successes > trials) {
     throw std::invalid_argument("wilson_ci95: " + std::to_string(successes) + " successes of " +
                                 std::to_string(trials) + " trials");
   }
-  if (trials == 0) return {};
+  if (trials == 0) return {0.0, 1.0};
   constexpr double z = 1.959963984540054;
   const double n = static_cast<double>(trials);
   const double p = static_cast<double>(successes) / n;

@@ -73,16 +73,16 @@ TEST(Statistics, TheMedianIsTheMiddleOrTheMeanOfTheTwoMiddleValues) {
 
 TEST(Statistics, WilsonsIntervalOfAShareMatchesTheTextbookAndStaysInsideZeroToOne) {
   // Newcombe (1998), table I: 0 of 10 gives 0 to 0.2775; 5 of 10, 0.2366 to 0.7634.
-  const ShareInterval none = wilson_ci95(0, 10);
+  const Interval none = wilson_ci95(0, 10);
   EXPECT_DOUBLE_EQ(none.low, 0.0);
   EXPECT_NEAR(none.high, 0.2775, 1e-4);
-  const ShareInterval half = wilson_ci95(5, 10);
+  const Interval half = wilson_ci95(5, 10);
   EXPECT_NEAR(half.low, 0.2366, 1e-4);
   EXPECT_NEAR(half.high, 0.7634, 1e-4);
-  const ShareInterval all = wilson_ci95(10, 10);
+  const Interval all = wilson_ci95(10, 10);
   EXPECT_NEAR(all.low, 0.7225, 1e-4);
   EXPECT_DOUBLE_EQ(all.high, 1.0);
-  const ShareInterval no_trials = wilson_ci95(0, 0);
+  const Interval no_trials = wilson_ci95(0, 0);
   EXPECT_EQ(no_trials.low, 0.0);
   EXPECT_EQ(no_trials.high, 1.0);
   EXPECT_THROW(wilson_ci95(11, 10), std::invalid_argument);

@@ -39,14 +39,14 @@ double robust_sigma(const std::vector<double>& values);
 /// 12.71 for 1, 2.23 for 10, 1.96 in the limit. Infinite for dof < 1.
 double student_t95(std::int64_t dof);
 
-/// A 95 % interval of a share.
-struct ShareInterval {
-  double low = 0.0;
-  double high = 1.0;
+/// A confidence interval [low, high].
+struct Interval {
+  double low = 0.0;   ///< lower end
+  double high = 0.0;  ///< upper end
 };
 
 /// Wilson's 95 % score interval of the share `successes` / `trials`; [0, 1]
 /// for no trials. Throws std::invalid_argument for successes outside [0, trials].
-ShareInterval wilson_ci95(std::int64_t successes, std::int64_t trials);
+Interval wilson_ci95(std::int64_t successes, std::int64_t trials);
 
 }  // namespace pinball

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "pinball/core/running_stats.h"
+#include "pinball/core/statistics.h"
 
 namespace pinball::learn {
 
@@ -19,11 +20,7 @@ double hoeffding_half_width(std::int64_t n, double range_b, double confidence);
 /// that a mean made negative by the loss penalty still gives a positive range.
 double thesis_range_bound(const RunningStats& stats);
 
-/// A confidence interval [low, high] around a sample mean.
-struct Interval {
-  double low = 0.0;   ///< lower end
-  double high = 0.0;  ///< upper end
-};
+using pinball::Interval;  // core/statistics.h
 
 /// The Hoeffding interval of the relay race: mean ± t with B from
 /// thesis_range_bound; infinite (±inf) with fewer than 2 samples.
