@@ -268,9 +268,12 @@ std::string to_text(const CradleReport& report) {
     const CradleDropResult& r = report.drops[d];
     out << (d == report.best ? "* " : "  ") << "drop " << format_number(r.drop_s * 1e3) << " ms: returns "
         << r.returns << " of " << r.shots << " shots = " << format_number(r.return_share()) << " ("
-        << format_number(r.return_interval.low) << "-" << format_number(r.return_interval.high) << "), needed "
-        << format_number(r.return_share_needed()) << "; period " << format_number(r.mean_period_s) << " s, "
-        << format_number(r.points_per_cycle) << " points a cycle; lost after a drop: outlane "
+        << format_number(r.return_interval.low) << "-" << format_number(r.return_interval.high) << ")";
+    if (r.returns > 0) {
+      out << ", needed " << format_number(r.return_share_needed()) << "; period " << format_number(r.mean_period_s)
+          << " s, " << format_number(r.points_per_cycle) << " points a cycle";
+    }
+    out << "; lost after a drop: outlane "
         << r.drains.left_outlane + r.drains.right_outlane << ", centre " << r.drains.centre << "; cut "
         << r.cut << " (" << r.cut_cycling << " cycling); mean ball " << format_number(r.mean_ball_time_s)
         << " s, " << format_number(r.mean_score) << " points\n";
@@ -278,9 +281,10 @@ std::string to_text(const CradleReport& report) {
   if (!report.drops.empty()) {
     const CradleDropResult& b = report.drops[report.best];
     out << "best drop " << format_number(b.drop_s * 1e3) << " ms: at " << format_number(b.return_share())
-        << " a return and " << format_number(b.mean_period_s) << " s a cycle, "
-        << format_number(100.0 * b.projected_share_at_10_min()) << " % of cradled balls would live 10 minutes (1 % "
-        << "needs " << format_number(b.return_share_needed()) << ")\n";
+        << " a return and " << format_number(b.mean_period_s) << " s a cycle, ";
+    const double projected = b.projected_share_at_10_min();
+    out << (projected < 1e-4 ? std::string("under 0.01") : format_number(100.0 * projected))
+        << " % of cradled balls would live 10 minutes (1 % needs " << format_number(b.return_share_needed()) << ")\n";
   }
   return out.str();
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "common/thesis_board.h"
 #include "pinball/core/rng.h"
@@ -89,6 +90,27 @@ TEST(CradleBench, TenMinutesAtOnePercentNeedsTheReturnShareToThePowerOfTheCycles
   EXPECT_EQ(none.return_share(), 0.0);
   EXPECT_EQ(none.return_share_needed(), 1.0);
   EXPECT_EQ(none.projected_share_at_10_min(), 0.0);
+}
+
+TEST(CradleBench, TheTextMarksTheBestDropAndLeavesOutThePeriodOfADropWithNoReturn) {
+  CradleReport report;
+  report.world = "twin";
+  CradleDropResult none;
+  none.drop_s = 0.230;
+  none.shots = 2;
+  CradleDropResult good;
+  good.drop_s = 0.240;
+  good.shots = 10;
+  good.returns = 9;
+  good.mean_period_s = 3.0;
+  report.drops = {none, good};
+  report.best = 1;
+  const std::string text = to_text(report);
+  EXPECT_NE(text.find("  drop 230 ms: returns 0 of 2 shots = 0 (0-"), std::string::npos) << text;
+  EXPECT_EQ(text.find("drop 230 ms: returns 0 of 2 shots = 0 (0-0.658), needed"), std::string::npos) << text;
+  EXPECT_NE(text.find("* drop 240 ms: returns 9 of 10 shots = 0.9"), std::string::npos) << text;
+  EXPECT_NE(text.find("under 0.01 % of cradled balls would live 10 minutes (1 % needs 0.977"), std::string::npos)
+      << text;
 }
 
 TEST(CradleBench, RefusesOptionsItCannotUse) {
