@@ -99,6 +99,7 @@ struct LearnArgs {
   std::string identified;               ///< identified overlay laid over the belief (docs/identification.md); empty: none
   std::string randomize;                ///< searches: draw each ball's world from this file (docs/learning.md); empty: none
   std::string shot_values;              ///< imitate: the teacher values its plans' shots by this table (learn/shot_values.h); empty: none
+  double drain_penalty = -1.0;          ///< imitate's teacher, shot-values' player: points a lost ball costs a plan; negative: the planner's default
   bool lead = false;                    ///< searches: controllers act on projections led by latency + actuation delay
   std::string method;                   ///< tournament | relay | cem | none | spastic | evaluate | launcher
   std::uint64_t budget_balls = 2000;    ///< simulated balls the search may play

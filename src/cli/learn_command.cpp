@@ -60,6 +60,11 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
                   "imitate: the teacher values each plan at its shot by this table of what shots are worth "
                   "(learn/shot_values.h, docs/learning.md) rather than by the branch played past it")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--drain-penalty", a.drain_penalty,
+                  "imitate (its teacher) and shot-values (its player, and so the table's values): the points a plan "
+                  "loses when the ball drains in it")
+      ->check(CLI::Range(0.0, 1e9))
+      ->default_str(format_number(learn::LookaheadConfig{}.drain_penalty));
   cmd->add_option("--method", a.method,
                   "tournament (thesis 6.2), relay (Hoeffding relay race, 6.3), cem (cross-entropy with common "
                   "random numbers and sequential halving); or no search: none, spastic, evaluate (--controller); "
@@ -328,6 +333,7 @@ int run_shot_values(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   config.actuation_delay_s = a.actuation_delay_s;
   config.max_ball_time_s = a.max_ball_time_s;
   config.pull = a.pull;
+  if (a.drain_penalty >= 0.0) config.player.drain_penalty = a.drain_penalty;
   const auto start = std::chrono::steady_clock::now();
   const learn::ShotValueTable table = learn::collect_shot_values(
       board, config, static_cast<int>(a.budget_balls), a.seed, a.threads, [&](const std::string& line) {
@@ -342,7 +348,8 @@ int run_shot_values(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                         {"seed", a.seed},           {"balls", a.budget_balls},
                         {"out", a.out},             {"shots", learn::shots_in(table)},
                         {"valued_bins", valued_bins}, {"bins", table.smoothed.size()},
-                        {"horizon_s", config.player.horizon_s}, {"actuation_delay_s", config.actuation_delay_s},
+                        {"horizon_s", config.player.horizon_s}, {"drain_penalty", config.player.drain_penalty},
+                        {"actuation_delay_s", config.actuation_delay_s},
                         {"max_ball_time_s", config.max_ball_time_s}, {"wall_s", wall_s}};
     j.update(identified_report(a.identified));
     out << j.dump(2) << "\n";
@@ -360,6 +367,9 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   a.actuation_delay_s = world_actuation_delay_s(
       args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,
       args.identified);
+  if (a.drain_penalty >= 0.0 && a.method != "imitate" && a.method != "shot-values")
+    throw std::invalid_argument("learn: --drain-penalty is for imitate (its teacher) or shot-values, not --method " +
+                                a.method);
   if (a.method == "launcher") return run_launcher_search(a, out, err);
   if (a.method == "shot-values") return run_shot_values(a, out, err);
   const bool search = a.method == "tournament" || a.method == "relay" || a.method == "cem";
@@ -498,6 +508,8 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     ic.demonstration.max_ball_time_s = a.max_ball_time_s;
     ic.demonstration.pull = a.pull;
     ic.rounds = a.rounds;
+    if (a.drain_penalty >= 0.0) ic.demonstration.teacher.drain_penalty = a.drain_penalty;
+    j["teacher_drain_penalty"] = ic.demonstration.teacher.drain_penalty;
     if (!a.shot_values.empty()) {
       ic.demonstration.teacher.shot_values =
           std::make_shared<const learn::ShotValueTable>(learn::read_shot_value_table(a.shot_values));

@@ -344,6 +344,36 @@ TEST_F(Cli, LearnShotValuesWritesATableThatImitateAndThePlannerUse) {
   EXPECT_NE(wrong.err.find("not a shot-value table"), std::string::npos) << wrong.err;
 }
 
+// --drain-penalty prices a lost ball for the shot-value player (and so its
+// table) and for imitate's teacher; other methods refuse it.
+TEST_F(Cli, LearnDrainPenaltyPricesTheShotTableAndTheTeacher) {
+  const std::string common = " --seed 3 --max-ball-time 4 --json";
+  const std::string table = (dir_ / "shots.json").string(), cheap = (dir_ / "shots_cheap.json").string();
+  const CommandResult r = run("learn boards/mit1993.board --method shot-values --budget-balls 3 --threads 2 --out " +
+                              table + common);
+  const CommandResult c = run("learn boards/mit1993.board --method shot-values --budget-balls 3 --threads 2 --out " +
+                              cheap + common + " --drain-penalty 5000");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("drain_penalty"), 20000.0) << "the planner's default";
+  EXPECT_EQ(nlohmann::json::parse(c.out).at("drain_penalty"), 5000.0);
+  EXPECT_NE(slurp(cheap), slurp(table)) << "a lost ball costs its branch less, so the values differ";
+  const std::string learned = (dir_ / "imitate.json").string();
+  const std::string imitate = "learn boards/mit1993.board --method imitate --budget-balls 2 --rounds 1 --eval-balls 2 --out ";
+  const CommandResult plain = run(imitate + learned + common);
+  const CommandResult priced = run(imitate + learned + common + " --drain-penalty 12000");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  ASSERT_EQ(priced.exit_code, 0) << priced.err;
+  EXPECT_EQ(nlohmann::json::parse(plain.out).at("teacher_drain_penalty"), 20000.0);
+  EXPECT_EQ(nlohmann::json::parse(priced.out).at("teacher_drain_penalty"), 12000.0);
+  for (const std::string& method : {"cem --budget-balls 2 --out " + learned, std::string("launcher")}) {
+    const CommandResult refused = run("learn boards/mit1993.board --method " + method + " --drain-penalty 5000");
+    EXPECT_EQ(refused.exit_code, 1) << method;
+    EXPECT_NE(refused.err.find("--drain-penalty is for imitate"), std::string::npos) << refused.err;
+  }
+  EXPECT_EQ(run(imitate + learned + " --drain-penalty -1").exit_code, 2) << "below the range";
+}
+
 // The overlay `pinball identify` writes (docs/identification.md) is part of
 // the belief: the report names it, and a bad one is refused naming file:key.
 TEST_F(Cli, SimNamesTheIdentifiedOverlayAndRefusesABadOne) {
