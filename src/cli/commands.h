@@ -67,15 +67,15 @@ int run_track(const TrackArgs& args, std::ostream& out, std::ostream& err);
 struct BenchArgs {
   std::string which;                                 ///< speed | tracker | latency | detector | camera | calibration | precision | ceiling | aim | cradle | transfer | protocol | draw
   std::string board = "boards/mit1993.board";        ///< board to measure on
-  std::string identified;                            ///< ceiling, transfer: overlay laid over the belief; empty: none
+  std::string identified;                            ///< ceiling, aim, cradle, transfer: overlay laid over the belief; empty: none
   std::uint64_t steps = 2'000'000;                   ///< steps per timed run
   int repeats = 3;                                   ///< timed runs per configuration
   int approaches = 2000;                             ///< tracker: free-flight approaches
   std::uint64_t seed = 1;                            ///< tracker: approach and noise seed
   bool quick = false;                                ///< tracker, detector, precision, ceiling: a short run
-  int balls = 0;                                     ///< ceiling: balls per player; transfer: per cell (0: the bench's)
+  int balls = 0;                                     ///< ceiling: balls per player; aim: ceiling balls; cradle: per drop; transfer: per cell (0: the bench's)
   int twin_balls = 0;                                ///< transfer: per cell in the twin (0: the bench's)
-  int threads = 2;                                   ///< ceiling, transfer: worker threads (results do not depend on it)
+  int threads = 2;                                   ///< ceiling, cradle, transfer: worker threads (results do not depend on it)
   double max_ball_time_s = 0.0;                      ///< ceiling, aim, transfer, cradle: a ball alive after this is cut (0: the bench's, 60 s; cradle 600 s)
   std::vector<double> drop_ms;                       ///< cradle: drop durations FROM TO STEP (ms); empty: the bench's
   double target_ratio = 2.5;                         ///< transfer: the ratio to the spastic flipper the summary holds each world to
@@ -101,7 +101,7 @@ struct LearnArgs {
   std::string shot_values;              ///< imitate: the teacher values its plans' shots by this table (learn/shot_values.h); empty: none
   double drain_penalty = -1.0;          ///< imitate's teacher, shot-values' player: points a lost ball costs a plan; negative: the planner's default
   bool lead = false;                    ///< searches: controllers act on projections led by latency + actuation delay
-  std::string method;                   ///< tournament | relay | cem | none | spastic | evaluate | launcher
+  std::string method;                   ///< tournament | relay | cem | imitate | none | spastic | evaluate | launcher | shot-values
   std::uint64_t budget_balls = 2000;    ///< simulated balls the search may play
   std::uint64_t seed = 1;               ///< the only source of randomness
   std::string out;                      ///< controller file to write (searches)
