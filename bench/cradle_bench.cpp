@@ -9,6 +9,7 @@
 #include "pinball/core/format.h"
 #include "pinball/core/progress.h"
 #include "pinball/core/rng.h"
+#include "pinball/core/running_stats.h"
 #include "pinball/learn/parallel_runner.h"
 #include "pinball/sim/ball_runner.h"
 
@@ -183,7 +184,8 @@ CradleReport run_cradle_bench(const sim::World& world, const CradleBenchOptions&
   for (std::size_t d = 0; d < drops.size(); ++d) {
     CradleDropResult r;
     r.drop_s = drops[d];
-    double time_sum_s = 0.0, cycle_time_s = 0.0, cycle_points = 0.0, score_sum = 0.0;
+    double time_sum_s = 0.0, cycle_time_s = 0.0, cycle_points = 0.0;
+    RunningStats score;
     for (std::size_t b = 0; b < balls; ++b) {
       const CradleBall& ball = played[d * balls + b];
       ++r.balls;
@@ -197,13 +199,14 @@ CradleReport run_cradle_bench(const sim::World& world, const CradleBenchOptions&
       time_sum_s += ball.ball_time_s;
       cycle_time_s += ball.cycle_time_s;
       cycle_points += ball.cycle_points;
-      score_sum += ball.score;
+      score.add(ball.score);
     }
     r.return_interval = wilson_ci95(r.returns, r.shots);
     r.mean_period_s = r.returns > 0 ? cycle_time_s / r.returns : 0.0;
     r.points_per_cycle = r.returns > 0 ? cycle_points / r.returns : 0.0;
     r.mean_ball_time_s = time_sum_s / r.balls;
-    r.mean_score = score_sum / r.balls;
+    r.mean_score = score.mean();
+    r.score_ci95 = score.ci95_half_width();
     report.drops.push_back(r);
     const CradleDropResult& best = report.drops[report.best];
     if (r.return_share() > best.return_share() ||
@@ -240,7 +243,8 @@ nlohmann::json to_json(const CradleReport& report) {
                      {"cut", r.cut},
                      {"cut_cycling", r.cut_cycling},
                      {"mean_ball_time_s", r.mean_ball_time_s},
-                     {"mean_score", r.mean_score}});
+                     {"mean_score", r.mean_score},
+                     {"score_ci95_half_width", r.score_ci95}});
   }
   return {{"benchmark", "cradle"},
           {"world", report.world},
@@ -276,7 +280,7 @@ std::string to_text(const CradleReport& report) {
     out << "; lost after a drop: outlane "
         << r.drains.left_outlane + r.drains.right_outlane << ", centre " << r.drains.centre << "; cut "
         << r.cut << " (" << r.cut_cycling << " cycling); mean ball " << format_number(r.mean_ball_time_s)
-        << " s, " << format_number(r.mean_score) << " points\n";
+        << " s, " << format_number(r.mean_score) << " ± " << format_number(r.score_ci95) << " points\n";
   }
   if (!report.drops.empty()) {
     const CradleDropResult& b = report.drops[report.best];

@@ -80,6 +80,7 @@ struct CradleDropResult {
   int cut = 0;
   int cut_cycling = 0;
   double mean_score = 0.0;
+  double score_ci95 = 0.0;     ///< half-width of mean_score's 95 % interval (Student's t)
 
   /// returns / shots (0 for none).
   double return_share() const;

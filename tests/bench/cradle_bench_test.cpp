@@ -103,12 +103,15 @@ TEST(CradleBench, TheTextMarksTheBestDropAndLeavesOutThePeriodOfADropWithNoRetur
   good.shots = 10;
   good.returns = 9;
   good.mean_period_s = 3.0;
+  good.mean_score = 391.0;
+  good.score_ci95 = 120.0;
   report.drops = {none, good};
   report.best = 1;
   const std::string text = to_text(report);
   EXPECT_NE(text.find("  drop 230 ms: returns 0 of 2 shots = 0 (0-"), std::string::npos) << text;
   EXPECT_EQ(text.find("drop 230 ms: returns 0 of 2 shots = 0 (0-0.658), needed"), std::string::npos) << text;
   EXPECT_NE(text.find("* drop 240 ms: returns 9 of 10 shots = 0.9"), std::string::npos) << text;
+  EXPECT_NE(text.find("391 ± 120 points"), std::string::npos) << "a score is given with its interval\n" << text;
   EXPECT_NE(text.find("under 0.01 % of cradled balls would live 10 minutes (1 % needs 0.977"), std::string::npos)
       << text;
 }

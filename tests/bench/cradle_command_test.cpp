@@ -26,6 +26,7 @@ TEST_F(CradleCommand, QuickRunInTheTwinGivesEveryDropInOneJsonObject) {
     EXPECT_LE(d.at("return_ci95_low").get<double>(), d.at("return_share").get<double>());
     EXPECT_GE(d.at("return_ci95_high").get<double>(), d.at("return_share").get<double>());
     EXPECT_EQ(d.at("balls"), 2);
+    EXPECT_GE(d.at("score_ci95_half_width").get<double>(), 0.0) << "a score is a noisy mean: its interval";
   }
   EXPECT_NE(r.err.find("ETA"), std::string::npos) << r.err;
 }
