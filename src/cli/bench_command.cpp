@@ -23,6 +23,7 @@
 #include "transfer_bench.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/learn/planning_controller.h"
+#include "pinball/learn/world_perturbation.h"
 #include "camera_bench.h"
 #include "detector_bench.h"
 #include "daemon_latency_bench.h"
@@ -102,6 +103,12 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
       ->type_name("FROM TO STEP")
       ->check(CLI::PositiveNumber)
       ->default_str("230 250 1");
+  cmd->add_option("--perturb", a.perturb,
+                  "cradle (repeatable): change the model world's table as the transfer sweep's cells do, NAME=VALUE "
+                  "in the perturbation's unit: pivot_y_mm, theta_min_deg, flipper_mu_pct, wall_rho, gravity_pct "
+                  "(e.g. --perturb gravity_pct=-3); the delay and camera ones do not apply: the cradle player sees "
+                  "the true ball at rest")
+      ->type_name("NAME=VALUE");
   cmd->add_option("--target-ratio", a.target_ratio,
                   "transfer: the ratio to the spastic flipper the summary holds every world to (counts the worlds at "
                   "it and those whose interval lies below it)")
@@ -319,16 +326,40 @@ int run_cradle(const BenchArgs& a, const table::Board& board, std::ostream& out,
   options.seed = a.seed;
   options.threads = a.threads;
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
-  const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
+  // The player reads the world's true ball, never the belief, so a perturbed
+  // copy of the belief can simply be the model world's table.
+  learn::WorldSettings table{board, 0.0, {}};
+  nlohmann::json perturbations = nlohmann::json::object();
+  for (const std::string& setting : a.perturb) {
+    const auto [p, value] = learn::parse_perturbation_setting(setting);
+    if (!learn::changes_table(p)) {
+      throw std::invalid_argument("bench cradle: --perturb " + setting +
+                                  ": the cradle player sees the true ball at rest and acts on the world's step, so "
+                                  "the solenoid's delay and the camera do not apply");
+    }
+    table = learn::perturb(table, p, value);
+    perturbations[std::string(learn::perturbation_name(p))] = value;
+  }
+  if (!a.perturb.empty() && (world_spec.kind != simlab::WorldKind::kModel || !world_spec.board_path.empty())) {
+    throw std::invalid_argument("bench cradle: --perturb changes the model world's table; not with --world twin or "
+                                "--world-board");
+  }
+  const simlab::OwnedWorld world = simlab::make_world(world_spec, table.board);
   const bench::CradleReport report =
       bench::run_cradle_bench(*world.world, options, [&](const std::string& line) { err << "bench " << line << "\n"; });
   if (a.json) {
     nlohmann::json j = bench::to_json(report);
     j.update(world_report(world_spec, a.board, *world.world));
     j.update(identified_report(a.identified));
+    j["perturbations"] = perturbations;
     out << j.dump(2) << "\n";
   } else {
     out << bench::to_text(report) << identified_text_line(a.identified);
+    if (!a.perturb.empty()) {
+      out << "the world's table perturbed:";
+      for (const std::string& setting : a.perturb) out << " " << setting;
+      out << "\n";
+    }
   }
   return 0;
 }
@@ -484,6 +515,9 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   }
   if (!a.drop_ms.empty() && a.which != "cradle") {
     throw std::invalid_argument("bench " + a.which + ": --drop-ms applies to cradle only");
+  }
+  if (!a.perturb.empty() && a.which != "cradle") {
+    throw std::invalid_argument("bench " + a.which + ": --perturb applies to cradle only (transfer plays the whole sweep)");
   }
   const table::Board board = table::load_belief_board(a.board, a.identified);  // the belief of ceiling and transfer
   if (a.which == "tracker") return run_tracker(a, board, out, err);

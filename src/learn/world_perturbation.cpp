@@ -1,10 +1,13 @@
 #include "pinball/learn/world_perturbation.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+
+#include "pinball/core/read_archive.h"
 
 namespace pinball::learn {
 
@@ -36,10 +39,40 @@ std::string_view perturbation_label(Perturbation p) {
   return "?";
 }
 
-bool is_offset(Perturbation p) {
+Perturbation parse_perturbation(std::string_view name) {
+  std::string names;
+  for (const Perturbation p : kAllPerturbations) {
+    if (perturbation_name(p) == name) return p;
+    names += (names.empty() ? "" : ", ") + std::string(perturbation_name(p));
+  }
+  throw std::invalid_argument("perturbation: no perturbation named '" + std::string(name) + "' (names: " + names + ")");
+}
+
+std::pair<Perturbation, double> parse_perturbation_setting(std::string_view text) {
+  const std::size_t eq = text.find('=');
+  const std::string quoted = quote_value(std::string(text));
+  if (eq == std::string_view::npos) {
+    throw std::invalid_argument("perturbation " + quoted + ": expected NAME=VALUE, e.g. gravity_pct=-10");
+  }
+  const Perturbation p = parse_perturbation(text.substr(0, eq));
+  std::string_view number = text.substr(eq + 1);
+  const bool plus = !number.empty() && number.front() == '+';  // "+3" reads as a sweep row names it
+  if (plus) number.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
+  if (number.empty() || (plus && number.front() == '-') || ec != std::errc() ||
+      end != number.data() + number.size() || !std::isfinite(value)) {
+    throw std::invalid_argument("perturbation " + quoted + ": the value is not a finite number");
+  }
+  return {p, value};
+}
+
+bool changes_table(Perturbation p) {
   return p != Perturbation::kActuationDelay_ms && p != Perturbation::kCameraLatency_ms &&
          p != Perturbation::kCameraNoise_px;
 }
+
+bool is_offset(Perturbation p) { return changes_table(p); }
 
 WorldSettings perturb(const WorldSettings& nominal, Perturbation p, double value) {
   if (!std::isfinite(value)) throw std::invalid_argument("perturbation: a perturbation's value must be finite");

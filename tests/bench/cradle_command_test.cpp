@@ -1,5 +1,6 @@
 // `pinball bench cradle` end to end: the quick run's one JSON object in the
-// twin, and bad input refused on one line with nothing on stdout.
+// twin, a perturbed model world, and bad input refused on one line with
+// nothing on stdout.
 #include <nlohmann/json.hpp>
 
 #include "common/command_test.h"
@@ -31,6 +32,25 @@ TEST_F(CradleCommand, QuickRunInTheTwinGivesEveryDropInOneJsonObject) {
   EXPECT_NE(r.err.find("ETA"), std::string::npos) << r.err;
 }
 
+TEST_F(CradleCommand, PerturbPlaysTheSweepsCellAndSaysSo) {
+  const std::string quick = "bench cradle --quick --drop-ms 390 390 1 --balls 4 --json";
+  const CommandResult nominal = run(quick);
+  const CommandResult lighter = run(quick + " --perturb gravity_pct=-10 --perturb wall_rho=-0.1");
+  ASSERT_EQ(nominal.exit_code, 0) << nominal.err;
+  ASSERT_EQ(lighter.exit_code, 0) << lighter.err;
+  const auto n = nlohmann::json::parse(nominal.out);
+  const auto l = nlohmann::json::parse(lighter.out);
+  EXPECT_TRUE(n.at("perturbations").empty());
+  EXPECT_EQ(l.at("perturbations").at("gravity_pct"), -10.0);
+  EXPECT_EQ(l.at("perturbations").at("wall_rho"), -0.1);
+  EXPECT_EQ(l.at("world"), "thesis");
+  EXPECT_NE(n.at("drops")[0].at("mean_ball_time_s"), l.at("drops")[0].at("mean_ball_time_s"))
+      << "another table plays another game";
+  const CommandResult text = run("bench cradle --quick --drop-ms 390 390 1 --balls 1 --perturb pivot_y_mm=+3");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("the world's table perturbed: pivot_y_mm=+3"), std::string::npos) << text.out;
+}
+
 TEST_F(CradleCommand, RefusesWhatItCannotUse) {
   struct Case {
     std::string args;
@@ -41,7 +61,14 @@ TEST_F(CradleCommand, RefusesWhatItCannotUse) {
                         Case{"bench cradle --drop-ms 240 250", 2, "--drop-ms"},
                         Case{"bench cradle --drop-ms 0 250 1", 2, "--drop-ms"},
                         Case{"bench aim --quick --drop-ms 240 250 1", 1, "cradle only"},
-                        Case{"bench cradle --balls 0", 2, "--balls"}}) {
+                        Case{"bench cradle --balls 0", 2, "--balls"},
+                        Case{"bench cradle --quick --perturb gravity=-3", 1, "gravity_pct"},
+                        Case{"bench cradle --quick --perturb gravity_pct", 1, "NAME=VALUE"},
+                        Case{"bench cradle --quick --perturb gravity_pct=lots", 1, "not a finite number"},
+                        Case{"bench cradle --quick --perturb camera_noise_px=2", 1, "camera do not apply"},
+                        Case{"bench cradle --quick --perturb gravity_pct=-100", 1, "g must stay > 0"},
+                        Case{"bench cradle --quick --world twin --perturb gravity_pct=-3", 1, "not with --world twin"},
+                        Case{"bench aim --quick --perturb gravity_pct=-3", 1, "cradle only"}}) {
     const CommandResult r = run(c.args);
     EXPECT_EQ(r.exit_code, c.exit_code) << c.args << "\n" << r.err;
     EXPECT_NE(r.err.find(c.names), std::string::npos) << c.args << "\n" << r.err;

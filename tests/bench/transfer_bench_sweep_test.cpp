@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <set>
@@ -29,6 +30,38 @@ TEST(TransferSweep, DefaultSweepIsTheIssuesAndQuickHasOneValuePerFamily) {
   EXPECT_EQ(nominal_value(Perturbation::kCameraLatency_ms, o), 5.0);
   EXPECT_EQ(nominal_value(Perturbation::kCameraNoise_px, o), 0.3);
   EXPECT_EQ(nominal_value(Perturbation::kGravity_pct, o), 0.0);
+}
+
+TEST(TransferSweep, EveryPerturbationIsFoundByItsNameAndOnlyTheTableOnesChangeTheTable) {
+  for (const Perturbation p : kAllPerturbations) EXPECT_EQ(learn::parse_perturbation(perturbation_name(p)), p);
+  try {
+    learn::parse_perturbation("gravity");
+    ADD_FAILURE() << "an unknown name is refused";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'gravity'"), std::string::npos) << what;
+    EXPECT_NE(what.find("gravity_pct"), std::string::npos) << "the message lists the names: " << what;
+  }
+  EXPECT_EQ(learn::parse_perturbation_setting("gravity_pct=-10"), std::make_pair(Perturbation::kGravity_pct, -10.0));
+  EXPECT_EQ(learn::parse_perturbation_setting("pivot_y_mm=+3"), std::make_pair(Perturbation::kPivotY_mm, 3.0))
+      << "a sweep row's own spelling";
+  EXPECT_EQ(learn::parse_perturbation_setting("wall_rho=0.1"), std::make_pair(Perturbation::kWallRho, 0.1));
+  for (const char* bad : {"gravity_pct", "gravity_pct=", "gravity_pct=ten", "gravity_pct=3x", "gravity_pct=nan",
+                          "gravity_pct=inf", "=3", "gravity_pct=+-3"}) {
+    EXPECT_THROW(learn::parse_perturbation_setting(bad), std::invalid_argument) << bad;
+  }
+  const WorldSettings n = nominal();
+  for (const Perturbation p : kAllPerturbations) {
+    const WorldSettings w = perturb(n, p, 1.0);
+    const bool table_changed = w.board.gravity_mps2 != n.board.gravity_mps2 ||
+                               w.board.flippers[0].pivot != n.board.flippers[0].pivot ||
+                               w.board.flippers[0].theta_min_rad != n.board.flippers[0].theta_min_rad ||
+                               w.board.flippers[0].mu != n.board.flippers[0].mu ||
+                               std::ranges::any_of(w.board.obstacles, [&](const table::Obstacle& o) {
+                                 return o.rho != n.board.obstacles[static_cast<std::size_t>(&o - w.board.obstacles.data())].rho;
+                               });
+    EXPECT_EQ(learn::changes_table(p), table_changed) << perturbation_name(p);
+  }
 }
 
 TEST(TransferSweep, GeometryMovesBothFlippersTheSameWay) {

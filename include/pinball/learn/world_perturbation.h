@@ -5,6 +5,7 @@
 // (randomized_evaluator.h), so a controller learns not to lean on one model.
 
 #include <string_view>
+#include <utility>
 
 #include "pinball/firmware/flipper_actuation.h"
 #include "pinball/table/board.h"
@@ -35,8 +36,21 @@ inline constexpr Perturbation kAllPerturbations[] = {
 std::string_view perturbation_name(Perturbation p);
 /// For people and plots: "flipper pivots along y (mm)", ...
 std::string_view perturbation_label(Perturbation p);
+/// The perturbation whose perturbation_name() is `name`; throws
+/// std::invalid_argument naming `name` and listing every name otherwise.
+Perturbation parse_perturbation(std::string_view name);
+/// One perturbation as a person writes it: "NAME=VALUE" ("gravity_pct=-10",
+/// "pivot_y_mm=+3"), VALUE in the perturbation's unit. Throws
+/// std::invalid_argument naming the text for no '=', an unknown name
+/// (parse_perturbation) or a value that is not a whole finite number.
+std::pair<Perturbation, double> parse_perturbation_setting(std::string_view text);
+/// True for a change of the table itself (pivots, θ_min, μ, wall ρ, g), which
+/// a world plays; false for the solenoid's delay and the camera, which the
+/// controller's loop plays.
+bool changes_table(Perturbation p);
 /// True for an offset from the nominal world (the nominal value is 0); false
-/// for an absolute setting (delay, latency, noise).
+/// for an absolute setting (delay, latency, noise). The table's perturbations
+/// are the offsets: each is an error of a calibrated or identified value.
 bool is_offset(Perturbation p);
 
 /// The world a cell plays beside its board: the perturbed table and the
