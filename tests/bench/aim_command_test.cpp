@@ -37,20 +37,12 @@ TEST_F(AimCommand, OneNoiseLevelFromTrueStateNoiseAndThePlannersSettings) {
 }
 
 TEST_F(AimCommand, RefusesWhatItCannotUse) {
-  struct Case {
-    std::string args;
-    int exit_code;
-    std::string names;
-  };
-  for (const Case& c : {Case{"--controller controllers/best.json", 1, "not a planner file"},
-                        Case{"--world twin", 1, "model only"},
-                        Case{"--stepper event", 1, "--stepper"},
-                        Case{"--true-state-noise -1 0", 2, "--true-state-noise"},
-                        Case{"--balls 0", 2, "--balls"}}) {
-    const CommandResult r = run("bench aim --quick " + c.args);
-    EXPECT_EQ(r.exit_code, c.exit_code) << c.args << "\n" << r.err;
-    EXPECT_NE(r.err.find(c.names), std::string::npos) << c.args << "\n" << r.err;
-    EXPECT_TRUE(r.out.empty()) << c.args;
+  for (const Refusal& refusal : {Refusal{"--controller controllers/best.json", 1, "not a planner file"},
+                                 Refusal{"--world twin", 1, "model only"},
+                                 Refusal{"--stepper event", 1, "--stepper"},
+                                 Refusal{"--true-state-noise -1 0", 2, "--true-state-noise"},
+                                 Refusal{"--balls 0", 2, "--balls"}}) {
+    expect_refused("bench aim --quick ", refusal);
   }
 }
 

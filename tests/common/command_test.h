@@ -57,6 +57,26 @@ class CommandTest : public ::testing::Test {
     return run_shell("cd " + cwd.string() + " && " PINBALL_EXE " " + args);
   }
 
+  /// A bad input a command must refuse: the arguments, the exit code, and
+  /// what its error must name.
+  struct Refusal {
+    std::string args;
+    int exit_code;
+    std::string names;
+  };
+
+  /// Runs `pinball <prefix><refusal.args>` and checks the refusal: the exit
+  /// code, the error naming what it must, and nothing on stdout. Returns the
+  /// result for a test's own further checks.
+  CommandResult expect_refused(const std::string& prefix, const Refusal& refusal) {
+    const std::string args = prefix + refusal.args;
+    const CommandResult r = run(args);
+    EXPECT_EQ(r.exit_code, refusal.exit_code) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(refusal.names), std::string::npos) << args << "\n" << r.err;
+    EXPECT_TRUE(r.out.empty()) << args;
+    return r;
+  }
+
   /// Runs a shell command line (e.g. `mpirun ... PINBALL_EXE ...`), its stderr captured too.
   CommandResult run_shell(const std::string& command_line) {
     const std::filesystem::path err = dir_ / "stderr.txt";
