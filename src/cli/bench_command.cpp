@@ -1,10 +1,13 @@
 // `pinball bench KIND`: the measurements behind docs/results.md.
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <fstream>
 #include <ostream>
 #include <stdexcept>
+#include <string_view>
+#include <vector>
 
 #include "camera_options.h"
 #include "data_file.h"
@@ -127,6 +130,13 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   add_camera_model_options(*cmd, a.camera);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   add_progress_flag(*cmd, a.progress);
+  // Which flags were given, for run_bench to refuse one the chosen bench would not read.
+  cmd->parse_complete_callback([cmd, &a] {
+    a.flags_given.clear();
+    for (const CLI::Option* option : cmd->get_options()) {
+      if (option->count() > 0 && !option->get_lnames().empty()) a.flags_given.push_back("--" + option->get_lnames().front());
+    }
+  });
   return cmd;
 }
 
@@ -496,6 +506,61 @@ int run_draw(const BenchArgs& a, const table::Board& board, std::ostream& out, s
   return 0;
 }
 
+// Which benches read each flag that not every bench reads. A flag given to a
+// bench that would ignore it is refused, so that `bench tracker --noise-px 1`
+// does not quietly measure 0.3 px.
+struct FlagUse {
+  std::vector<std::string_view> flags;
+  std::vector<std::string_view> benches;
+};
+
+const std::vector<FlagUse>& bench_flag_uses() {
+  static const std::vector<FlagUse> uses = {
+      {{"--board"}, {"speed", "tracker", "detector", "camera", "calibration", "precision", "ceiling", "aim", "cradle",
+                     "transfer", "draw"}},
+      {{"--steps"}, {"speed"}},
+      {{"--repeats"}, {"speed", "draw"}},
+      {{"--approaches"}, {"tracker"}},
+      {{"--seed"}, {"tracker", "detector", "camera", "calibration", "ceiling", "aim", "cradle", "transfer", "protocol"}},
+      {{"--quick"}, {"tracker", "latency", "detector", "camera", "calibration", "precision", "ceiling", "aim", "cradle",
+                     "transfer", "protocol", "draw"}},
+      {{"--balls", "--max-ball-time", "--identified"}, {"ceiling", "aim", "cradle", "transfer"}},
+      {{"--twin-balls", "--target-ratio"}, {"transfer"}},
+      {{"--threads"}, {"ceiling", "cradle", "transfer"}},
+      {{"--controller"}, {"ceiling", "aim", "transfer"}},
+      {{"--true-state-noise"}, {"ceiling", "aim"}},
+      {{"--drop-ms", "--perturb"}, {"cradle"}},
+      {{"--frames", "--seeds"}, {"protocol"}},
+      {{"--csv", "--png"}, {"precision", "transfer"}},
+      // aim and transfer read these only to refuse them, each with its reason.
+      {{"--world", "--world-board", "--stepper", "--dt"}, {"ceiling", "aim", "cradle", "transfer"}},
+      {{"--twin-params"}, {"ceiling", "cradle", "transfer"}},
+      {{"--fps", "--m-per-px", "--noise-px", "--latency", "--drop"}, {"ceiling", "transfer"}},
+  };
+  return uses;
+}
+
+// "cradle", "ceiling and aim", "ceiling, aim, cradle and transfer".
+std::string list_in_words(const std::vector<std::string_view>& items) {
+  std::string text;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    text += (i == 0 ? "" : i + 1 == items.size() ? " and " : ", ") + std::string(items[i]);
+  }
+  return text;
+}
+
+void refuse_flags_the_bench_does_not_read(const BenchArgs& a) {
+  for (const std::string& flag : a.flags_given) {
+    for (const FlagUse& use : bench_flag_uses()) {
+      if (std::ranges::find(use.flags, flag) == use.flags.end()) continue;
+      if (std::ranges::find(use.benches, a.which) == use.benches.end()) {
+        throw std::invalid_argument("bench " + a.which + ": " + flag + " applies to " + list_in_words(use.benches) +
+                                    " only");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
@@ -504,21 +569,9 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   // Progress only on a terminal or with --progress: a stream without a buffer swallows it.
   std::ostream no_progress(nullptr);
   std::ostream& err = progress_wanted(a.progress) ? all_err : no_progress;
+  refuse_flags_the_bench_does_not_read(a);
   if (a.which == "latency") return run_latency(a, out, err);
   if (a.which == "protocol") return run_protocol(a, out, err);
-  if (!a.true_state_noise.empty() && a.which != "ceiling" && a.which != "aim") {
-    throw std::invalid_argument("bench " + a.which + ": --true-state-noise applies to ceiling and aim only");
-  }
-  if (!a.identified.empty() && a.which != "ceiling" && a.which != "aim" && a.which != "cradle" &&
-      a.which != "transfer") {
-    throw std::invalid_argument("bench " + a.which + ": --identified applies to ceiling, aim, cradle and transfer only");
-  }
-  if (!a.drop_ms.empty() && a.which != "cradle") {
-    throw std::invalid_argument("bench " + a.which + ": --drop-ms applies to cradle only");
-  }
-  if (!a.perturb.empty() && a.which != "cradle") {
-    throw std::invalid_argument("bench " + a.which + ": --perturb applies to cradle only (transfer plays the whole sweep)");
-  }
   const table::Board board = table::load_belief_board(a.board, a.identified);  // the belief of ceiling and transfer
   if (a.which == "tracker") return run_tracker(a, board, out, err);
   if (a.which == "detector") return run_detector(a, board, out, err);

@@ -79,6 +79,7 @@ struct BenchArgs {
   double max_ball_time_s = 0.0;                      ///< ceiling, aim, transfer, cradle: a ball alive after this is cut (0: the bench's, 60 s; cradle 600 s)
   std::vector<double> drop_ms;                       ///< cradle: drop durations FROM TO STEP (ms); empty: the bench's
   std::vector<std::string> perturb;                  ///< cradle: the sweep's table perturbations, "NAME=VALUE", laid over the world
+  std::vector<std::string> flags_given;              ///< the long flags on the command line ("--noise-px"), set by the parser
   double target_ratio = 2.5;                         ///< transfer: the ratio to the spastic flipper the summary holds each world to
   std::vector<std::string> controllers;              ///< ceiling: one controller file; transfer: the controllers
   std::vector<double> true_state_noise;              ///< ceiling: play the controller fed the true state, noise (mm, m/s); empty: not

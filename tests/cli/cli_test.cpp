@@ -537,6 +537,23 @@ TEST_F(Cli, BenchCeilingWithThePlannerPlansWithItsSettingsOnTheTrueState) {
   EXPECT_NE(run("bench speed --true-state-noise 0.3 0.005").exit_code, 0);
 }
 
+TEST_F(Cli, BenchRefusesAFlagTheChosenBenchWouldNotRead) {
+  // Each would otherwise run the bench quietly without it: the tracker at 0.3 px, not 1.
+  for (const Refusal& refusal :
+       {Refusal{"bench tracker --quick --noise-px 1", 1, "--noise-px applies to ceiling and transfer only"},
+        Refusal{"bench cradle --quick --latency 0.01", 1, "--latency applies to ceiling and transfer only"},
+        Refusal{"bench tracker --quick --world twin", 1, "--world applies to ceiling, aim, cradle and transfer only"},
+        Refusal{"bench speed --quick", 1, "--quick applies to tracker, latency,"},
+        Refusal{"bench protocol --balls 3", 1, "--balls applies to"},
+        Refusal{"bench latency --seed 3", 1, "--seed applies to"},
+        Refusal{"bench detector --threads 1", 1, "--threads applies to ceiling, cradle and transfer only"},
+        Refusal{"bench cradle --quick --twin-balls 2", 1, "--twin-balls applies to transfer only"},
+        Refusal{"bench tracker --quick --csv x.csv", 1, "--csv applies to precision and transfer only"}}) {
+    const CommandResult r = expect_refused("", refusal);
+    EXPECT_EQ(count_lines(r.err), 1) << refusal.args << "\n" << r.err;
+  }
+}
+
 TEST_F(Cli, BenchPrecisionQuickWritesJsonCsvAndPng) {
   const fs::path csv = dir_ / "precision.csv";
   const fs::path png = dir_ / "precision.png";
