@@ -508,7 +508,7 @@ int run_draw(const BenchArgs& a, const table::Board& board, std::ostream& out, s
 
 // Which benches read each flag that not every bench reads. A flag given to a
 // bench that would ignore it is refused, so that `bench tracker --noise-px 1`
-// does not quietly measure 0.3 px.
+// does not quietly run the tracker bench's own camera grid instead.
 struct FlagUse {
   std::vector<std::string_view> flags;
   std::vector<std::string_view> benches;
