@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pinball/core/check.h"
 #include "pinball/core/json_read_archive.h"
 #include "pinball/core/json_write_archive.h"
 
@@ -157,6 +158,13 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
     refuse(r, "planner", check_planner_settings(p));
     s.planner = p;
   }
+  if (j.contains("spastic")) {
+    if (s.shot_table || s.planner) r.fail("spastic", "a spastic controller file holds no imitation or planner object");
+    SpasticConfig spastic;
+    r.read(&j["spastic"], "spastic", &spastic);
+    refuse(r, "spastic", check_spastic_config(spastic));
+    s.spastic = spastic;
+  }
   if (j.contains("actuator")) {
     r.read(&j["actuator"], "actuator", &s.actuator);
     refuse(r, "actuator", check_actuator_config(s.actuator));
@@ -179,6 +187,9 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
 }  // namespace
 
 std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec) {
+  check_input(!spec.spastic || (!spec.shot_table && !spec.planner), "controller",
+              "spastic settings beside a shot table or a planner");
+  if (spec.spastic) return std::make_unique<SpasticController>(*spec.spastic);
   if (spec.planner) {
     throw std::invalid_argument("controller: the planner needs the belief board (learn::make_controller)");
   }
@@ -207,6 +218,7 @@ std::string controller_to_json(const ControllerSpec& s) {
                                                  s.launch_pull_max})},
   };
   if (s.planner) j["planner"] = to_json_value(*s.planner);
+  if (s.spastic) j["spastic"] = to_json_value(*s.spastic);
   if (!s.shot_table) return j.dump(2) + "\n";
   // One line per shot: the table stays readable (and diffable) at thousands of shots.
   json table = shot_table_json(*s.shot_table);

@@ -226,6 +226,10 @@ ViewScene load_view_scene(const std::string& board_path, const std::string& cali
 std::optional<double> d_critical_m(const ViewScene& scene, const pinball_lcm::lcmt_pinball_projection& m) {
   if (!scene.controller || !m.valid) return std::nullopt;
   const track::TrajectoryProjection p = bus::from_lcm_projection(m);
+  if (scene.controller->spastic) {
+    if (!p.hittable) return std::nullopt;
+    return scene.controller->spastic->reach_m;
+  }
   if (scene.controller->shot_table) {
     const control::ImitationDecision d = scene.controller->shot_table->decide(p);
     if (!d.fire) return std::nullopt;

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -209,6 +212,47 @@ TEST(ControllerFile, IntegersAreNotTruncatedNorKeysRepeated) {
   expect_error(with(good, "\"max_hold_s\": 1.0", "\"max_hold_s\": 1e400"), "bad.json: (file): not valid JSON");
 }
 
+ControllerSpec spastic_spec(double reach_m, double max_hold_s) {
+  ControllerSpec s;
+  s.spastic = SpasticConfig{reach_m, max_hold_s};
+  return s;
+}
+
+TEST(ControllerFile, ASpasticFileRoundTripsAndPlaysTheSpasticFlipper) {
+  const ControllerSpec s = spastic_spec(0.03, 0.5);
+  const ControllerSpec r = controller_from_json(controller_to_json(s), "spastic.json");
+  ASSERT_TRUE(r.spastic);
+  EXPECT_EQ(r.spastic->reach_m, 0.03);
+  EXPECT_EQ(r.spastic->max_hold_s, 0.5);
+  EXPECT_EQ(controller_to_json(r), controller_to_json(s));
+  EXPECT_EQ(controller_to_json(ControllerSpec{}).find("spastic"), std::string::npos) << "no settings, no key";
+  // It fires within its reach, where the default actuator's zero gains would not.
+  const std::unique_ptr<FlipperController> c = make_flipper_controller(r);
+  track::TrackerOutput out;
+  out.projection.valid = true;
+  out.projection.hittable = true;
+  out.projection.flipper = track::kRightFlipper;
+  out.projection.d_m = 0.02;
+  std::array<bool, 2> on{false, false};
+  c->update(out, 1.0, on);
+  EXPECT_TRUE(on[track::kRightFlipper]);
+  EXPECT_FALSE(on[track::kLeftFlipper]);
+}
+
+TEST(ControllerFile, ASpasticFileIsRefusedOutOfRangeOrBesideAnotherController) {
+  const std::string good = controller_to_json(spastic_spec(0.03, 0.5));
+  expect_error(with(good, "\"reach_m\": 0.03", "\"reach_m\": -1"), "bad.json: spastic.reach_m: must be in (0, 1] m");
+  expect_error(with(good, "\"max_hold_s\": 0.5", "\"max_hold_s\": 0"), "bad.json: spastic.max_hold_s: must be in (0, 10] s");
+  // Which would play? Neither: the file is refused.
+  ControllerSpec both = with_shots();
+  both.spastic = SpasticConfig{};
+  expect_error(controller_to_json(both), "bad.json: spastic: a spastic controller file holds no imitation or planner object");
+  both.shot_table.reset();
+  both.planner = PlannerSettings{};
+  expect_error(controller_to_json(both), "bad.json: spastic: a spastic controller file holds no imitation or planner object");
+  EXPECT_THROW(make_flipper_controller(both), std::invalid_argument);
+}
+
 // docs/results.md quotes every file under controllers/: each must load as shipped.
 TEST(ControllerFile, EveryShippedControllerLoads) {
   int loaded = 0;
@@ -217,7 +261,8 @@ TEST(ControllerFile, EveryShippedControllerLoads) {
     EXPECT_NO_THROW(load_controller(entry.path().string())) << entry.path();
     ++loaded;
   }
-  EXPECT_GE(loaded, 12);
+  EXPECT_GE(loaded, 13);
+  EXPECT_TRUE(load_controller(PINBALL_SOURCE_DIR "/controllers/spastic.json").spastic);
 }
 
 }  // namespace

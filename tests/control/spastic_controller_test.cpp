@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <stdexcept>
+
 namespace pinball::control {
 namespace {
 
@@ -98,6 +101,18 @@ TEST(SpasticController, ReleasesAfterMaxHold) {
   EXPECT_TRUE(on[kRightFlipper]);
   c.update(nothing(), 12.6, on);
   EXPECT_FALSE(on[kRightFlipper]);
+}
+
+TEST(SpasticController, SettingsOutOfRangeAreRefused) {
+  EXPECT_FALSE(check_spastic_config(settings()));
+  EXPECT_FALSE(check_spastic_config(settings(1.0, kMaxHold_s)));
+  EXPECT_EQ(check_spastic_config(settings(0.0)).key, "reach_m");
+  EXPECT_EQ(check_spastic_config(settings(1.5)).key, "reach_m");
+  EXPECT_EQ(check_spastic_config(settings(std::nan(""))).key, "reach_m");
+  // 0 would drop the coil on every update: no hold at all, not "no limit".
+  EXPECT_EQ(check_spastic_config(settings(0.05, 0.0)).key, "max_hold_s");
+  EXPECT_EQ(check_spastic_config(settings(0.05, kMaxHold_s + 1.0)).key, "max_hold_s");
+  EXPECT_THROW(SpasticController(settings(-0.01)), std::invalid_argument);
 }
 
 TEST(SpasticController, ResetReleasesEverything) {

@@ -115,6 +115,11 @@ TEST(HotPath, CorrectingARealCamerasFaultsAllocatesNothingPerFrame) {
   expect_no_allocation_per_frame(std::string(PINBALL_SOURCE_DIR) + "/controllers/best.json", "typical");
 }
 
+TEST(HotPath, TheSpasticControllerFileAllocatesNothingPerFrame) {
+  if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
+  expect_no_allocation_per_frame(std::string(PINBALL_SOURCE_DIR) + "/controllers/spastic.json");
+}
+
 TEST(HotPath, TheImitationControllerAllocatesNothingPerFrame) {
   if (!PINBALL_COUNTING_ALLOCATOR) GTEST_SKIP() << "the sanitizer owns malloc in this build";
   // A table of random shots, most of them fired, so lookups and flips happen every approach.

@@ -12,6 +12,7 @@
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/imitation_controller.h"
 #include "pinball/control/planner_settings.h"
+#include "pinball/control/spastic_controller.h"
 
 namespace pinball::control {
 
@@ -31,6 +32,12 @@ struct ControllerSpec {
   /// function are not used. Only learn::make_controller, which is given the
   /// belief board, can build it.
   std::optional<PlannerSettings> planner;
+  /// The spastic flipper (thesis 1.1.1): when set, it drives the flippers and
+  /// nothing else in the file is used. A file, so that pinballd and every
+  /// command that reads a controller can play the baseline
+  /// (`controllers/spastic.json`); a file may not also hold a shot table or a
+  /// planner.
+  std::optional<SpasticConfig> spastic;
   double launcher_pull = -1.0;    ///< launcher pull fraction; negative: the board's
   bool randomise_launch = false;  ///< draw the pull per ball from [launch_pull_min, launch_pull_max] (thesis 7.1)
   double launch_pull_min = 0.5;   ///< lower end of a randomised pull
@@ -38,10 +45,12 @@ struct ControllerSpec {
   std::string note;               ///< free text: how it was produced
 };
 
-/// The flipper controller a spec describes: the imitation controller when it
-/// holds a shot table, the action function's actuator controller otherwise.
-/// Throws std::invalid_argument for a planner spec, which needs the belief
-/// board (learn::make_controller builds every kind).
+/// The flipper controller a spec describes: the spastic flipper when it holds
+/// spastic settings, the imitation controller when it holds a shot table, the
+/// action function's actuator controller otherwise. Throws
+/// std::invalid_argument for a planner spec, which needs the belief board
+/// (learn::make_controller builds every kind), and for spastic settings beside
+/// a shot table or a planner.
 std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec);
 
 /// Bad controller input; what() is "file: field: message".
