@@ -87,6 +87,7 @@ nlohmann::json run_json(const DaemonLatencyRun& r) {
 DaemonLatencyReport run_daemon_latency_bench(const DaemonLatencyOptions& options,
                                              const std::function<void(const std::string&)>& progress) {
   DaemonLatencyReport r;
+  r.controller = options.controller;
   if (progress) progress("baseline: eventfd wake-up between two threads");
   doorbell_baseline(options.baseline_samples, r.wake_p50_us, r.wake_p99_us);
   const daemon::ThreadSettings defaults;
@@ -109,6 +110,7 @@ DaemonLatencyReport run_daemon_latency_bench(const DaemonLatencyOptions& options
 
 nlohmann::json to_json(const DaemonLatencyReport& r) {
   return {{"fps", r.fps},
+          {"controller", r.controller},
           {"lockstep", run_json(r.lockstep)},
           {"lockstep_unpinned", run_json(r.lockstep_unpinned)},
           {"realtime", run_json(r.realtime)},

@@ -25,7 +25,7 @@ namespace pinball::bench {
 /// What to measure.
 struct DaemonLatencyOptions {
   std::string board = "boards/mit1993.board";        ///< simulated table
-  std::string controller = "controllers/best.json";  ///< controller file
+  std::string controller = "controllers/imitation.json";  ///< controller file: pinballd's default
   int lockstep_balls = 100;                          ///< balls on the lockstep clock
   double realtime_s = 60.0;                          ///< seconds paced to the wall clock, per run
   int baseline_samples = 5000;                       ///< doorbell wake-ups for the baseline
@@ -52,6 +52,7 @@ struct DaemonLatencyReport {
   double wake_p50_us = 0.0;         ///< baseline: eventfd wake-up of another thread, median (us)
   double wake_p99_us = 0.0;         ///< baseline 99th percentile (us)
   double fps = 200.0;               ///< camera rate
+  std::string controller;           ///< the controller file every run played
 };
 
 /// Runs both; `progress` (may be empty) gets one line per part.

@@ -59,7 +59,8 @@ start=$(date +%s)
 for c in "${cases[@]}"; do
   IFS='|' read -r label pivot length theta <<<"$c"
   config="$work/sim$n.yaml"
-  printf 'version: 1\nmode: sim\nlcm_url: "memq://"\n' >"$config"
+  # best.json, which docs/results.md's figures were measured with (pinballd's default until 2026-12-04).
+  printf 'version: 1\nmode: sim\nlcm_url: "memq://"\ncontroller: %s\n' "$PWD/controllers/best.json" >"$config"
   if [ "$pivot" != none ]; then
     cal="$work/cal$n.yaml"
     cp "$work/camera.yaml" "$cal"

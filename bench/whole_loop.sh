@@ -9,7 +9,7 @@
 #
 # Usage: bench/whole_loop.sh [--dir DIR] [--minutes "5 15 30"] [--twin-balls N]
 #          [--home-balls N] [--cem-budgets "B1 B2"] [--imitate-budget B]
-#          [--imitate-rounds R] [--threads T] [--json]
+#          [--imitate-rounds R] [--threads T] [--recorder FILE] [--json]
 #   from the repository root after `cmake --build --preset release`; needs jq.
 # Home: the controller in the identified model it was learned on (500 balls, seed 7).
 # Recordings (pinballd --balls 15 / 45 / 90, seeds 21 / 31 / 11: about 5, 14
@@ -17,7 +17,11 @@
 # and results stay in DIR (default /tmp/whole_loop); a run cut short resumes
 # where it stopped (each finished row is kept in DIR/rows.tsv). Learning uses
 # --seed 7, the twin --seed 1, so no controller is judged on a ball it was
-# learned on. Balls are cut at 60 s of game time.
+# learned on. Balls are cut at 60 s of game time. The recordings are played by
+# --recorder (default controllers/best.json, which the figures in
+# docs/results.md were recorded with; controllers/spastic.json is the spastic
+# play the issue names). The held-out recording is always best.json's, so
+# that every overlay is judged on the same moments.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -29,11 +33,12 @@ cem_budgets="6000 30000"
 imitate_budget=1500
 imitate_rounds=5
 threads=2
+recorder=controllers/best.json
 json=false
 while [ $# -gt 0 ]; do
   case "$1" in
     --json|-h|--help) ;;
-    --dir|--minutes|--twin-balls|--home-balls|--cem-budgets|--imitate-budget|--imitate-rounds|--threads)
+    --dir|--minutes|--twin-balls|--home-balls|--cem-budgets|--imitate-budget|--imitate-rounds|--threads|--recorder)
       [ $# -ge 2 ] || { echo "whole_loop: $1 needs a value (try --help)" >&2; exit 2; } ;;
   esac
   case "$1" in
@@ -45,8 +50,9 @@ while [ $# -gt 0 ]; do
     --imitate-budget) imitate_budget="$2"; shift 2 ;;
     --imitate-rounds) imitate_rounds="$2"; shift 2 ;;
     --threads) threads="$2"; shift 2 ;;
+    --recorder) recorder="$2"; shift 2 ;;
     --json) json=true; shift ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     *) echo "whole_loop: unknown argument '$1' (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -72,17 +78,26 @@ for m in "${minutes[@]}"; do
     *) echo "whole_loop: --minutes takes 5, 15 and 30, not '$m'" >&2; exit 2 ;;
   esac
 done
+[ -f "$recorder" ] || { echo "whole_loop: --recorder $recorder: no such file" >&2; exit 1; }
 for r in "${recordings[@]}"; do
   IFS='|' read -r name balls seed <<<"$r"
-  [ -f "$dir/$name.done" ] && continue
-  echo "whole_loop: recording $name ($balls balls in the twin)" >&2
+  player=$recorder
+  [ "$name" = heldout ] && player=controllers/best.json
+  if [ -f "$dir/$name.done" ]; then
+    # A run resumes only with the recordings it asked for (older runs left the file empty: best.json).
+    recorded_by=$(cat "$dir/$name.done"); recorded_by=${recorded_by:-controllers/best.json}
+    [ "$recorded_by" = "$player" ] ||
+      { echo "whole_loop: $dir/$name.lcm was recorded by $recorded_by, not $player: use another --dir" >&2; exit 1; }
+    continue
+  fi
+  echo "whole_loop: recording $name ($balls balls in the twin, $player)" >&2
   rm -f "$dir/$name.lcm"
-  "$bin/pinballd" --world twin --balls "$balls" --seed "$seed" --lcm-url "file://$dir/$name.lcm?mode=w" --json \
-    >"$dir/$name.report.json"
+  "$bin/pinballd" --world twin --controller "$player" --balls "$balls" --seed "$seed" \
+    --lcm-url "file://$dir/$name.lcm?mode=w" --json >"$dir/$name.report.json"
   [ "$(jq -r .recording_complete "$dir/$name.report.json")" = true ] ||
     { echo "whole_loop: the recording $dir/$name.lcm is incomplete ($dir/$name.report.json)" >&2; exit 1; }
   echo "whole_loop: $name: $(jq -r '.sim_s / 60 | . * 10 | round / 10' "$dir/$name.report.json") minutes of play" >&2
-  touch "$dir/$name.done"
+  echo "$player" >"$dir/$name.done"
 done
 
 for m in "${minutes[@]}"; do
@@ -156,8 +171,8 @@ ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a == "") print "null"; else print
 # The rows, the baselines first.
 ordered_rows() { grep '|spastic|' "$rows"; grep -v '|spastic|' "$rows"; }
 if $json; then
-  printf '{"twin_balls": %s, "home_balls": %s, "twin_seed": 1, "learn_seed": 7, "max_ball_time_s": 60, "rows": [' \
-    "$twin_balls" "$home_balls"
+  printf '{"recorder": "%s", "twin_balls": %s, "home_balls": %s, "twin_seed": 1, "learn_seed": 7, "max_ball_time_s": 60, "rows": [' \
+    "$recorder" "$twin_balls" "$home_balls"
   sep=""
   while IFS='|' read -r m controller budget learn_s home home_ci twin twin_ci cut; do
     printf '%s{"minutes_recorded": %s, "recorded_s": %s, "controller": "%s", "budget_balls": %s, "learn_wall_s": %s, "home_score": %s, "home_ci95": %s, "twin_score": %s, "twin_ci95": %s, "twin_balls_cut": %s, "ratio_to_spastic_at_home": %s, "ratio_to_spastic_in_twin": %s}' \
@@ -167,6 +182,7 @@ if $json; then
   done < <(ordered_rows)
   printf ']}\n'
 else
+  echo "recordings played by $recorder (held out: controllers/best.json)"
   echo "twin: $twin_balls balls (seed 1); home: $home_balls balls of the identified model (seed 7); each ball cut at 60 s;"
   echo "(Nx): the score over the spastic flipper's in the same world with the same belief"
   while IFS='|' read -r m controller budget learn_s home home_ci twin twin_ci cut; do

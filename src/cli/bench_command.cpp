@@ -84,10 +84,10 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--threads", a.threads, "ceiling, cradle, transfer: worker threads (results do not depend on it)")
       ->check(CLI::Range(1, 256));
   cmd->add_option("--controller", a.controllers,
-                  "ceiling: also play this controller file through the camera model and tracker (a planner file: the ceiling plans with its settings); aim: a planner file whose settings the ceiling player plans with; transfer "
+                  "latency: the controller pinballd plays (default: pinballd's, controllers/imitation.json); ceiling: also play this controller file through the camera model and tracker (a planner file: the ceiling plans with its settings); aim: a planner file whose settings the ceiling player plans with; transfer "
                   "(repeatable): play these instead of controllers/best.json, imitation.json and cem.json")
       ->transform(data_file())
-      ->default_str("ceiling none, transfer controllers/best.json imitation.json cem.json");
+      ->default_str("latency controllers/imitation.json, ceiling none, transfer controllers/best.json imitation.json cem.json");
   cmd->add_option("--true-state-noise", a.true_state_noise,
                   "ceiling: also play the --controller fed the TRUE ball every frame instead of the tracker's estimate, "
                   "plus Gaussian noise of MM (position, mm) and MPS (velocity, m/s) per coordinate; aim: replay the "
@@ -213,6 +213,8 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   auto progress = [&](const std::string& line) { err << "bench latency: " << line << "\n"; };
   bench::LatencyBenchOptions lo;
   bench::DaemonLatencyOptions dlo;
+  if (a.controllers.size() > 1) throw std::invalid_argument("bench latency: pinballd plays one --controller");
+  if (!a.controllers.empty()) dlo.controller = a.controllers.front();
   if (a.quick) {
     lo.samples = 200;
     lo.codec_frames = 10'000;
@@ -235,7 +237,8 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
       << "  baseline raw 16-byte write+read: p50 " << r.raw_p50_us << " us, p99 " << r.raw_p99_us << " us ("
       << r.stack_overhead_ratio << "x)\n"
       << "encode+decode per frame " << r.encode_decode_ns << " ns (copy baseline " << r.copy_baseline_ns << " ns)\n"
-      << "coil safety violations " << r.coil_violations << "\n";
+      << "coil safety violations " << r.coil_violations << "\n"
+      << "pinballd plays " << d.controller << "\n";
   const std::array<std::pair<const char*, const bench::DaemonLatencyRun*>, 4> runs{{
       {"lockstep", &d.lockstep},
       {"lockstep, threads free to move (baseline)", &d.lockstep_unpinned},
@@ -527,7 +530,7 @@ const std::vector<FlagUse>& bench_flag_uses() {
       {{"--balls", "--max-ball-time", "--identified"}, {"ceiling", "aim", "cradle", "transfer"}},
       {{"--twin-balls", "--target-ratio"}, {"transfer"}},
       {{"--threads"}, {"ceiling", "cradle", "transfer"}},
-      {{"--controller"}, {"ceiling", "aim", "transfer"}},
+      {{"--controller"}, {"latency", "ceiling", "aim", "transfer"}},
       {{"--true-state-noise"}, {"ceiling", "aim"}},
       {{"--drop-ms", "--perturb"}, {"cradle"}},
       {{"--frames", "--seeds"}, {"protocol"}},

@@ -138,6 +138,27 @@ TEST_F(Cli, LearnRandomizeSearchesAcrossDrawnWorldsAndJudgesInTheHomeWorld) {
   EXPECT_NE(bad.err.find("bad.yaml:ranges.g"), std::string::npos) << bad.err;
 }
 
+// controllers/spastic.json is the baseline itself, so a command that reads
+// controller files (pinballd among them) plays the ratios' denominator.
+TEST_F(Cli, TheSpasticControllerFilePlaysTheSpasticBaseline) {
+  const std::string balls = " --eval-balls 20 --max-ball-time 20 --seed 4 --threads 2 --json";
+  const CommandResult method = run("learn boards/mit1993.board --method spastic" + balls);
+  const CommandResult file = run("learn boards/mit1993.board --method evaluate --controller controllers/spastic.json" + balls);
+  ASSERT_EQ(method.exit_code, 0) << method.err;
+  ASSERT_EQ(file.exit_code, 0) << file.err;
+  const nlohmann::json a = nlohmann::json::parse(method.out).at("evaluation");
+  const nlohmann::json b = nlohmann::json::parse(file.out).at("evaluation");
+  EXPECT_GT(a.at("mean_score_per_ball").get<double>(), 0.0);
+  EXPECT_EQ(a.at("mean_score_per_ball"), b.at("mean_score_per_ball")) << "the same balls, the same flips";
+  EXPECT_EQ(a.at("flips_per_ball"), b.at("flips_per_ball"));
+  EXPECT_EQ(a.at("mean_ball_time_s"), b.at("mean_ball_time_s"));
+  const CommandResult policy = run("sim boards/mit1993.board --policy spastic --balls 3 --seed 3 --json");
+  const CommandResult played = run("sim boards/mit1993.board --controller controllers/spastic.json --balls 3 --seed 3 --json");
+  ASSERT_EQ(policy.exit_code, 0) << policy.err;
+  ASSERT_EQ(played.exit_code, 0) << played.err;
+  EXPECT_EQ(nlohmann::json::parse(policy.out).at("state_hash"), nlohmann::json::parse(played.out).at("state_hash"));
+}
+
 TEST_F(Cli, SimLearnAndBenchCeilingPlayTheTwin) {
   if (!pinball::simlab::twin_available()) GTEST_SKIP() << "this build has no MuJoCo twin";
   const CommandResult sim = run("sim boards/mit1993.board --world twin --policy spastic --balls 2 --seed 3 --json");
@@ -552,6 +573,16 @@ TEST_F(Cli, BenchRefusesAFlagTheChosenBenchWouldNotRead) {
     const CommandResult r = expect_refused("", refusal);
     EXPECT_EQ(count_lines(r.err), 1) << refusal.args << "\n" << r.err;
   }
+}
+
+TEST_F(Cli, BenchLatencyPlaysPinballdsDefaultControllerOrTheOneGiven) {
+  const CommandResult given = run("bench latency --quick --controller controllers/spastic.json --json");
+  ASSERT_EQ(given.exit_code, 0) << given.err;
+  const nlohmann::json d = nlohmann::json::parse(given.out).at("daemon");
+  EXPECT_EQ(fs::path(d.at("controller").get<std::string>()).filename(), "spastic.json");
+  EXPECT_GT(d.at("lockstep").at("frames").get<double>(), 0.0);
+  expect_refused("", {"bench latency --quick --controller controllers/spastic.json --controller controllers/best.json", 1,
+                      "bench latency: pinballd plays one --controller"});
 }
 
 TEST_F(Cli, BenchPrecisionQuickWritesJsonCsvAndPng) {

@@ -33,7 +33,7 @@ TEST(DaemonConfig, TheDefaultsAreTheEmbeddedSimulation) {
   EXPECT_EQ(c.sim.board, "boards/mit1993.board");
   EXPECT_EQ(c.sim.balls, 10);
   EXPECT_EQ(c.lcm_url, "memq://");
-  EXPECT_EQ(c.controller, "controllers/best.json");
+  EXPECT_EQ(c.controller, "controllers/imitation.json");
   EXPECT_FALSE(c.sim.realtime);
   EXPECT_EQ(c.threads.chain_cpu, "auto");
   EXPECT_EQ(c.threads.cpu_dma_latency_us, -1);
@@ -267,7 +267,7 @@ TEST(DaemonConfig, RelativePathsAreRelativeToTheConfigurationsFolder) {
   // Keys left out keep their defaults, found as before (the working directory, then the source tree).
   write_file(dir / "pinballd.yaml", "version: 1\n");
   in_dir("/", [&] { c = load_daemon_config((dir / "pinballd.yaml").string()); });
-  EXPECT_EQ(c.controller, "controllers/best.json");
+  EXPECT_EQ(c.controller, "controllers/imitation.json");
 }
 
 TEST(DaemonConfig, AMissingFileNamesTheConfigurationTheKeyAndThePath) {

@@ -13,7 +13,7 @@ fail() { echo "install_test: $*" >&2; exit 1; }
 
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log" >&2; fail "cmake --install failed"; }
 for f in bin/pinball bin/pinballd bin/pinball-lcm-spy \
-         share/pinball/boards/mit1993.board share/pinball/controllers/best.json \
+         share/pinball/boards/mit1993.board share/pinball/controllers/imitation.json share/pinball/controllers/spastic.json \
          share/pinball/config/lab.example.yaml share/pinball/lcmtypes/lcmt_pinball_game_event.lcm \
          share/doc/pinball/daemon.md share/doc/pinball/README.md lib/systemd/system/pinballd.service; do
   [ -e "$prefix/$f" ] || fail "$f not installed"
