@@ -1,8 +1,9 @@
 #pragma once
 // The seam between the tracker and the flipper solenoids (thesis 5.2.3): a
-// flipper controller turns each tracker update into solenoid commands. Two
-// implementations: the spastic flipper and the learned action function with
-// its actuator controller.
+// flipper controller turns each tracker update into solenoid commands.
+// Implementations: the spastic flipper, the learned action function with its
+// actuator controller, the imitation shot table and learn::PlanningController;
+// a controller file says which (make_flipper_controller, learn::make_controller).
 
 #include <array>
 #include <optional>
