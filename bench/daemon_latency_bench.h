@@ -24,12 +24,12 @@ namespace pinball::bench {
 
 /// What to measure.
 struct DaemonLatencyOptions {
-  std::string board = "boards/mit1993.board";             ///< simulated table
-  std::string controller = "controllers/imitation.json";  ///< controller file: pinballd's default
-  int lockstep_balls = 100;                               ///< balls on the lockstep clock
-  double realtime_s = 60.0;                               ///< seconds paced to the wall clock, per run
-  int baseline_samples = 5000;                            ///< doorbell wake-ups for the baseline
-  std::uint64_t seed = 1;                                 ///< launch seed
+  std::string board = "boards/mit1993.board";                 ///< simulated table
+  std::string controller = daemon::DaemonConfig{}.controller;  ///< controller file: pinballd's default
+  int lockstep_balls = 100;                                   ///< balls on the lockstep clock
+  double realtime_s = 60.0;                                   ///< seconds paced to the wall clock, per run
+  int baseline_samples = 5000;                                ///< doorbell wake-ups for the baseline
+  std::uint64_t seed = 1;                                     ///< launch seed
 };
 
 /// One run's latency table.

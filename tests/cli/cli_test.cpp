@@ -575,7 +575,7 @@ TEST_F(Cli, BenchRefusesAFlagTheChosenBenchWouldNotRead) {
   }
 }
 
-TEST_F(Cli, BenchLatencyPlaysPinballdsDefaultControllerOrTheOneGiven) {
+TEST_F(Cli, BenchLatencyPlaysTheControllerGivenAndRefusesTwo) {
   const CommandResult given = run("bench latency --quick --controller controllers/spastic.json --json");
   ASSERT_EQ(given.exit_code, 0) << given.err;
   const nlohmann::json d = nlohmann::json::parse(given.out).at("daemon");
