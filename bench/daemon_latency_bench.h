@@ -25,7 +25,7 @@ namespace pinball::bench {
 /// What to measure.
 struct DaemonLatencyOptions {
   std::string board = "boards/mit1993.board";                 ///< simulated table
-  std::string controller = daemon::DaemonConfig{}.controller;  ///< controller file: pinballd's default
+  std::string controller = daemon::kDefaultController;         ///< controller file: pinballd's default
   int lockstep_balls = 100;                                   ///< balls on the lockstep clock
   double realtime_s = 60.0;                                   ///< seconds paced to the wall clock, per run
   int baseline_samples = 5000;                                ///< doorbell wake-ups for the baseline

@@ -152,6 +152,11 @@ struct SimSettings {
 };
 
 /// Everything pinballd reads.
+/// pinballd's controller file unless told otherwise. imitation.json: it keeps
+/// its lead over the spastic flipper with a camera noisier than the
+/// simulation's, where best.json falls below it (controllers/README.md).
+inline constexpr const char* kDefaultController = "controllers/imitation.json";
+
 struct DaemonConfig {
   int version = kConfigVersion;  ///< format version
   std::string mode = "sim";      ///< sim: embedded simulation; lab: camera + SocketCAN
@@ -165,10 +170,7 @@ struct DaemonConfig {
   std::string identified;
   CanSettings can;               ///< CAN link
   firmware::DriverConfig coils;  ///< pulse, hold, caps and recycle time of every flipper coil (protocol limits)
-  /// Controller file (docs/learning.md). imitation.json: it keeps its lead over
-  /// the spastic flipper with a camera noisier than the simulation's, where
-  /// best.json falls below it (controllers/README.md).
-  std::string controller = "controllers/imitation.json";
+  std::string controller = kDefaultController;       ///< controller file (docs/learning.md)
   std::string lcm_url = "memq://";                   ///< LCM provider URL
   ThreadSettings threads;                            ///< scheduling
 
