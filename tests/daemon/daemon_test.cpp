@@ -139,6 +139,7 @@ TEST(Daemon, PlaysTheTwinThroughPixelsAndCanFrames) {
   if (!simlab::twin_available()) GTEST_SKIP() << "this build has no MuJoCo twin";
   DaemonConfig c = sim_config(2, 5);
   c.sim.world = simlab::WorldKind::kTwin;
+  c.sim.max_ball_time_s = 5.0;  // two balls through every stage; more game adds a minute under TSan, no coverage
   DaemonReport r;
   {
     Daemon d(c);
