@@ -12,6 +12,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "common/ball_radius.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/simlab/oracle_policy.h"
@@ -23,8 +24,7 @@ namespace pinball::sim {
 namespace {
 
 using namespace pinball::sim::testing;
-
-constexpr double kR = 0.0135;
+using pinball::testing::kR;
 
 double energy(const table::Board& b, const GameState& s) {
   return 0.5 * s.ball.velocity_mps.squaredNorm() + b.gravity_mps2 * s.ball.position_m.y();
