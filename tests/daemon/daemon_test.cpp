@@ -49,6 +49,15 @@ DaemonConfig sim_config(int balls, std::uint64_t seed) {
   return c;
 }
 
+// sim_config with each ball cut at 10 s: time for every stage, the tracker's
+// noise estimate and the recordings to see a game; the rest of a 60 s ball
+// adds only run time (up to a minute a test under ThreadSanitizer).
+DaemonConfig short_sim_config(int balls, std::uint64_t seed) {
+  DaemonConfig c = sim_config(balls, seed);
+  c.sim.max_ball_time_s = 10.0;
+  return c;
+}
+
 TEST(Daemon, LockstepRunsAreDeterminedByTheSeed) {
   DaemonReport a, b;
   {
@@ -76,7 +85,7 @@ TEST(Daemon, LockstepRunsAreDeterminedByTheSeed) {
 // The tracker measures the camera's noise as it plays; the report gives it
 // beside the calibration's, and says when the camera wants calibrating again.
 TEST(Daemon, TheReportGivesTheCameraNoiseTheTrackerMeasured) {
-  Daemon d(sim_config(1, 3));
+  Daemon d(short_sim_config(1, 3));
   const DaemonReport r = d.run();
   ASSERT_GT(r.camera_noise_calibrated_m, 0.0);
   ASSERT_TRUE(r.camera_noise_measured_m.has_value());
@@ -137,9 +146,8 @@ TEST(Daemon, TheWorldIsConfiguredApartFromTheBelief) {
 
 TEST(Daemon, PlaysTheTwinThroughPixelsAndCanFrames) {
   if (!simlab::twin_available()) GTEST_SKIP() << "this build has no MuJoCo twin";
-  DaemonConfig c = sim_config(2, 5);
+  DaemonConfig c = short_sim_config(2, 5);
   c.sim.world = simlab::WorldKind::kTwin;
-  c.sim.max_ball_time_s = 5.0;  // two balls through every stage; more game adds a minute under TSan, no coverage
   DaemonReport r;
   {
     Daemon d(c);
@@ -241,7 +249,7 @@ struct StatsCounter {
 
 TEST(Daemon, PublishesStatsAndGameEventsOnLcm) {
   StatsCounter c;
-  Daemon d(sim_config(1, 3));
+  Daemon d(short_sim_config(1, 3));
   bus::subscribe_raw(d.lcm_bus().lcm(), bus::kStatsChannel, c.on_stats);
   bus::subscribe_raw(d.lcm_bus().lcm(), bus::kGameChannel, c.on_game);
   const DaemonReport r = d.run();
@@ -261,7 +269,7 @@ std::string read_text(const std::string& path) {
 // still hold every frame, in candump's format to the byte, and say so.
 TEST(Daemon, ACanLogHoldsEveryFrameAndTheReportAndStatsSaySo) {
   const std::string path = ::testing::TempDir() + "/pinballd_can_" + std::to_string(getpid()) + ".log";
-  DaemonConfig config = sim_config(2, 6);
+  DaemonConfig config = short_sim_config(2, 6);
   config.can.log = path;
   StatsCounter c;
   Daemon d(config);
@@ -308,7 +316,7 @@ TEST(Daemon, EveryCommandIsPublishedTheShutdownReleaseLast) {
         ++published;
         last_cause = m.cause;
       });
-  Daemon d(sim_config(2, 4));
+  Daemon d(short_sim_config(2, 4));
   bus::subscribe_raw(d.lcm_bus().lcm(), bus::kFlipperCommandChannel, on_command);
   const DaemonReport r = d.run();
   EXPECT_GT(r.commands, 1u);
@@ -627,7 +635,7 @@ TEST(Pinballd, RealTimeRefusedWarnsAndPlaysOrWithEnforceExitsOne) {
 // replay at the game's pace and line up.
 TEST(Daemon, EveryRecordingOfALockstepRunIsStampedOnTheGamesClock) {
   const std::string base = ::testing::TempDir() + "/pinballd_clock_" + std::to_string(getpid());
-  DaemonConfig config = sim_config(1, 6);
+  DaemonConfig config = short_sim_config(1, 6);
   config.can.log = base + ".can";
   config.lcm_url = "file://" + base + ".lcmlog?mode=w";
   DaemonReport r;
