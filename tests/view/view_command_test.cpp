@@ -60,10 +60,11 @@ TEST_F(ViewCommand, SnapshotOfALiveSourceThroughLiblcm) {
 TEST_F(ViewCommand, LiveFromARunningPinballdOverUdpMulticast) {
   const std::string url = "'udpm://239.255.76.67:7671?ttl=0'";
   const std::string png = (dir_ / "udpm.png").string();
-  const CommandResult r = run_shell("(sleep 0.3; timeout -s INT 8 " PINBALLD_EXE " --lcm-url " + url +
-                                    " --realtime --balls 1 > /dev/null 2>&1) & env -u DISPLAY " PINBALL_EXE
+  // pinballd stops at 8 s at the latest, or when the view has its snapshot.
+  const CommandResult r = run_shell("(sleep 0.3; exec timeout -s INT 8 " PINBALLD_EXE " --lcm-url " + url +
+                                    " --realtime --balls 1 > /dev/null 2>&1) & daemon=$!; env -u DISPLAY " PINBALL_EXE
                                     " view --lcm-url " + url + " --snapshot " + png +
-                                    " --at 1 --wait-s 15 --json; status=$?; wait; exit $status");  // pinballd stops at 8 s
+                                    " --at 1 --wait-s 15 --json; status=$?; kill -INT $daemon 2>/dev/null; wait; exit $status");
   if (r.exit_code == 1 && r.err.find("nothing arrived") != std::string::npos) {
     GTEST_SKIP() << "UDP multicast does not loop back on this machine: " << r.err;
   }
