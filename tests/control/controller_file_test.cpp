@@ -214,9 +214,7 @@ TEST(ControllerFile, IntegersAreNotTruncatedNorKeysRepeated) {
 
 ControllerSpec spastic_spec(double reach_m, double max_hold_s) {
   ControllerSpec s;
-  s.spastic = SpasticConfig{};
-  s.spastic->reach_m = reach_m;
-  s.spastic->max_hold_s = max_hold_s;
+  s.spastic = SpasticConfig{reach_m, max_hold_s};
   return s;
 }
 
@@ -228,12 +226,6 @@ TEST(ControllerFile, ASpasticFileRoundTripsAndPlaysTheSpasticFlipper) {
   EXPECT_EQ(r.spastic->max_hold_s, 0.5);
   EXPECT_EQ(controller_to_json(r), controller_to_json(s));
   EXPECT_EQ(controller_to_json(ControllerSpec{}).find("spastic"), std::string::npos) << "no settings, no key";
-  EXPECT_EQ(controller_to_json(s).find("reach_max_m"), std::string::npos) << "no spread, no key";
-  ControllerSpec spread = s;
-  spread.spastic->reach_max_m = 0.08;
-  const ControllerSpec rs = controller_from_json(controller_to_json(spread), "spread.json");
-  ASSERT_TRUE(rs.spastic && rs.spastic->reach_max_m);
-  EXPECT_EQ(*rs.spastic->reach_max_m, 0.08);
   // It fires within its reach, where the default actuator's zero gains would not.
   const std::unique_ptr<FlipperController> c = make_flipper_controller(r);
   track::TrackerOutput out;
@@ -251,8 +243,6 @@ TEST(ControllerFile, ASpasticFileIsRefusedOutOfRangeOrBesideAnotherController) {
   const std::string good = controller_to_json(spastic_spec(0.03, 0.5));
   expect_error(with(good, "\"reach_m\": 0.03", "\"reach_m\": -1"), "bad.json: spastic.reach_m: must be in (0, 1] m");
   expect_error(with(good, "\"max_hold_s\": 0.5", "\"max_hold_s\": 0"), "bad.json: spastic.max_hold_s: must be in (0, 10] s");
-  expect_error(with(good, "\"max_hold_s\": 0.5", "\"max_hold_s\": 0.5, \"reach_max_m\": 0.02"),
-               "bad.json: spastic.reach_max_m: must be in [reach_m, 1] m");
   // Which would play? Neither: the file is refused.
   ControllerSpec both = with_shots();
   both.spastic = SpasticConfig{};

@@ -2,10 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <vector>
 
 namespace pinball::control {
 namespace {
@@ -115,70 +113,6 @@ TEST(SpasticController, SettingsOutOfRangeAreRefused) {
   EXPECT_EQ(check_spastic_config(settings(0.05, 0.0)).key, "max_hold_s");
   EXPECT_EQ(check_spastic_config(settings(0.05, kMaxHold_s + 1.0)).key, "max_hold_s");
   EXPECT_THROW(SpasticController(settings(-0.01)), std::invalid_argument);
-  SpasticConfig spread = settings(0.05);
-  spread.reach_max_m = 0.05;  // no spread at all is allowed
-  EXPECT_FALSE(check_spastic_config(spread));
-  spread.reach_max_m = 0.04;
-  EXPECT_EQ(check_spastic_config(spread).key, "reach_max_m");
-  spread.reach_max_m = 1.2;
-  EXPECT_EQ(check_spastic_config(spread).key, "reach_max_m");
-  spread.reach_max_m = std::nan("");
-  EXPECT_EQ(check_spastic_config(spread).key, "reach_max_m");
-}
-
-// A recorder's spread: the first fire of a ball at reach_m, then the golden-ratio
-// sequence k/phi mod 1 over [reach_m, reach_max_m], whose points split the largest gap.
-TEST(SpasticController, ASpreadReachWalksTheGoldenRatioSequence) {
-  SpasticConfig c = settings(0.02);
-  EXPECT_DOUBLE_EQ(spastic_reach_m(c, 5), 0.02);  // no spread: the baseline's reach, always
-  c.reach_max_m = 0.08;
-  EXPECT_DOUBLE_EQ(spastic_reach_m(c, 0), 0.02);
-  EXPECT_NEAR(spastic_reach_m(c, 1), 0.02 + 0.06 * 0.6180339887, 1e-10);
-  EXPECT_NEAR(spastic_reach_m(c, 2), 0.02 + 0.06 * 0.2360679775, 1e-10);
-  EXPECT_NEAR(spastic_reach_m(c, 3), 0.02 + 0.06 * 0.8541019662, 1e-10);
-  // Any first 20 fires leave no gap in the range wider than a tenth of it.
-  std::vector<double> r{0.02, 0.08};
-  for (int k = 0; k < 20; ++k) {
-    r.push_back(spastic_reach_m(c, k));
-    ASSERT_GE(r.back(), 0.02);
-    ASSERT_LE(r.back(), 0.08);
-  }
-  std::sort(r.begin(), r.end());
-  for (std::size_t i = 1; i < r.size(); ++i) EXPECT_LT(r[i] - r[i - 1], 0.006) << i;
-}
-
-TEST(SpasticController, ASpreadReachFiresTheNextApproachFartherOutAndRestartsEachBall) {
-  SpasticConfig spread = settings(0.02, 1.0);
-  spread.reach_max_m = 0.08;
-  SpasticController c(spread);
-  std::array<bool, 2> on{false, false};
-  c.update(heading_for(kRightFlipper, 0.05), 0.0, on);
-  EXPECT_FALSE(on[kRightFlipper]);  // the first fire waits for reach_m
-  c.update(heading_for(kRightFlipper, 0.02), 0.005, on);
-  ASSERT_TRUE(on[kRightFlipper]);
-  c.update(nothing(), 1.1, on);  // held past max_hold_s: dropped
-  ASSERT_FALSE(on[kRightFlipper]);
-  c.update(heading_for(kRightFlipper, 0.05), 1.2, on);
-  EXPECT_TRUE(on[kRightFlipper]);  // the second fire reaches 0.02 + 0.618 * 0.06 = 0.057 m
-  // The left flipper has its own count: its first fire still waits for reach_m.
-  c.update(heading_for(kLeftFlipper, 0.05), 1.3, on);
-  EXPECT_FALSE(on[kLeftFlipper]);
-  // A launch (a shot leaving the bat) releases the coils but keeps the ball's count:
-  // the third fire reaches 0.02 + 0.236 * 0.06 = 0.034 m.
-  track::TrackerOutput launch;
-  launch.launch.launched = true;
-  c.update(launch, 2.0, on);
-  ASSERT_FALSE(on[kRightFlipper]);
-  c.update(heading_for(kRightFlipper, 0.04), 2.1, on);
-  EXPECT_FALSE(on[kRightFlipper]);
-  c.update(heading_for(kRightFlipper, 0.03), 2.105, on);
-  EXPECT_TRUE(on[kRightFlipper]);
-  // A new ball (reset) starts the sequence again at reach_m.
-  c.reset(on);
-  c.update(heading_for(kRightFlipper, 0.05), 3.0, on);
-  EXPECT_FALSE(on[kRightFlipper]);
-  c.update(heading_for(kRightFlipper, 0.02), 3.005, on);
-  EXPECT_TRUE(on[kRightFlipper]);
 }
 
 TEST(SpasticController, ResetReleasesEverything) {

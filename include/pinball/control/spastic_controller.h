@@ -5,7 +5,6 @@
 // every learned controller is compared against.
 
 #include <array>
-#include <optional>
 
 #include "pinball/control/flipper_controller.h"
 #include "pinball/core/name_value.h"
@@ -17,29 +16,17 @@ namespace pinball::control {
 struct SpasticConfig {
   double reach_m = 0.02;     ///< flip when d_impact <= this (m): about 1.5 ball radii (docs/results.md)
   double max_hold_s = 1.0;   ///< release a flipper held this long with no launch seen (a cradled ball)
-  /// A recorder's spread (docs/identification.md): each fire of a flipper
-  /// after its first of a ball (reset()) uses the next reach of a golden-ratio sequence
-  /// over [reach_m, reach_max_m], so one recording strikes balls at many
-  /// points of the stroke. Absent: always reach_m (the thesis's baseline).
-  std::optional<double> reach_max_m;
 
   /// The keys of a controller file's `spastic` object (docs/learning.md).
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(PINBALL_NVP(reach_m));
     a->Visit(PINBALL_NVP(max_hold_s));
-    a->Visit(PINBALL_NVP(reach_max_m));
   }
 };
 
-/// A setting outside its range: reach_m in (0, 1] m, max_hold_s in (0, kMaxHold_s],
-/// reach_max_m in [reach_m, 1] m.
+/// A setting outside its range: reach_m in (0, 1] m, max_hold_s in (0, kMaxHold_s].
 RangeViolation check_spastic_config(const SpasticConfig& config);
-
-/// The reach of a flipper's `fire_index`-th fire in a ball (0 first): reach_m,
-/// then points of the golden-ratio sequence over [reach_m, reach_max_m] (evenly
-/// spread at every length, the same every ball, so a replay repeats it).
-double spastic_reach_m(const SpasticConfig& config, int fire_index);
 
 /// Flipper commands from tracker output.
 class SpasticController final : public FlipperController {
@@ -55,11 +42,8 @@ class SpasticController final : public FlipperController {
   void reset(std::array<bool, 2>& energized) override;
 
  private:
-  void release(std::array<bool, 2>& energized);  ///< coils off; the ball's fire counts stay
-
   SpasticConfig config_;
   std::array<double, 2> held_since_s_{};
-  std::array<int, 2> fires_{};  ///< each flipper's fires this ball: the next reach's index
 };
 
 }  // namespace pinball::control
