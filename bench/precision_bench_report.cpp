@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "pinball/plot/chart.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/sim/event_stepper.h"
 
 namespace pinball::bench {

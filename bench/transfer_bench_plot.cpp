@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "pinball/plot/chart.h"
+#include "pinball/plot/png_file.h"
 #include "transfer_bench.h"
 
 namespace pinball::bench {

@@ -39,6 +39,7 @@
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/socketcan_transport.h"
 #include "pinball/plot/draw.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/simlab/sim_lab.h"
 #include "pinball/simlab/sim_latency_lab.h"
 #include "pinball/simlab/sim_target_view.h"

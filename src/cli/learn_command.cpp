@@ -43,6 +43,7 @@
 #include "pinball/learn/relay_race.h"
 #include "pinball/learn/team.h"
 #include "pinball/learn/tournament.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/table/board_overlay.h"
 
 namespace pinball::cli {
@@ -482,7 +483,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     if (writer) {
       control::save_controller(result_spec, a.out);
       if (!a.curve.empty()) learn::write_curve_csv(r, a.curve);
-      if (!a.plot.empty()) learn::plot_curve_png(r, a.plot);
+      if (!a.plot.empty()) plot::write_png(learn::draw_curve(r), a.plot);
     }
     eval_spec = &result_spec;
     nlohmann::json counters = nlohmann::json::object();
@@ -546,7 +547,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
         &teacher_worlds);
     const learn::SearchResult curve = learn::imitation_curve(im);
     if (writer && !a.curve.empty()) learn::write_curve_csv(curve, a.curve);
-    if (writer && !a.plot.empty()) learn::plot_curve_png(curve, a.plot);
+    if (writer && !a.plot.empty()) plot::write_png(learn::draw_curve(curve), a.plot);
     j["cycle_found"] = curve.cycle_found;
     j["balls_used"] = curve.balls_used;
     result_spec = objective.prototype();

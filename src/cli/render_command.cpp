@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "data_file.h"
 #include "pinball/plot/draw.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/renderer.h"

@@ -19,6 +19,7 @@
 #include "pinball/core/format.h"
 #include "pinball/daemon/daemon_config.h"
 #include "pinball/plot/draw.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/view/lcm_listener.h"
 #include "pinball/view/log_player.h"
 #include "pinball/view/view_render.h"

@@ -18,7 +18,7 @@ void write_curve_csv(const SearchResult& r, const std::string& path) {
   if (!f) throw std::runtime_error(path + ": write failed");
 }
 
-void plot_curve_png(const SearchResult& r, const std::string& path) {
+cv::Mat draw_curve(const SearchResult& r) {
   plot::Figure figure;
   figure.title = "Learning curve of " + r.method + ": mean score per ball - pinball learn";
   figure.notes = {"population: the mean over each generation's balls, band: its 95 % interval (Student's t)",
@@ -48,7 +48,7 @@ void plot_curve_png(const SearchResult& r, const std::string& path) {
   if (r.curve.size() < 2) population.marker = generation.marker = best.marker = plot::Marker::kCircle;
   panel.series = {population, generation, best};
   figure.panels.push_back(std::move(panel));
-  plot::write_png(plot::render(figure), path);
+  return plot::render(figure);
 }
 
 }  // namespace pinball::learn

@@ -7,7 +7,6 @@
 #include <stdexcept>
 #include <utility>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "pinball/plot/ticks.h"
@@ -269,16 +268,6 @@ cv::Mat annotated_picture(const cv::Mat& picture, std::span<const LegendEntry> l
   draw_legend(key, legend, Corner::kTopLeft);
   const std::vector<cv::Mat> parts{bgr, key};
   return with_title(place(parts, true), title, notes);
-}
-
-void write_png(const cv::Mat& image, const std::string& path) {
-  bool ok = false;
-  try {
-    ok = !image.empty() && cv::imwrite(path, image);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error("write_png: cannot write '" + path + "': " + e.what());
-  }
-  if (!ok) throw std::runtime_error("write_png: cannot write '" + path + "'");
 }
 
 }  // namespace pinball::plot

@@ -8,6 +8,7 @@
 #include "common/figure_check.h"
 #include "common/temp_path.h"
 #include "pinball/plot/draw.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/simlab/sim_lab.h"
 #include "pinball/table/board_loader.h"
 

@@ -12,6 +12,7 @@
 #include "common/figure_check.h"
 #include "common/temp_path.h"
 #include "pinball/core/rng.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/simlab/sim_target_view.h"
 
 namespace pinball::calibration {

@@ -39,16 +39,23 @@ inline cv::Mat read_figure(const std::string& path) {
   return image;
 }
 
-/// A figure read back from `path` that is at least `min_size`, with ink on
+/// A figure (`name` in messages) that is at least `min_size`, with ink on
 /// more than 2 % of it (not blank) and at least `palette_colours` of the
 /// palette's first `palette_n` colours.
+inline void expect_figure_image(const cv::Mat& image, const std::string& name, cv::Size min_size, int palette_colours,
+                                int palette_n = 8) {
+  ASSERT_FALSE(image.empty()) << name << " is empty";
+  EXPECT_GE(image.cols, min_size.width) << name;
+  EXPECT_GE(image.rows, min_size.height) << name;
+  EXPECT_GT(count_ink(image), image.rows * image.cols / 50) << name << " is (nearly) blank";
+  EXPECT_GE(palette_colours_present(image, palette_n), palette_colours) << name << ": too few palette colours";
+}
+
+/// expect_figure_image of the figure read back from `path`.
 inline void expect_figure(const std::string& path, cv::Size min_size, int palette_colours, int palette_n = 8) {
   const cv::Mat image = read_figure(path);
   if (image.empty()) return;
-  EXPECT_GE(image.cols, min_size.width) << path;
-  EXPECT_GE(image.rows, min_size.height) << path;
-  EXPECT_GT(count_ink(image), image.rows * image.cols / 50) << path << " is (nearly) blank";
-  EXPECT_GE(palette_colours_present(image, palette_n), palette_colours) << path << ": too few palette colours";
+  expect_figure_image(image, path, min_size, palette_colours, palette_n);
 }
 
 }  // namespace pinball::testing

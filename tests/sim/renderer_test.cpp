@@ -13,6 +13,7 @@
 
 #include "common/figure_check.h"
 #include "pinball/plot/draw.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 

@@ -92,7 +92,4 @@ cv::Mat place(std::span<const cv::Mat> images, bool horizontal, int gap_px = 8);
 cv::Mat annotated_picture(const cv::Mat& picture, std::span<const LegendEntry> legend, const std::string& title,
                           std::span<const std::string> notes = {});
 
-/// Writes an image as PNG. Throws std::runtime_error naming the path on failure.
-void write_png(const cv::Mat& image, const std::string& path);
-
 }  // namespace pinball::plot
