@@ -38,7 +38,7 @@ BoardOverlay full() {
   bumpers.kick_mps = value(0.7, 0.1, 20);
   o.obstacle_groups = {arcs, bumpers};
   o.flippers = {{"left_flipper", value(1.4, 0.1, 55), value(40.0, 2.0, 54), value(0.012, 0.001, 54)},
-                {"right_flipper", value(1.7, 0.12, 48)}};
+                {"right_flipper", value(1.7, 0.12, 48), std::nullopt, std::nullopt}};
   o.launcher = LauncherOverlay{value(0.9, 0.01, 30), value(0.05, 0.01, 30)};
   o.wall_thickness_m = value(0.00277, 0.00004, 32030);
   return o;
