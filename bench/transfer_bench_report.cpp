@@ -27,6 +27,7 @@ nlohmann::json cell_json(const TransferCell& c) {
   return {{"mean_score_per_ball", c.score.mean()},
           {"score_ci95_half_width", c.score.ci95_half_width()},
           {"score_stddev", c.score.stddev()},
+          {"max_score_per_ball", c.score.max()},
           {"balls", c.score.count()},
           {"ratio_to_spastic", c.ratio_to_spastic},
           {"ratio_ci95_low", c.ratio_interval ? nlohmann::json(c.ratio_interval->low) : nlohmann::json()},
@@ -249,7 +250,7 @@ std::string to_csv(const TransferReport& r) {
   out << "world,family,value,stepper,controller,status,balls,mean_score_per_ball,score_ci95_half_width,"
          "ratio_to_spastic,balls_cut_at_time_limit,max_ball_time_s,mean_ball_time_s,flips_per_ball,"
          "drains_left_outlane,drains_right_outlane,drains_centre,drains_other,drains_left_table,wall_s,"
-         "ratio_ci95_low,ratio_ci95_high,outlane_drain_after_flipper_s_mean\n";
+         "ratio_ci95_low,ratio_ci95_high,outlane_drain_after_flipper_s_mean,max_score_per_ball\n";
   const std::vector<std::string> names = player_names(r);
   for (const TransferWorld& w : r.worlds) {
     std::ostringstream value;
@@ -258,7 +259,7 @@ std::string to_csv(const TransferReport& r) {
     if (!w.played) {
       for (const std::string& n : names) {
         out << head << n << ',' << csv_text("skipped: " + w.skipped_reason) << ",0,,,,," << r.options.max_ball_time_s
-            << ",,,,,,,,,,,\n";
+            << ",,,,,,,,,,,,\n";
       }
       continue;
     }
@@ -272,7 +273,7 @@ std::string to_csv(const TransferReport& r) {
       else out << ',';
       out << ',';
       if (c.outlane_after_flipper_s.count() > 0) out << c.outlane_after_flipper_s.mean();
-      out << '\n';
+      out << ',' << c.score.max() << '\n';
     }
   }
   return out.str();

@@ -31,11 +31,15 @@ TEST(TransferReport, JsonHasTheOptionsEveryCellAndTheSameKeysAsEveryCommand) {
     for (const char* c : {"spastic", "learned"}) {
       for (const char* k : {"mean_score_per_ball", "score_ci95_half_width", "balls_cut_at_time_limit", "wall_s",
                             "ratio_to_spastic", "drains_left_outlane", "drains_right_outlane", "drains_centre",
-                            "drains_other", "drains_left_table", "outlane_drain_after_flipper_s_mean"}) {
+                            "drains_other", "drains_left_table", "outlane_drain_after_flipper_s_mean",
+                            "max_score_per_ball"}) {
         EXPECT_TRUE(w.at("cells").at(c).contains(k)) << w.at("name") << " " << c << " " << k;
       }
     }
     EXPECT_EQ(w.at("cells").at("spastic").at("ratio_to_spastic"), 1.0);
+    // The best ball: a heavy tail (one ball scoring for a minute on end) shows here before it moves a mean.
+    EXPECT_EQ(w.at("cells").at("spastic").at("max_score_per_ball").get<double>(),
+              w.at("cells").at("spastic").at("mean_score_per_ball").get<double>() + 100.0);
     EXPECT_TRUE(w.at("cells").at("spastic").at("ratio_ci95_low").is_null()) << "no interval for itself";
     const auto& learned = w.at("cells").at("learned");
     EXPECT_LT(learned.at("ratio_ci95_low").get<double>(), learned.at("ratio_to_spastic").get<double>());
@@ -107,7 +111,7 @@ TEST(TransferReport, CsvHasAHeaderAndOneRowPerWorldAndController) {
   ASSERT_TRUE(interval.has_value());
   std::ostringstream tail;
   tail.precision(10);
-  tail << ',' << interval->low << ',' << interval->high << ",2.5\n";
+  tail << ',' << interval->low << ',' << interval->high << ",2.5,2100\n";  // the best of 1900, 2100, 1900, 2100
   EXPECT_NE(csv.find(tail.str()), std::string::npos) << tail.str() << csv;
   EXPECT_NE(csv.find("model,nominal,0,thesis,spastic,played,4,1000,"), std::string::npos) << csv;
 }
