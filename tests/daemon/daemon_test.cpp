@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -546,7 +547,8 @@ TEST(Pinballd, ACanLogPipeNobodyReadsHoldsNeitherHeartbeatsNorSigint) {
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   const int reader = open(fifo.c_str(), O_RDONLY | O_NONBLOCK);  // there, and never reads
   ASSERT_GE(reader, 0);
-  ASSERT_GT(fcntl(reader, F_SETPIPE_SZ, 4096), 0);  // full within a second of frames
+  const int pipe_bytes = fcntl(reader, F_SETPIPE_SZ, 4096);  // full within a second of frames
+  ASSERT_GT(pipe_bytes, 0);
   const std::string cmd = std::string(PINBALLD_EXE) + " --balls 1000 --realtime --json --can-log " + fifo + " > " +
                           base + ".json 2> " + base + ".err";
   const pid_t pid = fork();
@@ -555,7 +557,22 @@ TEST(Pinballd, ACanLogPipeNobodyReadsHoldsNeitherHeartbeatsNorSigint) {
     execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(3000));
+  // Wait for the pipe to fill, not for a fixed time: a slow start (ThreadSanitizer on a
+  // loaded machine) once let 3 s pass before the pipe was full, and nothing stalled.
+  // Full: within 64 bytes of its size (seen stopping 20 bytes short: the last bytes of a
+  // pipe page need not take a write).
+  const int full_bytes = pipe_bytes - 64;
+  int queued_bytes = 0;
+  for (int i = 0; i < 600 && queued_bytes <= full_bytes; ++i) {  // 60 s
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ASSERT_EQ(ioctl(reader, FIONREAD, &queued_bytes), 0);
+  }
+  if (queued_bytes <= full_bytes) {
+    kill(pid, SIGKILL);
+    waitpid(pid, nullptr, 0);
+  }
+  ASSERT_GT(queued_bytes, full_bytes) << "the CAN log did not fill its pipe within 60 s";
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // stalled behind the full pipe for a second
   ASSERT_EQ(kill(pid, SIGINT), 0);
   int status = 0;
   pid_t done = 0;
