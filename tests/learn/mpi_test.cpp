@@ -90,7 +90,7 @@ TEST_F(Mpi, AnEvaluationAndTheImitationTeacherAreTheSameOnTwoAndThreeRanks) {
 }
 
 TEST_F(Mpi, TheCeilingBenchIsTheSameOnTwoRanks) {
-  const std::string args = "bench ceiling --quick --seed 4 --json";
+  const std::string args = "bench ceiling --quick --seed 4 --max-ball-time 10 --json";  // 10 s balls: half the time
   const testing::CommandResult one = run(args);
   ASSERT_EQ(one.exit_code, 0) << one.err;
   const testing::CommandResult two = run_shell(mpirun(2) + args + " --threads 1");
