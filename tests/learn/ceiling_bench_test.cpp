@@ -137,6 +137,12 @@ TEST(CeilingBench, ThePlannerFedTheTrueStatePlaysBesideItAndItsNoiseMatters) {
   bad = o;
   bad.controller = nullptr;
   EXPECT_THROW(run_ceiling_bench(thesis_board(), bad, {}), std::invalid_argument) << "nothing to feed";
+  // A controller that acts on the projection would never fire on the feed: refused, not scored.
+  control::ControllerSpec table_spec;
+  table_spec.spastic = control::SpasticConfig{};
+  bad = o;
+  bad.controller = &table_spec;
+  EXPECT_THROW(run_ceiling_bench(thesis_board(), bad, {}), std::invalid_argument) << "not a planner";
 }
 
 }  // namespace
