@@ -170,18 +170,19 @@ CeilingReport run_ceiling_bench(const table::Board& board, const CeilingBenchOpt
                                 const std::function<void(const std::string&)>& progress, const sim::World* world) {
   if (options.balls < 1) throw std::invalid_argument("ceiling bench: balls must be >= 1");
   if (!(options.max_ball_time_s > 0.0)) throw std::invalid_argument("ceiling bench: max ball time must be > 0");
-  // Checked before any ball is played: the players before the fed one take minutes.
-  if (options.true_state_feed && options.controller == nullptr)
-    throw std::invalid_argument("ceiling bench: the true-state feed needs a controller to feed");
-  // The feed writes the tracker's fit, which a planner places its ball by; a shot
-  // table or the spastic flipper acts on the projection, which the feed does not make,
-  // and would play a ball without ever firing.
-  if (options.true_state_feed && !options.controller->planner)
-    throw std::invalid_argument("ceiling bench: the true-state feed drives a planner file only (it gives the tracker's "
-                                "fit, not the projection a shot table or the spastic flipper acts on)");
-  if (options.true_state_feed && !(options.true_state_feed->position_noise_m >= 0.0 &&
-                                   options.true_state_feed->velocity_noise_mps >= 0.0))
-    throw std::invalid_argument("ceiling bench: the true-state feed's noise must be >= 0");
+  // The feed is checked before any ball is played: the players before it take minutes.
+  if (const auto& feed = options.true_state_feed) {
+    if (options.controller == nullptr)
+      throw std::invalid_argument("ceiling bench: the true-state feed needs a controller to feed");
+    // The feed writes the tracker's fit, which a planner places its ball by; a shot
+    // table or the spastic flipper acts on the projection, which the feed does not make,
+    // and would play a ball without ever firing.
+    if (!options.controller->planner)
+      throw std::invalid_argument("ceiling bench: the true-state feed drives a planner file only (it gives the "
+                                  "tracker's fit, not the projection a shot table or the spastic flipper acts on)");
+    if (!(feed->position_noise_m >= 0.0 && feed->velocity_noise_mps >= 0.0))
+      throw std::invalid_argument("ceiling bench: the true-state feed's noise must be >= 0");
+  }
   const sim::ThesisStepper model(board);
   const std::unique_ptr<sim::World> world_prototype = world != nullptr ? world->fork() : sim::make_model_world(board);
   sim::check_same_flippers(world_prototype->board(), board);
