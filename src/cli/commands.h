@@ -120,7 +120,6 @@ struct LearnArgs {
   int balls_per_controller = 5;         ///< tournament: b
   int population = 0;                   ///< relay / cem population (0: the method's default)
   int rounds = 4;                       ///< imitate: rounds (1: the teacher's balls only; more: DAgger)
-  int value_labels = 0;                 ///< imitate: k of the value labels (0: the teacher's own labels)
   double max_ball_time_s = 60.0;        ///< a ball alive after this is cut: a cycle
   double loss_penalty = 500.0;          ///< reward of an opportunity that lost the ball
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;     ///< command to flipper motion (s): run_learn resolves it

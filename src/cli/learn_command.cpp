@@ -106,11 +106,6 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
                   "imitate: rounds sharing the budget; round 1 the teacher plays, later rounds the learner plays "
                   "and the teacher labels its approaches (DAgger)")
       ->check(CLI::Range(1, 1000));
-  cmd->add_option("--value-labels", a.value_labels,
-                  "imitate: relabel each approach with the plan whose teacher value, averaged over its K nearest "
-                  "approaches in what the tracker sees, is highest (docs/learning.md, \"Value labels\"); 0: the "
-                  "teacher's own plan")
-      ->check(CLI::Range(0, 32));
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball is cut (a cycle)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--loss-penalty", a.loss_penalty, "reward of a flip opportunity that lost the ball (6.3.1)");
@@ -514,8 +509,6 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     ic.demonstration.max_ball_time_s = a.max_ball_time_s;
     ic.demonstration.pull = a.pull;
     ic.rounds = a.rounds;
-    ic.value_label_neighbours = a.value_labels;
-    j["value_labels"] = a.value_labels;
     if (a.drain_penalty >= 0.0) ic.demonstration.teacher.drain_penalty = a.drain_penalty;
     j["teacher_drain_penalty"] = ic.demonstration.teacher.drain_penalty;
     if (!a.shot_values.empty()) {

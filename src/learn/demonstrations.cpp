@@ -22,10 +22,8 @@ namespace {
 class ShotRecorder final : public control::FlipperController {
  public:
   // `lead_actuation_delay_s`: the examples hold the projection a table with this lead looks up.
-  // `values_out`: one ApproachValues per example, parallel to `out`.
-  ShotRecorder(std::vector<control::ShotExample>& out, std::vector<ApproachValues>& values_out,
-               std::optional<double> lead_actuation_delay_s)
-      : out_(out), values_out_(values_out), lead_actuation_delay_s_(lead_actuation_delay_s) {}
+  ShotRecorder(std::vector<control::ShotExample>& out, std::optional<double> lead_actuation_delay_s)
+      : out_(out), lead_actuation_delay_s_(lead_actuation_delay_s) {}
 
   void update(const track::TrackerOutput& o, double now_s, std::array<bool, 2>&) override {
     if (o.launch.launched || o.launch.lost) {
@@ -53,45 +51,31 @@ class ShotRecorder final : public control::FlipperController {
   bool teacher_fired(int flipper, double hold_s, double now_s, double lead_m = 0.0) {
     if (open_ && fired_ && last_time_s_ == now_s) return true;  // a second flip in one approach: the first is the shot
     if (!can_label(now_s)) return false;
-    push(example(flipper, last_.d_m - lead_m, hold_s));
+    out_.push_back(example(flipper, last_.d_m - lead_m, hold_s));
     fired_ = true;
     return true;
   }
   // The teacher would let the ball pass: the approach's example is a pass.
   void teacher_passes(double now_s) {
     if (!can_label(now_s)) return;
-    push(example(-1, 0.0, 0.0));
+    out_.push_back(example(-1, 0.0, 0.0));
     fired_ = true;
   }
   // Label this approach no more (the learner acted where the teacher cannot judge).
   void give_up() { fired_ = true; }
   void close() {
-    if (open_ && !fired_) push(example(-1, 0.0, 0.0));
+    if (open_ && !fired_) out_.push_back(example(-1, 0.0, 0.0));
     open_ = false;
     fired_ = false;
-    values_ = {};
-  }
-  // The teacher's values of its plans for bat `flipper` (tracker index) in this
-  // frame: kept for the approach's example if they are its first.
-  void teacher_valued(const std::vector<LookaheadCandidate>& candidates, int flipper, double frame_s, double now_s) {
-    if (!can_label(now_s) || values_.flipper >= 0) return;
-    values_ = approach_values(candidates, flipper, last_.d_m, last_.speed_mps, frame_s);
   }
 
  private:
   control::ShotExample example(int fired_flipper, double d_m, double hold_s) const {
     return {last_.flipper, last_.rolling, last_.angle_rad, last_.h, last_.speed_mps, fired_flipper, d_m, hold_s};
   }
-  void push(const control::ShotExample& e) {
-    out_.push_back(e);
-    values_out_.push_back(values_);
-    values_ = {};
-  }
 
   std::vector<control::ShotExample>& out_;
-  std::vector<ApproachValues>& values_out_;
   std::optional<double> lead_actuation_delay_s_;
-  ApproachValues values_;  // the open approach's, once the teacher has judged it
   bool open_ = false;
   bool fired_ = false;  // labelled (fired or passed) in this approach
   track::TrajectoryProjection last_;
@@ -157,7 +141,7 @@ DemonstrationBall record_correction(const table::Board& belief, sim::World& worl
                                     const std::shared_ptr<const control::ShotTable>& learner_table,
                                     std::uint64_t seed) {
   DemonstrationBall ball;
-  ShotRecorder recorder(ball.shots, ball.values, config.lead_actuation_delay_s);
+  ShotRecorder recorder(ball.shots, config.lead_actuation_delay_s);
   control::ImitationController learner(learner_table);
   Tee tee(learner, recorder);
   simlab::SimulatedPlayer watcher = make_watcher(belief, config, tee, seed);
@@ -181,7 +165,6 @@ DemonstrationBall record_correction(const table::Board& belief, sim::World& worl
             const std::vector<LookaheadCandidate>& c = teacher.evaluate(s, delay, f);
             const LookaheadCandidate& best = c[teacher.best()];
             const int tf = track_index[static_cast<std::size_t>(f)];
-            recorder.teacher_valued(c, tf, frame_s, s.time_s);
             if (best.fire_frame == 0) {
               recorder.teacher_fired(tf, best.hold_frames * frame_s, s.time_s);
             } else if (learner_fired && best.fire_frame > 0) {
@@ -208,11 +191,10 @@ DemonstrationBall record_correction(const table::Board& belief, sim::World& worl
 DemonstrationBall record_demonstration(const table::Board& belief, sim::World& world, const sim::ThesisStepper& model,
                                        const DemonstrationConfig& config, std::uint64_t seed) {
   DemonstrationBall ball;
-  ShotRecorder recorder(ball.shots, ball.values, config.lead_actuation_delay_s);
+  ShotRecorder recorder(ball.shots, config.lead_actuation_delay_s);
   simlab::SimulatedPlayer watcher = make_watcher(belief, config, recorder, seed);
   LookaheadPlayer teacher(model, config.teacher, config.actuation_delay_s);
   const std::array<int, 2> track_index = tracker_index_of(watcher);
-  const double frame_s = model.dt_s() * config.teacher.frame_steps;
   sim::GameState state = sim::make_game_state(world.board(), seed);
   const sim::BallResult r = sim::play_ball(
       world, state, limits_of(config),
@@ -220,13 +202,7 @@ DemonstrationBall record_demonstration(const table::Board& belief, sim::World& w
         const std::uint64_t before = watcher.observations();
         watcher.act(s);
         // The teacher decides at the camera's frames, when a controller can.
-        const int decisions_before = teacher.decisions();
         teacher.act(s, watcher.observations() != before);
-        if (teacher.decisions() != decisions_before) {
-          const int planned = teacher.planned_flipper();
-          recorder.teacher_valued(teacher.planner().candidates(), track_index[static_cast<std::size_t>(planned)],
-                                  frame_s, s.time_s);
-        }
         const int f = teacher.fired_flipper();
         if (f < 0) return;
         ++ball.teacher_fires;
@@ -272,7 +248,7 @@ const TeacherWorlds::Place& TeacherWorlds::place_of(std::uint64_t ball_seed) con
 
 Blob to_blob(const DemonstrationBall& b) {
   BlobWriter w;
-  w.put_vector(b.shots).put_vector(b.values).put(b.score).put(b.duration_s).put(b.cut).put(b.teacher_fires).put(b.unmatched_fires);
+  w.put_vector(b.shots).put(b.score).put(b.duration_s).put(b.cut).put(b.teacher_fires).put(b.unmatched_fires);
   return w.take();
 }
 
@@ -280,7 +256,6 @@ DemonstrationBall demonstration_ball_from_blob(const Blob& blob) {
   BlobReader r(blob);
   DemonstrationBall b;
   b.shots = r.get_vector<control::ShotExample>();
-  b.values = r.get_vector<ApproachValues>();
   b.score = r.get<double>();
   b.duration_s = r.get<double>();
   b.cut = r.get<bool>();
@@ -336,7 +311,6 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
   double time = 0.0;
   for (const DemonstrationBall& b : played) {
     out.shots.insert(out.shots.end(), b.shots.begin(), b.shots.end());
-    out.values.insert(out.values.end(), b.values.begin(), b.values.end());
     score += b.score;
     time += b.duration_s;
     out.cut += b.cut ? 1 : 0;
@@ -360,12 +334,8 @@ ImitationResult learn_by_imitation(const table::Board& board, const ImitationLea
   if (budget_balls < static_cast<std::uint64_t>(config.rounds)) {
     throw std::invalid_argument("imitation: the budget must give every round a ball");
   }
-  if (config.value_label_neighbours < 0 || config.value_label_neighbours > control::kMaxNeighbours)
-    throw std::invalid_argument("imitation: value-label neighbours must be in [0, " +
-                                std::to_string(control::kMaxNeighbours) + "]");
   ImitationResult result;
   std::vector<control::ShotExample> shots;
-  std::vector<ApproachValues> values;  // parallel to shots
   const std::uint64_t per_round = budget_balls / static_cast<std::uint64_t>(config.rounds);
   for (int r = 0; r < config.rounds; ++r) {
     const std::uint64_t balls = r + 1 == config.rounds ? budget_balls - per_round * static_cast<std::uint64_t>(r)
@@ -380,11 +350,7 @@ ImitationResult learn_by_imitation(const table::Board& board, const ImitationLea
                               r == 0 ? nullptr : result.table, worlds);
     if (r > 0 && d.cut > 0 && on_cycle) on_cycle(*result.table, d.best_cut_score);  // the table that played it
     shots.insert(shots.end(), d.shots.begin(), d.shots.end());
-    values.insert(values.end(), d.values.begin(), d.values.end());
-    result.table = std::make_shared<const control::ShotTable>(
-        config.value_label_neighbours > 0 ? relabel_by_values(shots, values, config.value_label_neighbours, config.table)
-                                          : shots,
-        config.table);
+    result.table = std::make_shared<const control::ShotTable>(shots, config.table);
     result.rounds.push_back({r, d.balls, shots.size(), d.mean_teacher_score, d.mean_ball_time_s, d.cut,
                              d.teacher_fires, d.unmatched_fires, d.wall_s});
     if (progress) {

@@ -167,7 +167,6 @@ void LookaheadPlayer::decide(const sim::GameState& s) {
   const int f = planner_.decision_flipper(s);
   if (f < 0) return;
   ++decisions_;
-  planned_ = f;
   const std::vector<LookaheadCandidate>& c = planner_.evaluate(s, delay_, f);
   const LookaheadCandidate& b = c[planner_.best()];
   if (b.fire_frame == 0) {

@@ -21,7 +21,6 @@
 #include "pinball/learn/lookahead_player.h"
 #include "pinball/learn/randomized_evaluator.h"
 #include "pinball/learn/search.h"
-#include "pinball/learn/value_labels.h"
 #include "pinball/sim/thesis_stepper.h"
 #include "pinball/sim/world.h"
 #include "pinball/track/camera_model.h"
@@ -46,7 +45,6 @@ struct DemonstrationConfig {
 /// One teacher ball's examples and figures.
 struct DemonstrationBall {
   std::vector<control::ShotExample> shots;  ///< one per approach, in order
-  std::vector<ApproachValues> values;       ///< the teacher's values of each approach's plans, parallel to shots
   double score = 0.0;        ///< the teacher's score
   double duration_s = 0.0;   ///< simulated time of the ball
   bool cut = false;          ///< alive at the time limit
@@ -107,7 +105,6 @@ class TeacherWorlds {
 /// Everything recorded over many balls.
 struct Demonstrations {
   std::vector<control::ShotExample> shots;  ///< ball by ball, in ball order
-  std::vector<ApproachValues> values;       ///< parallel to shots
   int balls = 0;
   double mean_teacher_score = 0.0;  ///< mean score per ball of whoever played
   double mean_ball_time_s = 0.0;
@@ -138,10 +135,6 @@ struct ImitationLearningConfig {
   DemonstrationConfig demonstration;  ///< teacher, camera, delay, time limit
   control::ImitationConfig table;     ///< the learned table's lookup settings
   int rounds = 4;                     ///< round 0: the teacher plays; rounds 1..: the learner plays, the teacher labels
-  /// k of the value labels (value_labels.h): each round's table is learned
-  /// from the labels best on average over k alike approaches; 0: the teacher's
-  /// own labels. 0..control::kMaxNeighbours.
-  int value_label_neighbours = 0;
 };
 
 /// One round's figures (the player's own balls: the teacher's in round 0, the learner's after).

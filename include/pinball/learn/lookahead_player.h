@@ -121,8 +121,6 @@ class LookaheadPlayer {
   void act(sim::GameState& state, bool frame);
   /// The flipper fired by the last act() (-1: none), and the hold it chose (s).
   int fired_flipper() const { return fired_; }
-  /// The flipper the last decision planned for (the planner's candidates are its).
-  int planned_flipper() const { return planned_; }
   double fired_hold_s() const { return fired_hold_s_; }
   /// Frames at which candidates were evaluated, and lookahead steps simulated.
   int decisions() const { return decisions_; }
@@ -141,7 +139,6 @@ class LookaheadPlayer {
   int release_in_ = 0;
   int decisions_ = 0;
   int fired_ = -1;
-  int planned_ = -1;
   double fired_hold_s_ = 0.0;
   double frame_s_ = 0.0;  // one decision frame (s)
 };
