@@ -431,6 +431,16 @@ TEST(Daemon, TheLabCameraNeedsACalibratedHomography) {
   }
 }
 
+// Whether process `pid` has a handler of its own for `signal` (the SigCgt mask of /proc/PID/status).
+bool catches_signal(pid_t pid, int signal) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (signal - 1)) & 1ULL;
+  }
+  return false;
+}
+
 // pinballd as a child process: SIGINT releases every coil and exits 0.
 TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
   const std::string out = ::testing::TempDir() + "/pinballd_sigint.json";
@@ -444,7 +454,11 @@ TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
     execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+  // SIGUSR1's default is to end the process: wait (up to 60 s) until pinballd
+  // catches it, which a slow start under ThreadSanitizer can take long to do.
+  for (int i = 0; i < 600 && !catches_signal(pid, SIGUSR1); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(catches_signal(pid, SIGUSR1)) << "pinballd did not install its SIGUSR1 handler within 60 s";
+  std::this_thread::sleep_for(std::chrono::milliseconds(2000));  // a game under way
   ASSERT_EQ(kill(pid, SIGUSR1), 0);  // prints the latency table and goes on
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   ASSERT_EQ(kill(pid, SIGINT), 0);
