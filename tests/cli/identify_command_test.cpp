@@ -86,7 +86,7 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   EXPECT_DOUBLE_EQ(written.wall_thickness_m->value, j["wall_thickness"]["thickness_m"].get<double>());
 
   // The text report says the same and where the overlay went.
-  const pinball::testing::CommandResult text = run("identify " + train + " --bootstrap 0 --sigma-m 0.0005");
+  const pinball::testing::CommandResult text = run("identify " + held + " --bootstrap 0 --sigma-m 0.0005");
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("g along the table"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("not identified: camera latency"), std::string::npos) << text.out;
