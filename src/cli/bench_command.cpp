@@ -89,7 +89,8 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
       ->transform(data_file())
       ->default_str("latency controllers/imitation.json, ceiling none, transfer controllers/best.json imitation.json cem.json");
   cmd->add_option("--true-state-noise", a.true_state_noise,
-                  "ceiling: also play the --controller (a planner file) fed the TRUE ball every frame instead of the tracker's estimate, "
+                  "ceiling: also play the --controller (a planner file) fed the TRUE ball every frame instead of "
+                  "the tracker's estimate, "
                   "plus Gaussian noise of MM (position, mm) and MPS (velocity, m/s) per coordinate; aim: replay the "
                   "shots from a ball with this noise only (default: 0.3 mm 0.005, 1 mm 0.02 and 3 mm 0.1 m/s)")
       ->expected(2)

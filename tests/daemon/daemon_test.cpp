@@ -456,7 +456,9 @@ TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
   }
   // SIGUSR1's default is to end the process: wait (up to 60 s) until pinballd
   // catches it, which a slow start under ThreadSanitizer can take long to do.
-  for (int i = 0; i < 600 && !catches_signal(pid, SIGUSR1); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  for (int i = 0; i < 600 && !catches_signal(pid, SIGUSR1); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
   ASSERT_TRUE(catches_signal(pid, SIGUSR1)) << "pinballd did not install its SIGUSR1 handler within 60 s";
   std::this_thread::sleep_for(std::chrono::milliseconds(2000));  // a game under way
   ASSERT_EQ(kill(pid, SIGUSR1), 0);  // prints the latency table and goes on
