@@ -22,6 +22,14 @@ TEST(Blob, ValuesAndVectorsComeBackInOrder) {
   EXPECT_NO_THROW(r.expect_end());
 }
 
+TEST(Blob, AnEmptyVectorComesBackEmptyAndTheNextFieldAfterIt) {
+  const Blob b = BlobWriter().put_vector(std::vector<int>{}).put(std::int32_t{42}).take();
+  BlobReader r(b);
+  EXPECT_TRUE(r.get_vector<int>().empty());
+  EXPECT_EQ(r.get<std::int32_t>(), 42);
+  EXPECT_NO_THROW(r.expect_end());
+}
+
 TEST(Blob, RefusesShortAndOverlongBlobs) {
   const Blob b = BlobWriter().put_vector(std::vector<int>{1, 2}).take();
   Blob cut(b.begin(), b.end() - 1);

@@ -69,6 +69,9 @@ class BlobReader {
     const auto n = get<std::uint64_t>();
     if (n > (blob_.size() - at_) / sizeof(T)) throw std::runtime_error("blob: a vector longer than the bytes left");
     std::vector<T> values(static_cast<std::size_t>(n));
+    // An empty vector's data() may be null, and memcpy from or to null is
+    // undefined even for no bytes (UBSan's nonnull-attribute check).
+    if (values.empty()) return values;
     std::memcpy(values.data(), blob_.data() + at_, values.size() * sizeof(T));
     at_ += values.size() * sizeof(T);
     return values;
