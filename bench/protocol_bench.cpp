@@ -90,7 +90,10 @@ double decode_only_rate(const ProtocolBenchOptions& o) {
 }  // namespace
 
 ReleaseUnderLoss measure_release_under_loss(double drop_p, bool closed_loop, int cycles, std::uint64_t seed) {
-  auto [host_end, board_end] = StreamTransport::make_pair();
+  // Named, not a structured binding: the lambda below captures board_end, which
+  // clang before 16 cannot parse (C++20 P1091), and clang-tidy reads this file.
+  const auto [host_end, board_end_ptr] = StreamTransport::make_pair();
+  StreamTransport& board_end = *board_end_ptr;
   VirtualDriverBoard board;
   CoilSafetyMonitor monitor;
   board.add_listener(&monitor);
@@ -108,7 +111,7 @@ ReleaseUnderLoss measure_release_under_loss(double drop_p, bool closed_loop, int
   auto tick = [&] {
     t += 0.001;
     bus.poll_once(t);
-    board.service(*board_end, t);
+    board.service(board_end, t);
   };
   for (int k = 0; k < 100; ++k) tick();
   std::vector<double> on_after_release_s;
