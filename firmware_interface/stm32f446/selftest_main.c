@@ -850,17 +850,25 @@ static void instruction_counts(void) {
 
 #define STACK_PAINT 0xA5A5A5A5u
 
-/* Paints the unused stack below the current frame. */
+/* Stack positions as word indices from _sstack, as startup.c walks .data and
+ * .bss: comparing pointers to two linker symbols is undefined in C. */
+static uintptr_t stack_words_below(uintptr_t address) {
+  return (address - (uintptr_t)_sstack) / sizeof(uint32_t);
+}
+
+/* Paints the unused stack below the current frame, 16 words clear of it. */
 __attribute__((noinline)) static void paint_stack(void) {
-  uint32_t* sp;
+  uintptr_t sp;
   __asm__ volatile("mov %0, sp" : "=r"(sp));
-  for (uint32_t* p = _sstack; p < sp - 16; ++p) *p = STACK_PAINT;
+  const uintptr_t painted_words = stack_words_below(sp) - 16u;
+  for (uintptr_t i = 0; i < painted_words; ++i) _sstack[i] = STACK_PAINT;
 }
 
 static uint32_t stack_used_bytes(void) {
-  const uint32_t* p = _sstack;
-  while (p < _estack && *p == STACK_PAINT) ++p;
-  return (uint32_t)((uintptr_t)_estack - (uintptr_t)p);
+  const uintptr_t stack_words = stack_words_below((uintptr_t)_estack);
+  uintptr_t untouched_words = 0;
+  while (untouched_words < stack_words && _sstack[untouched_words] == STACK_PAINT) ++untouched_words;
+  return (uint32_t)((stack_words - untouched_words) * sizeof(uint32_t));
 }
 
 int main(void) {
