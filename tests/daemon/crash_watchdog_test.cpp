@@ -21,7 +21,11 @@ namespace pinball::daemon {
 namespace {
 
 TEST(CrashWatchdog, KillingTheHostProcessSwitchesEveryCoilOff) {
-  auto [host, far] = firmware::StreamTransport::make_pair();
+  // Named ends, not a structured binding, which a lambda below would capture
+  // and clang before 16 cannot parse (C++20 P1091).
+  auto ends = firmware::StreamTransport::make_pair();
+  auto& host = ends.first;
+  auto& far = ends.second;
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {

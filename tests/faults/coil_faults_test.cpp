@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <functional>
+#include <tuple>
 
 #include "../firmware/board_harness.h"
 #include "pinball/firmware/driver_bus.h"
@@ -145,7 +146,10 @@ INSTANTIATE_TEST_SUITE_P(OneAndFivePercent, LossyLink, ::testing::Values(0.01, 0
 class FrozenThread : public CoilFaults, public ::testing::WithParamInterface<std::tuple<int, bool>> {};
 
 TEST_P(FrozenThread, EveryCoilIsOffWithinTheWatchdogPlusOneHeartbeatPeriod) {
-  const auto [frozen, lose_release_all] = GetParam();
+  // Not a structured binding: the lambda below captures frozen, which clang
+  // before 16 cannot parse (C++20 P1091), and clang-tidy reads this file.
+  const int frozen = std::get<0>(GetParam());
+  const bool lose_release_all = std::get<1>(GetParam());
   DroppingLink lossy(*host_, [&, lose = lose_release_all](const CanFrame& f) {
     return lose && is_kind(f, MessageKind::kReleaseAll) && bus_running_;
   });

@@ -54,7 +54,9 @@ TEST(CameraHomography, LocalScaleIsTheSquareRootOfTheAreaMagnification) {
 }
 
 TEST(CameraHomography, RejectsSingularMatricesAndBadViews) {
-  EXPECT_THROW(CameraHomography(cv::Matx33d::zeros()), std::invalid_argument);
+  // Braces: with parentheses the statement may be read as a declaration of
+  // cv::Matx33d::zeros (clang does, and refuses it).
+  EXPECT_THROW(CameraHomography{cv::Matx33d::zeros()}, std::invalid_argument);
   EXPECT_THROW(CameraHomography(cv::Matx33d(1, 2, 3, 2, 4, 6, 0, 0, 1)), std::invalid_argument);
   CameraView bad;
   bad.keystone = 0.7;
