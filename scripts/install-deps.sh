@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Installs every Debian package the project needs to build, test and run.
+# Installs every Debian package the project needs to build, test and run,
+# and any named on the command line (tools one script alone needs, e.g.
+# scripts/static-analysis.sh: clang-tidy cppcheck).
 # Idempotent: when everything is already present it prints nothing and exits 0.
+# Usage: scripts/install-deps.sh [PACKAGE ...]
 set -euo pipefail
 
 packages=(
@@ -26,6 +29,7 @@ packages=(
   libopenmpi-dev openmpi-bin
   # The MuJoCo lab twin (--world twin, ctest label twin, docs/worlds.md).
   libmujoco-dev
+  "$@"
 )
 
 missing=()
