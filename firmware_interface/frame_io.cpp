@@ -95,6 +95,7 @@ RxStatus receive_frame(int fd, CanFrame& frame, int timeout_ms, AtomicTransportC
   }
   frame = CanFrame{};
   frame.error = (raw.can_id & CAN_ERR_FLAG) != 0;
+  // NOLINTNEXTLINE(bugprone-branch-clone): the two masks are equal in value; each is named for what it keeps
   frame.id = frame.error ? (raw.can_id & CAN_ERR_MASK) : (raw.can_id & CAN_EFF_MASK);
   frame.len = raw.len;
   std::memcpy(frame.data.data(), raw.data, raw.len);

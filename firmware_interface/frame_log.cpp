@@ -4,6 +4,7 @@
 #include <pthread.h>
 
 #include <cerrno>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -30,7 +31,7 @@ std::string format_log_line(const CanFrame& frame, double time_s, std::string_vi
   // 0 rather than overflowing the cast (UBSan float-cast-overflow).
   if (!(time_s >= 0.0 && time_s < 1e12)) time_s = 0.0;
   const auto whole = static_cast<long long>(time_s);
-  long long micros = static_cast<long long>((time_s - static_cast<double>(whole)) * 1e6 + 0.5);
+  long long micros = std::llround((time_s - static_cast<double>(whole)) * 1e6);
   long long secs = whole;
   if (micros >= 1'000'000) {
     micros -= 1'000'000;

@@ -185,7 +185,7 @@ track::TrajectoryProjection from_lcm_projection(const pinball_lcm::lcmt_pinball_
   track::TrajectoryProjection p;
   p.valid = m.valid;
   p.reason = static_cast<track::NoProjection>(m.reason);
-  p.flipper = m.flipper;
+  p.flipper = m.flipper;  // NOLINT(bugprone-signed-char-misuse): an int8 index, not a character
   p.speed_mps = m.speed_mps;
   p.angle_rad = m.angle_rad;
   p.h = m.h;

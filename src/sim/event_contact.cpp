@@ -168,11 +168,10 @@ void classify(StepContext& ctx) {
   p -= contact.gap * contact.normal;
   v -= v.dot(contact.normal) * contact.normal;
   ctx.m.a = gravity - gravity.dot(contact.normal) * contact.normal;
-  if (contact.surface == Surface::kObstacle && board.shapes[contact.index].kind == table::ShapeKind::kCircle) {
-    set_circle_range(ctx, contact, p);
-  } else if (contact.surface == Surface::kFlipperEnd) {
-    set_circle_range(ctx, contact, p);
-  }
+  const bool on_circle =
+      contact.surface == Surface::kFlipperEnd ||
+      (contact.surface == Surface::kObstacle && board.shapes[contact.index].kind == table::ShapeKind::kCircle);
+  if (on_circle) set_circle_range(ctx, contact, p);
 }
 
 }  // namespace pinball::sim::event

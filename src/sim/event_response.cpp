@@ -96,9 +96,8 @@ void handle(StepContext& ctx, const Next& next) {
   GameState& state = ctx.state;
   switch (next.kind) {
     case Kind::kHorizon:
+    case Kind::kEdge:  // the next classification lets it fly
       return;
-    case Kind::kEdge:
-      return;  // the next classification lets it fly
     case Kind::kFlipperStop: {
       const table::Flipper& f = board.flippers[next.index];
       FlipperState& fs = state.flippers[next.index];

@@ -12,7 +12,7 @@
 
 #include "pinball/view/view_state.h"
 
-typedef struct _lcm_t lcm_t;
+typedef struct _lcm_t lcm_t;  // NOLINT(bugprone-reserved-identifier): liblcm's own name (lcm/lcm.h)
 
 namespace pinball::view {
 
