@@ -42,7 +42,7 @@ TEST(FileSink, WritesTruncatesAndAppends) {
   EXPECT_EQ(read_all(path), "one\ntwo\n");
   std::remove(path.c_str());
   try {
-    FileSink("/nonexistent-dir/x.log");
+    const FileSink refused("/nonexistent-dir/x.log");
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent-dir/x.log"), std::string::npos) << e.what();

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <functional>
 #include <tuple>
 
@@ -59,7 +60,7 @@ class CoilFaults : public testing::BoardTest {
   // Host and board in lockstep; `each_tick` runs before the host polls (the
   // watched threads' beats, a test's commands).
   void run(DriverBus& bus, double seconds, const std::function<void()>& each_tick = [] {}) {
-    const int ticks = static_cast<int>(seconds / kTick_s + 0.5);
+    const int ticks = static_cast<int>(std::lround(seconds / kTick_s));
     for (int k = 0; k < ticks; ++k) {
       t_ += kTick_s;
       each_tick();

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <thread>
 
 #include "board_harness.h"
@@ -26,7 +27,7 @@ class DriverBusTest : public testing::BoardTest {
   }
   // Runs host and board in lockstep for `seconds` in 1 ms ticks.
   void run(DriverBus& bus, double seconds, bool host_alive = true) {
-    const int ticks = static_cast<int>(seconds * 1000.0 + 0.5);
+    const int ticks = static_cast<int>(std::lround(seconds * 1000.0));
     for (int k = 0; k < ticks; ++k) {
       t_ += 0.001;
       if (host_alive) bus.poll_once(t_);

@@ -775,8 +775,10 @@ TEST(ThesisStepper, GridOnAndOffAreBitIdentical) {
     const StepEvents ec = c.step(sc);
     ASSERT_EQ(ea.flags, ec.flags) << "step " << i;
     ASSERT_EQ(ea.obstacle, ec.obstacle) << "step " << i;
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the same bits is the assertion
     ASSERT_EQ(std::memcmp(sa.ball.position_m.data(), sc.ball.position_m.data(), sizeof(double) * 2), 0)
         << "step " << i;
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the same bits is the assertion
     ASSERT_EQ(std::memcmp(sa.ball.velocity_mps.data(), sc.ball.velocity_mps.data(), sizeof(double) * 2), 0)
         << "step " << i;
     ASSERT_EQ(sa.score, sc.score);

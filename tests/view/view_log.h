@@ -4,6 +4,7 @@
 // one release of the left flipper, driver statuses and one PINBALL_STATS, in
 // LCM's log format as pinballd writes it.
 
+#include <cmath>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -42,7 +43,7 @@ inline int write_view_log(const std::string& path) {
   std::int64_t n = 0;
   auto add = [&](const char* channel, double t_s, const auto& m) {
     const std::vector<std::uint8_t> data = bus::encode_message(m);
-    const std::int64_t utime = kViewLogStart_us + static_cast<std::int64_t>(t_s * 1e6 + 0.5);
+    const std::int64_t utime = kViewLogStart_us + std::llround(t_s * 1e6);
     bus::append_lcm_event(bytes, n++, utime, channel, data.data(), data.size());
   };
   bool fired = false, released = false;
