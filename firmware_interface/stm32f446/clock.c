@@ -85,6 +85,8 @@ clock_tree clock_init(void) {
   RCC->CR |= RCC_CR_HSEON;
   if (!wait_for(&RCC->CR, RCC_CR_HSERDY, RCC_CR_HSERDY)) return fall_back_to_hsi(CLOCK_STEP_HSE_READY);
 
+  /* PLLP's field is 0 for /2: written all the same, so every field is named. */
+  /* cppcheck-suppress badBitmaskCheck */
   RCC->PLLCFGR = (PLL_M << RCC_PLLCFGR_PLLM_SHIFT) | (PLL_N << RCC_PLLCFGR_PLLN_SHIFT) |
                  (PLL_P_DIV2 << RCC_PLLCFGR_PLLP_SHIFT) | RCC_PLLCFGR_PLLSRC_HSE |
                  (PLL_Q << RCC_PLLCFGR_PLLQ_SHIFT) | (PLL_R << RCC_PLLCFGR_PLLR_SHIFT);
@@ -107,7 +109,9 @@ clock_tree clock_init(void) {
   if ((FLASH->ACR & FLASH_ACR_LATENCY_MASK) != FLASH_WAIT_STATES_180MHZ)
     return fall_back_to_hsi(CLOCK_STEP_FLASH_LATENCY);
 
-  /* Bus dividers before the switch, so APB1 never sees more than 45 MHz. */
+  /* Bus dividers before the switch, so APB1 never sees more than 45 MHz;
+   * AHB undivided (HPRE 0), written all the same. */
+  /* cppcheck-suppress badBitmaskCheck */
   RCC->CFGR = (RCC->CFGR & RCC_CFGR_SW_MASK) | (0u << RCC_CFGR_HPRE_SHIFT) |
               (RCC_CFGR_PPRE_DIV4 << RCC_CFGR_PPRE1_SHIFT) | (RCC_CFGR_PPRE_DIV2 << RCC_CFGR_PPRE2_SHIFT);
   RCC->CFGR = (RCC->CFGR & ~RCC_CFGR_SW_MASK) | RCC_CFGR_SW_PLLP;

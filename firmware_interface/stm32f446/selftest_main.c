@@ -32,7 +32,8 @@
 #define MAX_EVENTS 64u
 #define MAX_REPLIES 64u
 
-extern uint32_t _sstack[], _estack[];
+/* The stack's ends, from the linker script. */
+extern uint32_t _sstack[], _estack[]; /* NOLINT(bugprone-reserved-identifier): stm32f446.ld's names */
 
 /* ---------------------------------------------------------------- checks */
 
@@ -158,7 +159,7 @@ static void deliver(const pbfw_frame* f) {
 
 static pbfw_frame encode(pbfw_message m) {
   m.board = BOARD_ID;
-  pbfw_frame f;
+  pbfw_frame f = {0};
   pbfw_encode(&m, &f);
   return f;
 }

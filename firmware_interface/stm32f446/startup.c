@@ -17,10 +17,12 @@
 #include "registers.h"
 #include "startup.h"
 
-/* Linker script symbols (stm32f446.ld). */
+/* Linker script symbols (stm32f446.ld): names reserved for such use. */
+/* NOLINTBEGIN(bugprone-reserved-identifier) */
 extern uint32_t _estack[];
 extern uint32_t _sidata[], _sdata[], _edata[];
 extern uint32_t _sbss[], _ebss[];
+/* NOLINTEND(bugprone-reserved-identifier) */
 
 int main(void);
 
