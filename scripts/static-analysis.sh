@@ -13,7 +13,7 @@
 # Exit 0: nothing reported; 1: reports, or a tool that failed; 2: bad usage.
 # Installs clang-tidy and cppcheck itself (scripts/install-deps.sh), builds
 # the release preset (its objects include headers the build generates).
-# Usage: scripts/static-analysis.sh [-j N] [--json]    (about 7 min on 2 cores once built)
+# Usage: scripts/static-analysis.sh [-j N] [--json]    (5 to 6 min on 2 cores once built)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -31,7 +31,10 @@ while [ $# -gt 0 ]; do
     *) echo "static-analysis: unknown argument '$1' ($usage)" >&2; exit 2 ;;
   esac
 done
-[[ $parallel =~ ^[1-9][0-9]*$ ]] || { echo "static-analysis: -j takes a whole number from 1, not '$parallel'" >&2; exit 2; }
+if ! [[ $parallel =~ ^[1-9][0-9]*$ ]]; then
+  echo "static-analysis: -j takes a whole number from 1, not '$parallel'" >&2
+  exit 2
+fi
 
 say() { echo "static-analysis: $*" >&2; }
 start_s=$(date +%s)
@@ -79,7 +82,8 @@ progress() {  # finished of units, with the time left at the pace so far
   finished=$(find "$work" -name '*.rc' | wc -l)
   elapsed=$(($(date +%s) - start_tidy_s))
   if [ "$finished" -gt 0 ]; then
-    say "clang-tidy: $finished of $units objects, ${elapsed} s, about $((elapsed * (units - finished) / finished)) s left"
+    local left=$((elapsed * (units - finished) / finished))
+    say "clang-tidy: $finished of $units objects, $elapsed s, about $left s left"
   fi
 }
 
