@@ -12,8 +12,9 @@
 # and the reports as one JSON object instead.
 # Exit 0: nothing reported; 1: reports, or a tool that failed; 2: bad usage.
 # Installs clang-tidy and cppcheck itself (scripts/install-deps.sh), builds
-# the release preset (its objects include headers the build generates).
-# Usage: scripts/static-analysis.sh [-j N] [--json]    (5 to 6 min on 2 cores once built)
+# the release preset (its objects include headers the build generates) and the
+# firmware (scripts/build-firmware.sh).
+# Usage: scripts/static-analysis.sh [-j N] [--json]    (5 to 7 min on 2 cores once built)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -27,7 +28,7 @@ while [ $# -gt 0 ]; do
         parallel=$2; shift 2 ;;
     -j*) parallel=${1#-j}; shift ;;
     --json) json=1; shift ;;
-    -h|--help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "static-analysis: unknown argument '$1' ($usage)" >&2; exit 2 ;;
   esac
 done
@@ -43,9 +44,9 @@ scripts/install-deps.sh clang-tidy cppcheck
 say "building the release preset (its compile database and generated headers)"
 cmake --preset release >/dev/null
 cmake --build --preset release >/dev/null
-firmware_build=build/static-analysis-firmware
-cmake -S firmware_interface/stm32f446 -B "$firmware_build" -G Ninja \
-  -DCMAKE_TOOLCHAIN_FILE="$root/cmake/arm-none-eabi.cmake" >/dev/null
+# The firmware as scripts/build-firmware.sh builds it: its compile database.
+firmware_build=build/firmware-stm32f446
+scripts/build-firmware.sh "$firmware_build" >/dev/null
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
