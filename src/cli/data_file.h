@@ -1,27 +1,15 @@
 #pragma once
-// Board, controller and configuration options take a path that may name the
-// shipped data from any folder (pinball/core/data_path.h), as pinballd does:
-// `pinball sim boards/mit1993.board` works outside the source tree too.
+// What the commands' file options share: data_file(), the transform that
+// finds the shipped data from any folder (pinball/core/data_file_option.h,
+// as pinballd does), and the check that an output's folder exists.
 
 #include <filesystem>
 #include <stdexcept>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
-#include "pinball/core/data_path.h"
+#include "pinball/core/data_file_option.h"
 
 namespace pinball::cli {
-
-/// A transform for a file option: the path through find_data_file, which must then exist.
-inline CLI::Validator data_file() {
-  return CLI::Validator(
-      [](std::string& path) {
-        path = find_data_file(path);
-        return CLI::ExistingFile(path);
-      },
-      "FILE");
-}
 
 /// A file a command writes when it has finished: its folder must exist now,
 /// so that a long run does not end in a write error. Throws

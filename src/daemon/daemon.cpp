@@ -17,7 +17,6 @@
 #include "pinball/daemon/can_link_check.h"
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/controller_file.h"
-#include "pinball/core/data_path.h"
 #include "pinball/core/format.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/core/clock.h"
@@ -195,11 +194,7 @@ void Daemon::Impl::build() {
   // Mode sim with camera.source lcm plays no world: observations come from LCM (virtual_board_runner.h).
   const bool plays_world = sim_mode && config.camera.source != "lcm";
   cpus = plan_cpus(config.threads.chain_cpu);
-  config.sim.board = find_data_file(config.sim.board);
-  if (!config.sim.world_board.empty()) config.sim.world_board = find_data_file(config.sim.world_board);
-  if (!config.sim.twin_params.empty()) config.sim.twin_params = find_data_file(config.sim.twin_params);
-  config.board = find_data_file(config.board);
-  config.controller = find_data_file(config.controller);
+  find_data_files(config);
   lockstep = plays_world && !config.sim.realtime;
   if (const std::string w = lcm_pace_warning(config); !w.empty()) {
     std::fprintf(stderr, "pinballd: warning: %s\n", w.c_str());

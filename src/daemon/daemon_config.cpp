@@ -7,6 +7,7 @@
 #include <sstream>
 #include <utility>
 
+#include "pinball/core/data_path.h"
 #include "pinball/core/yaml_read_archive.h"
 #include "pinball/daemon/thread_table.h"
 #include "pinball/firmware/codec.h"
@@ -317,6 +318,12 @@ void validate_daemon_config(const DaemonConfig& c, const std::string& s) {
   check_sim(c.sim, s);
   check_threads(c.threads, s);
   check_mode(c, s);
+}
+
+void find_data_files(DaemonConfig& c) {
+  for (std::string* path : {&c.board, &c.identified, &c.controller, &c.sim.board, &c.sim.world_board,
+                            &c.sim.twin_params})
+    *path = find_data_file(*path);
 }
 
 }  // namespace pinball::daemon

@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "pinball/core/data_file_option.h"
 #include "pinball/daemon/daemon.h"
 #include "pinball/daemon/thread_table.h"
 
@@ -61,19 +62,21 @@ int main(int argc, char** argv) {
   bool realtime = false, json = false, threads = false;
   const DaemonConfig defaults;  // what --help shows as each option's default (no --config)
   app.add_option("--config", config_path, "YAML configuration (config/lab.example.yaml); none: embedded simulation")
-      ->check(CLI::ExistingFile);
-  app.add_option("--sim", sim_board, "simulate this board")->check(CLI::ExistingFile)->default_str(defaults.sim.board);
+      ->transform(pinball::data_file());
+  app.add_option("--sim", sim_board, "simulate this board")
+      ->transform(pinball::data_file())
+      ->default_str(defaults.sim.board);
   app.add_option("--world-board", world_board,
                  "simulation: the board the table really is (default: the --sim board, which stays the belief of "
                  "the tracker and the controller); same flippers required")
-      ->check(CLI::ExistingFile);
+      ->transform(pinball::data_file());
   app.add_option("--world", world_kind,
                  "simulation: which world plays the table, model (the thesis model on --stepper) or twin (the MuJoCo "
                  "lab twin, docs/worlds.md)")
       ->check(CLI::IsMember({"model", "twin"}))
       ->default_str(std::string(pinball::simlab::world_kind_name(defaults.sim.world)));
   app.add_option("--twin-params", twin_params, "simulation: the twin's parameter file (default: config/twin.yaml)")
-      ->check(CLI::ExistingFile);
+      ->transform(pinball::data_file());
   app.add_option("--sim-camera", sim_camera,
                  "simulation: the camera, ideal or typical (lens distortion, rolling shutter, 8 ms latency, flicker; "
                  "docs/vision.md)")
@@ -84,9 +87,9 @@ int main(int argc, char** argv) {
       ->default_str(std::string(pinball::sim::stepper_kind_name(defaults.sim.stepper)));
   app.add_option("--identified", identified,
                  "identified parameters laid over the belief board (`pinball identify`, docs/identification.md)")
-      ->check(CLI::ExistingFile);
+      ->transform(pinball::data_file());
   app.add_option("--controller", controller, "controller file")
-      ->check(CLI::ExistingFile)
+      ->transform(pinball::data_file())
       ->default_str(defaults.controller);
   app.add_option("--balls", balls, "balls to play in simulation")->check(CLI::Range(0, 1000000))
       ->default_str(std::to_string(defaults.sim.balls));

@@ -41,8 +41,9 @@ bool decided_by_observations(int cause) {
 
 }  // namespace
 
-ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
+ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
                         const std::function<void(const std::string&)>& progress) {
+  find_data_files(config);  // the defaults name the shipped data from any folder, as pinballd's do
   try {
     bus::require_lcm_log(log_path);
   } catch (const std::runtime_error& e) {

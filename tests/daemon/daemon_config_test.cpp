@@ -270,6 +270,26 @@ TEST(DaemonConfig, RelativePathsAreRelativeToTheConfigurationsFolder) {
   EXPECT_EQ(c.controller, "controllers/imitation.json");
 }
 
+// The defaults and a command line's relative paths name the shipped data
+// from any folder; what a configuration file gave (absolute) is kept.
+TEST(DaemonConfig, FindDataFilesFindsTheShippedDataFromAnyFolder) {
+  const std::string source = PINBALL_SOURCE_DIR;
+  DaemonConfig c;
+  c.board = "boards/mit1993.board";  // the lab board, as --board would give it
+  c.identified = "config/twin.identified.yaml";
+  c.sim.twin_params = "config/twin.yaml";
+  const std::string given = (fresh_dir("config_given") / "mine.json").string();
+  c.sim.world_board = given;  // absolute: kept though it does not exist, for the loader's error to name
+  in_dir("/", [&] { find_data_files(c); });
+  EXPECT_TRUE(std::filesystem::exists(c.controller)) << c.controller;
+  EXPECT_TRUE(std::filesystem::exists(c.board)) << c.board;
+  EXPECT_TRUE(std::filesystem::exists(c.sim.board)) << c.sim.board;
+  EXPECT_TRUE(std::filesystem::exists(c.identified)) << c.identified;
+  EXPECT_TRUE(std::filesystem::exists(c.sim.twin_params)) << c.sim.twin_params;
+  EXPECT_EQ(std::filesystem::path(c.sim.board).filename(), "mit1993.board");
+  EXPECT_EQ(c.sim.world_board, given);
+}
+
 TEST(DaemonConfig, AMissingFileNamesTheConfigurationTheKeyAndThePath) {
   namespace fs = std::filesystem;
   const fs::path dir = fresh_dir("config_missing");

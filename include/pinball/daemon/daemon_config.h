@@ -214,6 +214,11 @@ std::vector<std::string> daemon_config_path_keys();
 /// Checks every key's range and the cross-key rules (sim mode needs
 /// camera.source sim and can.interface sim, ...). Throws ConfigError.
 void validate_daemon_config(const DaemonConfig& config, const std::string& source_name);
+/// The data files a configuration names (boards, overlay, twin parameters,
+/// controller) through find_data_file, so that the defaults and a command
+/// line's relative paths name the shipped data from any folder; what a
+/// configuration file gave is already absolute and stays as it is.
+void find_data_files(DaemonConfig& config);
 
 }  // namespace pinball::daemon
 

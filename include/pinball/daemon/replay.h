@@ -30,10 +30,11 @@ struct ReplayReport {
   bool reproduced = false;              ///< every recorded decision was reproduced, in order
 };
 
-/// Replays `log_path` with the board and controller of `config`. Throws
-/// std::runtime_error naming the file when it cannot be read. `progress`
-/// (may be empty) gets a line now and then.
-ReplayReport replay_log(const std::string& log_path, const DaemonConfig& config,
+/// Replays `log_path` with the board and controller of `config` (looked up
+/// as pinballd does, find_data_files). Throws std::runtime_error naming the
+/// file when it cannot be read. `progress` (may be empty) gets a line now
+/// and then.
+ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
                         const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace pinball::daemon
