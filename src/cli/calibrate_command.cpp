@@ -152,8 +152,8 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
                   "or the file's camera_timing)")
       ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--exposure-us", a.exposure_us,
-                  "latency: the camera's fixed exposure time (us), corrected for; 0: not corrected (default: the "
-                  "simulated camera's)")
+                  "latency: the camera's fixed exposure time (us), set on the camera (auto-exposure off) and "
+                  "corrected for; 0: neither (default: the simulated camera's)")
       ->check(CLI::Range(0.0, 100000.0));
   cmd->add_option("--fps", a.fps, "latency: the frame rate asked of the camera")->check(CLI::Range(1.0, 2000.0));
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
@@ -163,12 +163,6 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
 namespace {
 
 constexpr double kDeg = 180.0 / std::numbers::pi;
-
-cv::Mat read_gray(const std::string& path) {
-  const cv::Mat img = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (img.empty()) throw std::runtime_error(path + ": not an image");
-  return img;
-}
 
 nlohmann::json vec_json(const Vec2& v) { return nlohmann::json::array({v.x(), v.y()}); }
 
@@ -200,7 +194,7 @@ struct Context {
 calibration::HomographyFit camera(Context& c) {
   const std::vector<Vec2> layout = c.a.markers.empty() ? calibration::default_marker_layout(c.board)
                                                        : calibration::read_marker_layout_csv(c.a.markers);
-  const cv::Mat image = c.lab ? c.lab->camera_image() : read_gray(c.a.image);
+  const cv::Mat image = c.lab ? c.lab->camera_image() : plot::read_gray_image(c.a.image);
   c.err << "calibrate camera: " << layout.size() << " markers in the layout, image " << image.cols << "x" << image.rows
         << "\n";
   // The homography maps the board into the ideal image: with the file's lens the markers are undistorted first.
@@ -268,8 +262,8 @@ void run_flippers(Context& c) {
   }
   std::vector<Vec2> down, up;
   if (markers) {
-    const cv::Mat di = c.lab ? c.lab->flipper_markers_image(false) : read_gray(c.a.down);
-    const cv::Mat ui = c.lab ? c.lab->flipper_markers_image(true) : read_gray(c.a.up);
+    const cv::Mat di = c.lab ? c.lab->flipper_markers_image(false) : plot::read_gray_image(c.a.down);
+    const cv::Mat ui = c.lab ? c.lab->flipper_markers_image(true) : plot::read_gray_image(c.a.up);
     std::vector<calibration::DetectedMarker> seen_down = calibration::detect_markers(di);
     std::vector<calibration::DetectedMarker> seen_up = calibration::detect_markers(ui);
     if (lens) {  // the homography is the ideal image's
@@ -585,6 +579,7 @@ void run_latency_lab(Context& c) {
   cc.width_px = size.width;
   cc.height_px = size.height;
   cc.fps = a.fps;
+  if (a.exposure_us > 0.0) cc.exposure_s = a.exposure_us * 1e-6;  // fixed, as pinballd's camera.exposure_s fixes it
   vision::CaptureSource camera(cc);
   if (camera.frame_size() != size) {
     throw std::runtime_error("calibrate latency: " + a.device + " gives " + std::to_string(camera.frame_size().width) +
@@ -808,16 +803,7 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
         << size_text(size.width, size.height) << " lens\n";
   } else {
     if (a.images.empty()) throw std::runtime_error("calibrate intrinsics: give --images FILES or DIR (or --sim BOARD)");
-    for (const std::string& path : image_paths(a.images)) {
-      cv::Mat gray;
-      try {
-        gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
-      } catch (const cv::Exception&) {
-        gray.release();
-      }
-      if (gray.empty()) throw std::runtime_error(path + ": cannot be read as an image");
-      images.push_back({path, gray});
-    }
+    for (const std::string& path : image_paths(a.images)) images.push_back({path, plot::read_gray_image(path)});
     if (!a.out.empty()) check_camera_size(cal, a.out, images.front().gray.size());
   }
   err << "calibrate intrinsics: " << images.size() << " images of the " << target.describe() << "\n";

@@ -294,6 +294,9 @@ void Daemon::Impl::build() {
     apply_camera_corrections(lens, timing, config.camera.fps, dc);
     detector = std::make_unique<vision::BallDetector>(*homography, frame_size, dc);
     if (world) detector->set_occluder_mask(world->camera().occluder_mask());
+    if (!config.camera.occluder_mask.empty()) {
+      detector->set_occluder_mask(load_occluder_mask(config.camera.occluder_mask, frame_size));
+    }
   }
   camera_stage = std::make_unique<CameraStage>(detector.get(), *tracker, lost_after_s_for(config));
   controller_stage =
@@ -539,12 +542,7 @@ DaemonReport Daemon::run() {
     }
   }
   if (d.config.camera.source == "file" || d.config.camera.source == "v4l2") {
-    vision::CaptureConfig cc;
-    cc.source = d.config.camera.device;
-    cc.width_px = d.config.camera.width_px;
-    cc.height_px = d.config.camera.height_px;
-    cc.fps = d.config.camera.fps;
-    d.capture = std::make_unique<vision::CaptureSource>(cc);
+    d.capture = std::make_unique<vision::CaptureSource>(capture_config_for(d.config.camera));
   }
   d.learn_background();
   d.warm_up_bus();

@@ -1,5 +1,6 @@
 #include "pinball/daemon/daemon_config.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -46,6 +47,14 @@ void check_camera(const CameraSettings& c, const std::string& s) {
   // 10000 frames is 50 s at 200 fps of keeping the ball off the table: more is a typo.
   require(c.background_frames >= 1 && c.background_frames <= 10000, s, "camera.background_frames",
           "must be in [1, 10000]");
+  const bool printable = std::all_of(c.fourcc.begin(), c.fourcc.end(), [](char ch) { return ch > ' ' && ch < 127; });
+  require(c.fourcc.empty() || (c.fourcc.size() == 4 && printable), s, "camera.fourcc",
+          "must be four characters, e.g. GREY, Y800, YUYV or MJPG (empty: the driver's format)");
+  require(std::isfinite(c.exposure_s) && (c.exposure_s < 0.0 || (c.exposure_s > 0.0 && c.exposure_s <= 1.0)), s,
+          "camera.exposure_s", "must be in (0, 1] s, or negative for the driver's automatic exposure");
+  const bool lab_camera = c.source == "v4l2" || c.source == "file";
+  require(c.occluder_mask.empty() || lab_camera, s, "camera.occluder_mask",
+          "is for camera.source v4l2 or file (the simulated camera knows its plastics)");
 }
 
 void check_can(const CanSettings& c, const std::string& s) {
@@ -171,6 +180,7 @@ std::vector<PathField> path_fields(DaemonConfig& c) {
       {"identified", &c.identified, PathUse::kRead},
       {"controller", &c.controller, PathUse::kRead},
       {"camera.device", &c.camera.device, use(c.camera.source == "file", PathUse::kRead)},
+      {"camera.occluder_mask", &c.camera.occluder_mask, PathUse::kRead},
       {"can.log", &c.can.log, PathUse::kWrite},
   };
 }

@@ -5,6 +5,7 @@
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/core/utime.h"
 #include "pinball/core/clock.h"
+#include "pinball/plot/png_file.h"
 
 namespace pinball::daemon {
 
@@ -187,6 +188,32 @@ void apply_camera_corrections(const std::optional<vision::CameraIntrinsics>& len
   // The latency is measured on the steady clock's dates (pinball calibrate latency), so date frames by it.
   config.dejitter_frames = vision::kDefaultDejitterFrames;
   config.frame_period_s = 1.0 / fps;
+}
+
+vision::CaptureConfig capture_config_for(const CameraSettings& camera) {
+  vision::CaptureConfig cc;
+  cc.source = camera.device;
+  cc.width_px = camera.width_px;
+  cc.height_px = camera.height_px;
+  cc.fps = camera.fps;
+  cc.fourcc = camera.fourcc;
+  cc.exposure_s = camera.exposure_s;
+  return cc;
+}
+
+cv::Mat load_occluder_mask(const std::string& path, cv::Size frame_size) {
+  cv::Mat mask;
+  try {
+    mask = plot::read_gray_image(path);
+  } catch (const std::runtime_error& e) {
+    throw ConfigError(std::string("config: camera.occluder_mask: ") + e.what());
+  }
+  if (mask.size() != frame_size) {
+    throw ConfigError("config: camera.occluder_mask: " + path + " is " + std::to_string(mask.cols) + "x" +
+                      std::to_string(mask.rows) + " px, the frames are " + std::to_string(frame_size.width) + "x" +
+                      std::to_string(frame_size.height));
+  }
+  return mask;
 }
 
 ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const table::Board& board) {

@@ -16,4 +16,15 @@ void write_png(const cv::Mat& image, const std::string& path) {
   if (!ok) throw std::runtime_error("write_png: cannot write '" + path + "'");
 }
 
+cv::Mat read_gray_image(const std::string& path) {
+  cv::Mat image;
+  try {
+    image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error(path + ": cannot be read as an image (" + e.what() + ")");
+  }
+  if (image.empty()) throw std::runtime_error(path + ": cannot be read as an image");
+  return image;
+}
+
 }  // namespace pinball::plot

@@ -23,6 +23,11 @@ double steady_now_s() {
 
 }  // namespace
 
+double v4l2_exposure_units(double exposure_s) {
+  constexpr double kUnit_s = 100e-6;  // V4L2_CID_EXPOSURE_ABSOLUTE (the V4L2 camera control reference)
+  return std::max(1.0, std::round(exposure_s / kUnit_s));
+}
+
 bool is_device_source(const std::string& source) { return all_digits(source) || source.rfind("/dev/", 0) == 0; }
 
 CaptureSource::CaptureSource(const CaptureConfig& config) : config_(config) {
@@ -71,9 +76,9 @@ CaptureSource::CaptureSource(const CaptureConfig& config) : config_(config) {
     if (config_.height_px > 0) capture_.set(cv::CAP_PROP_FRAME_HEIGHT, config_.height_px);
     if (config_.fps > 0.0) capture_.set(cv::CAP_PROP_FPS, config_.fps);
     if (config_.buffers > 0) capture_.set(cv::CAP_PROP_BUFFERSIZE, config_.buffers);
-    if (config_.exposure >= 0.0) {
+    if (config_.exposure_s >= 0.0) {
       capture_.set(cv::CAP_PROP_AUTO_EXPOSURE, 1);  // V4L2: 1 = manual
-      capture_.set(cv::CAP_PROP_EXPOSURE, config_.exposure);
+      capture_.set(cv::CAP_PROP_EXPOSURE, v4l2_exposure_units(config_.exposure_s));
     }
   }
   size_ = cv::Size(static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH)),

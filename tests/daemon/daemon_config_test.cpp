@@ -162,6 +162,31 @@ TEST(DaemonConfig, TheWorldIsReadApartFromTheBelief) {
             "t.yaml: sim.stepper: unknown stepper 'euler' (expected thesis or event)");
 }
 
+// The lab camera's format, exposure and occluder mask (docs/vision.md).
+TEST(DaemonConfig, TheLabCamerasFormatExposureAndMask) {
+  const DaemonConfig c =
+      daemon_config_from_yaml("mode: lab\nboard: b\ncan: {interface: can0}\n"
+                              "camera: {source: v4l2, device: /dev/video0, fourcc: GREY, exposure_s: 0.002, "
+                              "occluder_mask: m.png}",
+                              "t.yaml");
+  EXPECT_EQ(c.camera.fourcc, "GREY");
+  EXPECT_DOUBLE_EQ(c.camera.exposure_s, 0.002);
+  EXPECT_EQ(c.camera.occluder_mask, "m.png");  // no base folder: kept as written
+  EXPECT_EQ(DaemonConfig().camera.exposure_s, -1.0);  // the default leaves the driver's automatic exposure
+  EXPECT_EQ(error_of("camera: {fourcc: GRE}"),
+            "t.yaml: camera.fourcc: must be four characters, e.g. GREY, Y800, YUYV or MJPG (empty: the driver's format)");
+  EXPECT_EQ(error_of("camera: {fourcc: \"GR Y\"}"),
+            "t.yaml: camera.fourcc: must be four characters, e.g. GREY, Y800, YUYV or MJPG (empty: the driver's format)");
+  const std::string exposure =
+      "t.yaml: camera.exposure_s: must be in (0, 1] s, or negative for the driver's automatic exposure";
+  EXPECT_EQ(error_of("camera: {exposure_s: 0}"), exposure);
+  EXPECT_EQ(error_of("camera: {exposure_s: 2}"), exposure);
+  EXPECT_EQ(error_of("camera: {exposure_s: .nan}"),
+            "t.yaml: camera.exposure_s: expected a finite number (double), got '.nan' (line 1)");
+  EXPECT_EQ(error_of("camera: {occluder_mask: m.png}"),
+            "t.yaml: camera.occluder_mask: is for camera.source v4l2 or file (the simulated camera knows its plastics)");
+}
+
 TEST(DaemonConfig, LabModeNeedsItsHardware) {
   EXPECT_EQ(error_of("mode: lab"), "t.yaml: camera.source: cannot be sim in mode lab");
   EXPECT_EQ(error_of("mode: lab\ncamera: {source: v4l2}"), "t.yaml: camera.device: is required in mode lab");
@@ -303,6 +328,11 @@ TEST(DaemonConfig, AMissingFileNamesTheConfigurationTheKeyAndThePath) {
   EXPECT_EQ(load_error(file), file + ": can.log: 'nowhere/can.log' is " + (dir / "nowhere" / "can.log").string() +
                                   " (a relative path is relative to the configuration's folder): its folder " +
                                   (dir / "nowhere").string() + " does not exist");
+  write_file(file, "version: 1\nmode: lab\nboard: " + std::string(PINBALL_SOURCE_DIR) +
+                       "/boards/mit1993.board\ncan: {interface: can0}\n"
+                       "camera: {source: v4l2, device: /dev/video0, occluder_mask: mask.png}\n");
+  EXPECT_EQ(load_error(file), file + ": camera.occluder_mask: 'mask.png' is " + (dir / "mask.png").string() +
+                                  " (a relative path is relative to the configuration's folder), which does not exist");
   write_file(file, "version: 1\ncontroller: /nonexistent/c.json\n");
   EXPECT_EQ(load_error(file), file + ": controller: '/nonexistent/c.json', which does not exist");
   write_file(file, "version: 1\nsim: {board: ../config_missing}\n");

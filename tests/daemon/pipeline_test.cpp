@@ -8,6 +8,7 @@
 
 #include "pinball/firmware/stream_transport.h"
 #include "pinball/firmware/virtual_driver_board.h"
+#include "pinball/plot/png_file.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/track/flipper_geometry.h"
 
@@ -268,6 +269,50 @@ TEST(TrackingSetup, TheCalibrationsLensAndTimingReachTheDetector) {
     EXPECT_NE(std::string(e.what()).find("1280x960"), std::string::npos) << e.what();
   }
   std::remove(path.c_str());
+}
+
+TEST(LabCamera, TheConfigurationReachesTheCapture) {
+  CameraSettings camera;
+  camera.device = "/dev/video2";
+  camera.width_px = 1280;
+  camera.height_px = 1024;
+  camera.fps = 150.0;
+  vision::CaptureConfig cc = capture_config_for(camera);
+  EXPECT_EQ(cc.source, "/dev/video2");
+  EXPECT_EQ(cc.width_px, 1280);
+  EXPECT_EQ(cc.height_px, 1024);
+  EXPECT_DOUBLE_EQ(cc.fps, 150.0);
+  EXPECT_EQ(cc.fourcc, "");
+  EXPECT_LT(cc.exposure_s, 0.0) << "no exposure_s: the driver's automatic exposure is left alone";
+  camera.fourcc = "GREY";
+  camera.exposure_s = 0.0025;
+  cc = capture_config_for(camera);
+  EXPECT_EQ(cc.fourcc, "GREY");
+  EXPECT_DOUBLE_EQ(cc.exposure_s, 0.0025);
+}
+
+TEST(LabCamera, TheOccluderMaskMustBeAnImageOfTheFramesSize) {
+  const std::string path = ::testing::TempDir() + "/pipeline_mask.png";
+  cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(0));
+  mask(cv::Rect(100, 50, 40, 30)).setTo(255);
+  plot::write_png(mask, path);
+  const cv::Mat back = load_occluder_mask(path, cv::Size(640, 480));
+  EXPECT_EQ(cv::norm(back, mask, cv::NORM_INF), 0.0);
+  try {
+    load_occluder_mask(path, cv::Size(1280, 1024));
+    FAIL() << "a 640x480 mask for 1280x1024 frames was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "config: camera.occluder_mask: " + path + " is 640x480 px, the frames are 1280x1024");
+  }
+  std::remove(path.c_str());
+  try {
+    load_occluder_mask(path, cv::Size(640, 480));
+    FAIL() << "a missing mask was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("config: camera.occluder_mask: " + path + ": cannot be read", 0), 0u)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -48,6 +48,13 @@ TEST(CaptureSource, TellsDevicesFromFiles) {
   EXPECT_FALSE(is_device_source("/tmp/0.avi"));
 }
 
+TEST(CaptureSource, AnExposureIsSetInV4l2sStepsOf100Microseconds) {
+  EXPECT_DOUBLE_EQ(v4l2_exposure_units(0.002), 20.0);
+  EXPECT_DOUBLE_EQ(v4l2_exposure_units(0.00249), 25.0);  // rounded to the nearest step
+  EXPECT_DOUBLE_EQ(v4l2_exposure_units(1e-6), 1.0);      // shorter than a step: the shortest the driver has
+  EXPECT_DOUBLE_EQ(v4l2_exposure_units(1.0), 10000.0);
+}
+
 TEST(CaptureSource, MissingOrUnreadableSourcesGiveAClearError) {
   expect_error_naming([] { CaptureSource(source("/nonexistent/dir/play.avi")); }, "/nonexistent/dir/play.avi");
   expect_error_naming([] { CaptureSource(source("/dev/video97")); }, "/dev/video97");

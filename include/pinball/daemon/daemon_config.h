@@ -41,6 +41,11 @@ struct CameraSettings {
   double fps = 200.0;             ///< requested frame rate (frames per second)
   double stall_timeout_s = 0.02;  ///< no frame (or no ball while a flipper is up) this long: release all (s), in (0, 1)
   int background_frames = 30;     ///< ball-free frames averaged into the detector's background at start, 1..10000
+  std::string fourcc;             ///< v4l2: pixel format, four characters (GREY, Y800, YUYV, MJPG); empty: the driver's
+  /// v4l2: a fixed exposure (s), (0, 1]; set in V4L2's units of 100 µs with
+  /// auto-exposure off. Negative: the driver's automatic exposure.
+  double exposure_s = -1.0;
+  std::string occluder_mask;      ///< v4l2, file: image of the frame's size, white where plastics hide the playfield
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -49,6 +54,9 @@ struct CameraSettings {
     a->Visit(PINBALL_NVP(width_px));
     a->Visit(PINBALL_NVP(height_px));
     a->Visit(PINBALL_NVP(fps));
+    a->Visit(PINBALL_NVP(fourcc));
+    a->Visit(PINBALL_NVP(exposure_s));
+    a->Visit(PINBALL_NVP(occluder_mask));
     a->Visit(PINBALL_NVP(stall_timeout_s));
     a->Visit(PINBALL_NVP(background_frames));
   }

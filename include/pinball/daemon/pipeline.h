@@ -21,6 +21,7 @@
 #include "pinball/track/tracker.h"
 #include "pinball/vision/camera_homography.h"
 #include "pinball/vision/ball_detector.h"
+#include "pinball/vision/capture_source.h"
 #include "pinball/vision/frame.h"
 
 namespace pinball::daemon {
@@ -198,6 +199,16 @@ struct TrackingSetup {
 void apply_camera_corrections(const std::optional<vision::CameraIntrinsics>& lens,
                               const std::optional<calibration::CameraTiming>& timing, double fps,
                               vision::BallDetectorConfig& config);
+/// What pinballd asks of a lab camera (camera.source v4l2 or file): the
+/// device, the requested size and rate, the pixel format and a fixed
+/// exposure (camera.exposure_s < 0: the driver's automatic exposure, left
+/// as it is).
+vision::CaptureConfig capture_config_for(const CameraSettings& camera);
+/// The occluder mask camera.occluder_mask names, white where plastics hide
+/// the playfield. Throws ConfigError naming the key and the file when it is
+/// not an image or not `frame_size`.
+cv::Mat load_occluder_mask(const std::string& path, cv::Size frame_size);
+
 /// The setup for `config` on `board` (the table's board file). Throws
 /// std::runtime_error naming the calibration file and key when it is bad or
 /// calibrates a flipper the board lacks.

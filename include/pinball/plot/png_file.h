@@ -1,7 +1,8 @@
 #pragma once
-// Writes a figure or picture to a PNG file. Apart from draw.h because OpenCV's
+// Writes a figure or picture to a PNG file, and reads a gray picture back
+// (a calibration frame, an occluder mask). Apart from draw.h because OpenCV's
 // imgcodecs loads about 120 shared libraries (codecs, GDAL) that only the
-// programs writing files need, not every library that draws.
+// programs reading or writing files need, not every library that draws.
 
 #include <string>
 
@@ -11,5 +12,9 @@ namespace pinball::plot {
 
 /// Writes an image as PNG. Throws std::runtime_error naming the path on failure.
 void write_png(const cv::Mat& image, const std::string& path);
+
+/// Reads an image file (PNG, or any format OpenCV decodes) as 8-bit gray.
+/// Throws std::runtime_error "PATH: cannot be read as an image" when it cannot.
+cv::Mat read_gray_image(const std::string& path);
 
 }  // namespace pinball::plot

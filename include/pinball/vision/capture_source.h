@@ -23,9 +23,13 @@ struct CaptureConfig {
   int height_px = 480;         ///< requested height (devices; 0 leaves the driver's)
   double fps = 200.0;          ///< requested frame rate (devices; 0 leaves the driver's); a file's own rate is used
   std::string fourcc;          ///< requested pixel format, e.g. "GREY", "YUYV", "MJPG" (devices; empty: the driver's)
-  double exposure = -1.0;      ///< manual exposure in the driver's units (V4L2: 100 µs steps); < 0 leaves auto
+  double exposure_s = -1.0;    ///< fixed exposure (s), set with auto-exposure off (devices); < 0 leaves the driver's
   int buffers = 2;             ///< driver buffer count (devices; fewer: less latency, more drops); 0 leaves it
 };
+
+/// An exposure time in V4L2's exposure_time_absolute units of 100 µs,
+/// rounded, at least 1 (the shortest a driver has).
+double v4l2_exposure_units(double exposure_s);
 
 /// True when `source` names a V4L2 device (a number or a /dev/ path) rather than a file.
 bool is_device_source(const std::string& source);
