@@ -173,10 +173,10 @@ TEST(DaemonConfig, TheLabCamerasFormatExposureAndMask) {
   EXPECT_DOUBLE_EQ(c.camera.exposure_s, 0.002);
   EXPECT_EQ(c.camera.occluder_mask, "m.png");  // no base folder: kept as written
   EXPECT_EQ(DaemonConfig().camera.exposure_s, -1.0);  // the default leaves the driver's automatic exposure
-  EXPECT_EQ(error_of("camera: {fourcc: GRE}"),
-            "t.yaml: camera.fourcc: must be four characters, e.g. GREY, Y800, YUYV or MJPG (empty: the driver's format)");
-  EXPECT_EQ(error_of("camera: {fourcc: \"GR Y\"}"),
-            "t.yaml: camera.fourcc: must be four characters, e.g. GREY, Y800, YUYV or MJPG (empty: the driver's format)");
+  const std::string fourcc =
+      "t.yaml: camera.fourcc: must be four characters, e.g. GREY, Y800, YUYV or MJPG (empty: the driver's format)";
+  EXPECT_EQ(error_of("camera: {fourcc: GRE}"), fourcc);
+  EXPECT_EQ(error_of("camera: {fourcc: \"GR Y\"}"), fourcc);
   const std::string exposure =
       "t.yaml: camera.exposure_s: must be in (0, 1] s, or negative for the driver's automatic exposure";
   EXPECT_EQ(error_of("camera: {exposure_s: 0}"), exposure);
@@ -184,7 +184,8 @@ TEST(DaemonConfig, TheLabCamerasFormatExposureAndMask) {
   EXPECT_EQ(error_of("camera: {exposure_s: .nan}"),
             "t.yaml: camera.exposure_s: expected a finite number (double), got '.nan' (line 1)");
   EXPECT_EQ(error_of("camera: {occluder_mask: m.png}"),
-            "t.yaml: camera.occluder_mask: is for camera.source v4l2 or file (the simulated camera knows its plastics)");
+            "t.yaml: camera.occluder_mask: is for camera.source v4l2 or file "
+            "(the simulated camera knows its plastics)");
 }
 
 TEST(DaemonConfig, LabModeNeedsItsHardware) {
