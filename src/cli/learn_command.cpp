@@ -241,6 +241,11 @@ std::string run_fingerprint(const LearnArgs& a) {
     j["randomize"] = a.randomize;
     j["randomize_fnv1a"] = file_digest(a.randomize);
   }
+  if (a.drain_penalty >= 0.0) j["drain_penalty"] = a.drain_penalty;  // likewise
+  if (!a.shot_values.empty()) {  // likewise
+    j["shot_values"] = a.shot_values;
+    j["shot_values_fnv1a"] = file_digest(a.shot_values);
+  }
   if (!a.identified.empty()) {  // only then: a checkpoint of a run without an overlay still resumes
     j["identified"] = a.identified;
     j["identified_fnv1a"] = file_digest(a.identified);

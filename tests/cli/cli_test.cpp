@@ -387,6 +387,16 @@ TEST_F(Cli, LearnDrainPenaltyPricesTheShotTableAndTheTeacher) {
   ASSERT_EQ(priced.exit_code, 0) << priced.err;
   EXPECT_EQ(nlohmann::json::parse(plain.out).at("teacher_drain_penalty"), 20000.0);
   EXPECT_EQ(nlohmann::json::parse(priced.out).at("teacher_drain_penalty"), 12000.0);
+  // A checkpoint remembers the teacher's price and table: resumed with others, it is another run's.
+  const std::string resume = imitate + learned + common + " --checkpoint " + (dir_ / "imitate.ckpt").string();
+  ASSERT_EQ(run(resume).exit_code, 0);
+  for (const std::string& other : {std::string(" --drain-penalty 12000"), " --shot-values " + table}) {
+    const CommandResult resumed = run(resume + " --resume" + other);
+    EXPECT_EQ(resumed.exit_code, 1) << other;
+    EXPECT_NE(resumed.err.find("another run"), std::string::npos) << resumed.err;
+  }
+  const CommandResult same = run(resume + " --resume");
+  EXPECT_EQ(same.exit_code, 0) << same.err;
   for (const std::string& method : {"cem --budget-balls 2 --out " + learned, std::string("launcher")}) {
     const CommandResult refused = run("learn boards/mit1993.board --method " + method + " --drain-penalty 5000");
     EXPECT_EQ(refused.exit_code, 1) << method;
