@@ -244,8 +244,10 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
   cmd->add_option("--out", a.out, "overlay file to write (YAML); none: report only");
   cmd->add_option("--sigma-m", a.sigma_m, "detector noise of one coordinate (m): the free-flight χ² test")
       ->check(CLI::Range(1e-5, 0.05));
-  cmd->add_option("--bootstrap", a.bootstrap, "resamples of flights behind g's uncertainty (0: the fit's covariance)")
-      ->check(CLI::Range(0, 10000));
+  cmd->add_option("--bootstrap", a.bootstrap,
+                  "resamples behind g's and the wall thickness's uncertainties, 2..10000 (0: g's from the fit's "
+                  "covariance, the thickness not identified)")
+      ->check(CLI::IsMember({0}) | CLI::Range(2, 10000));
   cmd->add_option("--seed", a.seed, "seed of the bootstrap");
   cmd->add_flag("--json", a.json, "print one JSON object");
   add_progress_flag(*cmd, a.progress);

@@ -254,6 +254,10 @@ WallThicknessFit fit_wall_thickness(const table::Board& belief, std::span<const 
     fit.why_not = "the board has no two-sided wall";
     return fit;
   }
+  if (bootstrap < 2) {  // no covariance to fall back on: a thickness without an uncertainty is not reported
+    fit.why_not = "its uncertainty needs a bootstrap of at least 2 resamples of the moments (--bootstrap)";
+    return fit;
+  }
   const std::vector<PredictionStart> starts = prediction_starts(recordings, options);
   std::vector<double> thickness;
   std::vector<std::vector<double>> errors;  // per thickness, per start
@@ -305,7 +309,7 @@ WallThicknessFit fit_wall_thickness(const table::Board& belief, std::span<const 
     for (std::size_t& s : resample) s = used[static_cast<std::size_t>(rng.uniform01() * static_cast<double>(used.size()))];
     spread.add(best_of(means(resample)));
   }
-  fit.stderr_m = bootstrap > 1 ? spread.stddev() : 0.0;
+  fit.stderr_m = spread.stddev();
   fit.identified = true;
   return fit;
 }

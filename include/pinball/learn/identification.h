@@ -118,7 +118,8 @@ struct WallThicknessFit {
 /// Scans thicknesses 0 to 4 mm in steps of 0.5 mm, each the mean 100 ms
 /// prediction error over the moments of `recordings` of `belief` with that
 /// thickness, and takes the vertex of the parabola through the best and its
-/// neighbours; `bootstrap` resamples of the moments give the uncertainty.
+/// neighbours; `bootstrap` resamples of the moments give the uncertainty
+/// (fewer than 2: not identified, for want of one).
 /// Not identified (why_not) when the board has no two-sided wall or the
 /// recordings hold fewer than 100 moments.
 WallThicknessFit fit_wall_thickness(const table::Board& belief, std::span<const bus::RecordedPlay> recordings,
