@@ -149,8 +149,10 @@ EventStepper::EventStepper(const table::Board& board, EventStepperOptions option
   const double rest_speed = std::sqrt(2.0 * board.gravity_mps2 * options_.rest_height_m);
   touch_speed_mps_ = 1e-3 * rest_speed;
   separation_speed_mps_ = std::max(rest_speed, 1e-3);
-  // The tangent of a circle leaves it by circle_slide²/2R; a hundredth of the
-  // rest height keeps the slide's error far below it.
+  // At a circle of radius ρ the ball's centre moves on one of R = ρ + r, whose
+  // tangent leaves it by circle_slide²/2R: R = r (a point, the tightest) bounds
+  // the lift for every circle, and a hundredth of the rest height keeps the
+  // slide's error far below it.
   const double lift_m = std::max(1e-2 * options_.rest_height_m, 100.0 * touch_m_);
   circle_slide_m_ = std::sqrt(2.0 * r * lift_m);
 
