@@ -55,6 +55,7 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                       {"identified", g.identified},
                       {"why_not", g.identified ? nlohmann::json(nullptr) : nlohmann::json(g.why_not)},
                       {"rebounds", g.rebounds},
+                      {"at_speed_clamp", g.at_speed_clamp},
                       {"outliers", g.outliers},
                       {"rho", g.identified ? to_json_value(g.overlay.rho) : nlohmann::json(nullptr)},
                       {"kick_mps", g.overlay.kick_mps ? to_json_value(*g.overlay.kick_mps) : nlohmann::json(nullptr)},
@@ -167,7 +168,9 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     out << " (" << group.overlay.obstacles.size() << " obstacles: " << group.overlay.obstacles.front()
         << (group.overlay.obstacles.size() > 1 ? ", ..." : "") << "): rho " << value_text(group.overlay.rho, "");
     if (group.overlay.kick_mps) out << ", kick " << value_text(*group.overlay.kick_mps, " m/s");
-    out << " (" << group.rebounds << " rebounds, " << group.outliers << " outliers); residual "
+    out << " (" << group.rebounds << " rebounds, "
+        << (group.at_speed_clamp > 0 ? std::to_string(group.at_speed_clamp) + " at the speed clamp, " : std::string())
+        << group.outliers << " outliers); residual "
         << format_number(group.rms_nominal_mps) << " -> " << format_number(group.rms_fitted_mps) << " m/s";
     if (group.overlay.friction)
       out << "; friction " << value_text(*group.overlay.friction, "") << " (" << group.friction.outliers

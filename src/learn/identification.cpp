@@ -101,36 +101,19 @@ void identify_groups(const table::Board& board, const std::vector<FreeFlight>& f
   }
   for (std::size_t g = 0; g < result.groups.size(); ++g) {
     GroupResult& group = result.groups[g];
-    std::vector<std::pair<double, double>> in_out;
-    for (const Rebound& r : result.rebounds)
-      if (r.group == static_cast<int>(g)) in_out.emplace_back(r.speed_in_mps, r.speed_out_mps);
-    group.rebounds = static_cast<int>(in_out.size());
-    const bool with_kick = group.overlay.board_kick_mps > 0.0;
-    const int needed = o.min_rebounds + (with_kick ? 2 : 0);
-    group.rms_nominal_mps = rms_residual(in_out, {group.overlay.board_kick_mps, group.overlay.board_rho});
-    if (group.rebounds < needed) {
-      group.why_not = std::to_string(group.rebounds) + " clean rebounds (both flights seen, one obstacle near), needs " +
-                      std::to_string(needed);
-      result.not_identified.push_back({group_label(group.overlay) + (with_kick ? ": rho and kick" : ": rho"),
-                                       group.why_not});
-      continue;
-    }
-    // speed out ≈ ρ·speed in (+ kick)
-    const TrimmedLineFit fit = fit_line_trimmed(in_out, !with_kick);
-    group.identified = true;
-    group.outliers = fit.outliers;
-    group.overlay.rho = {fit.line.slope, fit.slope_stderr, fit.used};
-    if (with_kick) group.overlay.kick_mps = table::IdentifiedValue{fit.line.intercept, fit.intercept_stderr, fit.used};
-    group.rms_fitted_mps = rms_residual(in_out, fit.line);
     std::vector<Rebound> own;
     for (const Rebound& r : result.rebounds)
       if (r.group == static_cast<int>(g)) own.push_back(r);
-    group.friction = fit_wall_friction(own, group.overlay.rho.value, group.overlay.kick_mps.value_or(table::IdentifiedValue{}).value);
-    if (std::isfinite(group.friction.stderr_)) {
-      group.overlay.friction = table::IdentifiedValue{group.friction.friction, group.friction.stderr_, group.friction.used};
-    } else {
-      result.not_identified.push_back({group_label(group.overlay) + ": wall friction",
-                                       "no rebound came in along the obstacle fast enough for friction to show"});
+    fit_material_group(own, o, board.ball.speed_max_mps, group);
+    const std::string label = group_label(group.overlay);
+    if (!group.identified) {
+      result.not_identified.push_back({label + (group.overlay.board_kick_mps > 0.0 ? ": rho and kick" : ": rho"),
+                                       group.why_not});
+      continue;
+    }
+    if (!group.overlay.friction) {
+      result.not_identified.push_back(
+          {label + ": wall friction", "no rebound came in along the obstacle fast enough for friction to show"});
     }
     result.overlay.obstacle_groups.push_back(group.overlay);
   }
@@ -242,6 +225,46 @@ bool has_two_sided_wall(const table::Board& board) {
 }
 
 }  // namespace
+
+void fit_material_group(std::span<const Rebound> rebounds, const IdentifyOptions& o, double speed_max_mps,
+                        GroupResult& group) {
+  // The model clamps the ball's speed after every bounce (thesis 3.3): a
+  // rebound that left at the clamp says nothing of ρ or the kick, and fitted
+  // as if it did pulls ρ down (the slingshots' 1.4 came out 1.3 from the
+  // model's own play).
+  const double clamp_mps = o.clamp_share * speed_max_mps;
+  std::vector<std::pair<double, double>> in_out;
+  std::vector<Rebound> kept;
+  group.rebounds = static_cast<int>(rebounds.size());
+  for (const Rebound& r : rebounds) {
+    if (std::hypot(r.speed_out_mps, r.tangent_out_mps) > clamp_mps) {
+      ++group.at_speed_clamp;
+      continue;
+    }
+    in_out.emplace_back(r.speed_in_mps, r.speed_out_mps);
+    kept.push_back(r);
+  }
+  const bool with_kick = group.overlay.board_kick_mps > 0.0;
+  const int needed = o.min_rebounds + (with_kick ? 2 : 0);
+  group.rms_nominal_mps = rms_residual(in_out, {group.overlay.board_kick_mps, group.overlay.board_rho});
+  if (static_cast<int>(in_out.size()) < needed) {
+    group.why_not = std::to_string(in_out.size()) + " clean rebounds (both flights seen, one obstacle near" +
+                    (group.at_speed_clamp > 0 ? ", below the speed clamp" : "") + "), needs " + std::to_string(needed);
+    return;
+  }
+  // speed out ≈ ρ·speed in (+ kick)
+  const TrimmedLineFit fit = fit_line_trimmed(in_out, !with_kick);
+  group.identified = true;
+  group.outliers = fit.outliers;
+  group.overlay.rho = {fit.line.slope, fit.slope_stderr, fit.used};
+  if (with_kick) group.overlay.kick_mps = table::IdentifiedValue{fit.line.intercept, fit.intercept_stderr, fit.used};
+  group.rms_fitted_mps = rms_residual(in_out, fit.line);
+  group.friction =
+      fit_wall_friction(kept, group.overlay.rho.value, group.overlay.kick_mps.value_or(table::IdentifiedValue{}).value);
+  if (std::isfinite(group.friction.stderr_)) {
+    group.overlay.friction = table::IdentifiedValue{group.friction.friction, group.friction.stderr_, group.friction.used};
+  }
+}
 
 WallThicknessFit fit_wall_thickness(const table::Board& belief, std::span<const bus::RecordedPlay> recordings,
                                     const PredictionOptions& options, int bootstrap, std::uint64_t seed,

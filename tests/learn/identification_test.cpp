@@ -123,6 +123,60 @@ std::vector<Rebound> rebounds_with_friction(double rho, double kick_mps, double 
   return out;
 }
 
+// A slingshot (ρ 1.4, kick 0.6 m/s) as the thesis model plays it: the
+// response, then the ball's speed clamped to the board's (thesis 3.3).
+TEST(MaterialGroupFit, ReboundsThatLeftAtTheSpeedClampAreLeftOut) {
+  const table::Board board = pinball::testing::thesis_board();
+  table::Obstacle sling;
+  sling.rho = 1.4;
+  sling.action.kick_mps = 0.6;
+  const double clamp_mps = board.ball.speed_max_mps;
+  Rng rng(11);
+  std::vector<Rebound> rebounds;
+  int clamped = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Vec2 n(0.0, 1.0);
+    const Vec2 v_in(rng.uniform(-2.0, 2.0), -rng.uniform(0.3, 4.0));
+    Vec2 v_out = sim::obstacle_response(sling, n, v_in);
+    if (v_out.norm() > clamp_mps) v_out *= clamp_mps / v_out.norm(), ++clamped;
+    Rebound r;
+    r.speed_in_mps = -v_in.y();
+    r.speed_out_mps = v_out.y() + 0.01 * rng.normal();
+    r.tangent_in_mps = std::abs(v_in.x());
+    r.tangent_out_mps = v_in.x() >= 0.0 ? v_out.x() : -v_out.x();
+    rebounds.push_back(r);
+  }
+  ASSERT_GT(clamped, 30) << "the test needs balls thrown out at the clamp";
+  GroupResult group;
+  group.overlay.board_rho = 1.4;
+  group.overlay.board_kick_mps = 0.6;
+  fit_material_group(rebounds, IdentifyOptions{}, clamp_mps, group);
+  ASSERT_TRUE(group.identified) << group.why_not;
+  EXPECT_EQ(group.rebounds, 300);
+  EXPECT_GE(group.at_speed_clamp, clamped);  // those at it, and those the noise put a hair under it
+  EXPECT_LE(group.at_speed_clamp, clamped + 10);
+  EXPECT_NEAR(group.overlay.rho.value, 1.4, 0.01);
+  ASSERT_TRUE(group.overlay.kick_mps.has_value());
+  EXPECT_NEAR(group.overlay.kick_mps->value, 0.6, 0.02);
+  EXPECT_LT(group.rms_fitted_mps, 0.02);
+
+  // Kept, they pull ρ down: the bias the rule removes.
+  IdentifyOptions no_rule;
+  no_rule.clamp_share = 1e9;
+  GroupResult biased;
+  biased.overlay = group.overlay;
+  fit_material_group(rebounds, no_rule, clamp_mps, biased);
+  EXPECT_EQ(biased.at_speed_clamp, 0);
+  EXPECT_LT(biased.overlay.rho.value, 1.35);
+
+  // Too few below the clamp: not identified, and the reason says so.
+  GroupResult few;
+  few.overlay = group.overlay;
+  fit_material_group(std::span<const Rebound>(rebounds.data(), 8), IdentifyOptions{}, 0.1, few);
+  EXPECT_FALSE(few.identified);
+  EXPECT_EQ(few.why_not, "0 clean rebounds (both flights seen, one obstacle near, below the speed clamp), needs 10");
+}
+
 TEST(WallFrictionFit, RecoversTheFrictionExactlyWithoutNoiseAndWithinItsUncertaintyWithNoise) {
   for (double friction : {0.0, 0.05, 0.12, 0.4}) {
     SCOPED_TRACE(friction);

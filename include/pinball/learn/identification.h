@@ -57,6 +57,10 @@ struct IdentifyOptions {
   double kick_dwell_s = 0.02;
   double min_normal_speed_mps = 0.15;///< a slower approach gives no usable ratio (m/s)
   int min_rebounds = 8;              ///< a group needs this many rebounds for ρ (and 2 more for a kick)
+  /// A rebound whose speed out is above this share of the belief's clamp is
+  /// left out of its group's fit (the flights' fits put a clamped ball's
+  /// speed within about 1 % of the clamp).
+  double clamp_share = 0.97;
   int min_launches = 5;              ///< launches needed for the pull and the noise
   double launch_reach_m = 0.03;      ///< a launch flight starts within this of the rest position across the chute, and up to 5x this above it (m)
   ShotOptions shots;                 ///< how flipper shots are found and fitted
@@ -96,11 +100,23 @@ struct GroupResult {
   bool identified = false;              ///< enough rebounds
   std::string why_not;                  ///< when not identified
   int rebounds = 0;                     ///< rebounds seen (before trimming outliers)
+  /// Left out before the fit: the ball left at the belief's speed clamp,
+  /// where the model's response no longer depends on ρ, kick or friction.
+  int at_speed_clamp = 0;
   int outliers = 0;                     ///< left out: residual beyond 3.5 robust σ
   double rms_nominal_mps = 0.0;         ///< RMS of speed out − board prediction (m/s)
   double rms_fitted_mps = 0.0;          ///< ... − identified prediction (m/s)
   WallFrictionFit friction;             ///< when identified: the tangential speeds' fit
 };
+
+/// Fits one material group (its `overlay` holds the board's values) to its
+/// rebounds: speed out against speed in, a line (through 0 without a kick)
+/// trimmed once at 3.5 robust σ, then the wall friction. Rebounds that left
+/// faster than o.clamp_share of `speed_max_mps`, where the model's clamp and
+/// not ρ sets the speed, are counted and left out. Sets the group's counts,
+/// residuals and fit, or its why_not when too few rebounds remain.
+void fit_material_group(std::span<const Rebound> rebounds, const IdentifyOptions& o, double speed_max_mps,
+                        GroupResult& group);
 
 /// The two-sided walls' thickness that makes the model predict the
 /// recordings' moments best (table::set_wall_thickness).
