@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "common/thesis_board.h"
 #include "pinball/core/rng.h"
@@ -204,36 +205,60 @@ TEST(WallFrictionFit, TrimsOutliersAndNeedsTwoRebounds) {
   EXPECT_THROW(fit_wall_friction(std::span<const Rebound>(rebounds.data(), 1), 0.5, 0.0), std::invalid_argument);
 }
 
-// A pop bumper that holds the ball 8 ms, then throws it from its ring's
-// 10 mm reach at ρ·(normal speed in) + kick: balls from below, 14 of them,
-// at 0.3 to 1.2 m/s, each seen at 200 fps for 60 ms in and 60 ms out.
-bus::RecordedPlay kicker_play(const table::Board& board, double rho, double kick_mps, double dwell_s,
-                              double reach_m) {
-  std::size_t bumper = 0;
-  while (board.obstacles[bumper].name != "bumper_low") ++bumper;
-  const table::Shape& circle = board.shapes[bumper];
+// One ball at a circular obstacle: it arrives at the contact (normal n)
+// with v_in, lies there dwell_s, then leaves from reach_m further out along
+// n with v_out.
+struct CircleBounce {
+  Vec2 n;
+  Vec2 v_in;
+  Vec2 v_out;
+  double t_contact_s = 0.0;
+  double dwell_s = 0.0;
+  double reach_m = 0.0;
+};
+
+// The bounces off the obstacle named, seen at 200 fps (frames every 5 ms
+// from t = 0, so a contact may fall between two) for 60 ms in and 60 ms out.
+bus::RecordedPlay circle_bounce_play(const table::Board& board, const std::string& obstacle,
+                                     const std::vector<CircleBounce>& bounces) {
+  std::size_t index = 0;
+  while (board.obstacles[index].name != obstacle) ++index;
+  const table::Shape& circle = board.shapes[index];
   const Vec2 g_vec(0.0, -board.gravity_mps2);
   bus::RecordedPlay play;
-  play.source = "kicker";
+  play.source = obstacle;
   std::int64_t seq = 0;
-  const auto see = [&](double t, const Vec2& p) { play.frames.push_back({t, seq++, true, p, false, false}); };
+  for (const CircleBounce& b : bounces) {
+    const Vec2 contact = circle.p0 + (circle.radius_m + board.ball.radius_m) * b.n;
+    const double t_out = b.t_contact_s + b.dwell_s;
+    for (auto frame = static_cast<std::int64_t>(std::ceil((b.t_contact_s - 0.06) / 0.005));
+         frame * 0.005 <= t_out + 0.06 + 1e-9; ++frame) {
+      const double t = static_cast<double>(frame) * 0.005;
+      const double in = t - b.t_contact_s, out = t - t_out;
+      const Vec2 p = in < 0.0    ? contact + b.v_in * in + 0.5 * in * in * g_vec
+                     : out < 0.0 ? contact
+                                 : contact + b.reach_m * b.n + b.v_out * out + 0.5 * out * out * g_vec;
+      play.frames.push_back({t, seq++, true, p, false, false});
+    }
+  }
+  return play;
+}
+
+// A pop bumper that holds the ball dwell_s, then throws it from its ring's
+// reach at ρ·(normal speed in) + kick: balls from below, 14 of them, at 0.3
+// to 1.2 m/s.
+bus::RecordedPlay kicker_play(const table::Board& board, double rho, double kick_mps, double dwell_s,
+                              double reach_m) {
+  std::vector<CircleBounce> bounces;
   for (int k = 0; k < 14; ++k) {
     const double angle = -1.2 + 0.05 * k;  // below the bumper, pointing down and sideways
     const Vec2 n(std::sin(angle), -std::cos(angle));
     const Vec2 tangent(-n.y(), n.x());
-    const Vec2 contact = circle.p0 + (circle.radius_m + board.ball.radius_m) * n;
     const double speed_in = 0.3 + 0.07 * k;
-    const Vec2 v_in = -speed_in * n + 0.1 * tangent;
-    const Vec2 v_out = (rho * speed_in + kick_mps) * n + 0.1 * tangent;
-    const double t_contact = 2.0 * k + 1.0;
-    for (double tau = -0.06; tau < -1e-9; tau += 0.005)
-      see(t_contact + tau, contact + v_in * tau + 0.5 * tau * tau * g_vec);
-    for (double tau = 0.0; tau < dwell_s; tau += 0.005) see(t_contact + tau, contact);
-    const Vec2 thrown = contact + reach_m * n;
-    for (double tau = 0.0; tau <= 0.06 + 1e-9; tau += 0.005)
-      see(t_contact + dwell_s + tau, thrown + v_out * tau + 0.5 * tau * tau * g_vec);
+    bounces.push_back({n, -speed_in * n + 0.1 * tangent, (rho * speed_in + kick_mps) * n + 0.1 * tangent,
+                       2.0 * k + 1.0, dwell_s, reach_m});
   }
-  return play;
+  return circle_bounce_play(board, "bumper_low", bounces);
 }
 
 TEST(Identification, AKickerThatHoldsTheBallAndThrowsItFromItsReachIsIdentified) {
@@ -261,32 +286,19 @@ TEST(Identification, AKickerThatHoldsTheBallAndThrowsItFromItsReachIsIdentified)
   EXPECT_EQ(group_with(identify_table(board, held, options), 1.1, 0.8)->rebounds, 0);
 }
 
-// Balls bouncing off a post at ρ 0.6, coming in at glancing angles: each
-// seen at 200 fps for 60 ms in and 60 ms out of the contact, no noise.
+// Balls bouncing off a post at ρ 0.6, coming in at glancing angles, each
+// touching it 1.3 ms after a frame.
 bus::RecordedPlay post_play(const table::Board& board, double rho) {
-  std::size_t post = 0;
-  while (board.obstacles[post].name != "post_left") ++post;
-  const table::Shape& circle = board.shapes[post];
-  const Vec2 g_vec(0.0, -board.gravity_mps2);
-  bus::RecordedPlay play;
-  play.source = "post";
-  std::int64_t seq = 0;
-  const auto see = [&](double t, const Vec2& p) { play.frames.push_back({t, seq++, true, p, false, false}); };
+  std::vector<CircleBounce> bounces;
   for (int k = 0; k < 12; ++k) {
     const double angle = -1.4 + 0.08 * k;  // below the post, in the open towards the triangle
     const Vec2 n(std::cos(angle), std::sin(angle));
     const Vec2 tangent(-n.y(), n.x());
-    const Vec2 contact = circle.p0 + (circle.radius_m + board.ball.radius_m) * n;
     const double speed_in = 0.4 + 0.05 * k;
     const Vec2 v_in = -speed_in * n + (k % 2 == 0 ? 1.0 : -1.0) * tangent;  // glancing: fast along the post
-    const Vec2 v_out = v_in + (1.0 + rho) * speed_in * n;
-    const double t_contact = 2.0 * k + 1.0 + 0.0013;  // between frames
-    for (double tau = -0.0613; tau < 0.0; tau += 0.005)
-      see(t_contact + tau, contact + v_in * tau + 0.5 * tau * tau * g_vec);
-    for (double tau = 0.0037; tau <= 0.06; tau += 0.005)
-      see(t_contact + tau, contact + v_out * tau + 0.5 * tau * tau * g_vec);
+    bounces.push_back({n, v_in, v_in + (1.0 + rho) * speed_in * n, 2.0 * k + 1.0013});
   }
-  return play;
+  return circle_bounce_play(board, "post_left", bounces);
 }
 
 // The contact is where the extrapolated ball touches the post, not the
