@@ -284,7 +284,8 @@ void fit_material_group(std::span<const Rebound> rebounds, const IdentifyOptions
   group.friction =
       fit_wall_friction(kept, group.overlay.rho.value, group.overlay.kick_mps.value_or(table::IdentifiedValue{}).value);
   if (std::isfinite(group.friction.stderr_)) {
-    group.overlay.friction = table::IdentifiedValue{group.friction.friction, group.friction.stderr_, group.friction.used};
+    group.overlay.friction =
+        table::IdentifiedValue{group.friction.friction, group.friction.stderr_, group.friction.used};
   }
 }
 
