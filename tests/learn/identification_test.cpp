@@ -261,12 +261,18 @@ bus::RecordedPlay kicker_play(const table::Board& board, double rho, double kick
   return circle_bounce_play(board, "bumper_low", bounces);
 }
 
-TEST(Identification, AKickerThatHoldsTheBallAndThrowsItFromItsReachIsIdentified) {
-  const table::Board& board = pinball::testing::thesis_board();
-  const std::vector<bus::RecordedPlay> plays{kicker_play(board, 0.6, 1.0, 0.008, 0.010)};
+// What the tests of drawn plays identify with: their noise, no bootstrap.
+IdentifyOptions drawn_play_options() {
   IdentifyOptions options;
   options.flights.sigma_m = 0.0005;
   options.bootstrap = 0;
+  return options;
+}
+
+TEST(Identification, AKickerThatHoldsTheBallAndThrowsItFromItsReachIsIdentified) {
+  const table::Board& board = pinball::testing::thesis_board();
+  const std::vector<bus::RecordedPlay> plays{kicker_play(board, 0.6, 1.0, 0.008, 0.010)};
+  IdentifyOptions options = drawn_play_options();
   const IdentificationResult r = identify_table(board, plays, options);
   const GroupResult* bumpers = group_with(r, 1.1, 0.8);
   ASSERT_NE(bumpers, nullptr);
@@ -308,10 +314,7 @@ bus::RecordedPlay post_play(const table::Board& board, double rho) {
 TEST(Identification, AGlancingBounceOffAPostIsMeasuredAtItsContact) {
   const table::Board& board = pinball::testing::thesis_board();
   const std::vector<bus::RecordedPlay> plays{post_play(board, 0.6)};
-  IdentifyOptions options;
-  options.flights.sigma_m = 0.0005;
-  options.bootstrap = 0;
-  const IdentificationResult r = identify_table(board, plays, options);
+  const IdentificationResult r = identify_table(board, plays, drawn_play_options());
   const GroupResult* posts = group_with(r, 0.9, 0.0);
   ASSERT_NE(posts, nullptr);
   ASSERT_TRUE(posts->identified) << posts->why_not;
