@@ -200,8 +200,9 @@ void Daemon::Impl::build() {
     std::fprintf(stderr, "pinballd: warning: %s\n", w.c_str());
     warnings.push_back(w);
   }
-  board = table::load_belief_board(sim_mode ? config.sim.board : config.board, config.identified);
-  spec = control::load_controller(config.controller);
+  DaemonInputs inputs = load_daemon_inputs(config);
+  board = std::move(inputs.board);
+  spec = std::move(inputs.spec);
   controller = learn::make_controller(spec, board);
   driver_of_flipper = controller_stage_options_for(config, board).driver_of_flipper;
   const int drivers = static_cast<int>(board.flippers.size());
@@ -234,7 +235,7 @@ void Daemon::Impl::build() {
   }
   bus = std::make_unique<firmware::DriverBus>(*host_link, bo);
 
-  TrackingSetup setup = tracking_setup_for(config, board);
+  const TrackingSetup& setup = inputs.setup;
   tracker = std::make_unique<track::Tracker>(setup.geometry, setup.tracker);
 
   cv::Size frame_size(config.camera.width_px, config.camera.height_px);
@@ -267,11 +268,7 @@ void Daemon::Impl::build() {
     homography = std::make_unique<vision::CameraHomography>(setup.homography ? *setup.homography
                                                                              : world->camera().homography());
   } else if (config.camera.source != "lcm") {
-    if (!setup.homography) {
-      throw ConfigError("config: calibration: the lab camera needs a calibration file with a camera section "
-                        "(docs/calibration.md)");
-    }
-    homography = std::make_unique<vision::CameraHomography>(*setup.homography);
+    homography = std::make_unique<vision::CameraHomography>(*setup.homography);  // load_daemon_inputs checked it
   }
   if (homography) {
     // OpenCV's thread pool would hand the camera thread's work to threads
@@ -294,9 +291,7 @@ void Daemon::Impl::build() {
     apply_camera_corrections(lens, timing, config.camera.fps, dc);
     detector = std::make_unique<vision::BallDetector>(*homography, frame_size, dc);
     if (world) detector->set_occluder_mask(world->camera().occluder_mask());
-    if (!config.camera.occluder_mask.empty()) {
-      detector->set_occluder_mask(load_occluder_mask(config.camera.occluder_mask, frame_size));
-    }
+    if (!inputs.occluder_mask.empty()) detector->set_occluder_mask(inputs.occluder_mask);
   }
   camera_stage = std::make_unique<CameraStage>(detector.get(), *tracker, lost_after_s_for(config));
   controller_stage =

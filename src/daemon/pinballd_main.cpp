@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "pinball/core/data_file_option.h"
+#include "pinball/daemon/config_check.h"
 #include "pinball/daemon/daemon.h"
 #include "pinball/daemon/thread_table.h"
 
@@ -59,7 +60,7 @@ int main(int argc, char** argv) {
       sim_camera, identified;
   int balls = -1;
   long long seed = -1;
-  bool realtime = false, json = false, threads = false;
+  bool realtime = false, json = false, threads = false, check = false;
   const DaemonConfig defaults;  // what --help shows as each option's default (no --config)
   app.add_option("--config", config_path, "YAML configuration (config/lab.example.yaml); none: embedded simulation")
       ->transform(pinball::data_file());
@@ -103,6 +104,10 @@ int main(int argc, char** argv) {
   app.add_flag("--realtime", realtime, "simulation paced to the wall clock (default: lockstep virtual clock)");
   app.add_flag("--json", json, "print the report as one JSON object on stdout");
   app.add_flag("--threads", threads, "print the thread table and exit");
+  app.add_flag("--check", check,
+               "load and check the configuration and every file it names, as at start, then exit: 0 when all is "
+               "well, 1 naming the first problem (in the lab also the camera device and the CAN interface's state; "
+               "nothing is opened or fired)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -140,6 +145,15 @@ int main(int argc, char** argv) {
     if (!lcm_url.empty()) config.lcm_url = lcm_url;
     if (realtime) config.sim.realtime = true;
     if (!can_log.empty()) config.can.log = can_log;
+    if (check) {
+      const ConfigCheck result = check_daemon_config(config);
+      if (json) {
+        std::cout << config_check_to_json(result).dump(2) << std::endl;
+      } else {
+        std::cout << config_check_to_text(result);
+      }
+      return 0;
+    }
     Daemon daemon(config);
     g_daemon = &daemon;
     if (g_stop_pending) daemon.request_stop();

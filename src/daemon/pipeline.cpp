@@ -6,6 +6,7 @@
 #include "pinball/core/utime.h"
 #include "pinball/core/clock.h"
 #include "pinball/plot/png_file.h"
+#include "pinball/table/board_overlay.h"
 
 namespace pinball::daemon {
 
@@ -151,6 +152,23 @@ int ControllerStage::apply(const std::array<bool, 2>& want, CommandCause cause, 
                       now_wall_s};
   }
   return n;
+}
+
+DaemonInputs load_daemon_inputs(const DaemonConfig& config) {
+  const bool sim = config.mode == "sim";
+  DaemonInputs in;
+  in.board = table::load_belief_board(sim ? config.sim.board : config.board, config.identified);
+  in.spec = control::load_controller(config.controller);
+  in.setup = tracking_setup_for(config, in.board);
+  if (!sim && config.camera.source != "lcm" && !in.setup.homography) {
+    throw ConfigError("config: calibration: the lab camera needs a calibration file with a camera section "
+                      "(docs/calibration.md)");
+  }
+  if (!config.camera.occluder_mask.empty()) {
+    in.occluder_mask =
+        load_occluder_mask(config.camera.occluder_mask, cv::Size(config.camera.width_px, config.camera.height_px));
+  }
+  return in;
 }
 
 TrackingSetup tracking_setup_for(const DaemonConfig& config, const table::Board& board) {

@@ -525,6 +525,30 @@ TEST(Pinballd, ACanLogOnAFullDiskExitsThreeAndTheReportSaysSo) {
   std::remove(out.c_str());
 }
 
+// --check loads what a run would and stops: 0 and the summary, or 1 naming
+// the problem; it opens no camera, no CAN and no LCM, and plays nothing.
+TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
+  std::string text;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --controller controllers/spastic.json --json 2>&1", text),
+            0)
+      << text;
+  const nlohmann::json j = nlohmann::json::parse(text);
+  EXPECT_TRUE(j.at("ok").get<bool>());
+  EXPECT_EQ(j.at("controller_kind"), "spastic");
+  EXPECT_EQ(j.at("mode"), "sim");
+
+  const std::string config = ::testing::TempDir() + "/pinballd_check_" + std::to_string(getpid()) + ".yaml";
+  write_file(config, "version: 1\nmode: lab\nboard: " + std::string(kSource) + "/boards/mit1993.board\n" +
+                         "calibration: " + kSource + "/calibration/lab.example.yaml\n" +
+                         "camera: {source: v4l2, device: /dev/pinball-check-no-such-video}\n" +
+                         "can: {interface: pbnosuch0}\n");
+  std::string lab;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " 2>&1", lab), 1) << lab;
+  EXPECT_NE(lab.find("no such camera device"), std::string::npos) << lab;
+  EXPECT_NE(lab.find("no interface pbnosuch0"), std::string::npos) << lab;
+  std::remove(config.c_str());
+}
+
 TEST(Pinballd, AnLcmFileLogOnAFullDiskExitsThree) {
   std::string text;
   const int status = run_shell(std::string(PINBALLD_EXE) +

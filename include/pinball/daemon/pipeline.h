@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "pinball/calibration/calibration_file.h"
+#include "pinball/control/controller_file.h"
 #include "pinball/control/flipper_controller.h"
 #include "pinball/core/single_writer_counter.h"
 #include "pinball/daemon/daemon_config.h"
@@ -208,6 +209,19 @@ vision::CaptureConfig capture_config_for(const CameraSettings& camera);
 /// the playfield. Throws ConfigError naming the key and the file when it is
 /// not an image or not `frame_size`.
 cv::Mat load_occluder_mask(const std::string& path, cv::Size frame_size);
+
+/// What a configuration names, loaded and checked as pinballd starts, before
+/// it opens anything: the belief board with its overlay, the controller file,
+/// the tracking setup from the calibration and the occluder mask. A lab
+/// camera needs the calibration's homography (ConfigError without one).
+/// `config`'s paths must be found already (find_data_files).
+struct DaemonInputs {
+  table::Board board;
+  control::ControllerSpec spec;
+  TrackingSetup setup;
+  cv::Mat occluder_mask;  ///< CV_8U; empty: none
+};
+DaemonInputs load_daemon_inputs(const DaemonConfig& config);
 
 /// The setup for `config` on `board` (the table's board file). Throws
 /// std::runtime_error naming the calibration file and key when it is bad or

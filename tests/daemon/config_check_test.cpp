@@ -1,0 +1,99 @@
+// pinballd --check: a configuration and its files, loaded as at start,
+// without a game, and in the lab the hardware looked for, not opened.
+
+#include "pinball/daemon/config_check.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "pinball/calibration/calibration_file.h"
+#include "pinball/plot/png_file.h"
+
+namespace pinball::daemon {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSourceTree = PINBALL_SOURCE_DIR;
+
+std::string check_error(const DaemonConfig& config) {
+  try {
+    check_daemon_config(config);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The lab example, with a camera device and a CAN interface no machine has:
+// the check finds neither, the same on the lab machine as here.
+DaemonConfig lab_without_hardware() {
+  DaemonConfig c = load_daemon_config(kSourceTree + "/config/lab.example.yaml");
+  c.camera.device = "/dev/pinball-check-no-such-video";
+  c.can.interface = "pbnosuch0";
+  return c;
+}
+
+TEST(ConfigCheck, TheEmbeddedSimulationIsWhatPinballdRunsWithNoArguments) {
+  const ConfigCheck c = check_daemon_config(DaemonConfig{});
+  EXPECT_EQ(c.mode, "sim");
+  EXPECT_EQ(fs::path(c.board).filename(), "mit1993.board");
+  EXPECT_EQ(fs::path(c.controller).filename(), "imitation.json");
+  EXPECT_EQ(c.controller_kind, "imitation");
+  EXPECT_EQ(c.world, "model on the thesis stepper");
+  EXPECT_EQ(c.camera, "sim 640x480 at 200 fps");
+  EXPECT_EQ(c.can, "sim (the virtual driver board)");
+  EXPECT_TRUE(c.warnings.empty());
+  const nlohmann::json j = config_check_to_json(c);
+  EXPECT_TRUE(j.at("ok").get<bool>());
+  EXPECT_TRUE(j.at("calibration").is_null());
+  EXPECT_EQ(j.at("controller_kind"), "imitation");
+  const std::string text = config_check_to_text(c);
+  EXPECT_NE(text.find("controller       " + c.controller + " (imitation)\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("ok: the configuration and every file it names load\n"), std::string::npos) << text;
+}
+
+TEST(ConfigCheck, TheTwinAndTheSpasticFileAreLoadedToo) {
+  DaemonConfig c;
+  c.sim.world = simlab::WorldKind::kTwin;
+  c.controller = "controllers/spastic.json";
+  const ConfigCheck check = check_daemon_config(c);
+  EXPECT_EQ(check.world, "twin");
+  EXPECT_EQ(check.controller_kind, "spastic");
+  c.sim.twin_params = kSourceTree + "/tests/bad_input/twin/empty.yaml";
+  EXPECT_NE(check_error(c), "") << "a bad twin parameter file is refused";
+}
+
+TEST(ConfigCheck, InTheLabEveryMissingPieceOfHardwareIsNamedAtOnce) {
+  const std::string what = check_error(lab_without_hardware());
+  EXPECT_NE(what.find("camera.device: /dev/pinball-check-no-such-video: no such camera device"), std::string::npos)
+      << what;
+  EXPECT_NE(what.find("can.interface: no interface pbnosuch0"), std::string::npos) << what;
+}
+
+TEST(ConfigCheck, ALabCameraNeedsTheCalibrationsHomographyAndAMaskOfItsSize) {
+  DaemonConfig c = lab_without_hardware();
+  calibration::Calibration no_camera = calibration::read_calibration(c.calibration);
+  no_camera.camera.reset();
+  const std::string cal = ::testing::TempDir() + "/config_check_cal.yaml";
+  calibration::write_calibration(no_camera, cal);
+  DaemonConfig without = c;
+  without.calibration = cal;
+  EXPECT_EQ(check_error(without),
+            "config: calibration: the lab camera needs a calibration file with a camera section (docs/calibration.md)");
+  fs::remove(cal);
+
+  const std::string mask = ::testing::TempDir() + "/config_check_mask.png";
+  plot::write_png(cv::Mat(240, 320, CV_8UC1, cv::Scalar(0)), mask);
+  c.camera.occluder_mask = mask;
+  EXPECT_EQ(check_error(c), "config: camera.occluder_mask: " + mask + " is 320x240 px, the frames are 640x480");
+  fs::remove(mask);
+}
+
+}  // namespace
+}  // namespace pinball::daemon
