@@ -566,8 +566,8 @@ void run_latency_lab(Context& c) {
   std::string missing;
   if (!vision::is_device_source(a.device)) {
     missing = a.device + ": not a camera device (a video file cannot watch a flipper being fired)";
-  } else if (a.device.rfind("/dev/", 0) == 0 && !std::filesystem::exists(a.device)) {
-    missing = a.device + ": no such camera device";
+  } else {
+    missing = vision::missing_camera_device(a.device);
   }
   const firmware::CanLinkVerdict link =
       firmware::judge_can_link(firmware::read_can_link(a.can), a.can, firmware::kBitrate_bps);

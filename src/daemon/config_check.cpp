@@ -1,6 +1,5 @@
 #include "pinball/daemon/config_check.h"
 
-#include <filesystem>
 #include <sstream>
 
 #include "pinball/calibration/calibration_file.h"
@@ -51,9 +50,10 @@ std::string camera_text(const CameraSettings& c) {
 // Mode lab: what the daemon opens must be there, all of it named at once.
 void check_lab_hardware(const DaemonConfig& config, ConfigCheck& out) {
   std::string missing;
-  if (config.camera.source == "v4l2" && config.camera.device.rfind("/dev/", 0) == 0 &&
-      !std::filesystem::exists(config.camera.device)) {
-    missing = "camera.device: " + config.camera.device + ": no such camera device";
+  if (config.camera.source == "v4l2") {
+    if (const std::string m = vision::missing_camera_device(config.camera.device); !m.empty()) {
+      missing = "camera.device: " + m;
+    }
   }
   try {
     if (std::string note = check_can_link(config.can); !note.empty()) out.warnings.push_back(note);

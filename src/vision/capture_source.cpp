@@ -30,6 +30,11 @@ double v4l2_exposure_units(double exposure_s) {
 
 bool is_device_source(const std::string& source) { return all_digits(source) || source.rfind("/dev/", 0) == 0; }
 
+std::string missing_camera_device(const std::string& source) {
+  if (source.rfind("/dev/", 0) != 0 || std::filesystem::exists(source)) return "";
+  return source + ": no such camera device";
+}
+
 CaptureSource::CaptureSource(const CaptureConfig& config) : config_(config) {
   const std::string& src = config_.source;
   if (src.empty()) throw std::runtime_error("capture: no camera device or video file given");

@@ -48,6 +48,13 @@ TEST(CaptureSource, TellsDevicesFromFiles) {
   EXPECT_FALSE(is_device_source("/tmp/0.avi"));
 }
 
+TEST(CaptureSource, AMissingDeviceIsNamedBeforeAnythingIsOpened) {
+  EXPECT_EQ(missing_camera_device("/dev/pinball-no-such-video"), "/dev/pinball-no-such-video: no such camera device");
+  EXPECT_EQ(missing_camera_device("/dev/null"), "");  // there: whether it is a camera is V4L2's to say
+  EXPECT_EQ(missing_camera_device("0"), "");          // an index: V4L2 resolves it
+  EXPECT_EQ(missing_camera_device("play.avi"), "");   // a file is not a device
+}
+
 TEST(CaptureSource, AnExposureIsSetInV4l2sStepsOf100Microseconds) {
   EXPECT_DOUBLE_EQ(v4l2_exposure_units(0.002), 20.0);
   EXPECT_DOUBLE_EQ(v4l2_exposure_units(0.00249), 25.0);  // rounded to the nearest step

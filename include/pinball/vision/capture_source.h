@@ -34,6 +34,11 @@ double v4l2_exposure_units(double exposure_s);
 /// True when `source` names a V4L2 device (a number or a /dev/ path) rather than a file.
 bool is_device_source(const std::string& source);
 
+/// "SOURCE: no such camera device" when `source` is a /dev/ path that does
+/// not exist (a number is left to V4L2), else "": what pinballd --check and
+/// calibrate latency say before they open anything.
+std::string missing_camera_device(const std::string& source);
+
 /// Frames lost between two frames stamped previous_s and current_s at a
 /// nominal period: a gap above 1.5 periods counts round(gap / period) − 1.
 std::uint64_t frames_dropped_between(double previous_s, double current_s, double period_s);
