@@ -15,7 +15,6 @@
 #include "pinball/core/utime.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/firmware/stream_transport.h"
-#include "pinball/table/board_overlay.h"
 #include "pinball/track/flipper_geometry.h"
 #include "pinball/learn/planning_controller.h"
 
@@ -51,11 +50,11 @@ ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
   }
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw std::runtime_error(log_path + ": cannot read the LCM log");
-  const table::Board board =
-      table::load_belief_board(config.mode == "sim" ? config.sim.board : config.board, config.identified);
-  const control::ControllerSpec spec = control::load_controller(config.controller);
-  const std::unique_ptr<control::FlipperController> controller = learn::make_controller(spec, board);
-  const TrackingSetup setup = tracking_setup_for(config, board);
+  // What the daemon starts with, loaded the way it loads it.
+  const DaemonInputs inputs = load_daemon_inputs(config);
+  const table::Board& board = inputs.board;
+  const std::unique_ptr<control::FlipperController> controller = learn::make_controller(inputs.spec, board);
+  const TrackingSetup& setup = inputs.setup;
   track::Tracker tracker(setup.geometry, setup.tracker);
   CameraStage camera(nullptr, tracker, lost_after_s_for(config));
   // The stage drives a DriverBus with no board behind it: its commands go
