@@ -3,7 +3,7 @@
 #include <stdexcept>
 
 #include "pinball/core/clock.h"
-#include "pinball/learn/evaluator.h"
+#include "pinball/core/rng.h"
 #include "pinball/sim/ball_runner.h"
 
 namespace pinball::simlab {
