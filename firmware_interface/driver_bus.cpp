@@ -390,6 +390,11 @@ void DriverBus::on_message(const Message& m, double now_s) {
   if (const auto* fault = std::get_if<Fault>(&m.payload)) on_board_fault(*fault, now_s);
 }
 
+void DriverBus::attach_log(FrameLog* log) {
+  const std::lock_guard<std::mutex> lock(io_mutex_);  // every frame is logged under it
+  options_.log = log;
+}
+
 void DriverBus::poll_once(double now_s) {
   const std::lock_guard<std::mutex> lock(io_mutex_);
   // 1. Everything the board said.

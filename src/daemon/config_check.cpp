@@ -67,6 +67,7 @@ void check_lab_hardware(const DaemonConfig& config, ConfigCheck& out) {
 
 ConfigCheck check_daemon_config(DaemonConfig config) {
   validate_daemon_config(config, "configuration");
+  check_written_paths(config, "configuration");
   find_data_files(config);
   const bool sim = config.mode == "sim";
   ConfigCheck out;
@@ -127,6 +128,8 @@ std::string config_check_to_text(const ConfigCheck& c) {
   s << "ok: the configuration and every file it names load\n";
   return s.str();
 }
+
+nlohmann::json config_check_failure_to_json(const std::string& error) { return {{"ok", false}, {"error", error}}; }
 
 nlohmann::json config_check_to_json(const ConfigCheck& c) {
   const auto or_null = [](const std::string& v) { return v.empty() ? nlohmann::json() : nlohmann::json(v); };

@@ -93,7 +93,7 @@ struct Daemon::Impl {
   std::unique_ptr<firmware::CanTransport> host_link;
   std::unique_ptr<firmware::StreamTransport> board_link;  // sim: the virtual board's end
   std::unique_ptr<VirtualBoardRunner> board_runner;  // sim without a world (camera.source lcm): that board's thread
-  std::unique_ptr<firmware::FrameLog> frame_log;  // optional candump log
+  std::unique_ptr<firmware::FrameLog> frame_log;  // optional candump log, opened in run() before the threads
   std::unique_ptr<firmware::Liveness> liveness;  // camera and controller progress, behind the heartbeat
   std::unique_ptr<firmware::DriverBus> bus;
   // Frames.
@@ -169,6 +169,7 @@ struct Daemon::Impl {
   }
   void build();
   void learn_background();
+  void open_can_log();
   void warm_up_bus();
   void make_workers();
   void publish_stats(lcm::LCM& lcm);
@@ -227,13 +228,7 @@ void Daemon::Impl::build() {
   }
   h.liveness = liveness.get();
   bo.liveness = liveness.get();
-  if (!config.can.log.empty()) {
-    frame_log = std::make_unique<firmware::FrameLog>(config.can.log,
-                                                     config.can.interface == "sim" ? "simcan" : config.can.interface);
-    frame_log->stamp_with([this] { return can_log_stamp_s(); });
-    bo.log = frame_log.get();
-  }
-  bus = std::make_unique<firmware::DriverBus>(*host_link, bo);
+  bus = std::make_unique<firmware::DriverBus>(*host_link, bo);  // its CAN log comes in run(): open_can_log()
 
   const TrackingSetup& setup = inputs.setup;
   tracker = std::make_unique<track::Tracker>(setup.geometry, setup.tracker);
@@ -297,6 +292,11 @@ void Daemon::Impl::build() {
   controller_stage =
       std::make_unique<ControllerStage>(*controller, *bus, controller_stage_options_for(config, board));
 
+  // The camera before the LCM bus, whose file:// log replaces an old one of
+  // its name: a camera that is missing or busy fails the start before that.
+  if (config.camera.source == "file" || config.camera.source == "v4l2") {
+    capture = std::make_unique<vision::CaptureSource>(capture_config_for(config.camera));
+  }
   lcm = std::make_unique<bus::LcmBus>(config.lcm_url);
   if (config.camera.source == "lcm") lcm->subscribe_observations(lcm_observations);
   clock = std::make_unique<PipelineClock>(h, plays_world, lockstep);
@@ -317,6 +317,17 @@ void Daemon::Impl::learn_background() {
     detector->background().add_training_frame(f.gray);
   }
   detector->background().finish_training();
+}
+
+// The CAN log is opened (and an old one of that name replaced) only once
+// every start-up step that can fail without a frame on the bus has passed:
+// a start that fails leaves the last run's log as it was.
+void Daemon::Impl::open_can_log() {
+  if (config.can.log.empty()) return;
+  frame_log = std::make_unique<firmware::FrameLog>(config.can.log,
+                                                   config.can.interface == "sim" ? "simcan" : config.can.interface);
+  frame_log->stamp_with([this] { return can_log_stamp_s(); });
+  bus->attach_log(frame_log.get());
 }
 
 void Daemon::Impl::warm_up_bus() {
@@ -499,6 +510,7 @@ void Daemon::Impl::publish_stats(lcm::LCM&) {
 Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>()) {
   impl_->config = config;
   validate_daemon_config(config, "config");
+  check_written_paths(config, "config");
   impl_->build();
 }
 
@@ -536,10 +548,8 @@ DaemonReport Daemon::run() {
       d.warnings.push_back(cpu_latency->why());
     }
   }
-  if (d.config.camera.source == "file" || d.config.camera.source == "v4l2") {
-    d.capture = std::make_unique<vision::CaptureSource>(capture_config_for(d.config.camera));
-  }
   d.learn_background();
+  d.open_can_log();
   d.warm_up_bus();
   // The simulated clock's offset before any thread reads it: the driver
   // thread's first poll must not see the steady clock's epoch (a false

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include "pinball/bus/lcm_bus.h"
 #include "pinball/core/data_path.h"
 #include "pinball/core/yaml_read_archive.h"
 #include "pinball/daemon/thread_table.h"
@@ -162,8 +163,7 @@ LcmFilePart lcm_file_part(const std::string& url) {
   const std::size_t query = url.find('?');
   LcmFilePart p;
   p.path = url.substr(scheme.size(), query == std::string::npos ? std::string::npos : query - scheme.size());
-  const std::string args = query == std::string::npos ? "" : url.substr(query);
-  p.writes = args.find("mode=w") != std::string::npos || args.find("mode=a") != std::string::npos;
+  p.writes = bus::lcm_log_target(url).has_value();  // mode=w or mode=a, as LcmBus reads it
   return p;
 }
 
@@ -195,6 +195,17 @@ bool file_gives(const YAML::Node& map, const std::string& dotted) {
   return dot == std::string::npos || file_gives(child, dotted.substr(dot + 1));
 }
 
+// Why the daemon could not create the file `path` ("": it can try): ": its
+// folder F does not exist", or ", which is a folder, not a file".
+std::string unwritable_path_problem(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return ", which is a folder, not a file";
+  const fs::path folder = fs::absolute(path, ec).parent_path();
+  if (!fs::is_directory(folder, ec)) return ": its folder " + folder.string() + " does not exist";
+  return "";
+}
+
 // Makes `value` (given at `key` of the file) absolute against `base_dir` and
 // checks it for its use. Messages: "file: key: 'cal.yaml' is /dir/cal.yaml
 // (relative paths are relative to the configuration's folder), which does not exist".
@@ -214,8 +225,8 @@ void resolve_one(const std::string& source, const std::string& key, std::string*
     require(fs::exists(resolved, ec), source, key, said + ", which does not exist");
     require(!fs::is_directory(resolved, ec), source, key, said + ", which is a folder, not a file");
   } else if (use == PathUse::kWrite) {
-    const fs::path folder = resolved.parent_path();
-    require(fs::is_directory(folder, ec), source, key, said + ": its folder " + folder.string() + " does not exist");
+    const std::string problem = unwritable_path_problem(resolved);
+    require(problem.empty(), source, key, said + problem);
   }
 }
 
@@ -288,6 +299,9 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
     throw ConfigError(source_name + ": " + e.key() + ": " + e.message());
   }
   validate_daemon_config(c, source_name);
+  // The lab's table, given in mode sim, would be read nowhere: said, not ignored.
+  require(c.mode != "sim" || !file_gives(root, "board"), source_name, "board",
+          "is the lab's table, unused in mode sim: the simulation's is sim.board (the world's sim.world_board)");
   if (!base_dir.empty()) resolve_paths(c, root, source_name, base_dir);
   return c;
 }
@@ -325,9 +339,23 @@ void validate_daemon_config(const DaemonConfig& c, const std::string& s) {
   check_coils(c.coils, s);
   require(!c.controller.empty(), s, "controller", "is required");
   require(!c.lcm_url.empty(), s, "lcm_url", "is required");
+  const std::size_t scheme_end = c.lcm_url.find("://");
+  static const std::set<std::string> kLcmProviders = {"udpm", "mpudpm", "file", "memq", "tcpq"};
+  require(scheme_end != std::string::npos && kLcmProviders.count(c.lcm_url.substr(0, scheme_end)) == 1, s, "lcm_url",
+          "'" + c.lcm_url + "' names no LCM provider: it starts with udpm://, mpudpm://, file://, memq:// or tcpq://");
   check_sim(c.sim, s);
   check_threads(c.threads, s);
   check_mode(c, s);
+}
+
+void check_written_paths(const DaemonConfig& c, const std::string& source_name) {
+  const auto check = [&](const char* key, const std::string& path) {
+    if (path.empty()) return;
+    const std::string problem = unwritable_path_problem(path);
+    require(problem.empty(), source_name, key, "'" + path + "'" + problem);
+  };
+  check("can.log", c.can.log);
+  if (const std::optional<bus::LcmLogTarget> log = bus::lcm_log_target(c.lcm_url)) check("lcm_url", log->path);
 }
 
 void find_data_files(DaemonConfig& c) {

@@ -146,13 +146,19 @@ int main(int argc, char** argv) {
     if (realtime) config.sim.realtime = true;
     if (!can_log.empty()) config.can.log = can_log;
     if (check) {
-      const ConfigCheck result = check_daemon_config(config);
-      if (json) {
-        std::cout << config_check_to_json(result).dump(2) << std::endl;
-      } else {
-        std::cout << config_check_to_text(result);
+      try {
+        const ConfigCheck result = check_daemon_config(config);
+        if (json) {
+          std::cout << config_check_to_json(result).dump(2) << std::endl;
+        } else {
+          std::cout << config_check_to_text(result);
+        }
+        return 0;
+      } catch (const std::exception& e) {
+        // A script reads one object whatever the verdict; a person reads stderr.
+        if (json) std::cout << config_check_failure_to_json(e.what()).dump(2) << std::endl;
+        throw;
       }
-      return 0;
     }
     Daemon daemon(config);
     g_daemon = &daemon;

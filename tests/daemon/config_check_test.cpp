@@ -76,6 +76,19 @@ TEST(ConfigCheck, InTheLabEveryMissingPieceOfHardwareIsNamedAtOnce) {
   EXPECT_NE(what.find("can.interface: no interface pbnosuch0"), std::string::npos) << what;
 }
 
+// The command line's CAN log is checked as the file's would be, and a failed
+// check is still one JSON object.
+TEST(ConfigCheck, ACanLogThatCannotBeWrittenFailsTheCheck) {
+  DaemonConfig c;
+  c.can.log = "/nonexistent-pinball-folder/can.log";
+  const std::string what = check_error(c);
+  EXPECT_EQ(what, "configuration: can.log: '/nonexistent-pinball-folder/can.log': its folder "
+                  "/nonexistent-pinball-folder does not exist");
+  const nlohmann::json j = config_check_failure_to_json(what);
+  EXPECT_FALSE(j.at("ok").get<bool>());
+  EXPECT_EQ(j.at("error"), what);
+}
+
 TEST(ConfigCheck, ALabCameraNeedsTheCalibrationsHomographyAndAMaskOfItsSize) {
   DaemonConfig c = lab_without_hardware();
   calibration::Calibration no_camera = calibration::read_calibration(c.calibration);

@@ -340,9 +340,51 @@ TEST(DaemonConfig, AMissingFileNamesTheConfigurationTheKeyAndThePath) {
   EXPECT_EQ(load_error(file), file + ": sim.board: '../config_missing' is " + dir.string() +
                                   " (a relative path is relative to the configuration's folder), which is a "
                                   "folder, not a file");
-  // A file the mode does not read is not required: the lab board in mode sim.
+  // The lab's board in mode sim would be read nowhere: refused, not ignored.
   write_file(file, "version: 1\nboard: lab.board\n");
-  EXPECT_EQ(load_error(file), "");
+  EXPECT_EQ(load_error(file), file + ": board: is the lab's table, unused in mode sim: the simulation's is sim.board "
+                                     "(the world's sim.world_board)");
+}
+
+// What the command line gives never passed the loader: the files the daemon
+// writes are checked on the configuration it runs with, and an LCM URL must
+// name a provider liblcm has.
+TEST(DaemonConfig, WrittenFilesAndTheLcmProviderAreCheckedWhereverTheyCameFrom) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fresh_dir("config_written");
+  DaemonConfig c;
+  EXPECT_NO_THROW(check_written_paths(c, "config"));
+  c.can.log = (dir / "can.log").string();
+  EXPECT_NO_THROW(check_written_paths(c, "config"));
+  c.can.log = (dir / "nowhere" / "can.log").string();
+  try {
+    check_written_paths(c, "config");
+    ADD_FAILURE() << "a CAN log in a missing folder was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "config: can.log: '" + c.can.log + "': its folder " + (dir / "nowhere").string() +
+                                         " does not exist");
+  }
+  c.can.log = dir.string();
+  EXPECT_THROW(check_written_paths(c, "config"), ConfigError) << "a folder is not a log";
+  c.can.log.clear();
+  c.lcm_url = "file://" + (dir / "nowhere" / "run.lcmlog").string() + "?mode=w";
+  EXPECT_THROW(check_written_paths(c, "config"), ConfigError);
+  c.lcm_url = "file://" + (dir / "nowhere" / "run.lcmlog").string();  // read: lcm-logplayer's, not written
+  EXPECT_NO_THROW(check_written_paths(c, "config"));
+
+  DaemonConfig bad_url;
+  bad_url.lcm_url = "bogus://x";
+  try {
+    validate_daemon_config(bad_url, "config");
+    ADD_FAILURE() << "an LCM URL with no provider was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "config: lcm_url: 'bogus://x' names no LCM provider: it starts with udpm://, "
+                                     "mpudpm://, file://, memq:// or tcpq://");
+  }
+  for (const char* url : {"udpm://239.255.76.67:7667?ttl=0", "memq://", "file:///tmp/x.lcmlog?mode=w"}) {
+    bad_url.lcm_url = url;
+    EXPECT_NO_THROW(validate_daemon_config(bad_url, "config")) << url;
+  }
 }
 
 // `identified:` names the overlay laid over the belief (docs/identification.md):

@@ -525,6 +525,22 @@ TEST(Pinballd, ACanLogOnAFullDiskExitsThreeAndTheReportSaysSo) {
   std::remove(out.c_str());
 }
 
+// The CAN log is opened only once the start has passed: a start that fails
+// (here the world's board is no board) leaves the last run's log as it was.
+TEST(Daemon, AStartThatFailsLeavesTheLastRunsCanLogAsItWas) {
+  const std::string stem = ::testing::TempDir() + "/pinballd_keep_" + std::to_string(getpid());
+  const std::string kept = "(1.000000) simcan 123#\n";
+  write_file(stem + ".can", kept);
+  write_file(stem + ".board", "this is not a board\n");
+  DaemonConfig config = short_sim_config(1, 1);
+  config.can.log = stem + ".can";
+  config.sim.world_board = stem + ".board";
+  EXPECT_THROW(Daemon d(config), std::exception);
+  EXPECT_EQ(read_text(stem + ".can"), kept);
+  std::remove((stem + ".can").c_str());
+  std::remove((stem + ".board").c_str());
+}
+
 // --check loads what a run would and stops: 0 and the summary, or 1 naming
 // the problem; it opens no camera, no CAN and no LCM, and plays nothing.
 TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
@@ -546,6 +562,12 @@ TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " 2>&1", lab), 1) << lab;
   EXPECT_NE(lab.find("no such camera device"), std::string::npos) << lab;
   EXPECT_NE(lab.find("no interface pbnosuch0"), std::string::npos) << lab;
+  // With --json a script reads one object on stdout either way.
+  std::string failed;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --json --config " + config + " 2>/dev/null", failed), 1);
+  const nlohmann::json f = nlohmann::json::parse(failed);
+  EXPECT_FALSE(f.at("ok").get<bool>());
+  EXPECT_NE(f.at("error").get<std::string>().find("no interface pbnosuch0"), std::string::npos) << failed;
   std::remove(config.c_str());
 }
 

@@ -6,9 +6,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <thread>
 
 #include "board_harness.h"
+#include "pinball/firmware/frame_log.h"
 #include "pinball/simlab/faulty_link.h"
 
 namespace pinball::firmware {
@@ -59,6 +62,33 @@ TEST_F(DriverBusTest, SessionReachesRunningAndFireReleaseMoveTheCoil) {
   EXPECT_GE(c.heartbeats, 4u);
   EXPECT_GT(c.statuses, 5u);
   EXPECT_EQ(c.rx_bad, 0u);
+}
+
+// A log attached to a running session holds every frame from then on, and
+// none from before (pinballd attaches its CAN log once its start has passed).
+TEST_F(DriverBusTest, AnAttachedLogRecordsEveryFrameFromThenOn) {
+  DriverBus bus(*host_, bus_options());
+  run(bus, 0.05);
+  ASSERT_EQ(bus.state(), BusState::kRunning);
+  const DriverBusCounters before = bus.counters();
+  const std::string path = ::testing::TempDir() + "/driver_bus_attach_" + std::to_string(::getpid()) + ".log";
+  FrameLog log(path, "can0");
+  bus.attach_log(&log);
+  EXPECT_TRUE(bus.fire(0));
+  run(bus, 0.05);
+  bus.attach_log(nullptr);
+  const DriverBusCounters after = bus.counters();
+  run(bus, 0.02);  // after detaching: not recorded
+  log.close();
+  // Every frame sent (or tried) and received in the attached stretch, no other.
+  const auto delta = [&](std::uint64_t DriverBusCounters::*field) { return after.*field - before.*field; };
+  const std::uint64_t expected = delta(&DriverBusCounters::frames_sent) + delta(&DriverBusCounters::tx_failures) +
+                                 delta(&DriverBusCounters::rx_frames) + delta(&DriverBusCounters::rx_bad) +
+                                 delta(&DriverBusCounters::error_frames);
+  EXPECT_GE(expected, 4u);  // the Fire, two heartbeats, Statuses
+  EXPECT_EQ(log.counters().written, expected);
+  EXPECT_EQ(log.counters().dropped(), 0u);
+  std::remove(path.c_str());
 }
 
 TEST_F(DriverBusTest, HeartbeatLossMidHoldSwitchesEverythingOffWithinTheTimeout) {

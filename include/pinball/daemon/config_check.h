@@ -42,5 +42,8 @@ ConfigCheck check_daemon_config(DaemonConfig config);
 /// The check as text (one line per item) and as one JSON object.
 std::string config_check_to_text(const ConfigCheck& check);
 nlohmann::json config_check_to_json(const ConfigCheck& check);
+/// A check that failed, as one JSON object: {"ok": false, "error": what the
+/// check threw (every missing piece of the lab's hardware at once)}.
+nlohmann::json config_check_failure_to_json(const std::string& error);
 
 }  // namespace pinball::daemon

@@ -222,6 +222,10 @@ std::vector<std::string> daemon_config_path_keys();
 /// Checks every key's range and the cross-key rules (sim mode needs
 /// camera.source sim and can.interface sim, ...). Throws ConfigError.
 void validate_daemon_config(const DaemonConfig& config, const std::string& source_name);
+/// The files the daemon writes (can.log, a file:// lcm_url with mode=w or
+/// mode=a) can be created: their folders exist and they are not folders. For
+/// paths from the command line, which the loader never saw. Throws ConfigError.
+void check_written_paths(const DaemonConfig& config, const std::string& source_name);
 /// The data files a configuration names (boards, overlay, twin parameters,
 /// controller) through find_data_file, so that the defaults and a command
 /// line's relative paths name the shipped data from any folder; what a

@@ -158,6 +158,12 @@ class DriverBus {
   /// Release every flipper; takes priority over queued commands. Never blocks.
   void release_all();
 
+  /// Records every frame from now on in `log` (borrowed; null: none), as
+  /// DriverBusOptions::log does from the start: for a log opened only once
+  /// the caller's start-up has succeeded (pinballd: a start that fails leaves
+  /// the last run's log as it was). Waits for a poll in progress.
+  void attach_log(FrameLog* log);
+
   /// One iteration at time `now_s` (s, any monotonic clock): receive, run the
   /// session, send commands and the heartbeat. For use without start().
   void poll_once(double now_s);
