@@ -12,10 +12,14 @@
 namespace pinball::cli {
 
 /// A file a command writes when it has finished: its folder must exist now,
-/// so that a long run does not end in a write error. Throws
-/// std::runtime_error "OPTION PATH: the folder F does not exist".
+/// and it must not be a folder itself, so that a long run (or a lab's flipper
+/// fired twenty times) does not end in a write error. Throws
+/// std::runtime_error "OPTION PATH: the folder F does not exist" or
+/// "OPTION PATH: is a folder, not a file".
 inline void check_output_folder(const std::string& path, const char* option) {
   if (path.empty()) return;
+  if (std::filesystem::is_directory(path))
+    throw std::runtime_error(std::string(option) + " " + path + ": is a folder, not a file");
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   if (!folder.empty() && !std::filesystem::is_directory(folder))
     throw std::runtime_error(std::string(option) + " " + path + ": the folder " + folder.string() + " does not exist");

@@ -96,6 +96,25 @@ TEST_F(Calibrate, BadInputsExitWithOne) {
             1);
 }
 
+// What is written at the end is checked before any work: in the lab,
+// `latency` would otherwise fire the flipper twenty times and then fail.
+TEST_F(Calibrate, AnOutputThatCannotBeWrittenIsRefusedBeforeAnyWork) {
+  const std::string nowhere = (dir_ / "nowhere" / "o.yaml").string();
+  Result r = run("calibrate latency --sim boards/mit1993.board --events 3 --out " + nowhere);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--out " + nowhere + ": the folder " + (dir_ / "nowhere").string() + " does not exist"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("simulating"), std::string::npos) << "nothing was simulated first: " << r.err;
+  r = run("calibrate gravity --sim boards/mit1993.board --out " + dir_.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--out " + dir_.string() + ": is a folder, not a file"), std::string::npos) << r.err;
+  r = run("calibrate camera --sim boards/mit1993.board --png " + nowhere + ".png");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--png " + nowhere + ".png: the folder"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "nowhere"));
+}
+
 // A mounting error is there when asked for, and the calibration finds it.
 TEST_F(Calibrate, TheSimulatedMachineIsMountedOffOnlyWhenAsked) {
   const std::string file = (dir_ / "off.yaml").string();
