@@ -124,6 +124,13 @@ void draw_polyline(cv::Mat& image, std::span<const cv::Point2d> points, const cv
       const bool on = phase < kDashOn_px;
       const double left = (on ? kDashOn_px : kDashOn_px + kDashOff_px) - phase;
       const double e = std::min(length, s + left);
+      if (!(e > s)) {
+        // The dash's end is nearer than s's last digit (fmod left the phase a
+        // hair short of it): step the pattern over that end, not along s,
+        // or the loop would never advance.
+        phase = on ? kDashOn_px : 0.0;
+        continue;
+      }
       if (on) segment(image, a + d * (s / length), a + d * (e / length), colour, thickness);
       phase = std::fmod(phase + (e - s), kDashOn_px + kDashOff_px);
       s = e;

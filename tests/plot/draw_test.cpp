@@ -1,6 +1,7 @@
 #include "pinball/plot/draw.h"
 
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -62,6 +63,21 @@ TEST(PlaceTest, SideBySideAndStacked) {
                                    cv::Mat(30, 40, CV_8UC3, cv::Scalar(255, 0, 0))};
   EXPECT_EQ(place(parts, true, 8).size(), cv::Size(108, 50));
   EXPECT_EQ(place(parts, false, 8).size(), cv::Size(60, 88));
+}
+
+// A dashed line whose phase fmod leaves a hair (6e-14 px) short of a dash's
+// end, where s + left == s: it drew for ever (`learn --plot` hung at 100 %
+// CPU on some learning curves). Found by searching random polylines.
+TEST(PolylineTest, ADashedLineEndsWhereFmodLeavesThePhaseAHairShortOfADash) {
+  cv::Mat image(1000, 1800, CV_8UC3, cv::Scalar(255, 255, 255));
+  const std::vector<cv::Point2d> points{{495.43508709194094, 788.7233511355132},
+                                        {720.18061948631, 788.7233511355132},
+                                        {1697.5700785704544, 788.7233511355132}};
+  draw_polyline(image, points, cv::Scalar(0, 0, 0), 1, LineStyle::kDashed);
+  // Dashes of 8 px and gaps of 5 px along the 1202 px: about 8/13 of it inked.
+  const double inked_fraction = count_colour(image, cv::Scalar(0, 0, 0), 100) / (1697.57 - 495.44);
+  EXPECT_GT(inked_fraction, 0.5);
+  EXPECT_LT(inked_fraction, 0.75);
 }
 
 }  // namespace
