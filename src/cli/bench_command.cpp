@@ -12,6 +12,7 @@
 #include "camera_options.h"
 #include "data_file.h"
 #include "pinball/core/format.h"
+#include "pinball/core/number_option.h"
 #include "pinball/core/progress.h"
 #include "progress_option.h"
 #include "commands.h"
@@ -58,13 +59,14 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--board", a.board, "board file (ceiling, transfer: the belief)")->transform(data_file());
   add_identified_option(*cmd, a.identified);
   cmd->add_option("--steps", a.steps, "speed: steps per timed run (the MuJoCo twin's runs: a tenth)")
-      ->check(CLI::Range(1000, 1'000'000'000));
-  cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(CLI::Range(1, 99));
+      ->check(finite_range(1000, 1'000'000'000));
+  cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(finite_range(1, 99));
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")
-      ->check(CLI::Range(10, 1'000'000));
+      ->check(finite_range(10, 1'000'000));
   cmd->add_option("--seed", a.seed,
                   "tracker, detector, camera, calibration, ceiling, aim, cradle, transfer: seed for play, camera noise, "
-                  "placements and balls");
+                  "placements and balls")
+      ->check(unsigned_64());
   cmd->add_flag("--quick", a.quick,
                 "tracker, detector, camera, calibration, latency, precision, ceiling, aim, cradle, transfer: a short run (fewer "
                 "approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one value per family; "
@@ -72,17 +74,17 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--balls", a.balls,
                   "ceiling: balls per player; aim: ceiling balls whose fires are replayed; cradle: balls per drop "
                   "duration; transfer: balls per world and controller (the same ball seeds for every player)")
-      ->check(CLI::Range(1, 1'000'000))
+      ->check(finite_range(1, 1'000'000))
       ->default_str("ceiling 200, aim " + std::to_string(aim_defaults.balls) + ", cradle " +
                     std::to_string(bench::CradleBenchOptions{}.balls) + ", transfer " +
                     std::to_string(bench::TransferBenchOptions{}.balls));
   cmd->add_option("--twin-balls", a.twin_balls,
                   "transfer: balls per controller in the MuJoCo twin, the first of the same seeds (it plays about "
                   "100x slower than the model)")
-      ->check(CLI::Range(1, 1'000'000))
+      ->check(finite_range(1, 1'000'000))
       ->default_str(std::to_string(bench::TransferBenchOptions{}.twin_balls));
   cmd->add_option("--threads", a.threads, "ceiling, cradle, transfer: worker threads (results do not depend on it)")
-      ->check(CLI::Range(1, 256));
+      ->check(finite_range(1, 256));
   cmd->add_option("--controller", a.controllers,
                   "latency: the controller pinballd plays (default: pinballd's, controllers/imitation.json); ceiling: also play this controller file through the camera model and tracker (a planner file: the ceiling plans with its settings); aim: a planner file whose settings the ceiling player plans with; transfer "
                   "(repeatable): play these instead of controllers/best.json, imitation.json and cem.json")
@@ -95,17 +97,17 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
                   "shots from a ball with this noise only (default: 0.3 mm 0.005, 1 mm 0.02 and 3 mm 0.1 m/s)")
       ->expected(2)
       ->type_name("MM MPS")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finite_non_negative());
   cmd->add_option("--max-ball-time", a.max_ball_time_s,
                   "ceiling, aim, cradle, transfer: seconds after which a ball still alive is cut")
-      ->check(CLI::Range(1.0, 3600.0))
+      ->check(finite_range(1.0, 3600.0))
       ->default_str("60; cradle 600");
   cmd->add_option("--drop-ms", a.drop_ms,
                   "cradle: the drop durations to try, FROM TO STEP in ms: how long the bat a ball rests on is "
                   "dropped before it shoots")
       ->expected(3)
       ->type_name("FROM TO STEP")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_positive())
       ->default_str("230 250 1");
   cmd->add_option("--perturb", a.perturb,
                   "cradle (repeatable): change the model world's table as the transfer sweep's cells do, NAME=VALUE "
@@ -116,11 +118,11 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--target-ratio", a.target_ratio,
                   "transfer: the ratio to the spastic flipper the summary holds every world to (counts the worlds at "
                   "it and those whose interval lies below it)")
-      ->check(CLI::Range(0.01, 1000.0))
+      ->check(finite_range(0.01, 1000.0))
       ->default_str(format_number(bench::TransferBenchOptions{}.target_ratio));
   cmd->add_option("--frames", a.frames, "protocol: random and mutated frames per seed")
-      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
-  cmd->add_option("--seeds", a.seeds, "protocol: seeds to run, from --seed on")->check(CLI::Range(1, 1000));
+      ->check(finite_range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
+  cmd->add_option("--seeds", a.seeds, "protocol: seeds to run, from --seed on")->check(finite_range(1, 1000));
   cmd->add_option("--csv", a.csv,
                   "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here; transfer: one "
                   "row per world and controller");

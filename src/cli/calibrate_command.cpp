@@ -34,6 +34,7 @@
 #include "pinball/core/clock.h"
 #include "pinball/core/format.h"
 #include "pinball/core/json_write_archive.h"
+#include "pinball/core/number_option.h"
 #include "pinball/core/rng.h"
 #include "pinball/firmware/can_link.h"
 #include "pinball/firmware/driver_bus.h"
@@ -91,7 +92,7 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->default_str("")
       ->excludes(sim);
   cmd->add_option("--sim-views", a.sim_views, "intrinsics with --sim: views of the target to render (5 at least: the fit needs 5)")
-      ->check(CLI::Range(5, 500))
+      ->check(finite_range(5, 500))
       ->capture_default_str()
       ->needs(sim);
   cmd->add_option("--camera-size", a.camera_size, "intrinsics with --sim: the simulated camera's image size, WxH")
@@ -113,23 +114,24 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--roll", a.rolls, "gravity: observation CSV (t,x,y) of one roll from rest (repeat)")
       ->check(CLI::ExistingFile)
       ->default_str("");
-  cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")->check(CLI::Range(1, 1000));
-  cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")->check(CLI::Range(1e-6, 0.1));
+  cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")->check(finite_range(1, 1000));
+  cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")->check(finite_range(1e-6, 0.1));
   cmd->add_option("--calibration", a.calibration, "calibration file holding the camera homography (default: --out)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", a.out, "calibration file to write, or update keeping its other sections");
   cmd->add_option("--png", a.png, "picture of the detected markers, fitted circles or gravity fit");
-  cmd->add_option("--seed", a.seed, "--sim: seed of the simulated lab");
+  cmd->add_option("--seed", a.seed, "--sim: seed of the simulated lab")
+      ->check(unsigned_64());
   cmd->add_option("--sim-pivot-offset-mm", a.sim_pivot_offset_mm,
                   "--sim: the machine's pivots sit X Y mm off the board file (default 0 0: the board file's machine)")
       ->expected(2)
-      ->check(CLI::Range(-20.0, 20.0))
+      ->check(finite_range(-20.0, 20.0))
       ->needs(sim);
   cmd->add_option("--sim-length-offset-mm", a.sim_length_offset_mm, "--sim: the machine's flippers are this much longer (mm)")
-      ->check(CLI::Range(-20.0, 20.0))
+      ->check(finite_range(-20.0, 20.0))
       ->needs(sim);
   cmd->add_option("--sim-theta-offset-deg", a.sim_theta_offset_deg, "--sim: both flipper stops this much higher (degrees)")
-      ->check(CLI::Range(-10.0, 10.0))
+      ->check(finite_range(-10.0, 10.0))
       ->needs(sim);
   cmd->add_option("--sim-camera", a.sim_camera,
                   "camera, flippers with --sim: the simulated camera, ideal or typical (a wide lens: calibrate "
@@ -139,23 +141,23 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--device", a.device, "latency: the camera, /dev/videoN");
   cmd->add_option("--can", a.can, "latency: the driver board's SocketCAN interface, e.g. can0");
   cmd->add_option("--flipper", a.flipper, "latency: the flipper to fire, by the board's name (default: the first)");
-  cmd->add_option("--events", a.events, "latency: times the flipper is fired")->check(CLI::Range(3, 1000));
+  cmd->add_option("--events", a.events, "latency: times the flipper is fired")->check(finite_range(3, 1000));
   cmd->add_option("--sim-latency-ms", a.sim_latency_ms,
                   "latency --sim: the simulated camera's minimum latency (ms; default: the typical camera's 7)")
-      ->check(CLI::Range(0.0, 100.0))
+      ->check(finite_range(0.0, 100.0))
       ->needs(sim);
   cmd->add_option("--actuation-delay-ms", a.actuation_delay_ms,
                   "latency: the host's command to the flipper's first motion (ms)")
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(finite_range(0.0, 100.0));
   cmd->add_option("--row-time-us", a.row_time_us,
                   "latency: rolling shutter row time (us; 0: global shutter; default: the simulated camera's, "
                   "or the file's camera_timing)")
-      ->check(CLI::Range(0.0, 1000.0));
+      ->check(finite_range(0.0, 1000.0));
   cmd->add_option("--exposure-us", a.exposure_us,
                   "latency: the camera's fixed exposure time (us), set on the camera (auto-exposure off) and "
                   "corrected for; 0: neither (default: the simulated camera's)")
-      ->check(CLI::Range(0.0, 100000.0));
-  cmd->add_option("--fps", a.fps, "latency: the frame rate asked of the camera")->check(CLI::Range(1.0, 2000.0));
+      ->check(finite_range(0.0, 100000.0));
+  cmd->add_option("--fps", a.fps, "latency: the frame rate asked of the camera")->check(finite_range(1.0, 2000.0));
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }

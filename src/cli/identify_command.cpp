@@ -13,6 +13,7 @@
 #include "data_file.h"
 #include "pinball/core/format.h"
 #include "pinball/core/json_write_archive.h"
+#include "pinball/core/number_option.h"
 #include "pinball/core/progress.h"
 #include "pinball/learn/identification.h"
 #include "pinball/learn/prediction_error.h"
@@ -246,12 +247,13 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
       ->transform(data_file());
   cmd->add_option("--out", a.out, "overlay file to write (YAML); none: report only");
   cmd->add_option("--sigma-m", a.sigma_m, "detector noise of one coordinate (m): the free-flight χ² test")
-      ->check(CLI::Range(1e-5, 0.05));
+      ->check(finite_range(1e-5, 0.05));
   cmd->add_option("--bootstrap", a.bootstrap,
                   "resamples behind g's and the wall thickness's uncertainties, 2..10000 (0: g's from the fit's "
                   "covariance, the thickness not identified)")
-      ->check(CLI::IsMember({0}) | CLI::Range(2, 10000));
-  cmd->add_option("--seed", a.seed, "seed of the bootstrap");
+      ->check(CLI::IsMember({0}) | finite_range(2, 10000));
+  cmd->add_option("--seed", a.seed, "seed of the bootstrap")
+      ->check(unsigned_64());
   cmd->add_flag("--json", a.json, "print one JSON object");
   add_progress_flag(*cmd, a.progress);
   return cmd;

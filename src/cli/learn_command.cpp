@@ -23,6 +23,7 @@
 #include "world_options.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/control/imitation_controller.h"
+#include "pinball/core/number_option.h"
 #include "pinball/learn/shot_value_collection.h"
 #include "pinball/learn/shot_values.h"
 #include "pinball/learn/demonstrations.h"
@@ -64,7 +65,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_option("--drain-penalty", a.drain_penalty,
                   "imitate (its teacher) and shot-values (its player, and so the table's values): the points a plan "
                   "loses when the ball drains in it")
-      ->check(CLI::Range(0.0, 1e9))
+      ->check(finite_range(0.0, 1e9))
       ->default_str(format_number(learn::LookaheadConfig{}.drain_penalty));
   cmd->add_option("--method", a.method,
                   "tournament (thesis 6.2), relay (Hoeffding relay race, 6.3), cem (cross-entropy with common "
@@ -74,19 +75,20 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
       ->required()
       ->check(CLI::IsMember({"tournament", "relay", "cem", "imitate", "none", "spastic", "evaluate", "launcher", "shot-values"}));
   cmd->add_option("--budget-balls", a.budget_balls, "simulated balls the search may play")
-      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
-  cmd->add_option("--seed", a.seed, "random seed; same seed, same result, whatever --threads");
+      ->check(finite_range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
+  cmd->add_option("--seed", a.seed, "random seed; same seed, same result, whatever --threads")
+      ->check(unsigned_64());
   cmd->add_option("--out", a.out, "controller file to write (JSON, docs/learning.md)");
   cmd->add_option("--controller", a.controller, "evaluate: the controller file")->transform(data_file());
-  cmd->add_option("--threads", a.threads, "worker threads")->check(CLI::Range(1, 256));
+  cmd->add_option("--threads", a.threads, "worker threads")->check(finite_range(1, 256));
   cmd->add_option("--curve", a.curve, "write the learning curve to this CSV");
   cmd->add_option("--plot", a.plot, "draw the learning curve to this PNG");
   cmd->add_option("--eval-balls", a.eval_balls,
                   "evaluate the result on this many fresh balls (default: 0 after a search, 1000 otherwise)")
-      ->check(CLI::Range(0, 10'000'000))
+      ->check(finite_range(0, 10'000'000))
       ->default_str("");  // 0: by method
   cmd->add_option("--partitions", a.partitions, "k: impact-angle partitions per flipper (uniform)")
-      ->check(CLI::Range(1, 64));
+      ->check(finite_range(1, 64));
   cmd->add_flag("--partition-h", a.partition_by_h, "also partition by h (pivot-to-tip | tip-to-V-centre)");
   cmd->add_flag("--rolling", a.rolling, "a separate minicontroller for a ball rolling on each flipper");
   cmd->add_flag("--lead", a.lead,
@@ -95,19 +97,19 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
                 "controller");
   cmd->add_flag("--randomise-launch", a.randomise_launch, "draw the launcher pull per ball from [0.5, 1]");
   cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")
-      ->check(CLI::Range(0.01, 1.0))
+      ->check(finite_range(0.01, 1.0))
       ->default_str("");  // -1: the board's
   cmd->add_option("--balls-per-controller", a.balls_per_controller, "tournament: balls per controller (b)")
-      ->check(CLI::Range(1, 100000));
+      ->check(finite_range(1, 100000));
   cmd->add_option("--population", a.population, "relay / cem: population size (default 20 / 16)")
-      ->check(CLI::Range(2, 100000))
+      ->check(finite_range(2, 100000))
       ->default_str("");  // 0: the method's
   cmd->add_option("--rounds", a.rounds,
                   "imitate: rounds sharing the budget; round 1 the teacher plays, later rounds the learner plays "
                   "and the teacher labels its approaches (DAgger)")
-      ->check(CLI::Range(1, 1000));
+      ->check(finite_range(1, 1000));
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball is cut (a cycle)")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive());
   cmd->add_option("--loss-penalty", a.loss_penalty, "reward of a flip opportunity that lost the ball (6.3.1)");
   cmd->add_option_function<double>(
          "--actuation-delay",
@@ -117,9 +119,9 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
          },
          "command to flipper motion (s); default: in a model world the --identified overlay's (its flippers' rise "
          "delay) when it has one, else the firmware's 0.004")
-      ->check(CLI::Range(0.0, 0.5));
+      ->check(finite_range(0.0, 0.5));
   cmd->add_option("--gravity-scale", a.gravity_scale, "tracker's g over the board's (miscalibration)")
-      ->check(CLI::Range(0.1, 10.0));
+      ->check(finite_range(0.1, 10.0));
   add_camera_model_options(*cmd, a.camera);
   add_world_options(*cmd, a.world);
   add_progress_flag(*cmd, a.progress);

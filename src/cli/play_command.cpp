@@ -19,6 +19,7 @@
 #include "pinball/core/data_path.h"
 #include "pinball/core/format.h"
 #include "pinball/core/json_write_archive.h"
+#include "pinball/core/number_option.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/core/utc_date.h"
 #include "pinball/simlab/human_play.h"
@@ -93,19 +94,20 @@ CLI::App* add_play_command(CLI::App& app, PlayArgs& a) {
   cmd->add_option("--player", a.player, "the player's name in the score file (default: $USER, else 'player')");
   cmd->add_option("--csv", a.csv, "score file each ball is appended to (created with its header)");
   cmd->add_option("--balls", a.balls, "stop after this many balls (default 0: play until Esc or q)")
-      ->check(CLI::Range(0, 1'000'000));
+      ->check(finite_range(0, 1'000'000));
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "simulated seconds after which a ball still in play is cut")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--seed", a.seed, "random seed (launch noise)");
+      ->check(finite_positive());
+  cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")->check(finite_range(0.0, 1.0));
+  cmd->add_option("--seed", a.seed, "random seed (launch noise)")
+      ->check(unsigned_64());
   add_world_options(*cmd, a.world);
   cmd->add_option("--keys", a.keys,
                   "play a key script instead of the keyboard's flippers: a file or 'T:ACTION,...' in simulated seconds, "
                   "ACTION launch, left-down, left-up, right-down, right-up, left, right (a 0.1 s tap)");
   cmd->add_flag("--headless", a.headless, "no window: play the --keys script as fast as possible (no display needed)");
-  cmd->add_option("--fps", a.fps, "frames drawn per second (at most)")->check(CLI::Range(30.0, 1000.0));
+  cmd->add_option("--fps", a.fps, "frames drawn per second (at most)")->check(finite_range(30.0, 1000.0));
   cmd->add_option("--px-per-m", a.px_per_m, "scale of the drawn table in pixels per metre")
-      ->check(CLI::Range(200.0, 3000.0));
+      ->check(finite_range(200.0, 3000.0));
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;
 }

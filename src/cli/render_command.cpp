@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "data_file.h"
+#include "pinball/core/number_option.h"
 #include "pinball/plot/draw.h"
 #include "pinball/plot/png_file.h"
 #include "pinball/table/board_loader.h"
@@ -19,7 +20,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& a) {
   CLI::App* cmd = app.add_subcommand("render", "draw a board file to a PNG");
   cmd->add_option("board", a.board, "board file")->required()->transform(data_file());
   cmd->add_option("--out", a.out, "PNG file to write")->required();
-  cmd->add_option("--px-per-m", a.px_per_m, "scale in pixels per metre")->check(CLI::Range(50.0, 10000.0));
+  cmd->add_option("--px-per-m", a.px_per_m, "scale in pixels per metre")->check(finite_range(50.0, 10000.0));
   cmd->add_flag("--normals", a.normals, "draw the normal of every line");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;

@@ -14,6 +14,7 @@
 #include "camera_options.h"
 #include "data_file.h"
 #include "commands.h"
+#include "pinball/core/number_option.h"
 #include "pinball/learn/planning_controller.h"
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/format.h"
@@ -47,7 +48,7 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
                   "a learned controller file (docs/learning.md); implies --policy controller")
       ->transform(data_file());
   cmd->add_option("--reach", a.reach_m, "spastic: flip when the projected impact is this close (m)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finite_range(0.0, 1.0));
   add_camera_model_options(*cmd, a.camera);
   cmd->add_option("--actuation", a.actuation,
                   "how commands reach the flippers: direct (the solenoid delay applied to the table), or can "
@@ -56,15 +57,16 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
   cmd->add_option("--actuation-delay", a.actuation_delay_s,
                   "solenoid rise before the flipper moves (s), for either actuation: the evaluator's and pinballd's "
                   "default")
-      ->check(CLI::Range(0.0, 0.1));
-  cmd->add_option("--balls", a.balls, "balls to play")->check(CLI::Range(1, 100'000'000));
-  cmd->add_option("--seed", a.seed, "random seed (launch noise); same seed, same results");
+      ->check(finite_range(0.0, 0.1));
+  cmd->add_option("--balls", a.balls, "balls to play")->check(finite_range(1, 100'000'000));
+  cmd->add_option("--seed", a.seed, "random seed (launch noise); same seed, same results")
+      ->check(unsigned_64());
   add_world_options(*cmd, a.world);
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball still in play is cut")
-      ->check(CLI::PositiveNumber);
+      ->check(finite_positive());
   cmd->add_option("--trace", a.trace, "write every step to this CSV (t,x,y,vx,vy,event)");
   cmd->add_option("--video", a.video, "write an MJPG AVI of the play to this file");
-  cmd->add_option("--video-fps", a.video_fps, "video frames per simulated second")->check(CLI::Range(1.0, 1000.0));
+  cmd->add_option("--video-fps", a.video_fps, "video frames per simulated second")->check(finite_range(1.0, 1000.0));
   cmd->add_flag("--video-camera", a.video_camera,
                 "--video: record what the simulated camera sees (perspective, lamps, blur, noise) at --video-fps");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");

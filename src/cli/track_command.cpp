@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "data_file.h"
 #include "pinball/calibration/calibration_file.h"
+#include "pinball/core/number_option.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/track/observation_io.h"
 #include "pinball/track/tracker.h"
@@ -23,11 +24,11 @@ CLI::App* add_track_command(CLI::App& app, TrackArgs& a) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--gravity", a.gravity_mps2, "gravity along the table (m/s^2); default: the board's")
-      ->check(CLI::Range(0.0, 100.0))
+      ->check(finite_range(0.0, 100.0))
       ->default_str("");  // -1: the board's
   cmd->add_option("--sigma", a.sigma_m,
                   "observation noise, standard deviation per coordinate (m); default: the default camera's")
-      ->check(CLI::Range(1e-7, 1.0))
+      ->check(finite_range(1e-7, 1.0))
       ->default_str("");  // 0: the camera's
   cmd->add_option("--calibration", a.calibration,
                   "calibration file (pinball calibrate): flipper geometry and gravity instead of the board's")

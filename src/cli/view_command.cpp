@@ -17,6 +17,7 @@
 #include "commands.h"
 #include "data_file.h"
 #include "pinball/core/format.h"
+#include "pinball/core/number_option.h"
 #include "pinball/daemon/daemon_config.h"
 #include "pinball/plot/draw.h"
 #include "pinball/plot/png_file.h"
@@ -248,13 +249,13 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
   cmd->add_option("--snapshot", a.snapshot,
                   "PNG to write: with --at, the picture at that time and no window; with --quit-at, the window's last frame");
   cmd->add_option("--at", a.at_s, "snapshot time: seconds from the log's first event or the first live message (default: the end)")
-      ->check(CLI::Range(0.0, 1e9));
+      ->check(finite_range(0.0, 1e9));
   cmd->add_option("--quit-at", a.quit_at_s, "window: play until this time (s), write --snapshot, quit")
-      ->check(CLI::Range(0.0, 1e9));
-  cmd->add_option("--speed", a.speed, "log playback speed (keys + and - change it)")->check(CLI::Range(1.0 / 64.0, 64.0));
-  cmd->add_option("--px-per-m", a.px_per_m, "scale of the table in pixels per metre")->check(CLI::Range(100.0, 4000.0));
+      ->check(finite_range(0.0, 1e9));
+  cmd->add_option("--speed", a.speed, "log playback speed (keys + and - change it)")->check(finite_range(1.0 / 64.0, 64.0));
+  cmd->add_option("--px-per-m", a.px_per_m, "scale of the table in pixels per metre")->check(finite_range(100.0, 4000.0));
   cmd->add_option("--wait-s", a.wait_s, "live without a window: stop when nothing arrives for this long (s)")
-      ->check(CLI::Range(0.1, 3600.0));
+      ->check(finite_range(0.1, 3600.0));
   cmd->add_flag("--json", a.json, "print one JSON object (what the view showed last)");
   return cmd;
 }

@@ -3,6 +3,7 @@
 #include "data_file.h"
 #include "pinball/core/json_read_archive.h"
 #include "pinball/core/json_write_archive.h"
+#include "pinball/core/number_option.h"
 #include "pinball/firmware/flipper_actuation.h"
 #include "pinball/table/board_overlay.h"
 
@@ -38,7 +39,7 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
   cmd.add_option("--dt", world.dt_s,
                  "the world's time step in seconds (default: the board's, the twin's own for --world twin); for --stepper event the rate at which "
                  "the flipper commands may change")
-      ->check(CLI::PositiveNumber)
+      ->check(finite_positive())
       ->default_str("");  // 0: the board's
 }
 

@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "pinball/core/data_file_option.h"
+#include "pinball/core/number_option.h"
 #include "pinball/daemon/config_check.h"
 #include "pinball/daemon/daemon.h"
 #include "pinball/daemon/thread_table.h"
@@ -92,9 +93,9 @@ int main(int argc, char** argv) {
   app.add_option("--controller", controller, "controller file")
       ->transform(pinball::data_file())
       ->default_str(defaults.controller);
-  app.add_option("--balls", balls, "balls to play in simulation")->check(CLI::Range(0, 1000000))
+  app.add_option("--balls", balls, "balls to play in simulation")->check(pinball::finite_range(0, 1000000))
       ->default_str(std::to_string(defaults.sim.balls));
-  app.add_option("--seed", seed, "launch noise seed in simulation")->check(CLI::NonNegativeNumber)
+  app.add_option("--seed", seed, "launch noise seed in simulation")->check(pinball::unsigned_64())
       ->default_str(std::to_string(defaults.sim.seed));
   app.add_option("--lcm-url", lcm_url, "LCM provider, e.g. memq:// or udpm://239.255.76.67:7667?ttl=0")
       ->default_str(defaults.lcm_url);

@@ -668,11 +668,11 @@ TEST_F(Cli, TrackRejectsABadObservationFileNamingTheLine) {
 TEST_F(Cli, HelpShowsEveryDefault) {
   const CommandResult sim = run("sim --help");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
-  // CLI11 2.1 writes a default after '=' ("--max-ball-time FLOAT:POSITIVE=300").
+  // CLI11 2.1 writes a default after '=' ("--max-ball-time FLOAT:> 0=300").
   EXPECT_NE(sim.out.find("=300\n"), std::string::npos) << "--max-ball-time's default\n" << sim.out;
   EXPECT_NE(sim.out.find("=0.02\n"), std::string::npos) << "--reach's default\n" << sim.out;
   EXPECT_NE(sim.out.find("--stepper {thesis,event}=thesis"), std::string::npos) << sim.out;
-  EXPECT_EQ(sim.out.find("POSITIVE=0 "), std::string::npos) << "a sentinel (0: the board's) is not a default\n"
+  EXPECT_EQ(sim.out.find("> 0=0 "), std::string::npos) << "a sentinel (0: the board's) is not a default\n"
                                                             << sim.out;
   const CommandResult learn = run("learn --help");
   EXPECT_NE(learn.out.find("=2000"), std::string::npos) << "--budget-balls' default\n" << learn.out;

@@ -1,0 +1,84 @@
+#pragma once
+// The checks of number options, for both programs (`pinball`, `pinballd`).
+// CLI11's own let two things through: CLI::Range and CLI::PositiveNumber
+// compare, and every comparison with NaN is false, so `--max-ball-time nan`
+// passed and ran a ball for ever; and an unsigned option takes "-1" as
+// 2^64 - 1 and clamps what overflows. Their messages also print a bound of
+// 1.8e308 with all its 309 digits. Header-only, like data_file_option.h.
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <system_error>
+
+#include <CLI/CLI.hpp>
+
+namespace pinball {
+
+namespace number_option_detail {
+
+// A bound as a reader writes it: 1000000000, 0.0001, 1e-07.
+inline std::string bound_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  return buf;
+}
+
+}  // namespace number_option_detail
+
+/// A finite number in [min, max]: "nan is not a finite number in [1, 1000]".
+inline CLI::Validator finite_range(double min, double max) {
+  const std::string range = "[" + number_option_detail::bound_text(min) + ", " +
+                            number_option_detail::bound_text(max) + "]";
+  return CLI::Validator(
+      [min, max, range](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v)) return "'" + text + "' is not a number";
+        if (!std::isfinite(v) || v < min || v > max) return text + " is not a finite number in " + range;
+        return "";
+      },
+      "in " + range);
+}
+
+/// A finite number > 0 (for CLI::PositiveNumber).
+inline CLI::Validator finite_positive() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v)) return "'" + text + "' is not a number";
+        if (!std::isfinite(v) || !(v > 0.0)) return text + " is not a finite number > 0";
+        return "";
+      },
+      "> 0");
+}
+
+/// A finite number >= 0 (for CLI::NonNegativeNumber).
+inline CLI::Validator finite_non_negative() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v)) return "'" + text + "' is not a number";
+        if (!std::isfinite(v) || !(v >= 0.0)) return text + " is not a finite number >= 0";
+        return "";
+      },
+      ">= 0");
+}
+
+/// A whole number in [0, 2^64 - 1], written in decimal: a seed. Refuses "-1"
+/// (which CLI11 would wrap to 2^64 - 1) and what does not fit (which it clamps).
+inline CLI::Validator unsigned_64() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::uint64_t v = 0;
+        const char* end = text.data() + text.size();
+        const auto [at, ec] = std::from_chars(text.data(), end, v);
+        if (ec == std::errc::result_out_of_range) return text + " does not fit in 64 bits (at most 18446744073709551615)";
+        if (ec != std::errc() || at != end) return "'" + text + "' is not a whole number >= 0";
+        return "";
+      },
+      "0..2^64-1");
+}
+
+}  // namespace pinball
