@@ -55,6 +55,18 @@ const json& need(const JsonReadArchive& r, const json& parent, const std::string
   return parent.at(key);
 }
 
+// The keys an object the reader walks by hand may hold: a misspelt one
+// (launcher.pul, minicontrollers[0].flipr) must not silently keep a default.
+// The sections read through the archive are checked by it.
+void refuse_unknown_keys(const JsonReadArchive& r, const json& object, const std::string& path,
+                         std::initializer_list<const char*> known) {
+  if (!object.is_object()) return;
+  for (const auto& item : object.items()) {
+    const bool ok = std::any_of(known.begin(), known.end(), [&](const char* k) { return item.key() == k; });
+    if (!ok) r.fail(join_key(path, item.key()), "unknown key");
+  }
+}
+
 // Order of a shot's numbers in the file (one short array per shot keeps a
 // table of thousands readable line by line).
 const char* const kShotFields[] = {"flipper",   "rolling",       "angle_rad", "h", "speed_mps",
@@ -77,7 +89,10 @@ ShotTable shot_table_from_json(const json& j, JsonReadArchive& r) {
     need(r, j, "imitation", key);
   }
   ImitationConfig c;
-  r.read(&j, "imitation", &c);
+  json settings = j;  // the table's settings; its shots are rows, read below
+  settings.erase("shots");
+  settings.erase("shot_fields");
+  r.read(&settings, "imitation", &c);
   refuse(r, "imitation", check_imitation_config(c));
   // The shots are rows of numbers, not keyed structs: read as lists, then checked here.
   const json& shots = need(r, j, "imitation", "shots");
@@ -149,6 +164,7 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
       r.fail(where + ".flipper", "must be \"left\" or \"right\"");
     }
     mc.flipper = f.get<std::string>() == "left" ? track::kLeftFlipper : track::kRightFlipper;
+    refuse_unknown_keys(r, m, where, {"partition", "name", "a", "flipper"});  // partition, name: for a reader
     refuse(r, where, check_minicontroller(mc));
   }
   if (j.contains("imitation")) s.shot_table = std::make_shared<const ShotTable>(shot_table_from_json(j["imitation"], r));
@@ -181,6 +197,9 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
       r.fail("launcher.pull_min", "need 0 < pull_min <= pull_max <= 1");
     }
   }
+  // Last: a required key misspelt is reported as missing, which says more.
+  refuse_unknown_keys(r, j, "", {"format", "version", "note", "partition", "minicontrollers", "actuator", "launcher",
+                                 "planner", "spastic", "imitation"});
   return s;
 }
 
@@ -237,7 +256,7 @@ std::string controller_to_json(const ControllerSpec& s) {
 ControllerSpec controller_from_json(const std::string& text, const std::string& src) {
   try {
     const json j = parse_json(text, src);  // refuses a repeated key too
-    JsonReadArchive r(src, {.refuse_unknown_keys = false});  // unknown keys are ignored (the format says nothing)
+    JsonReadArchive r(src);  // an unknown key is refused, as in every other file
     return spec_from_json(j, r);
   } catch (const KeyError& e) {
     // The archive says "file:key: message"; controller files say "file: field: message".

@@ -76,6 +76,13 @@ TEST(ControllerFile, BadFilesGiveClearErrors) {
   std::string missing = good;
   missing.replace(missing.find("\"minicontrollers\""), 17, "\"minis\"");
   expect_error(missing, "minicontrollers: missing");
+  // A misspelt optional key kept its default in silence; every file refuses it now.
+  std::string pul = good;
+  pul.replace(pul.find("\"pull\""), 6, "\"pul\"");
+  expect_error(pul, "launcher.pul: unknown key");
+  std::string extra = good;
+  extra.replace(extra.find("\"note\""), 6, "\"bogus\": 1, \"note\"");
+  expect_error(extra, "bad.json: bogus: unknown key");
   EXPECT_THROW(load_controller("/nonexistent/controller.json"), ControllerFileError);
 }
 
