@@ -175,9 +175,7 @@ std::string calibration_to_yaml(const Calibration& c) {
 }
 
 void write_calibration(const Calibration& calibration, const std::string& path) {
-  std::ofstream out(path);
-  out << calibration_to_yaml(calibration);
-  if (!out) throw std::runtime_error(path + ": cannot write");
+  write_text_file(path, calibration_to_yaml(calibration));  // a lab's measurements: never half a file
 }
 
 Calibration parse_calibration(const std::string& text, const std::string& name) {

@@ -371,6 +371,10 @@ int run_shot_values(const LearnArgs& a, std::ostream& out, std::ostream& err) {
 }
 
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
+  // What is written at the end can be written: a typo must not cost an hour's search.
+  check_output_folder(args.out, "--out");
+  check_output_folder(args.curve, "--curve");
+  check_output_folder(args.plot, "--plot");
   LearnArgs a = args;
   a.actuation_delay_s = world_actuation_delay_s(
       args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,

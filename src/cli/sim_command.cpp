@@ -82,25 +82,6 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   const double dt_s = world->dt_s();
   sim::GameState state = sim::make_game_state(world_board, a.seed);
 
-  std::optional<TraceWriter> trace;
-  if (!a.trace.empty()) trace.emplace(a.trace);
-  std::unique_ptr<sim::VideoRecorder> video;
-  sim::RenderOptions render_options;
-  double next_frame_s = 0.0;
-  std::unique_ptr<simlab::SimCameraSource> camera;  // --video-camera: the camera's own frames
-  vision::Frame camera_frame;
-  cv::Mat camera_bgr;
-  if (!a.video.empty() && a.video_camera) {
-    simlab::SimCameraConfig cc;
-    cc.fps = a.video_fps;
-    cc.exposure_s = std::min(cc.exposure_s, 1.0 / a.video_fps);
-    cc.seed = a.seed;
-    camera = std::make_unique<simlab::SimCameraSource>(world_board, cc);
-    video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, camera->frame_size());
-  } else if (!a.video.empty()) {
-    video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(world_board, render_options));
-  }
-
   std::string policy = a.policy;
   if (!a.controller.empty()) {
     if (policy == "spastic") throw std::invalid_argument("sim: --controller and --policy spastic exclude each other");
@@ -122,6 +103,26 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     spastic_config.reach_m = a.reach_m;
     spastic.emplace(board, a.camera, spastic_config, a.seed ^ 0x5DEECE66Dull);
   }
+  // The recordings are opened once every input has loaded: a bad controller leaves no file behind.
+  std::optional<TraceWriter> trace;
+  if (!a.trace.empty()) trace.emplace(a.trace);
+  std::unique_ptr<sim::VideoRecorder> video;
+  sim::RenderOptions render_options;
+  double next_frame_s = 0.0;
+  std::unique_ptr<simlab::SimCameraSource> camera;  // --video-camera: the camera's own frames
+  vision::Frame camera_frame;
+  cv::Mat camera_bgr;
+  if (!a.video.empty() && a.video_camera) {
+    simlab::SimCameraConfig cc;
+    cc.fps = a.video_fps;
+    cc.exposure_s = std::min(cc.exposure_s, 1.0 / a.video_fps);
+    cc.seed = a.seed;
+    camera = std::make_unique<simlab::SimCameraSource>(world_board, cc);
+    video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, camera->frame_size());
+  } else if (!a.video.empty()) {
+    video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(world_board, render_options));
+  }
+
   std::optional<simlab::CanFlipperDrive> can_drive;
   // One actuation model everywhere: commands reach the flippers actuation_delay_s later, through the
   // CAN path or straight (the fast loop's solenoid delay), as in the evaluator and pinballd.

@@ -12,6 +12,7 @@
 #include "pinball/core/check.h"
 #include "pinball/core/json_read_archive.h"
 #include "pinball/core/json_write_archive.h"
+#include "pinball/core/text_file.h"
 
 namespace pinball::control {
 
@@ -265,10 +266,11 @@ ControllerSpec controller_from_json(const std::string& text, const std::string& 
 }
 
 void save_controller(const ControllerSpec& spec, const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw ControllerFileError(path + ": cannot open for writing");
-  f << controller_to_json(spec);
-  if (!f) throw ControllerFileError(path + ": write failed");
+  try {
+    write_text_file(path, controller_to_json(spec));  // a run's result, or a cycle rewritten mid-run: never half
+  } catch (const std::runtime_error& e) {
+    throw ControllerFileError(e.what());
+  }
 }
 
 ControllerSpec load_controller(const std::string& path) {

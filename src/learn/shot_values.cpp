@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pinball/core/text_file.h"
+
 namespace pinball::learn {
 
 namespace {
@@ -135,10 +137,7 @@ void write_shot_value_table(const ShotValueTable& t, const std::string& path) {
   j["min_weight"] = t.min_weight;
   j["sum"] = t.sum;
   j["count"] = t.count;
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write");
-  out << j.dump() << "\n";
-  if (!out) throw std::runtime_error(path + ": write failed");
+  write_text_file(path, j.dump() + "\n");
 }
 
 ShotValueTable read_shot_value_table(const std::string& path) {

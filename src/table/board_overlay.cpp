@@ -1,11 +1,7 @@
 #include "pinball/table/board_overlay.h"
 
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
-
-#include <unistd.h>
 
 #include "pinball/core/text_file.h"
 #include "pinball/core/utc_date.h"
@@ -103,25 +99,7 @@ std::string board_overlay_to_yaml(const BoardOverlay& overlay) {
 }
 
 void write_board_overlay(const BoardOverlay& overlay, const std::string& path) {
-  const std::string text = board_overlay_to_yaml(overlay);
-  // A temporary beside the file, renamed over it when whole: a failed write leaves no half a file.
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw std::runtime_error(path + ": cannot write");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot write (" + ec.message() + ")");
-  }
+  write_text_file(path, board_overlay_to_yaml(overlay));
 }
 
 BoardOverlay parse_board_overlay(const std::string& text, const std::string& name) {

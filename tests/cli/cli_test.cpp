@@ -665,6 +665,31 @@ TEST_F(Cli, TrackRejectsABadObservationFileNamingTheLine) {
   EXPECT_NE(r.err.find(obs.string() + ":3: column 'y'"), std::string::npos) << r.err;
 }
 
+// Outputs are checked before the work, and a run refused on its inputs
+// leaves no recording behind.
+TEST_F(Cli, OutputsAreCheckedFirstAndARefusedRunWritesNothing) {
+  const std::string nowhere = (dir_ / "nowhere").string();
+  for (const char* option : {"--out", "--curve", "--plot"}) {
+    const std::string out = std::string(option) == "--out" ? " " : " --out " + (dir_ / "c.json").string() + " ";
+    const CommandResult r = run("learn boards/mit1993.board --method tournament --budget-balls 100 --threads 1" + out +
+                                option + " " + nowhere + "/f");
+    EXPECT_EQ(r.exit_code, 1) << option;
+    EXPECT_NE(r.err.find(std::string(option) + " " + nowhere + "/f: the folder " + nowhere + " does not exist"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("tournament"), std::string::npos) << "no search ran: " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "c.json"));
+  const fs::path empty = dir_ / "empty.json";
+  std::ofstream(empty) << "{}\n";
+  const CommandResult sim = run("sim boards/mit1993.board --balls 1 --controller " + empty.string() + " --trace " +
+                                (dir_ / "t.csv").string() + " --video " + (dir_ / "v.avi").string());
+  EXPECT_EQ(sim.exit_code, 1);
+  EXPECT_NE(sim.err.find("format: missing"), std::string::npos) << sim.err;
+  EXPECT_FALSE(fs::exists(dir_ / "t.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "v.avi"));
+}
+
 TEST_F(Cli, HelpShowsEveryDefault) {
   const CommandResult sim = run("sim --help");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;

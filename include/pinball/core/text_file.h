@@ -1,11 +1,17 @@
 #pragma once
 // The project's one way to read a whole text file (configuration, calibration,
-// overlay, randomization): its bytes, or an error naming the file.
+// overlay, randomization): its bytes, or an error naming the file; and to
+// write one whole (controller, overlay, calibration, shot values): a kill,
+// a full disk or a failed write never leaves half a file, nor harms the old one.
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 
 namespace pinball {
 
@@ -18,6 +24,29 @@ inline std::string read_text_file(const std::string& path) {
   s << in.rdbuf();
   if (in.bad()) throw std::runtime_error(path + ": cannot read");
   return s.str();
+}
+
+/// Writes `bytes` to `path` whole: to a temporary beside it, renamed over it
+/// once written and closed. Throws std::runtime_error "path: cannot write"
+/// (the old file, if any, is as it was).
+inline void write_text_file(const std::string& path, const std::string& bytes) {
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  std::error_code ec;
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << bytes;
+    out.close();
+    if (!out) {
+      std::filesystem::remove(tmp, ec);
+      throw std::runtime_error(path + ": cannot write");
+    }
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(path + ": cannot write (" + why + ")");
+  }
 }
 
 }  // namespace pinball

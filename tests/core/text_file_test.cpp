@@ -1,0 +1,67 @@
+// The one reader and writer of whole text files: a write is all or nothing.
+
+#include "pinball/core/text_file.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+namespace pinball {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_folder(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) / (name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Nothing but the files named: no temporary left beside them.
+std::size_t entries(const fs::path& dir) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++n;
+  return n;
+}
+
+TEST(TextFile, WritesWholeAndReadsBack) {
+  const fs::path dir = fresh_folder("text_file_write");
+  const std::string path = (dir / "a.json").string();
+  write_text_file(path, "first\n");
+  write_text_file(path, "second, longer\n");
+  EXPECT_EQ(read_text_file(path), "second, longer\n");
+  EXPECT_EQ(entries(dir), 1u);
+  fs::remove_all(dir);
+}
+
+TEST(TextFile, AWriteThatFailsLeavesTheOldFileAndNoTemporary) {
+  const fs::path dir = fresh_folder("text_file_fail");
+  // The rename fails: a folder stands where the file would go.
+  const fs::path folder = dir / "controller.json";
+  fs::create_directories(folder / "inside");
+  EXPECT_THROW(write_text_file(folder.string(), "x\n"), std::runtime_error);
+  EXPECT_TRUE(fs::is_directory(folder / "inside"));
+  EXPECT_EQ(entries(dir), 1u) << "the temporary was removed";
+  // The temporary cannot be created: its folder does not exist.
+  try {
+    write_text_file((dir / "nowhere" / "c.json").string(), "x\n");
+    ADD_FAILURE() << "a write into a missing folder succeeded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), (dir / "nowhere" / "c.json").string() + ": cannot write");
+  }
+  fs::remove_all(dir);
+}
+
+TEST(TextFile, ReadingAMissingFileNamesIt) {
+  try {
+    read_text_file("/nonexistent/pinball.yaml");
+    ADD_FAILURE() << "a missing file was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "/nonexistent/pinball.yaml: cannot open");
+  }
+}
+
+}  // namespace
+}  // namespace pinball
