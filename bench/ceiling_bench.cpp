@@ -132,11 +132,16 @@ CeilingPlayerReport run_player(const sim::World& world, const sim::ThesisStepper
       progress(format_progress(player_name(kind), d, share, "balls",
                                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
     }
-    return learn::BlobWriter().put(ball).take();
+    learn::BlobWriter w;
+    put_played_ball(w, ball);
+    w.put(ball.decisions).put(ball.branch_steps);
+    return w.take();
   });
   for (std::size_t i = 0; i < n; ++i) {
     learn::BlobReader r(blobs[i]);
-    balls[i] = r.get<CeilingBall>();
+    get_played_ball(r, balls[i]);
+    balls[i].decisions = r.get<int>();
+    balls[i].branch_steps = r.get<std::uint64_t>();
     r.expect_end();
   }
   const DrainZones zones = drain_zones(model.board());

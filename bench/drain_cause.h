@@ -15,6 +15,7 @@
 #include <limits>
 #include <string_view>
 
+#include "pinball/learn/blob.h"
 #include "pinball/sim/ball_runner.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/step_events.h"
@@ -116,6 +117,21 @@ struct PlayedBall {
   /// Seconds from the last flipper touch to that crossing (DrainWatch; NaN: none).
   double drain_after_flipper_s = 0.0;
 };
+
+/// A played ball as blob bytes, field by field (a struct's padding is no part
+/// of it), and back: what crosses between the benches' threads and ranks.
+inline void put_played_ball(learn::BlobWriter& w, const PlayedBall& b) {
+  w.put(b.score).put(b.duration_s).put(b.flips).put(b.cut).put(b.left_table).put(b.drain_x_m).put(b.drain_after_flipper_s);
+}
+inline void get_played_ball(learn::BlobReader& r, PlayedBall& b) {
+  b.score = r.get<double>();
+  b.duration_s = r.get<double>();
+  b.flips = r.get<int>();
+  b.cut = r.get<bool>();
+  b.left_table = r.get<bool>();
+  b.drain_x_m = r.get<double>();
+  b.drain_after_flipper_s = r.get<double>();
+}
 
 /// The ball `r` that `watch` saw.
 inline PlayedBall played_ball(const sim::BallResult& r, const DrainWatch& watch) {

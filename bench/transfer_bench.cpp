@@ -201,7 +201,10 @@ void play_world(PlannedWorld& w, const table::Board& belief, const TransferBench
                                         o.max_ball_time_s, ball_seed(o.seed, i % balls));
     b.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - ball_start).count();
     progress.ball_done(w.row.name);
-    return learn::BlobWriter().put(b).take();
+    learn::BlobWriter w;
+    put_played_ball(w, b);
+    w.put(b.wall_s);
+    return w.take();
   });
   w.row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const DrainZones zones = drain_zones(belief);
@@ -210,7 +213,9 @@ void play_world(PlannedWorld& w, const table::Board& belief, const TransferBench
     cell.controller = players[c].name;
     for (std::size_t i = 0; i < balls; ++i) {
       learn::BlobReader r(blobs[c * balls + i]);
-      const auto b = r.get<TransferBall>();
+      TransferBall b;
+      get_played_ball(r, b);
+      b.wall_s = r.get<double>();
       r.expect_end();
       cell.score.add(b.score);
       cell.duration_s.add(b.duration_s);

@@ -10,7 +10,10 @@
 namespace pinball::learn {
 namespace {
 
-constexpr const char* kHeader = "pinball checkpoint 1";
+// Format 2: a demonstration's shots field by field (format 1 wrote them with
+// the struct's padding, whatever the memory held).
+constexpr const char* kHeader = "pinball checkpoint 2";
+constexpr const char* kOldHeader = "pinball checkpoint 1";
 constexpr std::uint32_t kRecordMagic = 0x4B434250;  // "PBCK"
 
 struct Tape {
@@ -82,7 +85,12 @@ std::string open_on_root(const CheckpointOptions& o, Tape& tape) {
   std::ifstream in(o.path, std::ios::binary);
   std::string header;
   std::string fingerprint;
-  if (!std::getline(in, header) || header != kHeader) {
+  if (!std::getline(in, header)) header.clear();
+  if (header == kOldHeader) {
+    return "checkpoint " + o.path + " was written by an older build (format 1, this one writes 2): start the run "
+           "again without --resume";
+  }
+  if (header != kHeader) {
     return "checkpoint " + o.path + ": not a pinball checkpoint (its first line is not '" + kHeader + "')";
   }
   if (!std::getline(in, fingerprint)) return "checkpoint " + o.path + ": cut off in its header";

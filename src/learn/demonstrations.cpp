@@ -248,14 +248,32 @@ const TeacherWorlds::Place& TeacherWorlds::place_of(std::uint64_t ball_seed) con
 
 Blob to_blob(const DemonstrationBall& b) {
   BlobWriter w;
-  w.put_vector(b.shots).put(b.score).put(b.duration_s).put(b.cut).put(b.teacher_fires).put(b.unmatched_fires);
+  // A shot field by field: the struct's padding is no part of it.
+  w.put<std::uint64_t>(b.shots.size());
+  for (const control::ShotExample& e : b.shots) {
+    w.put(e.flipper).put(e.rolling).put(e.angle_rad).put(e.h).put(e.speed_mps).put(e.fired_flipper).put(e.d_fire_m)
+        .put(e.hold_s);
+  }
+  w.put(b.score).put(b.duration_s).put(b.cut).put(b.teacher_fires).put(b.unmatched_fires);
   return w.take();
 }
 
 DemonstrationBall demonstration_ball_from_blob(const Blob& blob) {
   BlobReader r(blob);
   DemonstrationBall b;
-  b.shots = r.get_vector<control::ShotExample>();
+  const auto shots = r.get<std::uint64_t>();
+  if (shots > blob.size()) throw std::runtime_error("blob: more shots than bytes");
+  b.shots.resize(static_cast<std::size_t>(shots));
+  for (control::ShotExample& e : b.shots) {
+    e.flipper = r.get<int>();
+    e.rolling = r.get<bool>();
+    e.angle_rad = r.get<double>();
+    e.h = r.get<double>();
+    e.speed_mps = r.get<double>();
+    e.fired_flipper = r.get<int>();
+    e.d_fire_m = r.get<double>();
+    e.hold_s = r.get<double>();
+  }
   b.score = r.get<double>();
   b.duration_s = r.get<double>();
   b.cut = r.get<bool>();

@@ -99,6 +99,10 @@ TEST(Checkpoint, RefusesWhatWouldLoseOrMixRuns) {
   close_checkpoint();
   { std::ofstream(path) << "not a checkpoint\n"; }
   EXPECT_THROW(open_checkpoint({path, true, "run C"}), std::runtime_error);
+  // Format 1 wrote a demonstration's shots with the struct's padding: said as such.
+  { std::ofstream(path) << "pinball checkpoint 1\nrun C\n"; }
+  const std::string old = refusal({path, true, "run C"});
+  EXPECT_NE(old.find("written by an older build (format 1, this one writes 2)"), std::string::npos) << old;
 }
 
 SearchResult cem(const std::string& checkpoint, bool resume) {

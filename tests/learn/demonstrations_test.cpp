@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <stdexcept>
 
@@ -35,6 +36,36 @@ void expect_sane(const control::ShotExample& e) {
   } else {
     EXPECT_EQ(e.hold_s, 0.0);
   }
+}
+
+// A ball's bytes are its values: a shot's padding (whatever the memory held)
+// made the same run write different checkpoints.
+TEST(Demonstrations, ABallsBytesAreItsValuesNotItsPadding) {
+  DemonstrationBall clean;
+  clean.shots = {{0, true, 0.25, 0.5, 1.5, 1, 0.03, 0.2}, {1, false, -0.1, 0.9, 2.0, -1, 0.0, 0.0}};
+  clean.score = 1234.5;
+  clean.teacher_fires = 3;
+  DemonstrationBall dirty = clean;
+  for (control::ShotExample& e : dirty.shots) {
+    const control::ShotExample value = e;
+    std::memset(static_cast<void*>(&e), 0xA5, sizeof e);  // padding as garbage, then the same fields
+    e.flipper = value.flipper;
+    e.rolling = value.rolling;
+    e.angle_rad = value.angle_rad;
+    e.h = value.h;
+    e.speed_mps = value.speed_mps;
+    e.fired_flipper = value.fired_flipper;
+    e.d_fire_m = value.d_fire_m;
+    e.hold_s = value.hold_s;
+  }
+  EXPECT_EQ(to_blob(dirty), to_blob(clean));
+  const DemonstrationBall back = demonstration_ball_from_blob(to_blob(clean));
+  ASSERT_EQ(back.shots.size(), 2u);
+  EXPECT_EQ(back.shots[1].fired_flipper, -1);
+  EXPECT_EQ(back.shots[0].rolling, true);
+  EXPECT_EQ(back.shots[0].hold_s, 0.2);
+  EXPECT_EQ(back.score, 1234.5);
+  EXPECT_EQ(back.teacher_fires, 3);
 }
 
 TEST(Demonstrations, TheTeachersShotsAreRecordedOnePerApproach) {

@@ -3,7 +3,9 @@
 // that results can cross between processes (MPI) and be kept in a checkpoint.
 // Values go in field by field as their own bytes: the reader on the same
 // build reads them back exactly (a checkpoint is for resuming on the machine
-// or cluster that wrote it, not an exchange format).
+// or cluster that wrote it, not an exchange format). Only types without
+// padding go in whole: a struct's padding holds whatever the memory held,
+// and the same run wrote different checkpoint bytes.
 
 #include <cstdint>
 #include <cstring>
@@ -16,20 +18,25 @@ namespace pinball::learn {
 /// One task's result as bytes.
 using Blob = std::vector<std::uint8_t>;
 
+/// A value whose every byte is its value: floating point (no padding, though
+/// two NaNs may differ) or what has a unique object representation.
+template <class T>
+inline constexpr bool kWholeValue = std::is_floating_point_v<T> || std::has_unique_object_representations_v<T>;
+
 /// Appends values to a blob.
 class BlobWriter {
  public:
-  /// Appends a trivially copyable value.
+  /// Appends a value with no padding bytes (a number, a bool, an array of them).
   template <class T>
   BlobWriter& put(const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>);
+    static_assert(kWholeValue<T>, "a struct's padding would be written: put its fields one by one");
     append(&value, sizeof(T));
     return *this;
   }
-  /// Appends a vector of trivially copyable values, its length first.
+  /// Appends a vector of values with no padding bytes, its length first.
   template <class T>
   BlobWriter& put_vector(const std::vector<T>& values) {
-    static_assert(std::is_trivially_copyable_v<T>);
+    static_assert(kWholeValue<T>, "a struct's padding would be written: put its fields one by one");
     put<std::uint64_t>(values.size());
     append(values.data(), values.size() * sizeof(T));
     return *this;
