@@ -86,7 +86,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_option("--eval-balls", a.eval_balls,
                   "evaluate the result on this many fresh balls (default: 0 after a search, 1000 otherwise)")
       ->check(finite_range(0, 10'000'000))
-      ->default_str("");  // 0: by method
+      ->default_str("");  // -1: by method
   cmd->add_option("--partitions", a.partitions, "k: impact-angle partitions per flipper (uniform)")
       ->check(finite_range(1, 64));
   cmd->add_flag("--partition-h", a.partition_by_h, "also partition by h (pivot-to-tip | tip-to-V-centre)");
@@ -389,6 +389,18 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     throw std::invalid_argument("learn: --out CONTROLLER is required for a search");
   }
   if (a.method == "evaluate" && a.controller.empty()) throw std::invalid_argument("learn: evaluate needs --controller FILE");
+  // Methods that only play: an option they would drop is refused, not ignored.
+  if (a.method == "evaluate" || a.method == "none" || a.method == "spastic") {
+    if (!a.out.empty()) {
+      throw std::invalid_argument("learn: --method " + a.method +
+                                  " writes no controller (--out is for tournament, relay, cem, imitate, launcher "
+                                  "and shot-values)");
+    }
+    if (a.eval_balls == 0) {
+      throw std::invalid_argument("learn: --eval-balls 0 leaves --method " + a.method +
+                                  " nothing to do: it plays fresh balls and reports them");
+    }
+  }
   const table::Board board = table::load_belief_board(a.board, a.identified);
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
   const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
@@ -584,7 +596,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     if (a.method == "spastic") return std::make_unique<control::SpasticController>();
     return std::make_unique<IdleController>();
   };
-  const int eval_balls = a.eval_balls > 0 ? a.eval_balls : (search ? 0 : 1000);
+  const int eval_balls = a.eval_balls >= 0 ? a.eval_balls : (search ? 0 : 1000);
   if (eval_balls > 0) {
     const Evaluation e = evaluate(objective.ev, a, eval_spec, make_controller, eval_balls);
     j["evaluation"] = to_json_value(e);

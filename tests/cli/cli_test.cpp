@@ -690,6 +690,22 @@ TEST_F(Cli, OutputsAreCheckedFirstAndARefusedRunWritesNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "v.avi"));
 }
 
+// A method that only plays refuses what it would drop: an --out it would not
+// write, and --eval-balls 0, which left it 1000 balls (0 read as not given).
+TEST_F(Cli, LearnMethodsThatOnlyPlayRefuseWhatTheyWouldDrop) {
+  const std::string out = (dir_ / "sp.json").string();
+  CommandResult r = run("learn boards/mit1993.board --method spastic --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--method spastic writes no controller"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = run("learn boards/mit1993.board --method none --eval-balls 0");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--eval-balls 0 leaves --method none nothing to do"), std::string::npos) << r.err;
+  r = run("learn boards/mit1993.board --method none --eval-balls 2 --threads 1 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("evaluation").at("balls").get<int>(), 2);
+}
+
 TEST_F(Cli, HelpShowsEveryDefault) {
   const CommandResult sim = run("sim --help");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
