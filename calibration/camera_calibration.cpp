@@ -12,6 +12,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/core/format.h"
+
 namespace pinball::calibration {
 namespace {
 
@@ -181,7 +183,7 @@ void check_marker_layout(std::span<const Vec2> p, double min_separation_m) {
     for (std::size_t j = i + 1; j < n; ++j) {
       if ((p[i] - p[j]).norm() < min_separation_m) {
         throw std::invalid_argument("marker layout: markers " + std::to_string(i) + " and " + std::to_string(j) +
-                                    " coincide (closer than " + std::to_string(min_separation_m) + " m)");
+                                    " coincide (closer than " + format_number(min_separation_m * 1e3) + " mm)");
       }
     }
   }

@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/core/format.h"
 #include "pinball/core/statistics.h"
 
 namespace pinball::calibration {
@@ -27,7 +28,7 @@ Vec2 nearest(std::span<const Vec2> points, const Vec2& target, double tolerance_
     }
   }
   if (!best) {
-    throw std::runtime_error("flipper calibration: no marker within " + std::to_string(tolerance_m * 1e3) +
+    throw std::runtime_error("flipper calibration: no marker within " + format_number(tolerance_m * 1e3) +
                              " mm of " + what);
   }
   return *best;
@@ -55,10 +56,10 @@ double flipper_angle(table::Side side, const Vec2& pivot, const Vec2& tip) {
 FlipperCalibration calibrate_flipper_markers(const table::Flipper& f, std::span<const Vec2> down, std::span<const Vec2> up,
                                              double tolerance_m) {
   const std::string name = "flipper '" + f.name + "'";
-  const Vec2 pivot_down = nearest(down, f.pivot, tolerance_m, name + "'s pivot (flippers down)");
-  const Vec2 tip_down = nearest(down, table::flipper_tip(f, f.theta_min_rad), tolerance_m, name + "'s tip (flippers down)");
-  const Vec2 pivot_up = nearest(up, f.pivot, tolerance_m, name + "'s pivot (flippers up)");
-  const Vec2 tip_up = nearest(up, table::flipper_tip(f, f.theta_max_rad), tolerance_m, name + "'s tip (flippers up)");
+  const Vec2 pivot_down = nearest(down, f.pivot, tolerance_m, "the pivot of " + name + " (flippers down)");
+  const Vec2 tip_down = nearest(down, table::flipper_tip(f, f.theta_min_rad), tolerance_m, "the tip of " + name + " (flippers down)");
+  const Vec2 pivot_up = nearest(up, f.pivot, tolerance_m, "the pivot of " + name + " (flippers up)");
+  const Vec2 tip_up = nearest(up, table::flipper_tip(f, f.theta_max_rad), tolerance_m, "the tip of " + name + " (flippers up)");
   FlipperCalibration c;
   c.name = f.name;
   c.side = f.side;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 
+#include "pinball/core/format.h"
 #include "pinball/core/statistics.h"
 
 namespace pinball::calibration {
@@ -90,7 +91,7 @@ RollFit fit_roll(const GravityRoll& roll, const GravityOptions& o) {
   std::size_t first = 0;
   while (first < n && (obs[first].p_board - rest).norm() < o.start_motion_m) ++first;
   if (n - first < min_points) {
-    f.why = "the ball never moved " + std::to_string(o.start_motion_m * 1e3) + " mm from where it started";
+    f.why = "the ball never moved " + format_number(o.start_motion_m * 1e3) + " mm from where it started";
     return f;
   }
   // Grow the parabola until two points in a row fall off it (the ball hit something).
