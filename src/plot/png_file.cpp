@@ -1,19 +1,32 @@
 #include "pinball/plot/png_file.h"
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <stdexcept>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
+
+#include "pinball/core/text_file.h"
 
 namespace pinball::plot {
 
 void write_png(const cv::Mat& image, const std::string& path) {
+  // PNG whatever the name would tell imwrite (r.jpg wrote a JPEG, a name
+  // without an extension OpenCV's raw error), and whole (core/text_file.h).
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext != ".png") throw std::runtime_error(path + ": a PNG is written; give the file name a .png extension");
+  std::vector<unsigned char> bytes;
   bool ok = false;
   try {
-    ok = !image.empty() && cv::imwrite(path, image);
+    ok = !image.empty() && cv::imencode(".png", image, bytes);
   } catch (const cv::Exception& e) {
-    throw std::runtime_error("write_png: cannot write '" + path + "': " + e.what());
+    throw std::runtime_error(path + ": cannot encode the PNG: " + e.what());
   }
-  if (!ok) throw std::runtime_error("write_png: cannot write '" + path + "'");
+  if (!ok) throw std::runtime_error(path + ": cannot encode the PNG");
+  write_text_file(path, std::string(bytes.begin(), bytes.end()));
 }
 
 cv::Mat read_gray_image(const std::string& path) {

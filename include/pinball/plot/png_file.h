@@ -10,7 +10,9 @@
 
 namespace pinball::plot {
 
-/// Writes an image as PNG. Throws std::runtime_error naming the path on failure.
+/// Writes an image as PNG, whole (a temporary renamed over the file). Throws
+/// std::runtime_error naming the path when it does not end in .png or the
+/// write fails.
 void write_png(const cv::Mat& image, const std::string& path);
 
 /// Reads an image file (PNG, or any format OpenCV decodes) as 8-bit gray.
