@@ -68,9 +68,9 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
                   "placements and balls")
       ->check(unsigned_64());
   cmd->add_flag("--quick", a.quick,
-                "tracker, detector, camera, calibration, latency, precision, ceiling, aim, cradle, transfer: a short run (fewer "
-                "approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one value per family; "
-                "cradle: 2 balls, 3 drops, 60 s)");
+                "tracker, detector, camera, calibration, latency, precision, ceiling, aim, cradle, transfer, protocol, draw: "
+                "a short run (fewer approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one "
+                "value per family; cradle: 2 balls, 3 drops, 60 s); --balls, when given, wins");
   cmd->add_option("--balls", a.balls,
                   "ceiling: balls per player; aim: ceiling balls whose fires are replayed; cradle: balls per drop "
                   "duration; transfer: balls per world and controller (the same ball seeds for every player)")
@@ -280,7 +280,7 @@ int run_precision(const BenchArgs& a, const table::Board& board, std::ostream& o
 
 int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::CeilingBenchOptions options = a.quick ? bench::quick_ceiling_bench_options() : bench::CeilingBenchOptions{};
-  if (!a.quick && a.balls > 0) options.balls = a.balls;
+  if (a.balls > 0) options.balls = a.balls;  // given, it wins over --quick's, as in cradle and transfer
   options.seed = a.seed;
   options.threads = a.threads;
   if (a.max_ball_time_s > 0.0) options.max_ball_time_s = a.max_ball_time_s;
@@ -382,7 +382,7 @@ int run_cradle(const BenchArgs& a, const table::Board& board, std::ostream& out,
 
 int run_aim(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::AimBenchOptions options;
-  options.balls = a.quick ? 3 : (a.balls > 0 ? a.balls : options.balls);
+  options.balls = a.balls > 0 ? a.balls : (a.quick ? 3 : options.balls);
   options.seed = a.seed;
   if (a.max_ball_time_s > 0.0) options.max_ball_time_s = a.max_ball_time_s;
   if (a.controllers.size() > 1) throw std::invalid_argument("bench aim: one --controller at most");
