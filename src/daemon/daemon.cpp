@@ -672,10 +672,12 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["clock"] = r.mode == "sim" ? (r.lockstep ? "lockstep" : "realtime") : "steady";
   j["identified"] = r.identified.empty() ? nlohmann::json() : nlohmann::json(r.identified);
   if (r.mode == "sim") {
-    // "stepper" names the world (thesis, event or twin), as before the twin.
-    j["world"] = {{"board", r.world_board},
-                  {"stepper", r.world},
-                  {"warnings", to_json_value(r.world_warnings)}};
+    // "stepper" names the world (thesis, event or twin), as before the twin;
+    // null when observations come from LCM and no world plays.
+    j["world"] = r.world.empty() ? nlohmann::json()
+                                 : nlohmann::json{{"board", r.world_board},
+                                                  {"stepper", r.world},
+                                                  {"warnings", to_json_value(r.world_warnings)}};
   }
   j["balls"] = r.balls;
   j["mean_score_per_ball"] = r.mean_score;
@@ -747,7 +749,9 @@ std::string report_to_text(const DaemonReport& r) {
       << " (95 %)  mean ball time " << format_number(r.mean_ball_time_s) << " s";
     if (r.cut_balls > 0) o << "  cut " << r.cut_balls;
     o << "\n";
-    if (r.world != "thesis") {
+    if (r.world.empty()) {
+      o << "world none: observations from LCM drive the tracker\n";
+    } else if (r.world != "thesis") {
       o << "world " << r.world << " on " << r.world_board << "  " << describe(r.world_warnings) << "\n";
     }
   }

@@ -389,6 +389,10 @@ TEST(Daemon, SimModeTakesObservationsFromLcm) {
   EXPECT_GE(r.driver.sessions, 1u);     // the virtual board answered Hello
   EXPECT_GT(r.driver.heartbeats, 0u);  // and the chain armed it (how often depends on the machine's load)
   EXPECT_TRUE(r.coils_off_at_exit);
+  // The report says that no world played, rather than a blank world line.
+  EXPECT_TRUE(report_to_json(r).at("world").is_null());
+  EXPECT_NE(report_to_text(r).find("world none: observations from LCM drive the tracker\n"), std::string::npos)
+      << report_to_text(r);
 }
 
 TEST(Daemon, ReadsACalibrationFile) {
