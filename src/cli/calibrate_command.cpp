@@ -377,6 +377,13 @@ void run_gravity(Context& c) {
   }
   c.err << "calibrate gravity: g = " << e.g_mps2 << " m/s^2, " << e.confidence * 100 << "% interval ["
         << e.ci_low_mps2 << ", " << e.ci_high_mps2 << "]\n";
+  if (e.rolls_used < 2) {
+    // Said, not refused: a first check of the rig may be one roll; the file is written all the same.
+    const std::string warning =
+        "one roll used: the interval is that roll's fit alone, not the spread between rolls (roll five or more)";
+    c.err << "calibrate gravity: warning: " << warning << "\n";
+    c.report["gravity"]["warning"] = warning;
+  }
   c.cal.gravity = e;
   if (!c.a.png.empty()) plot::write_png(calibration::draw_gravity_figure(rolls, g), c.a.png);
 }

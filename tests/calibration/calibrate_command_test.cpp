@@ -115,6 +115,19 @@ TEST_F(Calibrate, AnOutputThatCannotBeWrittenIsRefusedBeforeAnyWork) {
   EXPECT_FALSE(fs::exists(dir_ / "nowhere"));
 }
 
+// One roll gives a number and an interval from that roll's fit alone: said.
+TEST_F(Calibrate, GravityFromOneRollSaysItsIntervalIsThatRollsFit) {
+  Result r = run("calibrate gravity --sim boards/mit1993.board --sim-rolls 1 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("gravity").at("rolls_used"), 1);
+  EXPECT_NE(j.at("gravity").at("warning").get<std::string>().find("one roll used"), std::string::npos);
+  EXPECT_NE(r.err.find("warning: one roll used"), std::string::npos) << r.err;
+  r = run("calibrate gravity --sim boards/mit1993.board --sim-rolls 3 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(r.out).at("gravity").contains("warning"));
+}
+
 // A mounting error is there when asked for, and the calibration finds it.
 TEST_F(Calibrate, TheSimulatedMachineIsMountedOffOnlyWhenAsked) {
   const std::string file = (dir_ / "off.yaml").string();
