@@ -52,7 +52,11 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
   } else {
     out << "observations " << r.observations << "  recorded decisions " << r.recorded_commands << "  replayed "
         << r.replayed_commands << "  matched " << r.matched << "  malformed " << r.malformed << "\n";
-    if (r.observations == 0) {
+    if (r.observations == 0 && r.malformed > 0) {
+      out << "NOT reproduced: no PINBALL_OBSERVATION message decoded (" << r.malformed
+          << " malformed on PINBALL_OBSERVATION and PINBALL_FLIPPER_CMD: another message type on those channels, "
+             "or a log of another version)\n";
+    } else if (r.observations == 0) {
       out << "NOT reproduced: the log holds no PINBALL_OBSERVATION messages\n";
     } else if (r.reproduced) {
       out << "reproduced: every recorded decision came out again, in order\n";

@@ -255,6 +255,36 @@ TEST(Replay, PinballReplayExitsOneOnEachDamagedLog) {
   }
 }
 
+// A log whose observation channel carries another message type: the
+// command says that nothing decoded, not that the channel is missing.
+TEST(Replay, ALogOfAnotherTypeOnTheChannelIsSaidToBeMalformed) {
+  const std::string log = ::testing::TempDir() + "/pinball_replay_type_" + std::to_string(getpid()) + ".lcmlog";
+  {
+    lcm::LogFile out(log, "w");
+    pinball_lcm::lcmt_pinball_flipper_command m{};
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    for (int i = 0; i < 5; ++i) {
+      lcm::LogEvent e{};
+      e.eventnum = i;
+      e.timestamp = 1000 * i;
+      e.channel = bus::kObservationChannel;
+      e.datalen = static_cast<int32_t>(bytes.size());
+      e.data = bytes.data();
+      out.writeEvent(&e);
+    }
+  }
+  const std::string text_out = ::testing::TempDir() + "/pinball_replay_type_" + std::to_string(getpid()) + ".out";
+  const int status = std::system((std::string(PINBALL_EXE) + " replay " + log + " > " + text_out + " 2>&1").c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 3);
+  std::ifstream in(text_out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("NOT reproduced: no PINBALL_OBSERVATION message decoded (5 malformed"), std::string::npos) << text;
+  std::remove(log.c_str());
+  std::remove(text_out.c_str());
+}
+
 TEST(Replay, MissingLogIsNamed) {
   try {
     replay_log("/nonexistent/log.lcm", config_for_test());
