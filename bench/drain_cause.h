@@ -121,7 +121,8 @@ struct PlayedBall {
 /// A played ball as blob bytes, field by field (a struct's padding is no part
 /// of it), and back: what crosses between the benches' threads and ranks.
 inline void put_played_ball(learn::BlobWriter& w, const PlayedBall& b) {
-  w.put(b.score).put(b.duration_s).put(b.flips).put(b.cut).put(b.left_table).put(b.drain_x_m).put(b.drain_after_flipper_s);
+  w.put(b.score).put(b.duration_s).put(b.flips).put(b.cut).put(b.left_table);
+  w.put(b.drain_x_m).put(b.drain_after_flipper_s);
 }
 inline void get_played_ball(learn::BlobReader& r, PlayedBall& b) {
   b.score = r.get<double>();

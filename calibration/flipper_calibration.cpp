@@ -57,9 +57,11 @@ FlipperCalibration calibrate_flipper_markers(const table::Flipper& f, std::span<
                                              double tolerance_m) {
   const std::string name = "flipper '" + f.name + "'";
   const Vec2 pivot_down = nearest(down, f.pivot, tolerance_m, "the pivot of " + name + " (flippers down)");
-  const Vec2 tip_down = nearest(down, table::flipper_tip(f, f.theta_min_rad), tolerance_m, "the tip of " + name + " (flippers down)");
+  const Vec2 tip_down =
+      nearest(down, table::flipper_tip(f, f.theta_min_rad), tolerance_m, "the tip of " + name + " (flippers down)");
   const Vec2 pivot_up = nearest(up, f.pivot, tolerance_m, "the pivot of " + name + " (flippers up)");
-  const Vec2 tip_up = nearest(up, table::flipper_tip(f, f.theta_max_rad), tolerance_m, "the tip of " + name + " (flippers up)");
+  const Vec2 tip_up =
+      nearest(up, table::flipper_tip(f, f.theta_max_rad), tolerance_m, "the tip of " + name + " (flippers up)");
   FlipperCalibration c;
   c.name = f.name;
   c.side = f.side;

@@ -68,9 +68,9 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
                   "placements and balls")
       ->check(unsigned_64());
   cmd->add_flag("--quick", a.quick,
-                "tracker, detector, camera, calibration, latency, precision, ceiling, aim, cradle, transfer, protocol, draw: "
-                "a short run (fewer approaches, frames, roll sets, balls or settings; transfer: 5 balls per cell, one "
-                "value per family; cradle: 2 balls, 3 drops, 60 s); --balls, when given, wins");
+                "tracker, detector, camera, calibration, latency, precision, ceiling, aim, cradle, transfer, protocol, "
+                "draw: a short run (fewer approaches, frames, roll sets, balls or settings; transfer: 5 balls per "
+                "cell, one value per family; cradle: 2 balls, 3 drops, 60 s); --balls, when given, wins");
   cmd->add_option("--balls", a.balls,
                   "ceiling: balls per player; aim: ceiling balls whose fires are replayed; cradle: balls per drop "
                   "duration; transfer: balls per world and controller (the same ball seeds for every player)")

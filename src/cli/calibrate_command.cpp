@@ -115,7 +115,8 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->check(CLI::ExistingFile)
       ->default_str("");
   cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")->check(finite_range(1, 1000));
-  cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")->check(finite_range(1e-6, 0.1));
+  cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")
+      ->check(finite_range(1e-6, 0.1));
   cmd->add_option("--calibration", a.calibration, "calibration file holding the camera homography (default: --out)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", a.out, "calibration file to write, or update keeping its other sections");

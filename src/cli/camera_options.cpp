@@ -10,7 +10,8 @@ void add_camera_model_options(CLI::App& cmd, track::CameraModelConfig& camera) {
       ->check(finite_range(1e-5, 0.1));
   cmd.add_option("--noise-px", camera.noise_px, "camera model: centroid noise, standard deviation (px)")
       ->check(finite_range(0.0, 100.0));
-  cmd.add_option("--latency", camera.latency_s, "camera model: exposure to delivery (s)")->check(finite_range(0.0, 1.0));
+  cmd.add_option("--latency", camera.latency_s, "camera model: exposure to delivery (s)")
+      ->check(finite_range(0.0, 1.0));
   cmd.add_option("--drop", camera.drop_probability, "camera model: probability a frame is lost")
       ->check(finite_range(0.0, 0.99));
 }

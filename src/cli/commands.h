@@ -111,7 +111,7 @@ struct LearnArgs {
   int threads = 1;                      ///< worker threads (results do not depend on it)
   std::string curve;                    ///< learning curve CSV, or empty
   std::string plot;                     ///< learning curve PNG, or empty
-  int eval_balls = -1;                  ///< fresh balls to evaluate the result on (-1: by method, none after a search, 1000 otherwise)
+  int eval_balls = -1;  ///< fresh balls to evaluate the result on (-1: by method, 0 after a search, else 1000)
   int partitions = 4;                   ///< k angle partitions per flipper
   bool partition_by_h = false;          ///< also split by h (thesis 7.1)
   bool rolling = false;                 ///< separate rolling minicontrollers (thesis 7.1)

@@ -252,8 +252,10 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
       ->check(finite_range(0.0, 1e9));
   cmd->add_option("--quit-at", a.quit_at_s, "window: play until this time (s), write --snapshot, quit")
       ->check(finite_range(0.0, 1e9));
-  cmd->add_option("--speed", a.speed, "log playback speed (keys + and - change it)")->check(finite_range(1.0 / 64.0, 64.0));
-  cmd->add_option("--px-per-m", a.px_per_m, "scale of the table in pixels per metre")->check(finite_range(100.0, 4000.0));
+  cmd->add_option("--speed", a.speed, "log playback speed (keys + and - change it)")
+      ->check(finite_range(1.0 / 64.0, 64.0));
+  cmd->add_option("--px-per-m", a.px_per_m, "scale of the table in pixels per metre")
+      ->check(finite_range(100.0, 4000.0));
   cmd->add_option("--wait-s", a.wait_s, "live without a window: stop when nothing arrives for this long (s)")
       ->check(finite_range(0.1, 3600.0));
   cmd->add_flag("--json", a.json, "print one JSON object (what the view showed last)");

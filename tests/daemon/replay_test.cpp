@@ -280,7 +280,8 @@ TEST(Replay, ALogOfAnotherTypeOnTheChannelIsSaidToBeMalformed) {
   EXPECT_EQ(WEXITSTATUS(status), 3);
   std::ifstream in(text_out);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("NOT reproduced: no PINBALL_OBSERVATION message decoded (5 malformed"), std::string::npos) << text;
+  EXPECT_NE(text.find("NOT reproduced: no PINBALL_OBSERVATION message decoded (5 malformed"), std::string::npos)
+      << text;
   std::remove(log.c_str());
   std::remove(text_out.c_str());
 }

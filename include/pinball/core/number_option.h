@@ -74,7 +74,9 @@ inline CLI::Validator unsigned_64() {
         std::uint64_t v = 0;
         const char* end = text.data() + text.size();
         const auto [at, ec] = std::from_chars(text.data(), end, v);
-        if (ec == std::errc::result_out_of_range) return text + " does not fit in 64 bits (at most 18446744073709551615)";
+        if (ec == std::errc::result_out_of_range) {
+          return text + " does not fit in 64 bits (at most 18446744073709551615)";
+        }
         if (ec != std::errc() || at != end) return "'" + text + "' is not a whole number >= 0";
         return "";
       },
