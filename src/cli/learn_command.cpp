@@ -10,6 +10,7 @@
 #include <memory>
 #include <array>
 #include <atomic>
+#include <mutex>
 #include <ostream>
 #include <thread>
 #include <stdexcept>
@@ -169,23 +170,35 @@ struct Evaluation {
 
 // Plays `balls` fresh balls (seeds apart from any search's) with one controller.
 Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const control::ControllerSpec* spec,
-                    const std::function<std::unique_ptr<control::FlipperController>()>& make_controller, int balls) {
+                    const std::function<std::unique_ptr<control::FlipperController>()>& make_controller, int balls,
+                    std::ostream& err) {
   const auto start = std::chrono::steady_clock::now();
-  std::vector<learn::BallOutcome> out;
-  if (spec != nullptr) {
-    std::vector<learn::BallTask> tasks;
-    for (int i = 0; i < balls; ++i) {
-      tasks.push_back({spec, ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, static_cast<std::uint64_t>(i))});
-    }
-    out = learn::play_balls(ev, tasks, a.threads);
-  } else {  // a controller that is no action function (a baseline, the imitation table): one ball per task
-    const std::vector<learn::Blob> blobs =
-        learn::distributed_map(static_cast<std::size_t>(balls), a.threads, [&](std::size_t i) {
+  // Percent and ETA: a planner's thousand balls take minutes (this rank's share, under MPI).
+  ProgressMeter meter(progress_wanted(a.progress) ? &err : nullptr, "learn evaluation", balls, "balls",
+                      !a.progress && progress_wanted(false));
+  std::mutex meter_mutex;
+  std::atomic<int> done{0};
+  const auto ball_done = [&] {
+    const int d = ++done;
+    const std::lock_guard<std::mutex> lock(meter_mutex);
+    meter.update(d);
+  };
+  const std::vector<learn::Blob> blobs =
+      learn::distributed_map(static_cast<std::size_t>(balls), a.threads, [&](std::size_t i) {
+        const std::uint64_t seed = ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i);
+        learn::Blob blob;
+        if (spec != nullptr) {
+          blob = learn::to_blob(ev.play(*spec, seed));
+        } else {  // a controller that is no action function (a baseline, the imitation table)
           const std::unique_ptr<control::FlipperController> c = make_controller();
-          return learn::to_blob(ev.play_with(*c, a.pull, ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i)));
-        });
-    for (const learn::Blob& b : blobs) out.push_back(learn::ball_outcome_from_blob(b));
-  }
+          blob = learn::to_blob(ev.play_with(*c, a.pull, seed));
+        }
+        ball_done();
+        return blob;
+      });
+  std::vector<learn::BallOutcome> out;
+  out.reserve(blobs.size());
+  for (const learn::Blob& b : blobs) out.push_back(learn::ball_outcome_from_blob(b));
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   RunningStats score, duration_s, flips;
   Evaluation e;
@@ -598,7 +611,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   };
   const int eval_balls = a.eval_balls >= 0 ? a.eval_balls : (search ? 0 : 1000);
   if (eval_balls > 0) {
-    const Evaluation e = evaluate(objective.ev, a, eval_spec, make_controller, eval_balls);
+    const Evaluation e = evaluate(objective.ev, a, eval_spec, make_controller, eval_balls, err);
     j["evaluation"] = to_json_value(e);
     j["evaluation"]["camera_noise_px"] = a.camera.noise_px;
     j["evaluation"]["actuation_delay_s"] = a.actuation_delay_s;

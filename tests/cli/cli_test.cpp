@@ -701,9 +701,11 @@ TEST_F(Cli, LearnMethodsThatOnlyPlayRefuseWhatTheyWouldDrop) {
   r = run("learn boards/mit1993.board --method none --eval-balls 0");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("--eval-balls 0 leaves --method none nothing to do"), std::string::npos) << r.err;
-  r = run("learn boards/mit1993.board --method none --eval-balls 2 --threads 1 --json");
+  r = run("learn boards/mit1993.board --method none --eval-balls 2 --threads 1 --json --progress");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out).at("evaluation").at("balls").get<int>(), 2);
+  // The evaluation shows its progress (it printed none: a planner's takes minutes).
+  EXPECT_NE(r.err.find("learn evaluation: 2/2 balls (100 %)"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, HelpShowsEveryDefault) {
