@@ -36,6 +36,7 @@
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/number_option.h"
 #include "pinball/core/rng.h"
+#include "pinball/core/text_file.h"
 #include "pinball/firmware/can_link.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/socketcan_transport.h"
@@ -742,12 +743,7 @@ class Outputs {
     for (const auto& [path, tmp] : pending_) std::filesystem::remove(tmp);
   }
   void add(const std::string& path, const std::string& bytes) {
-    const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-    pending_.emplace_back(path, tmp);
-    std::ofstream f(tmp, std::ios::binary);
-    f << bytes;
-    f.close();
-    if (!f) throw std::runtime_error(path + ": cannot write");
+    pending_.emplace_back(path, write_temporary_beside(path, bytes));
   }
   void commit() {
     for (const auto& [path, tmp] : pending_) std::filesystem::rename(tmp, path);

@@ -26,44 +26,37 @@ inline std::string bound_text(double v) {
   return buf;
 }
 
+/// A check that `text` is a finite number for which `ok` holds; `rule` ends
+/// the message ("nan is not a finite number > 0") and is the help's text.
+template <class Ok>
+CLI::Validator finite_number(Ok ok, const std::string& rule) {
+  return CLI::Validator(
+      [ok, rule](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v)) return "'" + text + "' is not a number";
+        if (!std::isfinite(v) || !ok(v)) return text + " is not a finite number " + rule;
+        return "";
+      },
+      rule);
+}
+
 }  // namespace number_option_detail
 
 /// A finite number in [min, max]: "nan is not a finite number in [1, 1000]".
 inline CLI::Validator finite_range(double min, double max) {
-  const std::string range = "[" + number_option_detail::bound_text(min) + ", " +
-                            number_option_detail::bound_text(max) + "]";
-  return CLI::Validator(
-      [min, max, range](std::string& text) -> std::string {
-        double v = 0.0;
-        if (!CLI::detail::lexical_cast(text, v)) return "'" + text + "' is not a number";
-        if (!std::isfinite(v) || v < min || v > max) return text + " is not a finite number in " + range;
-        return "";
-      },
-      "in " + range);
+  return number_option_detail::finite_number([min, max](double v) { return v >= min && v <= max; },
+                                             "in [" + number_option_detail::bound_text(min) + ", " +
+                                                 number_option_detail::bound_text(max) + "]");
 }
 
 /// A finite number > 0 (for CLI::PositiveNumber).
 inline CLI::Validator finite_positive() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string {
-        double v = 0.0;
-        if (!CLI::detail::lexical_cast(text, v)) return "'" + text + "' is not a number";
-        if (!std::isfinite(v) || !(v > 0.0)) return text + " is not a finite number > 0";
-        return "";
-      },
-      "> 0");
+  return number_option_detail::finite_number([](double v) { return v > 0.0; }, "> 0");
 }
 
 /// A finite number >= 0 (for CLI::NonNegativeNumber).
 inline CLI::Validator finite_non_negative() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string {
-        double v = 0.0;
-        if (!CLI::detail::lexical_cast(text, v)) return "'" + text + "' is not a number";
-        if (!std::isfinite(v) || !(v >= 0.0)) return text + " is not a finite number >= 0";
-        return "";
-      },
-      ">= 0");
+  return number_option_detail::finite_number([](double v) { return v >= 0.0; }, ">= 0");
 }
 
 /// A whole number in [0, 2^64 - 1], written in decimal: a seed. Refuses "-1"

@@ -26,21 +26,28 @@ inline std::string read_text_file(const std::string& path) {
   return s.str();
 }
 
+/// Writes `bytes` to a temporary beside `path` and returns its name, for a
+/// rename over `path` once whole (write_text_file, or several files renamed
+/// together). Throws std::runtime_error "path: cannot write", leaving none.
+inline std::string write_temporary_beside(const std::string& path, const std::string& bytes) {
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  std::ofstream out(tmp, std::ios::binary);
+  out << bytes;
+  out.close();
+  if (!out) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(path + ": cannot write");
+  }
+  return tmp;
+}
+
 /// Writes `bytes` to `path` whole: to a temporary beside it, renamed over it
 /// once written and closed. Throws std::runtime_error "path: cannot write"
 /// (the old file, if any, is as it was).
 inline void write_text_file(const std::string& path, const std::string& bytes) {
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  const std::string tmp = write_temporary_beside(path, bytes);
   std::error_code ec;
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << bytes;
-    out.close();
-    if (!out) {
-      std::filesystem::remove(tmp, ec);
-      throw std::runtime_error(path + ": cannot write");
-    }
-  }
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     const std::string why = ec.message();
