@@ -17,7 +17,6 @@
 #include <sstream>
 #include <thread>
 
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
