@@ -17,7 +17,6 @@
 #include <sstream>
 #include <thread>
 
-
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
