@@ -201,10 +201,10 @@ void play_world(PlannedWorld& w, const table::Board& belief, const TransferBench
                                         o.max_ball_time_s, ball_seed(o.seed, i % balls));
     b.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - ball_start).count();
     progress.ball_done(w.row.name);
-    learn::BlobWriter w;
-    put_played_ball(w, b);
-    w.put(b.wall_s);
-    return w.take();
+    learn::BlobWriter out;
+    put_played_ball(out, b);
+    out.put(b.wall_s);
+    return out.take();
   });
   w.row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const DrainZones zones = drain_zones(belief);

@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
-#include <limits>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -74,10 +73,8 @@ int run_stats(const PlayArgs& a, std::ostream& out) {
       << "   Mean per ball (95 % interval)\n";
   for (const simlab::PlayerStats& s : stats) {
     const bool pooled = &s == &stats.back();
-    const std::string mean = std::isfinite(s.ci95_half_width) ? format_mean_ci(s.mean_score, s.ci95_half_width)
-                                                              : format_number(s.mean_score, 4) + " (one ball)";
     out << std::left << std::setw(20) << (pooled ? "all players" : s.player) << std::right << std::setw(14) << s.balls
-        << "   " << mean << "\n";
+        << "   " << format_mean_ci(s.mean_score, s.ci95_half_width, 4) << "\n";
   }
   out << "\nthesis 2.3: pooled human mean " << format_number(kThesisHumanMeanPerBall, 4)
       << " per ball on the 1993 table\n";
@@ -198,7 +195,7 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
                         {"balls", recorded},
                         {"ball_scores", balls},
                         {"mean_score_per_ball", score.mean()},
-                        {"score_ci95_half_width", recorded < 2 ? std::numeric_limits<double>::infinity() : score.ci95_half_width()},
+                        {"score_ci95_half_width", score.ci95_half_width()},
                         {"dt_s", world->dt_s()},
                         {"physics_hz", physics_hz},
                         {"simulated_s", session.time_s()},
@@ -217,10 +214,8 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
   out << "player           " << player << " (" << recorded << (recorded == 1 ? " ball" : " balls")
       << " appended to " << a.csv << ")\n";
   if (recorded > 0) {
-    out << "score per ball   "
-        << (recorded < 2 ? format_number(score.mean(), 6) + " (one ball)"
-                         : format_mean_ci(score.mean(), score.ci95_half_width()) + " (95 % interval)")
-        << ", max " << format_number(score.max(), 6) << "\n";
+    out << "score per ball   " << format_mean_ci(score.mean(), score.ci95_half_width()) << " (95 % interval), max "
+        << format_number(score.max(), 6) << "\n";
   }
   out << "physics          " << c.steps << " steps of " << format_number(world->dt_s() * 1e3) << " ms = "
       << format_number(session.time_s()) << " s simulated in " << format_number(wall_s) << " s wall, "

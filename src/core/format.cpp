@@ -42,6 +42,7 @@ std::string format_number(double x, int digits) {
 }
 
 std::string format_mean_ci(double mean, double half_width, int digits) {
+  if (!std::isfinite(half_width)) return format_number(mean, digits) + " ± ∞";
   if (!(half_width > 0.0)) return format_number(mean, digits) + " ± 0";
   const int d = decimals_for(half_width, 2);
   return fixed(mean, d) + " ± " + fixed(half_width, d);

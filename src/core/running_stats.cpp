@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace pinball {
 
@@ -40,7 +41,8 @@ void RunningStats::merge(const RunningStats& o) {
 double RunningStats::stddev() const { return std::sqrt(variance()); }
 
 double RunningStats::ci95_half_width() const {
-  if (n_ < 2) return 0.0;
+  // One sample says nothing of the spread: its interval is unbounded, not zero.
+  if (n_ < 2) return std::numeric_limits<double>::infinity();
   return student_t95(n_ - 1) * stddev() / std::sqrt(static_cast<double>(n_));
 }
 

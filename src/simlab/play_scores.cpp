@@ -6,7 +6,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string_view>
@@ -185,8 +184,7 @@ std::vector<PlayerStats> play_stats(const std::vector<PlayRow>& rows) {
     p.player = name;
     p.balls = s.count();
     p.mean_score = s.mean();
-    // One ball says nothing of the spread: its interval is unbounded, not zero.
-    p.ci95_half_width = s.count() < 2 ? std::numeric_limits<double>::infinity() : s.ci95_half_width();
+    p.ci95_half_width = s.ci95_half_width();  // infinite for one ball
     p.max_score = s.max();
     return p;
   };

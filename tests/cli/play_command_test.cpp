@@ -63,6 +63,8 @@ TEST_F(Play, AHeadlessScriptPlaysBallsAndEachGetsItsRow) {
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find("Number balls"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("all players"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find(" ± ∞\n"), std::string::npos) << "one ball bounds nothing:\n" << table.out;
+  EXPECT_EQ(table.out.find(" ± 0\n"), std::string::npos) << table.out;
 }
 
 TEST_F(Play, WithoutADisplayItSaysSoAndWritesNothing) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace pinball {
 namespace {
 
@@ -26,6 +28,8 @@ TEST(FormatMeanCi, RoundsTheMeanToItsIntervalsPlace) {
   EXPECT_EQ(format_mean_ci(1.2437, 0.3123), "1.24 ± 0.31");
   EXPECT_EQ(format_mean_ci(1.2437, 0.0031), "1.2437 ± 0.0031");
   EXPECT_EQ(format_mean_ci(812.5, 0.0), "812 ± 0");
+  // One sample bounds nothing: not a spread of zero.
+  EXPECT_EQ(format_mean_ci(812.4, std::numeric_limits<double>::infinity()), "812 ± ∞");
 }
 
 }  // namespace

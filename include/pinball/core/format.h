@@ -13,7 +13,8 @@ namespace pinball {
 std::string format_number(double x, int digits = 3);
 
 /// A mean and the half-width of its interval, both to the half-width's
-/// place at 2 significant digits, the mean to at least `digits` ("9193 ± 5430", "1.24 ± 0.31").
+/// place at 2 significant digits, the mean to at least `digits` ("9193 ± 5430", "1.24 ± 0.31");
+/// an infinite half-width (one sample: no bound) is "812 ± ∞".
 std::string format_mean_ci(double mean, double half_width, int digits = 3);
 
 }  // namespace pinball

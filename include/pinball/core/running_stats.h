@@ -23,7 +23,8 @@ class RunningStats {
   double variance() const { return n_ > 1 ? m2_ / static_cast<double>(n_ - 1) : 0.0; }
   /// Sample standard deviation.
   double stddev() const;
-  /// Half-width of the 95 % confidence interval of the mean (Student's t with n − 1 degrees of freedom).
+  /// Half-width of the 95 % confidence interval of the mean (Student's t with n − 1 degrees of freedom);
+  /// infinite with fewer than two samples (JSON writes it as null).
   double ci95_half_width() const;
   /// Smallest and largest sample (0 with no samples).
   double min() const { return min_; }
