@@ -314,8 +314,23 @@ HomographyFit fit_homography(std::span<const DetectedMarker> det, std::span<cons
                              " markers could be matched (" + std::to_string(nd) + " detected)");
   }
   if (!rival.empty()) {
-    throw std::runtime_error("camera calibration: the markers match the layout in more than one way (" +
-                             std::to_string(best_count) + " markers each); the layout is (nearly) symmetric");
+    // The same spots matched two ways is the layout's symmetry; other spots
+    // matched as well as the markers are something bright that is no marker.
+    const auto spots = [](const std::vector<int>& assignment) {
+      std::vector<int> s;
+      for (int d : assignment)
+        if (d >= 0) s.push_back(d);
+      std::sort(s.begin(), s.end());
+      return s;
+    };
+    const std::string count = std::to_string(best_count) + " markers each, " + std::to_string(nd) +
+                              " spots detected for " + std::to_string(m) + " markers";
+    if (spots(rival) != spots(best)) {
+      throw std::runtime_error("camera calibration: two sets of spots match the layout equally well (" + count +
+                               "); the spots that are no marker (reflections, lamps) need covering");
+    }
+    throw std::runtime_error("camera calibration: the markers match the layout in more than one way (" + count +
+                             "); the layout is (nearly) symmetric");
   }
 
   HomographyFit fit;

@@ -83,12 +83,42 @@ TEST(CameraCalibration, DegenerateLayoutsAreRefused) {
   EXPECT_NO_THROW(check_marker_layout(default_marker_layout(table())));
 }
 
-TEST(CameraCalibration, SymmetricLayoutIsAmbiguous) {
+// The message must name what to fix: the layout, or the spots that are no marker.
+std::string fit_error(const std::vector<DetectedMarker>& det, const std::vector<Vec2>& layout) {
+  try {
+    fit_homography(det, layout, cv::Size(640, 480));
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(CameraCalibration, SymmetricLayoutIsNamedAsTheCause) {
   const table::Board b = table();
   const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
   // A rectangle with its centre: a half turn maps it onto itself.
   const std::vector<Vec2> layout{{0.05, 0.05}, {0.45, 0.05}, {0.45, 1.0}, {0.05, 1.0}, {0.25, 0.525}};
-  EXPECT_THROW(fit_homography(seen(truth, layout, 0.0, 1), layout, cv::Size(640, 480)), std::runtime_error);
+  const std::string e = fit_error(seen(truth, layout, 0.0, 1), layout);
+  EXPECT_NE(e.find("the layout is (nearly) symmetric"), std::string::npos) << e;
+}
+
+TEST(CameraCalibration, StraySpotsThatMatchAsWellAreNamedNotTheLayout) {
+  const table::Board b = table();
+  const vision::CameraHomography truth = vision::CameraHomography::default_view(b, cv::Size(640, 480));
+  const std::vector<Vec2> layout = default_marker_layout(b);
+  // Five markers seen, and five reflections where a shifted camera would see them:
+  // two sets of spots, each a good view of five markers.
+  const cv::Matx33d shift(1, 0, 37.3, 0, 1, 21.9, 0, 0, 1);
+  const vision::CameraHomography ghost(shift * truth.image_from_board_matrix());
+  std::vector<DetectedMarker> det;
+  for (std::size_t i = 0; i < 5; ++i) {
+    det.push_back({truth.image_from_board(layout[i]), 50.0, 200.0});
+    det.push_back({ghost.image_from_board(layout[i]), 50.0, 200.0});
+  }
+  const std::string e = fit_error(det, layout);
+  EXPECT_NE(e.find("two sets of spots"), std::string::npos) << e;
+  EXPECT_NE(e.find("10 spots detected for 7 markers"), std::string::npos) << e;
+  EXPECT_EQ(e.find("symmetric"), std::string::npos) << e;
 }
 
 TEST(CameraCalibration, TooFewDetectionsIsAnError) {
