@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <filesystem>
-#include <fstream>
 #include <ostream>
 #include <stdexcept>
 #include <string_view>
@@ -14,6 +13,7 @@
 #include "pinball/core/format.h"
 #include "pinball/core/number_option.h"
 #include "pinball/core/progress.h"
+#include "pinball/core/text_file.h"
 #include "progress_option.h"
 #include "commands.h"
 #include "world_options.h"
@@ -260,16 +260,14 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
 }
 
 int run_precision(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
+  check_output_folder(a.csv, "--csv");
+  check_png_output(a.png, "--png");
   const bench::PrecisionBenchOptions options =
       a.quick ? bench::quick_precision_bench_options() : bench::default_precision_bench_options();
   const bench::PrecisionReport report = bench::run_precision_bench(
       board, options, [&](const std::string& line) { err << "bench precision: " << line << "\n"; });
-  if (!a.csv.empty()) {
-    std::ofstream f(a.csv);
-    f << bench::to_csv(report);
-    if (!f) throw std::runtime_error(a.csv + ": cannot write CSV");
-  }
   if (!a.png.empty()) bench::plot_precision_png(report, a.png);
+  if (!a.csv.empty()) write_text_file(a.csv, bench::to_csv(report));
   if (a.json) {
     out << bench::to_json(report).dump(2) << "\n";
   } else {
@@ -415,7 +413,7 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
         "--stepper and --dt do not apply");
   }
   check_output_folder(a.csv, "--csv");
-  check_output_folder(a.png, "--png");
+  check_png_output(a.png, "--png");
   bench::TransferBenchOptions options =
       a.quick ? bench::quick_transfer_bench_options() : bench::TransferBenchOptions{};
   if (a.balls > 0) options.balls = a.balls;
@@ -445,11 +443,7 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
       board, options, [&](const std::string& line) { err << "bench transfer: " << line << "\n"; });
   // The files only now, from a finished run.
   if (!a.png.empty()) bench::plot_transfer_png(report, a.png);
-  if (!a.csv.empty()) {
-    std::ofstream f(a.csv);
-    f << bench::to_csv(report);
-    if (!f) throw std::runtime_error(a.csv + ": cannot write CSV");
-  }
+  if (!a.csv.empty()) write_text_file(a.csv, bench::to_csv(report));
   if (a.json) {
     out << bench::to_json(report).dump(2) << "\n";
   } else {

@@ -892,8 +892,8 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
   // What is written at the end can be written: checked before any work, and
   // before `latency` fires a flipper in the lab.
   check_output_folder(a.out, "--out");
-  check_output_folder(a.png, "--png");
-  check_output_folder(a.print_target, "--print-target");
+  check_png_output(a.png, "--png");
+  check_png_output(a.print_target, "--print-target");
   if (a.kind == "intrinsics") return run_intrinsics(a, out, err);
   const std::string board_path = a.sim_board.empty() ? a.board : a.sim_board;
   if (board_path.empty()) throw std::runtime_error("calibrate: give --board BOARD (or --sim BOARD)");

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pinball/core/data_file_option.h"
+#include "pinball/plot/png_file.h"
 
 namespace pinball::cli {
 
@@ -23,6 +24,23 @@ inline void check_output_folder(const std::string& path, const char* option) {
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
   if (!folder.empty() && !std::filesystem::is_directory(folder))
     throw std::runtime_error(std::string(option) + " " + path + ": the folder " + folder.string() + " does not exist");
+}
+
+/// check_output_folder, and the writer's own check of the file's name
+/// (its extension), its error prefixed with the option.
+inline void check_named_output(const std::string& path, const char* option, void (*check_name)(const std::string&)) {
+  check_output_folder(path, option);
+  if (path.empty()) return;
+  try {
+    check_name(path);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(std::string(option) + " " + e.what());
+  }
+}
+
+/// A picture: "OPTION PATH: a PNG is written; give the file name a .png extension".
+inline void check_png_output(const std::string& path, const char* option) {
+  check_named_output(path, option, plot::check_png_name);
 }
 
 }  // namespace pinball::cli

@@ -387,7 +387,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   // What is written at the end can be written: a typo must not cost an hour's search.
   check_output_folder(args.out, "--out");
   check_output_folder(args.curve, "--curve");
-  check_output_folder(args.plot, "--plot");
+  check_png_output(args.plot, "--plot");
   LearnArgs a = args;
   a.actuation_delay_s = world_actuation_delay_s(
       args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,
@@ -510,6 +510,13 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
       learn::CrossEntropyConfig cc;
       if (a.population > 0) cc.population = a.population;
       r = learn::run_cross_entropy(objective, sc, cc);
+    }
+    if (r.generations == 0) {
+      // The seed search alone spent the budget: the "best" is an untrained prototype.
+      throw std::runtime_error("learn: --budget-balls " + std::to_string(a.budget_balls) + " ran out before the first " +
+                               a.method + " generation (" + std::to_string(r.balls_used) +
+                               " balls played; a generation needs " + std::to_string(r.generation_balls) +
+                               " left after the seed search); no controller written");
     }
     result_spec = r.best;
     result_spec.note = "pinball learn " + belief_args + " --method " + a.method + " --budget-balls " +

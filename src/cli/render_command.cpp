@@ -27,6 +27,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& a) {
 }
 
 int run_render(const RenderArgs& a, std::ostream& out, std::ostream&) {
+  check_png_output(a.out, "--out");
   const table::Board board = table::load_board(a.board);
   sim::RenderOptions options;
   options.px_per_m = a.px_per_m;

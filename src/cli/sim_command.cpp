@@ -75,6 +75,8 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
 }
 
 int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
+  check_output_folder(a.trace, "--trace");
+  check_named_output(a.video, "--video", sim::check_avi_name);
   const table::Board board = table::load_belief_board(a.board, a.identified);
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
   const simlab::OwnedWorld world = simlab::make_world(world_spec, board);
@@ -105,7 +107,6 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   }
   // The recordings are opened once every input has loaded: a bad controller leaves no file behind.
   std::optional<TraceWriter> trace;
-  if (!a.trace.empty()) trace.emplace(a.trace);
   std::unique_ptr<sim::VideoRecorder> video;
   sim::RenderOptions render_options;
   double next_frame_s = 0.0;
@@ -122,6 +123,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   } else if (!a.video.empty()) {
     video = std::make_unique<sim::VideoRecorder>(a.video, a.video_fps, sim::render_size(world_board, render_options));
   }
+  if (!a.trace.empty()) trace.emplace(a.trace);  // after the video, whose open can still fail
 
   std::optional<simlab::CanFlipperDrive> can_drive;
   // One actuation model everywhere: commands reach the flippers actuation_delay_s later, through the

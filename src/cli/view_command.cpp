@@ -263,7 +263,7 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
 }
 
 int run_view(const ViewArgs& a, std::ostream& out, std::ostream& err) {
-  check_output_folder(a.snapshot, "--snapshot");
+  check_png_output(a.snapshot, "--snapshot");
   const bool window = a.snapshot.empty() || a.quit_at_s >= 0.0;
   if (window && !has_display()) {
     throw std::runtime_error(

@@ -126,6 +126,7 @@ SearchResult run_cross_entropy(const BallObjective& objective, const SearchConfi
   const std::size_t elites = std::max<std::size_t>(2, static_cast<std::size_t>(std::lround(c.elite_fraction * c.population)));
   const auto final_race_budget =
       static_cast<std::uint64_t>(c.final_race_fraction * static_cast<double>(config.budget_balls));
+  run.set_generation_balls(per_generation + final_race_budget);
   std::vector<control::ControllerSpec> winners;  // the latest generations' winners, oldest first
   while (run.balls_left() >= per_generation + final_race_budget) {
     // Sample the population; the incumbent (best so far) is candidate 0.

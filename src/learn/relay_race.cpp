@@ -39,6 +39,7 @@ SearchResult run_relay_race(const BallObjective& objective, const SearchConfig& 
 
   int generation = 0;
   const std::uint64_t eval_balls = static_cast<std::uint64_t>(r.eval_balls);
+  run.set_generation_balls(n + eval_balls);
   while (run.balls_left() >= n + eval_balls) {
     ++generation;
     // 2(a): every controller plays one ball; flip opportunities update its minicontrollers' statistics.

@@ -12,6 +12,7 @@ SearchResult run_tournament(const BallObjective& objective, const SearchConfig& 
   const int k = parent.action_function.partitions();
   const std::uint64_t b = static_cast<std::uint64_t>(t.balls_per_controller);
   const std::uint64_t per_generation = static_cast<std::uint64_t>(k + 1) * b;
+  run.set_generation_balls(per_generation);
   while (run.balls_left() >= per_generation) {
     // 2(a): child i = the parent with minicontroller i replaced by a random one (eq. 6.1).
     std::vector<control::ControllerSpec> family(static_cast<std::size_t>(k + 1), parent);

@@ -12,12 +12,16 @@
 
 namespace pinball::plot {
 
-void write_png(const cv::Mat& image, const std::string& path) {
-  // PNG whatever the name would tell imwrite (r.jpg wrote a JPEG, a name
-  // without an extension OpenCV's raw error), and whole (core/text_file.h).
+void check_png_name(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   if (ext != ".png") throw std::runtime_error(path + ": a PNG is written; give the file name a .png extension");
+}
+
+void write_png(const cv::Mat& image, const std::string& path) {
+  // PNG whatever the name would tell imwrite (r.jpg wrote a JPEG, a name
+  // without an extension OpenCV's raw error), and whole (core/text_file.h).
+  check_png_name(path);
   std::vector<unsigned char> bytes;
   bool ok = false;
   try {

@@ -1,9 +1,18 @@
 #include "pinball/sim/video_recorder.h"
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
 namespace pinball::sim {
+
+void check_avi_name(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext != ".avi") throw std::runtime_error(path + ": an MJPG AVI is written; give the file name an .avi extension");
+}
 
 VideoRecorder::VideoRecorder(const std::string& path, double fps, cv::Size frame_size)
     : path_(path), size_(frame_size) {
@@ -13,15 +22,16 @@ VideoRecorder::VideoRecorder(const std::string& path, double fps, cv::Size frame
         << frame_size.width << " x " << frame_size.height;
     throw std::invalid_argument(msg.str());
   }
+  check_avi_name(path_);
   try {
     // OpenCV's own MJPEG writer: always built in, and unlike FFmpeg's it keeps
     // odd frame sizes (render_size often gives one) instead of cropping them.
     writer_.open(path_, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, size_,
                  /*isColor=*/true);
   } catch (const cv::Exception& e) {
-    throw std::runtime_error("VideoRecorder: cannot open '" + path_ + "': " + e.what());
+    throw std::runtime_error(path_ + ": cannot open the video for writing: " + e.what());
   }
-  if (!writer_.isOpened()) throw std::runtime_error("VideoRecorder: cannot open '" + path_ + "' for writing");
+  if (!writer_.isOpened()) throw std::runtime_error(path_ + ": cannot open the video for writing");
 }
 
 void VideoRecorder::write(const cv::Mat& frame_bgr) {

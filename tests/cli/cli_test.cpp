@@ -680,6 +680,23 @@ TEST_F(Cli, OutputsAreCheckedFirstAndARefusedRunWritesNothing) {
     EXPECT_EQ(r.err.find("tournament"), std::string::npos) << "no search ran: " << r.err;
   }
   EXPECT_FALSE(fs::exists(dir_ / "c.json"));
+  // A picture's name is checked with its folder, before the work.
+  const CommandResult jpg = run("learn boards/mit1993.board --method tournament --budget-balls 100 --threads 1 --out " +
+                                (dir_ / "c.json").string() + " --plot " + (dir_ / "curve.jpg").string());
+  EXPECT_EQ(jpg.exit_code, 1);
+  EXPECT_NE(jpg.err.find("--plot " + (dir_ / "curve.jpg").string() + ": a PNG is written"), std::string::npos) << jpg.err;
+  EXPECT_FALSE(fs::exists(dir_ / "c.json"));
+  const CommandResult precision = run("bench precision --quick --csv " + (dir_ / "p.csv").string() + " --png " +
+                                      nowhere + "/p.png");
+  EXPECT_EQ(precision.exit_code, 1);
+  EXPECT_NE(precision.err.find("--png " + nowhere + "/p.png: the folder"), std::string::npos) << precision.err;
+  EXPECT_FALSE(fs::exists(dir_ / "p.csv"));
+  const CommandResult video = run("sim boards/mit1993.board --balls 1 --trace " + (dir_ / "t.csv").string() +
+                                  " --video " + (dir_ / "v.txt").string());
+  EXPECT_EQ(video.exit_code, 1);
+  EXPECT_NE(video.err.find("--video " + (dir_ / "v.txt").string() + ": an MJPG AVI is written"), std::string::npos)
+      << video.err;
+  EXPECT_FALSE(fs::exists(dir_ / "t.csv"));
   const fs::path empty = dir_ / "empty.json";
   std::ofstream(empty) << "{}\n";
   const CommandResult sim = run("sim boards/mit1993.board --balls 1 --controller " + empty.string() + " --trace " +
@@ -688,6 +705,17 @@ TEST_F(Cli, OutputsAreCheckedFirstAndARefusedRunWritesNothing) {
   EXPECT_NE(sim.err.find("format: missing"), std::string::npos) << sim.err;
   EXPECT_FALSE(fs::exists(dir_ / "t.csv"));
   EXPECT_FALSE(fs::exists(dir_ / "v.avi"));
+}
+
+// A budget the seed search spends whole leaves no generation: refused, not an
+// untrained controller written as if learned.
+TEST_F(Cli, LearnWithABudgetTooSmallForOneGenerationWritesNothing) {
+  const std::string out = (dir_ / "small.json").string();
+  const CommandResult r = run("learn boards/mit1993.board --method cem --budget-balls 40 --threads 1 --out " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("learn: --budget-balls 40 ran out before the first cem generation"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("a generation needs "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 // A method that only plays refuses what it would drop: an --out it would not

@@ -138,6 +138,17 @@ TEST_F(VideoRecorderTest, UnopenablePathThrowsNamingIt) {
   }
 }
 
+TEST_F(VideoRecorderTest, ANameThatIsNoAviIsRefusedByName) {
+  const std::string file = path("out.txt");
+  try {
+    VideoRecorder rec(file, 25.0, cv::Size{64, 48});
+    FAIL() << "VideoRecorder opened " << file;
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), file + ": an MJPG AVI is written; give the file name an .avi extension");
+  }
+  EXPECT_NO_THROW(check_avi_name("x/Play.AVI"));
+}
+
 TEST_F(VideoRecorderTest, RejectsBadFpsAndSize) {
   EXPECT_THROW(VideoRecorder(path("a.avi"), 0.0, cv::Size{64, 48}), std::invalid_argument);
   EXPECT_THROW(VideoRecorder(path("b.avi"), 25.0, cv::Size{0, 48}), std::invalid_argument);

@@ -50,6 +50,7 @@ struct SearchResult {
   std::vector<CurvePoint> curve;        ///< per generation
   std::uint64_t balls_used = 0;         ///< balls played
   int generations = 0;                  ///< generations completed
+  std::uint64_t generation_balls = 0;   ///< balls the budget must still hold to start a generation
   bool cycle_found = false;             ///< some ball was cut at the time limit
   control::ControllerSpec cycle_controller;  ///< the first controller that cycled
   double wall_s = 0.0;                  ///< wall time (s)
@@ -80,6 +81,8 @@ class SearchRun {
   /// Closes a generation: a curve row and a progress line. `population_ci95`:
   /// half-width of the population mean's 95 % interval (0 when unknown).
   void end_generation(double population_mean, double generation_best, double population_ci95 = 0.0);
+  /// Records what a generation needs of the budget (for the report of a budget too small).
+  void set_generation_balls(std::uint64_t balls) { result_.generation_balls = balls; }
   /// Adds a method-specific counter.
   void count(const std::string& name, double value);
   /// The best estimated mean so far (0 before any).

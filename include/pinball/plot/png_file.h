@@ -10,6 +10,11 @@
 
 namespace pinball::plot {
 
+/// Throws std::runtime_error "PATH: a PNG is written; give the file name a
+/// .png extension" unless `path` ends in .png (any case): what write_png
+/// writes, so that a command can check its outputs before its work.
+void check_png_name(const std::string& path);
+
 /// Writes an image as PNG, whole (a temporary renamed over the file). Throws
 /// std::runtime_error naming the path when it does not end in .png or the
 /// write fails.

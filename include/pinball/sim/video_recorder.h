@@ -8,6 +8,11 @@
 
 namespace pinball::sim {
 
+/// Throws std::runtime_error "PATH: an MJPG AVI is written; give the file
+/// name an .avi extension" unless `path` ends in .avi (any case): OpenCV's
+/// MJPEG writer opens nothing else.
+void check_avi_name(const std::string& path);
+
 /// An open AVI file receiving frames of one fixed size.
 class VideoRecorder {
  public:
