@@ -6,10 +6,12 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "pinball/core/data_file_option.h"
 #include "pinball/core/number_option.h"
@@ -44,6 +46,23 @@ void install(int sig, void (*handler)(int)) {
   sa.sa_handler = handler;
   sigemptyset(&sa.sa_mask);
   sigaction(sig, &sa, nullptr);
+}
+
+// True when `flag` is one of the arguments: read where the parse failed before setting it.
+bool given(int argc, char** argv, const char* flag) {
+  for (int i = 1; i < argc; ++i)
+    if (std::strcmp(argv[i], flag) == 0) return true;
+  return false;
+}
+
+// The thread table for a script: {"threads": [{name, fifo_priority, ...}, ...]}.
+nlohmann::json thread_table_json() {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const pinball::daemon::ThreadSpec& t : pinball::daemon::kThreadTable) {
+    rows.push_back({{"name", t.name}, {"fifo_priority", t.fifo_priority}, {"nice", t.nice}, {"chain", t.chain},
+                    {"cpu", t.cpu}, {"period", t.period}, {"job", t.job}});
+  }
+  return {{"threads", rows}};
 }
 
 }  // namespace
@@ -111,11 +130,26 @@ int main(int argc, char** argv) {
                "nothing is opened or fired)");
   try {
     app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << app.help();
+    return 0;
+  } catch (const CLI::CallForVersion& e) {
+    std::cout << e.what() << "\n";
+    return 0;
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    // One line, as `pinball` says it; and --check --json still answers with one object.
+    std::fprintf(stderr, "pinballd: %s (try --help)\n", e.what());
+    if (given(argc, argv, "--check") && given(argc, argv, "--json")) {
+      std::cout << config_check_failure_to_json(e.what()).dump(2) << std::endl;
+    }
+    return 2;
   }
   if (threads) {
-    std::fputs(thread_table_markdown().c_str(), stdout);
+    if (json) {
+      std::cout << thread_table_json().dump(2) << std::endl;
+    } else {
+      std::fputs(thread_table_markdown().c_str(), stdout);
+    }
     return 0;
   }
   std::set_terminate(on_terminate);

@@ -32,6 +32,7 @@
 #include "pinball/control/controller_file.h"
 #include "pinball/core/clock.h"
 #include "pinball/core/running_stats.h"
+#include "pinball/daemon/thread_table.h"
 #include "pinball/firmware/frame_log.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/table/board_loader.h"
@@ -666,6 +667,29 @@ TEST(Pinballd, VersionNamesTheProgramAndItsVersion) {
   std::string text;
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --version", text), 0);
   EXPECT_EQ(text.rfind("pinballd 0.", 0), 0u) << text;
+}
+
+// A bad argument is one line naming the program, as `pinball` says it; --check
+// --json answers with one object even when the command line itself is wrong.
+TEST(Pinballd, BadArgumentsAreOneLineAndCheckJsonStillAnswers) {
+  std::string text;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --frobnicate 2>&1", text), 2);
+  EXPECT_EQ(text, "pinballd: The following argument was not expected: --frobnicate (try --help)\n");
+  std::string out;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --json --controller /nonexistent/c.json 2>/dev/null", out),
+            2);
+  const nlohmann::json j = nlohmann::json::parse(out);
+  EXPECT_FALSE(j.at("ok").get<bool>());
+  EXPECT_NE(j.at("error").get<std::string>().find("/nonexistent/c.json"), std::string::npos) << out;
+}
+
+TEST(Pinballd, TheThreadTableAsJson) {
+  std::string out;
+  ASSERT_EQ(run_shell(std::string(PINBALLD_EXE) + " --threads --json", out), 0);
+  const nlohmann::json j = nlohmann::json::parse(out);
+  ASSERT_EQ(j.at("threads").size(), kThreadTable.size());
+  EXPECT_EQ(j.at("threads")[0].at("name"), kThreadTable[0].name);
+  EXPECT_EQ(j.at("threads")[0].at("fifo_priority"), kThreadTable[0].fifo_priority);
 }
 
 TEST(Pinballd, BadConfigExitsOneNamingTheKey) {
