@@ -117,7 +117,7 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")
       ->check(finite_range(1e-6, 0.1));
   cmd->add_option("--calibration", a.calibration, "calibration file holding the camera homography (default: --out)")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   cmd->add_option("--out", a.out, "calibration file to write, or update keeping its other sections");
   cmd->add_option("--png", a.png, "picture of the detected markers, fitted circles or gravity fit");
   cmd->add_option("--seed", a.seed, "--sim: seed of the simulated lab")

@@ -58,11 +58,11 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
                   "searches and imitate (teacher and learner): play each ball in a world drawn from this file's ranges (g, wall "
                   "rho, flipper mu, pivots, delay, camera latency and noise, stepper) while the controller believes "
                   "the board (docs/learning.md); the final evaluation plays the board itself")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   cmd->add_option("--shot-values", a.shot_values,
                   "imitate: the teacher values each plan at its shot by this table of what shots are worth "
                   "(learn/shot_values.h, docs/learning.md) rather than by the branch played past it")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   cmd->add_option("--drain-penalty", a.drain_penalty,
                   "imitate (its teacher) and shot-values (its player, and so the table's values): the points a plan "
                   "loses when the ball drains in it")

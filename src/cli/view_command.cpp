@@ -46,13 +46,14 @@ bool has_display() {
 view::ViewScene scene_for(const ViewArgs& a) {
   daemon::DaemonConfig config;
   if (!a.config.empty()) config = daemon::load_daemon_config(a.config);
+  daemon::find_data_files(config);  // the defaults name the shipped data from any folder, as pinballd's do
   std::string board = config.mode == "lab" ? config.board : config.sim.board;
   std::string calibration = config.calibration;
   std::string controller = a.config.empty() ? std::string() : config.controller;
   if (!a.board.empty()) board = a.board;
   if (!a.calibration.empty()) calibration = a.calibration;
   if (!a.controller.empty()) controller = a.controller;
-  return view::load_view_scene(find_data_file(board), calibration, controller, a.px_per_m);
+  return view::load_view_scene(board, calibration, controller, a.px_per_m);
 }
 
 std::string live_url(const ViewArgs& a) {
@@ -243,7 +244,7 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
   cmd->add_option("--board", a.board, "board file (default: the configuration's, boards/mit1993.board)")
       ->transform(data_file());
   cmd->add_option("--calibration", a.calibration, "calibration file: flipper geometry and g (default: the configuration's)")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
   cmd->add_option("--controller", a.controller, "controller file, for d_critical (default: the configuration's, else none)")
       ->transform(data_file());
   cmd->add_option("--snapshot", a.snapshot,

@@ -46,7 +46,7 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
 void add_identified_option(CLI::App& cmd, std::string& identified) {
   cmd.add_option("--identified", identified,
                  "identified parameters laid over the belief board (`pinball identify`, docs/identification.md)")
-      ->check(CLI::ExistingFile);
+      ->transform(data_file());
 }
 
 double world_actuation_delay_s(std::optional<double> given_s, const simlab::WorldSpec& world,

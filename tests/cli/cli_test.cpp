@@ -761,6 +761,13 @@ TEST_F(Cli, FindsTheShippedBoardsAndControllersFromAnyFolder) {
   EXPECT_EQ(fs::path(j.at("controller").get<std::string>()), fs::path(PINBALL_SOURCE_DIR) / "controllers/best.json");
   // bench's default --board too.
   EXPECT_EQ(run_in(dir_, "bench ceiling --balls 1 --max-ball-time 2 --threads 1 --json").exit_code, 0);
+  // The shipped overlay and randomization files too.
+  const CommandResult overlay = run_in(dir_, "sim boards/mit1993.board --identified config/twin.identified.yaml "
+                                             "--balls 1 --max-ball-time 2");
+  EXPECT_EQ(overlay.exit_code, 0) << overlay.err;
+  // (found: the refusal is the method's, after the parse)
+  const CommandResult drawn = run_in(dir_, "learn boards/mit1993.board --method spastic --randomize config/randomize.yaml");
+  EXPECT_NE(drawn.err.find("--randomize is for a search"), std::string::npos) << drawn.err;
   // A board found nowhere is still refused, naming what was typed.
   const CommandResult missing = run_in(dir_, "sim boards/no_such.board");
   EXPECT_EQ(missing.exit_code, 2);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -43,6 +45,17 @@ TEST_F(ViewCommand, SnapshotOfALogShowsTheBallWhereTheLogSaysItWas) {
   const cv::Point2d c = ball_in(png);
   EXPECT_NEAR(c.x, j["ball"]["u_px"].get<double>(), 1.0);
   EXPECT_NEAR(c.y, j["ball"]["v_px"].get<double>(), 1.0);
+}
+
+// A configuration that keeps pinballd's default controller names the shipped
+// file, found from any folder as pinballd finds it.
+TEST_F(ViewCommand, AConfigurationsDefaultFilesAreFoundFromAnyFolder) {
+  const std::string config = (dir_ / "m.yaml").string();
+  std::ofstream(config) << "lcm_url: \"memq://\"\n";
+  const std::string png = (dir_ / "cfg.png").string();
+  const CommandResult r = run_shell("cd " + dir_.string() + " && env -u DISPLAY -u WAYLAND_DISPLAY " PINBALL_EXE
+                                    " view " + log_ + " --config m.yaml --snapshot " + png + " --at 0.1");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
 TEST_F(ViewCommand, SnapshotOfALiveSourceThroughLiblcm) {
