@@ -75,8 +75,8 @@ std::string to_text(const CeilingReport& r) {
       << (r.world == "twin" ? std::string("the MuJoCo twin") : "the " + r.world + " stepper") << "): " << o.balls << " balls per player (seed " << o.seed
       << "), cut at " << format_number(o.max_ball_time_s) << " s, actuation delay "
       << format_number(o.actuation_delay_s * 1e3) << " ms\n"
-      << "the ceiling player CHEATS (true state, lookahead with the true simulator): a reference, not a "
-         "controller\n";
+      << "the ceiling player CHEATS (the world's true state, lookahead in the belief's model, which is the "
+         "world itself only in the model world): a reference, not a controller\n";
   std::vector<const CeilingPlayerReport*> players = {&r.ceiling, &r.spastic, &r.no_flipping, &r.tracker_spastic};
   if (r.controller) players.push_back(&*r.controller);
   if (r.controller_true_state) players.push_back(&*r.controller_true_state);

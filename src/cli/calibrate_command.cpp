@@ -145,6 +145,7 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--sim-latency-ms", a.sim_latency_ms,
                   "latency --sim: the simulated camera's minimum latency (ms; default: the typical camera's 7)")
       ->check(finite_range(0.0, 100.0))
+      ->default_str("")  // -1: the typical camera's
       ->needs(sim);
   cmd->add_option("--actuation-delay-ms", a.actuation_delay_ms,
                   "latency: the host's command to the flipper's first motion (ms)")
@@ -152,11 +153,13 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--row-time-us", a.row_time_us,
                   "latency: rolling shutter row time (us; 0: global shutter; default: the simulated camera's, "
                   "or the file's camera_timing)")
-      ->check(finite_range(0.0, 1000.0));
+      ->check(finite_range(0.0, 1000.0))
+      ->default_str("");  // -1: the simulated camera's or the file's
   cmd->add_option("--exposure-us", a.exposure_us,
                   "latency: the camera's fixed exposure time (us), set on the camera (auto-exposure off) and "
                   "corrected for; 0: neither (default: the simulated camera's)")
-      ->check(finite_range(0.0, 100000.0));
+      ->check(finite_range(0.0, 100000.0))
+      ->default_str("");  // -1: the simulated camera's
   cmd->add_option("--fps", a.fps, "latency: the frame rate asked of the camera")->check(finite_range(1.0, 2000.0));
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   return cmd;

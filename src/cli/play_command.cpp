@@ -94,7 +94,9 @@ CLI::App* add_play_command(CLI::App& app, PlayArgs& a) {
       ->check(finite_range(0, 1'000'000));
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "simulated seconds after which a ball still in play is cut")
       ->check(finite_positive());
-  cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")->check(finite_range(0.0, 1.0));
+  cmd->add_option("--pull", a.pull, "launcher pull fraction (default: the board's)")
+      ->check(finite_range(0.0, 1.0))
+      ->default_str("");  // -1: the board's
   cmd->add_option("--seed", a.seed, "random seed (launch noise)")
       ->check(unsigned_64());
   add_world_options(*cmd, a.world);

@@ -250,9 +250,11 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
   cmd->add_option("--snapshot", a.snapshot,
                   "PNG to write: with --at, the picture at that time and no window; with --quit-at, the window's last frame");
   cmd->add_option("--at", a.at_s, "snapshot time: seconds from the log's first event or the first live message (default: the end)")
-      ->check(finite_range(0.0, 1e9));
+      ->check(finite_range(0.0, 1e9))
+      ->default_str("");  // -1: the end
   cmd->add_option("--quit-at", a.quit_at_s, "window: play until this time (s), write --snapshot, quit")
-      ->check(finite_range(0.0, 1e9));
+      ->check(finite_range(0.0, 1e9))
+      ->default_str("");  // -1: play until q
   cmd->add_option("--speed", a.speed, "log playback speed (keys + and - change it)")
       ->check(finite_range(1.0 / 64.0, 64.0));
   cmd->add_option("--px-per-m", a.px_per_m, "scale of the table in pixels per metre")

@@ -20,8 +20,8 @@ void check_launcher_clear(const LoadState& state) {
   const int line = state.seen.at("launcher");
   const auto overlap = [&](const std::string& what, double d) {
     throw BoardError(state.file, line,
-                     "launcher: ball at the launch position overlaps " + what + " (distance " + fmt(d) +
-                         " m, ball radius " + fmt(r) + " m)");
+                     "launcher: ball at the launch position overlaps " + what + " (distance " +
+                         in_file_unit(state, d) + ", ball radius " + in_file_unit(state, r) + ")");
   };
   for (std::size_t i = 0; i < board.shapes.size(); ++i) {
     const double d = distance_to_shape(board.shapes[i], p);
@@ -44,10 +44,12 @@ void check_launch_speed(const LoadState& state) {
   const double needed = min_launch_speed_mps(board);
   if (slowest >= needed) return;
   throw BoardError(state.file, state.seen.at("launcher"),
-                   "launcher: attribute pull=" + fmt(board.launcher.pull) + " launches as slowly as " + fmt(slowest) +
-                       " m/s (pull x (1 - noise) x SPEED_MAX), below the " + fmt(needed) +
-                       " m/s the ball needs to rise above its own radius against G (sqrt(2 G R + " +
-                       fmt(kLauncherStillSpeed_mps) + "^2) + G dt): it would be relaunched at its apex for ever");
+                   "launcher: attribute pull=" + fmt(board.launcher.pull) + " launches as slowly as " +
+                       in_file_unit(state, slowest, "/s") + " (pull x (1 - noise) x SPEED_MAX), below the " +
+                       in_file_unit(state, needed, "/s") +
+                       " the ball needs to rise above its own radius against G (sqrt(2 G R + (" +
+                       in_file_unit(state, kLauncherStillSpeed_mps, "/s") +
+                       ")^2) + G dt): it would be relaunched at its apex for ever");
 }
 
 /// The start must put the ball on the table, clear of every obstacle, flipper
@@ -61,25 +63,26 @@ void check_start(const LoadState& state) {
   const int line = state.seen.at("start");
   const auto fail = [&](const std::string& what) { throw BoardError(state.file, line, "start: " + what); };
   if (!(p.x() >= 0.0 && p.x() <= board.width_m && p.y() >= 0.0 && p.y() <= board.height_m)) {
-    fail("fields X Y (" + fmt(p.x()) + ", " + fmt(p.y()) + ") m lie outside the table (0..W, 0..H = " +
-         fmt(board.width_m) + ", " + fmt(board.height_m) + " m)");
+    fail("fields X Y (" + fmt(p.x() / state.length_scale) + ", " + fmt(p.y() / state.length_scale) + ") " +
+         unit_name(state) + " lie outside the table (0..W, 0..H = " + fmt(board.width_m / state.length_scale) + ", " +
+         in_file_unit(state, board.height_m) + ")");
   }
   if (!(v.norm() <= board.ball.speed_max_mps)) {
-    fail("speed of fields VX VY (" + fmt(v.norm()) + " m/s) exceeds the ball's SPEED_MAX (" +
-         fmt(board.ball.speed_max_mps) + " m/s)");
+    fail("speed of fields VX VY (" + in_file_unit(state, v.norm(), "/s") + ") exceeds the ball's SPEED_MAX (" +
+         in_file_unit(state, board.ball.speed_max_mps, "/s") + ")");
   }
   for (std::size_t i = 0; i < board.shapes.size(); ++i) {
     const double d = distance_to_shape(board.shapes[i], p);
     if (d < r) {
-      fail("ball at fields X Y overlaps '" + board.obstacles[i].name + "' (distance " + fmt(d) + " m, ball radius " +
-           fmt(r) + " m)");
+      fail("ball at fields X Y overlaps '" + board.obstacles[i].name + "' (distance " + in_file_unit(state, d) +
+           ", ball radius " + in_file_unit(state, r) + ")");
     }
   }
   for (const Flipper& f : board.flippers) {
     const double d = distance_point_segment(p, f.pivot, flipper_tip(f, f.theta_min_rad));
     if (d < r) {
-      fail("ball at fields X Y overlaps flipper '" + f.name + "' in its down position (distance " + fmt(d) +
-           " m, ball radius " + fmt(r) + " m)");
+      fail("ball at fields X Y overlaps flipper '" + f.name + "' in its down position (distance " +
+           in_file_unit(state, d) + ", ball radius " + in_file_unit(state, r) + ")");
     }
   }
   for (const Sensor& sensor : board.sensors) {
@@ -88,7 +91,7 @@ void check_start(const LoadState& state) {
     }
   }
   if ((p - board.launcher.position).norm() < r && v.norm() < min_launch_speed_mps(board)) {
-    fail("a ball at fields X Y this slow (" + fmt(v.norm()) + " m/s) counts as resting in the launcher and "
+    fail("a ball at fields X Y this slow (" + in_file_unit(state, v.norm(), "/s") + ") counts as resting in the launcher and "
          "would be served again for ever");
   }
 }

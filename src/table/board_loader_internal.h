@@ -90,6 +90,13 @@ struct LoadState {
   std::vector<int> bank_lines;      // same index as board.banks
 };
 
+/// The file's length unit as messages spell it: "m" or "mm".
+std::string unit_name(const LoadState& state);
+
+/// A length in metres (per second with per = "/s", ...) as the file states
+/// lengths: "48.5 mm/s" in a `units mm` file, "0.0485 m/s" otherwise.
+std::string in_file_unit(const LoadState& state, double si, const std::string& per = "");
+
 /// One statement kind: how the driver treats it, and the function that reads it.
 struct StatementKind {
   std::string_view keyword;

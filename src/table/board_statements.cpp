@@ -31,9 +31,6 @@ constexpr double kMaxRho = 2.0;              // reflectivity: > 1 kicks; 2 alrea
 constexpr double kMinDt_s = 1e-6;
 constexpr double kMaxDt_s = 0.01;
 
-/// The file's length unit as messages spell it.
-std::string unit_name(const LoadState& state) { return state.length_scale == 1.0 ? "m" : "mm"; }
-
 /// Requires `v`, read in the file's length unit (per second with per = "/s",
 /// ...), to be at most `max_si`; the message states the bound in the file's unit.
 void require_at_most(const LoadState& state, const Reader& r, double v, const std::string& label, double max_si,
@@ -361,6 +358,12 @@ void hole(LoadState& state, const Reader& r) {
 }
 
 }  // namespace
+
+std::string unit_name(const LoadState& state) { return state.length_scale == 1.0 ? "m" : "mm"; }
+
+std::string in_file_unit(const LoadState& state, double si, const std::string& per) {
+  return fmt(si / state.length_scale) + " " + unit_name(state) + per;
+}
 
 const StatementKind* find_kind(std::string_view keyword) {
   static constexpr std::string_view kObstacleTwoSided = "rho friction score kick contact eat hidden bank name two-sided";

@@ -573,7 +573,9 @@ TEST_F(Cli, BenchRefusesAFlagTheChosenBenchWouldNotRead) {
   for (const Refusal& refusal :
        {Refusal{"bench tracker --quick --noise-px 1", 1, "--noise-px applies to ceiling and transfer only"},
         Refusal{"bench cradle --quick --latency 0.01", 1, "--latency applies to ceiling and transfer only"},
-        Refusal{"bench tracker --quick --world twin", 1, "--world applies to ceiling, aim, cradle and transfer only"},
+        Refusal{"bench tracker --quick --world twin", 1, "--world applies to ceiling and cradle only"},
+        Refusal{"bench aim --quick --stepper event", 1, "--stepper applies to ceiling and cradle only"},
+        Refusal{"bench transfer --quick --world model", 1, "--world applies to ceiling and cradle only"},
         Refusal{"bench speed --quick", 1, "--quick applies to tracker, latency,"},
         Refusal{"bench protocol --balls 3", 1, "--balls applies to"},
         Refusal{"bench latency --seed 3", 1, "--seed applies to"},
@@ -749,6 +751,11 @@ TEST_F(Cli, HelpShowsEveryDefault) {
   EXPECT_NE(learn.out.find("=2000"), std::string::npos) << "--budget-balls' default\n" << learn.out;
   const CommandResult bench = run("bench --help");
   EXPECT_NE(bench.out.find("=boards/mit1993.board"), std::string::npos) << "--board's default\n" << bench.out;
+  // A -1 sentinel outside its own range is no default a user could pass.
+  for (const char* command : {"sim", "learn", "bench", "track", "calibrate", "view", "play", "identify", "replay"}) {
+    const CommandResult help = run(std::string(command) + " --help");
+    EXPECT_EQ(help.out.find("]=-1"), std::string::npos) << command << "\n" << help.out;
+  }
 }
 
 TEST_F(Cli, FindsTheShippedBoardsAndControllersFromAnyFolder) {

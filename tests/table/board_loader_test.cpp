@@ -346,6 +346,13 @@ TEST(BoardLoaderErrors, LaunchTooSlowToLeaveTheLauncher) {
   expect_error("pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 0\ndt 0.0005\nballs 3\n"
                "launcher 0.45 0.05 pull=0.005 noise=0\n",
                7, "attribute pull=0.005 launches as slowly as 0.025 m/s");
+  // In a `units mm` file the speeds are stated in mm/s, as every bound is.
+  expect_error("pinball-board 1\nunits mm\nsize 510 1070\nball 13.5 5000\ngravity 1110\ndt 0.0005\nballs 3\n"
+               "launcher 450 50 pull=0.03\n",
+               8, "launches as slowly as 145.5 mm/s (pull x (1 - noise) x SPEED_MAX), below the 180.749 mm/s");
+  expect_error("pinball-board 1\nunits mm\nsize 510 1070\nball 13.5 5000\ngravity 1110\ndt 0.0005\nballs 1\n"
+               "launcher 450 50\nstart 100 500 0 0\ncircle 100 520 10 name=post\n",
+               9, "overlaps 'post' (distance 10 mm, ball radius 13.5 mm)");
   // A board that serves from `start` never launches.
   EXPECT_NO_THROW(parse_board(head + "launcher 0.45 0.05 pull=0.03\nstart 0.25 0.5 0 0\n", "t.board"));
 }
