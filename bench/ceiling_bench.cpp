@@ -1,10 +1,8 @@
 #include "ceiling_bench.h"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
 
 #include "pinball/learn/planning_controller.h"
@@ -116,22 +114,17 @@ CeilingPlayerReport run_player(const sim::World& world, const sim::ThesisStepper
                                CeilingPlayerKind kind, const std::function<void(const std::string&)>& progress) {
   const auto n = static_cast<std::size_t>(options.balls);
   std::vector<CeilingBall> balls(n);
-  std::atomic<int> done{0};
-  std::mutex progress_mutex;
   const auto start = std::chrono::steady_clock::now();
   // Across the job (MPI ranks x threads); progress counts this rank's share.
   const int share = std::max(1, options.balls / learn::team_size());
-  const int every = std::max(1, share / 10);
+  SharedProgress balls_done(share, share / 10, [&](long d, double elapsed_s) {
+    // "ceiling: 40/200 balls (20 %), 12 s elapsed, ETA 48 s"
+    if (progress) progress(format_progress(player_name(kind), d, share, "balls", elapsed_s));
+  });
   const std::vector<learn::Blob> blobs = learn::distributed_map(n, options.threads, [&](std::size_t i) {
     const std::unique_ptr<sim::World> ball_world = world.fork();
     const CeilingBall ball = play_ceiling_bench_ball(*ball_world, model, options, kind, ball_seed(options.seed, i));
-    const int d = ++done;
-    if (progress && (d % every == 0 || d == share)) {
-      const std::lock_guard<std::mutex> lock(progress_mutex);
-      // "ceiling: 40/200 balls (20 %), 12 s elapsed, ETA 48 s"
-      progress(format_progress(player_name(kind), d, share, "balls",
-                               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
-    }
+    balls_done.one_done();
     learn::BlobWriter w;
     put_played_ball(w, ball);
     w.put(ball.decisions).put(ball.branch_steps);

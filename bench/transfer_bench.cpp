@@ -1,11 +1,9 @@
 #include "transfer_bench.h"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 
 #include "pinball/learn/planning_controller.h"
@@ -165,28 +163,23 @@ std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const Transfer
   return out;
 }
 
-// Shares one count of balls over every cell for the progress line.
+// Shares one count of balls over every cell for the progress line, which
+// names the world being played.
 class ProgressCount {
  public:
   ProgressCount(const std::function<void(const std::string&)>& progress, long total)
-      : progress_(progress), total_(std::max(1L, total)), every_(std::max(1L, total / 100)) {}
-  void ball_done(const std::string& world) {
-    const long d = ++done_;
-    if (!progress_ || (d % every_ != 0 && d != total_)) return;
-    const std::lock_guard<std::mutex> lock(mutex_);
-    // "transfer: 4000/116000 balls (3 %), 40 s elapsed, ETA 19 min 10 s; gravity_pct=+10"
-    progress_(format_progress("transfer", static_cast<double>(d), static_cast<double>(total_), "balls",
-                              std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(),
-                              world));
-  }
+      : total_(std::max(1L, total)), count_(total_, total_ / 100, [this, &progress](long d, double elapsed_s) {
+          // "transfer: 4000/116000 balls (3 %), 40 s elapsed, ETA 19 min 10 s; gravity_pct=+10"
+          if (progress) progress(format_progress("transfer", d, total_, "balls", elapsed_s, world_));
+        }) {}
+  /// Before a world's balls (no ball in flight): the name the lines carry.
+  void start_world(const std::string& world) { world_ = world; }
+  void ball_done() { count_.one_done(); }
 
  private:
-  const std::function<void(const std::string&)>& progress_;
   long total_;
-  long every_;
-  std::atomic<long> done_{0};
-  std::mutex mutex_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  std::string world_;
+  SharedProgress count_;
 };
 
 // Plays every controller's balls in one world, across the job.
@@ -194,13 +187,14 @@ void play_world(PlannedWorld& w, const table::Board& belief, const TransferBench
                 const std::vector<TransferController>& players, ProgressCount& progress) {
   const auto balls = static_cast<std::size_t>(w.row.balls);
   const auto start = std::chrono::steady_clock::now();
+  progress.start_world(w.row.name);
   const std::vector<learn::Blob> blobs = learn::distributed_map(players.size() * balls, o.threads, [&](std::size_t i) {
     const auto ball_start = std::chrono::steady_clock::now();
     const std::unique_ptr<sim::World> ball_world = w.world->fork();
     TransferBall b = play_transfer_ball(*ball_world, w.settings, belief, o.camera, players[i / balls].spec,
                                         o.max_ball_time_s, ball_seed(o.seed, i % balls));
     b.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - ball_start).count();
-    progress.ball_done(w.row.name);
+    progress.ball_done();
     learn::BlobWriter out;
     put_played_ball(out, b);
     out.put(b.wall_s);

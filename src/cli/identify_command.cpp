@@ -4,6 +4,7 @@
 // command holding a belief reads with --identified (docs/identification.md).
 
 #include <algorithm>
+#include <chrono>
 #include <ostream>
 #include <stdexcept>
 
@@ -260,6 +261,7 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
 }
 
 int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
+  const auto start = std::chrono::steady_clock::now();
   check_output_folder(a.out, "--out");
   const table::Board board = table::load_board(find_data_file(a.board));  // the default too, from any folder
   const std::vector<bus::RecordedPlay> plays = read_all(a.logs);
@@ -288,10 +290,13 @@ int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
                        learn::prediction_error(identified, held, starts, prediction)};
   }
   if (!a.out.empty()) table::write_board_overlay(r.overlay, a.out);
-  if (a.json)
-    out << result_json(a, board, r, held_out).dump(2) << "\n";
-  else
+  if (a.json) {
+    nlohmann::json j = result_json(a, board, r, held_out);
+    j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out << j.dump(2) << "\n";
+  } else {
     print_text(a, board, r, held_out, out);
+  }
   return 0;
 }
 

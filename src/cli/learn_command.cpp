@@ -5,12 +5,11 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <iterator>
 #include <sstream>
 #include <memory>
 #include <array>
-#include <atomic>
-#include <mutex>
 #include <ostream>
 #include <thread>
 #include <stdexcept>
@@ -153,7 +152,9 @@ struct Evaluation {
   double mean_ball_time_s = 0.0;       // simulated (s)
   double flips_per_ball = 0.0;
   int balls_cut_at_time_limit = 0;
-  double balls_per_s = 0.0;            // wall clock
+  std::int64_t balls_played = 0;       // by this run; the rest came from --checkpoint
+  double wall_s = 0.0;
+  double balls_per_s = 0.0;            // balls played over the wall clock; NaN (null) when none was
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -164,6 +165,8 @@ struct Evaluation {
     a->Visit(PINBALL_NVP(mean_ball_time_s));
     a->Visit(PINBALL_NVP(flips_per_ball));
     a->Visit(PINBALL_NVP(balls_cut_at_time_limit));
+    a->Visit(PINBALL_NVP(balls_played));
+    a->Visit(PINBALL_NVP(wall_s));
     a->Visit(PINBALL_NVP(balls_per_s));
   }
 };
@@ -176,13 +179,7 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
   // Percent and ETA: a planner's thousand balls take minutes (this rank's share, under MPI).
   ProgressMeter meter(progress_wanted(a.progress) ? &err : nullptr, "learn evaluation", balls, "balls",
                       !a.progress && progress_wanted(false));
-  std::mutex meter_mutex;
-  std::atomic<int> done{0};
-  const auto ball_done = [&] {
-    const int d = ++done;
-    const std::lock_guard<std::mutex> lock(meter_mutex);
-    meter.update(d);
-  };
+  SharedProgress balls_done(balls, 1, [&](long d, double) { meter.update(static_cast<double>(d)); });
   const std::vector<learn::Blob> blobs =
       learn::distributed_map(static_cast<std::size_t>(balls), a.threads, [&](std::size_t i) {
         const std::uint64_t seed = ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i);
@@ -193,7 +190,7 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
           const std::unique_ptr<control::FlipperController> c = make_controller();
           blob = learn::to_blob(ev.play_with(*c, a.pull, seed));
         }
-        ball_done();
+        balls_done.one_done();
         return blob;
       });
   std::vector<learn::BallOutcome> out;
@@ -214,7 +211,11 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
   e.score_stddev = score.stddev();
   e.mean_ball_time_s = duration_s.mean();
   e.flips_per_ball = flips.mean();
-  e.balls_per_s = wall > 0.0 ? balls / wall : 0.0;
+  e.balls_played = balls_done.done();
+  e.wall_s = wall;
+  // A resumed run's balls replayed from the checkpoint took no time: no rate.
+  e.balls_per_s = e.balls_played > 0 && wall > 0.0 ? static_cast<double>(e.balls_played) / wall
+                                                   : std::numeric_limits<double>::quiet_NaN();
   return e;
 }
 
@@ -384,6 +385,7 @@ int run_shot_values(const LearnArgs& a, std::ostream& out, std::ostream& err) {
 }
 
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
+  const auto start = std::chrono::steady_clock::now();
   // What is written at the end can be written: a typo must not cost an hour's search.
   check_output_folder(args.out, "--out");
   check_output_folder(args.curve, "--curve");
@@ -626,6 +628,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   }
   j["team"] = team_report();
   j.update(world_report(world_spec, a.board, *world.world));
+  j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (a.json) {
     out << j.dump(2) << "\n";
   } else {
@@ -666,7 +669,9 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
       out << "evaluation       " << e["balls"] << " fresh balls: "
           << format_mean_ci(e["mean_score_per_ball"].get<double>(), e["score_ci95_half_width"].get<double>())
           << " per ball (95 %), " << num(e["mean_ball_time_s"]) << " s per ball, " << num(e["flips_per_ball"])
-          << " flips per ball, " << num(e["balls_per_s"]) << " balls/s\n";
+          << " flips per ball, "
+          << (e["balls_played"].get<int>() > 0 ? num(e["balls_per_s"]) + " balls/s\n"
+                                                : std::string("every ball from the checkpoint\n"));
     }
   }
   return 0;

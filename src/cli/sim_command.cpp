@@ -65,10 +65,13 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball still in play is cut")
       ->check(finite_positive());
   cmd->add_option("--trace", a.trace, "write every step to this CSV (t,x,y,vx,vy,event)");
-  cmd->add_option("--video", a.video, "write an MJPG AVI of the play to this file");
-  cmd->add_option("--video-fps", a.video_fps, "video frames per simulated second")->check(finite_range(1.0, 1000.0));
+  CLI::Option* video = cmd->add_option("--video", a.video, "write an MJPG AVI of the play to this file");
+  cmd->add_option("--video-fps", a.video_fps, "video frames per simulated second")
+      ->check(finite_range(1.0, 1000.0))
+      ->needs(video);
   cmd->add_flag("--video-camera", a.video_camera,
-                "--video: record what the simulated camera sees (perspective, lamps, blur, noise) at --video-fps");
+                "--video: record what the simulated camera sees (perspective, lamps, blur, noise) at --video-fps")
+      ->needs(video);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   add_progress_flag(*cmd, a.progress);
   return cmd;

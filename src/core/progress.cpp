@@ -91,4 +91,20 @@ void ProgressMeter::update_at(double done, double elapsed_s, std::string_view no
   finished_ = last;
 }
 
+SharedProgress::SharedProgress(long total, long every, std::function<void(long, double)> report)
+    : total_(total), every_(every < 1 ? 1 : every), report_(std::move(report)) {}
+
+void SharedProgress::one_done() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const long d = ++done_;
+  if (report_ && (d % every_ == 0 || d == total_)) {
+    report_(d, std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
+  }
+}
+
+long SharedProgress::done() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return done_;
+}
+
 }  // namespace pinball

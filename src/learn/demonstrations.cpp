@@ -1,12 +1,11 @@
 #include "pinball/learn/demonstrations.h"
 
 #include <array>
-#include <atomic>
 #include <chrono>
-#include <mutex>
 #include <optional>
 #include <stdexcept>
 
+#include "pinball/core/progress.h"
 #include "pinball/simlab/simulated_player.h"
 #include "pinball/learn/evaluator.h"
 #include "pinball/learn/parallel_runner.h"
@@ -298,12 +297,14 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
   if (worlds == nullptr) worlds = &home.emplace(board, nullptr);
   const auto n = static_cast<std::size_t>(balls);
   std::vector<DemonstrationBall> played(n);
-  std::atomic<int> done{0};
-  std::mutex progress_mutex;
   const auto start = std::chrono::steady_clock::now();
   // Across the job: each rank plays its share (progress counts this rank's balls).
   const int share = std::max<int>(1, balls / team_size());
-  const int every = std::max(1, share / 10);
+  SharedProgress balls_done(share, share / 10, [&](long d, double) {
+    if (!progress) return;
+    progress(std::string(learner != nullptr ? "learner, teacher judging: " : "teacher: ") + std::to_string(d) + "/" +
+             std::to_string(share) + " balls" + (team_size() > 1 ? " (this rank's share)" : ""));
+  });
   const std::vector<Blob> blobs = distributed_map(n, threads, [&](std::size_t i) {
     const std::uint64_t b = ball_seed(seed, i);
     const TeacherWorlds::Place& place = worlds->place_of(b);
@@ -314,12 +315,7 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
     const DemonstrationBall ball = learner != nullptr
                                        ? record_correction(board, *ball_world, *place.teacher_model, c, learner, b)
                                        : record_demonstration(board, *ball_world, *place.teacher_model, c, b);
-    const int d = ++done;
-    if (progress && (d % every == 0 || d == share)) {
-      const std::lock_guard<std::mutex> lock(progress_mutex);
-      progress(std::string(learner != nullptr ? "learner, teacher judging: " : "teacher: ") + std::to_string(d) + "/" +
-               std::to_string(share) + " balls" + (team_size() > 1 ? " (this rank's share)" : ""));
-    }
+    balls_done.one_done();
     return to_blob(ball);
   });
   for (std::size_t i = 0; i < n; ++i) played[i] = demonstration_ball_from_blob(blobs[i]);

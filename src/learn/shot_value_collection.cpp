@@ -1,8 +1,6 @@
 #include "pinball/learn/shot_value_collection.h"
 
-#include <atomic>
 #include <chrono>
-#include <mutex>
 #include <stdexcept>
 
 #include "pinball/core/progress.h"
@@ -49,19 +47,14 @@ ShotValueTable collect_shot_values(const table::Board& belief, const ShotValueCo
   ShotValueTable total = make_shot_value_table(flippers);
   const sim::ThesisStepper model(belief);
   const std::unique_ptr<sim::World> prototype = sim::make_model_world(belief);
-  std::mutex report;
-  std::atomic<int> done{0};
-  const auto start = std::chrono::steady_clock::now();
+  SharedProgress balls_done(balls, balls / 20, [&](long d, double elapsed_s) {
+    if (progress) progress(format_progress("shot values", d, balls, "balls", elapsed_s));
+  });
   const std::vector<Blob> blobs = distributed_map(static_cast<std::size_t>(balls), threads, [&](std::size_t i) {
     ShotValueTable table = make_shot_value_table(flippers);
     const std::unique_ptr<sim::World> world = prototype->fork();
     play_collecting(model, *world, config, ball_seed(seed, i), table);
-    const int d = ++done;
-    if (progress && (d % std::max(1, balls / 20) == 0 || d == balls)) {
-      const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::lock_guard<std::mutex> lock(report);
-      progress(format_progress("shot values", d, balls, "balls", elapsed_s));
-    }
+    balls_done.one_done();
     BlobWriter w;
     w.put_vector(table.sum).put_vector(table.count);
     return w.take();

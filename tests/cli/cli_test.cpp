@@ -397,6 +397,11 @@ TEST_F(Cli, LearnDrainPenaltyPricesTheShotTableAndTheTeacher) {
   }
   const CommandResult same = run(resume + " --resume");
   EXPECT_EQ(same.exit_code, 0) << same.err;
+  // Every ball came from the file: no rate is made up from no time.
+  const nlohmann::json replayed = nlohmann::json::parse(same.out).at("evaluation");
+  EXPECT_EQ(replayed.at("balls_played"), 0);
+  EXPECT_TRUE(replayed.at("balls_per_s").is_null()) << same.out;
+  EXPECT_GT(nlohmann::json::parse(same.out).at("wall_s").get<double>(), 0.0);
   for (const std::string& method : {"cem --budget-balls 2 --out " + learned, std::string("launcher")}) {
     const CommandResult refused = run("learn boards/mit1993.board --method " + method + " --drain-penalty 5000");
     EXPECT_EQ(refused.exit_code, 1) << method;
@@ -483,7 +488,8 @@ TEST_F(Cli, BadBoardFileIsOneLineNamingFileAndLine) {
 
 TEST_F(Cli, BadArgumentsExitWithUsageError) {
   for (const char* args : {"sim boards/mit1993.board --balls 0", "sim boards/mit1993.board --policy wild",
-                           "sim no/such.board", "sim boards/mit1993.board --dt -1", "frobnicate"}) {
+                           "sim no/such.board", "sim boards/mit1993.board --dt -1", "frobnicate",
+                           "sim boards/mit1993.board --video-camera", "sim boards/mit1993.board --video-fps 30"}) {
     const CommandResult r = run(args);
     EXPECT_EQ(r.exit_code, 2) << args;
     EXPECT_EQ(count_lines(r.err), 1) << args << ": " << r.err;

@@ -2,7 +2,10 @@
 
 #include "pinball/core/progress.h"
 
+#include <algorithm>
 #include <sstream>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -55,6 +58,29 @@ TEST(ProgressMeter, ANullStreamShowsNothing) {
   ProgressMeter meter(nullptr, "sim", 1, "balls");
   meter.update_at(1, 1.0);  // must not crash
   SUCCEED();
+}
+
+// Threads finishing together: every report at least the one before, the
+// last one the total, and nothing lost from the count.
+TEST(SharedProgress, ReportsInOrderFromManyThreads) {
+  constexpr long kTotal = 4000;
+  std::vector<long> reported;  // written under the count's own lock
+  SharedProgress count(kTotal, 7, [&](long done, double elapsed_s) {
+    EXPECT_GE(elapsed_s, 0.0);
+    reported.push_back(done);
+  });
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&] {
+      for (long i = 0; i < kTotal / 4; ++i) count.one_done();
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(count.done(), kTotal);
+  ASSERT_FALSE(reported.empty());
+  EXPECT_TRUE(std::is_sorted(reported.begin(), reported.end()));
+  EXPECT_EQ(reported.back(), kTotal);
+  EXPECT_EQ(reported.size(), static_cast<std::size_t>(kTotal / 7 + 1));  // every 7th, and the last
 }
 
 }  // namespace

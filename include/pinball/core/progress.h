@@ -7,7 +7,9 @@
 // script's stderr stays quiet; stdout (the report, the JSON) never sees it.
 
 #include <chrono>
+#include <functional>
 #include <iosfwd>
+#include <mutex>
 #include <string>
 #include <string_view>
 
@@ -50,6 +52,28 @@ class ProgressMeter {
   std::chrono::steady_clock::time_point start_;
   double last_shown_s_ = -1.0;
   bool finished_ = false;
+};
+
+/// Units finished by worker threads, counted and reported in order: the count
+/// and its report share one lock, so a line never shows fewer units than the
+/// line before it (two threads finishing together once printed "10/10" and
+/// then "9/10"). `report(done, elapsed_s)` runs for every `every`-th unit and
+/// for the `total`-th; an empty `report` only counts.
+class SharedProgress {
+ public:
+  SharedProgress(long total, long every, std::function<void(long done, double elapsed_s)> report);
+  /// One more unit finished (any thread).
+  void one_done();
+  /// Units finished so far.
+  long done() const;
+
+ private:
+  long total_;
+  long every_;
+  std::function<void(long, double)> report_;
+  mutable std::mutex mutex_;
+  long done_ = 0;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
 }  // namespace pinball
