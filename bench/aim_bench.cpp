@@ -104,6 +104,12 @@ AimReport run_aim_bench(const table::Board& belief, const AimBenchOptions& optio
                                        options.shot_time_s));
     if (exact.back()) ++report.shots;
   }
+  if (report.shots == 0) {
+    // Every figure below is of shots: from none, a median of 0 deg would read as perfect aim.
+    throw std::runtime_error("bench aim: no shot to measure in " + std::to_string(options.balls) + " balls (" +
+                             std::to_string(report.fires) + " fires, balls cut at " +
+                             format_number(options.max_ball_time_s) + " s); raise --balls or --max-ball-time");
+  }
   // The baseline: each bat's shots against that bat's median direction.
   std::vector<std::vector<double>> by_bat(belief.flippers.size());
   for (std::size_t i = 0; i < fires.size(); ++i) {

@@ -2,7 +2,7 @@
 
 #include <chrono>
 #include <cmath>
-#include <mutex>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -164,22 +164,19 @@ CradleReport run_cradle_bench(const sim::World& world, const CradleBenchOptions&
                               const std::function<void(const std::string&)>& progress) {
   check_options(options);
   const auto start = std::chrono::steady_clock::now();
-  const auto elapsed_s = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   CradleReport report;
   report.options = options;
   report.world = std::string(world.name());
   const std::vector<double> drops = drop_durations(options);
   const std::size_t balls = static_cast<std::size_t>(options.balls);
   std::vector<CradleBall> played(drops.size() * balls);
-  std::mutex progress_mutex;
-  std::size_t done = 0;
+  const auto total = static_cast<long>(played.size());
+  SharedProgress balls_done(total, 1, [&](long d, double elapsed_s) {
+    if (progress) progress(format_progress("cradle", d, total, "balls", elapsed_s));
+  });
   learn::parallel_for(played.size(), options.threads, [&](std::size_t k) {
     played[k] = play_cradle_ball(world, ball_seed(options.seed, k % balls), drops[k / balls], options);
-    if (!progress) return;
-    const std::lock_guard<std::mutex> lock(progress_mutex);
-    ++done;
-    progress(format_progress("cradle", static_cast<double>(done), static_cast<double>(played.size()), "balls",
-                             elapsed_s()));
+    balls_done.one_done();
   });
   for (std::size_t d = 0; d < drops.size(); ++d) {
     CradleDropResult r;
@@ -202,8 +199,9 @@ CradleReport run_cradle_bench(const sim::World& world, const CradleBenchOptions&
       score.add(ball.score);
     }
     r.return_interval = wilson_ci95(r.returns, r.shots);
-    r.mean_period_s = r.returns > 0 ? cycle_time_s / r.returns : 0.0;
-    r.points_per_cycle = r.returns > 0 ? cycle_points / r.returns : 0.0;
+    // No return, no cycle: its period and points are unknown (null in JSON), not 0.
+    r.mean_period_s = r.returns > 0 ? cycle_time_s / r.returns : std::numeric_limits<double>::quiet_NaN();
+    r.points_per_cycle = r.returns > 0 ? cycle_points / r.returns : std::numeric_limits<double>::quiet_NaN();
     r.mean_ball_time_s = time_sum_s / r.balls;
     r.mean_score = score.mean();
     r.score_ci95 = score.ci95_half_width();
@@ -214,7 +212,7 @@ CradleReport run_cradle_bench(const sim::World& world, const CradleBenchOptions&
       report.best = d;
     }
   }
-  report.wall_s = elapsed_s();
+  report.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
 
@@ -240,10 +238,10 @@ nlohmann::json to_json(const CradleReport& report) {
                        {"right_outlane", r.drains.right_outlane},
                        {"centre", r.drains.centre},
                        {"other", r.drains.other}}},
-                     {"cut", r.cut},
-                     {"cut_cycling", r.cut_cycling},
+                     {"balls_cut_at_time_limit", r.cut},
+                     {"balls_cut_cycling", r.cut_cycling},
                      {"mean_ball_time_s", r.mean_ball_time_s},
-                     {"mean_score", r.mean_score},
+                     {"mean_score_per_ball", r.mean_score},
                      {"score_ci95_half_width", r.score_ci95}});
   }
   return {{"benchmark", "cradle"},
@@ -280,12 +278,12 @@ std::string to_text(const CradleReport& report) {
     out << "; lost after a drop: outlane "
         << r.drains.left_outlane + r.drains.right_outlane << ", centre " << r.drains.centre << "; cut "
         << r.cut << " (" << r.cut_cycling << " cycling); mean ball " << format_number(r.mean_ball_time_s)
-        << " s, " << format_number(r.mean_score) << " ± " << format_number(r.score_ci95) << " points\n";
+        << " s, " << format_mean_ci(r.mean_score, r.score_ci95) << " points\n";
   }
   if (!report.drops.empty()) {
     const CradleDropResult& b = report.drops[report.best];
     out << "best drop " << format_number(b.drop_s * 1e3) << " ms: at " << format_number(b.return_share())
-        << " a return and " << format_number(b.mean_period_s) << " s a cycle, ";
+        << (b.returns > 0 ? " a return and " + format_number(b.mean_period_s) + " s a cycle, " : " a return, ");
     const double projected = b.projected_share_at_10_min();
     out << (projected < 1e-4 ? std::string("under 0.01") : format_number(100.0 * projected))
         << " % of cradled balls would live 10 minutes (1 % needs " << format_number(b.return_share_needed()) << ")\n";

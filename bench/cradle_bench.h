@@ -74,8 +74,8 @@ struct CradleDropResult {
   int duds = 0;
   DrainCounts drains;          ///< balls lost after a drop, by route
   Interval return_interval;  ///< Wilson 95 % of returns / shots
-  double mean_period_s = 0.0;  ///< cradle to cradle over the returns
-  double points_per_cycle = 0.0;
+  double mean_period_s = 0.0;  ///< cradle to cradle over the returns (NaN without a return)
+  double points_per_cycle = 0.0;  ///< NaN without a return
   double mean_ball_time_s = 0.0;
   int cut = 0;
   int cut_cycling = 0;

@@ -198,6 +198,7 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
                         {"ball_scores", balls},
                         {"mean_score_per_ball", score.mean()},
                         {"score_ci95_half_width", score.ci95_half_width()},
+                        {"max_score", score.max()},
                         {"dt_s", world->dt_s()},
                         {"physics_hz", physics_hz},
                         {"simulated_s", session.time_s()},

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <ostream>
+#include <string>
 
 #include "commands.h"
 #include "data_file.h"
@@ -24,6 +25,22 @@ CLI::App* add_replay_command(CLI::App& app, ReplayArgs& a) {
   cmd->add_flag("--json", a.json, "print one JSON object");
   return cmd;
 }
+
+namespace {
+
+// The verdict in one sentence, the text's last line and the JSON's "verdict".
+std::string verdict(const daemon::ReplayReport& r) {
+  if (r.observations == 0 && r.malformed > 0) {
+    return "NOT reproduced: no PINBALL_OBSERVATION message decoded (" + std::to_string(r.malformed) +
+           " malformed on PINBALL_OBSERVATION and PINBALL_FLIPPER_CMD: another message type on those channels, "
+           "or a log of another version)";
+  }
+  if (r.observations == 0) return "NOT reproduced: the log holds no PINBALL_OBSERVATION messages";
+  if (r.reproduced) return "reproduced: every recorded decision came out again, in order";
+  return "NOT reproduced: first difference at decision " + std::to_string(r.first_mismatch) + ": " + r.mismatch;
+}
+
+}  // namespace
 
 int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
   daemon::DaemonConfig config;
@@ -46,23 +63,14 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
                           {"first_mismatch", r.first_mismatch},
                           {"mismatch", r.mismatch},
                           {"skipped_timing", r.skipped_timing},
-                          {"reproduced", r.reproduced}}
+                          {"reproduced", r.reproduced},
+                          {"verdict", verdict(r)}}
                .dump(2)
         << "\n";
   } else {
     out << "observations " << r.observations << "  recorded decisions " << r.recorded_commands << "  replayed "
         << r.replayed_commands << "  matched " << r.matched << "  malformed " << r.malformed << "\n";
-    if (r.observations == 0 && r.malformed > 0) {
-      out << "NOT reproduced: no PINBALL_OBSERVATION message decoded (" << r.malformed
-          << " malformed on PINBALL_OBSERVATION and PINBALL_FLIPPER_CMD: another message type on those channels, "
-             "or a log of another version)\n";
-    } else if (r.observations == 0) {
-      out << "NOT reproduced: the log holds no PINBALL_OBSERVATION messages\n";
-    } else if (r.reproduced) {
-      out << "reproduced: every recorded decision came out again, in order\n";
-    } else {
-      out << "NOT reproduced: first difference at decision " << r.first_mismatch << ": " << r.mismatch << "\n";
-    }
+    out << verdict(r) << "\n";
     if (r.observations_without_latency > 0) {
       out << r.observations_without_latency << " observations were recorded before the delivery stamp: their camera "
           << "latency is unknown (replayed as 0), so a leading controller's decisions may differ\n";

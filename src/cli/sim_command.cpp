@@ -214,6 +214,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
         {"max_score", score.max()},
         {"mean_ball_time_s", ball_time.mean()},
         {"balls_cut_at_time_limit", cut},
+        {"max_ball_time_s", a.max_ball_time_s},
         {"balls_left_table", left_table},
         {"steps", steps},
         {"state_hash", hash_hex},

@@ -118,6 +118,7 @@ struct Daemon::Impl {
   std::unique_ptr<ControllerWorker> controller_worker;
   std::unique_ptr<DriverWorker> driver_worker;
   std::atomic<bool> stats_requested{false};
+  std::atomic<bool> stop_requested{false};  // by a signal: the run ended early
   mutable std::mutex warnings_mutex;
   std::vector<std::string> warnings;
   double start_wall_s = 0.0;
@@ -450,6 +451,7 @@ DaemonReport Daemon::Impl::report() const {
     r.warnings = warnings;
   }
   r.coils_off_at_exit = coils_off_at_exit.load(std::memory_order_acquire);
+  r.stopped_by_signal = stop_requested.load(std::memory_order_acquire);
   {
     const std::lock_guard<std::mutex> lock(warnings_mutex);
     r.faults = faults;
@@ -472,6 +474,7 @@ DaemonReport Daemon::Impl::report() const {
       r.cut_balls += b.cut ? 1 : 0;
     }
     r.balls = static_cast<int>(r.results.size());
+    r.balls_asked = config.sim.balls;
     r.mean_score = score.mean();
     r.score_ci95 = score.ci95_half_width();
     r.mean_ball_time_s = time.mean();
@@ -612,6 +615,7 @@ DaemonReport Daemon::run() {
 }
 
 void Daemon::request_stop() {
+  impl_->stop_requested.store(true, std::memory_order_release);
   impl_->h.stop.store(true, std::memory_order_release);
   impl_->h.main_bell.ring();
 }
@@ -680,9 +684,12 @@ nlohmann::json report_to_json(const DaemonReport& r) {
                                                   {"warnings", to_json_value(r.world_warnings)}};
   }
   j["balls"] = r.balls;
-  j["mean_score_per_ball"] = r.mean_score;
+  j["balls_asked"] = r.balls_asked;
+  j["stopped_by_signal"] = r.stopped_by_signal;
+  // No ball, no mean: null, not 0.
+  j["mean_score_per_ball"] = r.balls > 0 ? nlohmann::json(r.mean_score) : nlohmann::json();
   j["score_ci95_half_width"] = r.score_ci95;
-  j["mean_ball_time_s"] = r.mean_ball_time_s;
+  j["mean_ball_time_s"] = r.balls > 0 ? nlohmann::json(r.mean_ball_time_s) : nlohmann::json();
   j["balls_cut_at_time_limit"] = r.cut_balls;
   nlohmann::json scores = nlohmann::json::array();
   for (const simlab::SimBallResult& b : r.results) scores.push_back(b.score);
@@ -745,8 +752,12 @@ std::string report_to_text(const DaemonReport& r) {
   std::ostringstream o;
   o << std::fixed << std::setprecision(1);
   if (r.mode == "sim") {
-    o << "balls " << r.balls << "  mean score per ball " << format_mean_ci(r.mean_score, r.score_ci95)
-      << " (95 %)  mean ball time " << format_number(r.mean_ball_time_s) << " s";
+    o << "balls " << r.balls;
+    if (r.stopped_by_signal && r.balls < r.balls_asked) o << " of " << r.balls_asked << " (stopped by a signal)";
+    if (r.balls > 0) {
+      o << "  mean score per ball " << format_mean_ci(r.mean_score, r.score_ci95) << " (95 %)  mean ball time "
+        << format_number(r.mean_ball_time_s) << " s";
+    }
     if (r.cut_balls > 0) o << "  cut " << r.cut_balls;
     o << "\n";
     if (r.world.empty()) {

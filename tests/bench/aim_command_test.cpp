@@ -38,7 +38,7 @@ TEST_F(AimCommand, OneNoiseLevelFromTrueStateNoiseAndThePlannersSettings) {
 
 TEST_F(AimCommand, RefusesWhatItCannotUse) {
   for (const Refusal& refusal : {Refusal{"--controller controllers/best.json", 1, "not a planner file"},
-                                 Refusal{"--world twin", 1, "model only"},
+                                 Refusal{"--world twin", 1, "--world applies to ceiling and cradle only"},
                                  Refusal{"--stepper event", 1, "--stepper"},
                                  Refusal{"--true-state-noise -1 0", 2, "--true-state-noise"},
                                  Refusal{"--balls 0", 2, "--balls"}}) {

@@ -1,8 +1,10 @@
 #include "cradle_bench.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -114,6 +116,27 @@ TEST(CradleBench, TheTextMarksTheBestDropAndLeavesOutThePeriodOfADropWithNoRetur
   EXPECT_NE(text.find("391 ± 120 points"), std::string::npos) << "a score is given with its interval\n" << text;
   EXPECT_NE(text.find("under 0.01 % of cradled balls would live 10 minutes (1 % needs 0.977"), std::string::npos)
       << text;
+}
+
+// No return measures no cycle: its period is null, not 0 s, and the best
+// drop's line does not quote one.
+TEST(CradleBench, ADropWithNoReturnHasNoPeriod) {
+  CradleReport report;
+  report.world = "twin";
+  CradleDropResult none;
+  none.drop_s = 0.230;
+  none.shots = 2;
+  none.mean_period_s = std::numeric_limits<double>::quiet_NaN();
+  none.points_per_cycle = std::numeric_limits<double>::quiet_NaN();
+  report.drops = {none};
+  const nlohmann::json j = nlohmann::json::parse(to_json(report).dump());
+  EXPECT_TRUE(j.at("drops")[0].at("mean_period_s").is_null());
+  EXPECT_TRUE(j.at("drops")[0].at("points_per_cycle").is_null());
+  EXPECT_TRUE(j.at("drops")[0].contains("mean_score_per_ball"));
+  EXPECT_TRUE(j.at("drops")[0].contains("balls_cut_at_time_limit"));
+  const std::string text = to_text(report);
+  EXPECT_NE(text.find("best drop 230 ms: at 0 a return, "), std::string::npos) << text;
+  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
 }
 
 TEST(CradleBench, RefusesOptionsItCannotUse) {

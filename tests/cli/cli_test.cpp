@@ -230,7 +230,7 @@ TEST_F(Cli, SimJsonReportsEveryFigure) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("balls"), 5);
   for (const char* key : {"mean_score_per_ball", "score_ci95_half_width", "mean_ball_time_s", "steps_per_s",
-                          "steps", "state_hash", "balls_cut_at_time_limit", "wall_s"}) {
+                          "steps", "state_hash", "balls_cut_at_time_limit", "max_ball_time_s", "wall_s"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_GT(j.at("mean_score_per_ball").get<double>(), 0.0);
@@ -582,6 +582,7 @@ TEST_F(Cli, BenchRefusesAFlagTheChosenBenchWouldNotRead) {
         Refusal{"bench tracker --quick --world twin", 1, "--world applies to ceiling and cradle only"},
         Refusal{"bench aim --quick --stepper event", 1, "--stepper applies to ceiling and cradle only"},
         Refusal{"bench transfer --quick --world model", 1, "--world applies to ceiling and cradle only"},
+        Refusal{"bench aim --balls 1 --max-ball-time 1", 1, "bench aim: no shot to measure in 1 balls"},
         Refusal{"bench speed --quick", 1, "--quick applies to tracker, latency,"},
         Refusal{"bench protocol --balls 3", 1, "--balls applies to"},
         Refusal{"bench latency --seed 3", 1, "--seed applies to"},

@@ -32,6 +32,7 @@ TEST_F(Play, AHeadlessScriptPlaysBallsAndEachGetsItsRow) {
   EXPECT_EQ(j.at("balls"), 1);
   EXPECT_EQ(j.at("player"), "ada");
   EXPECT_EQ(j.at("mode"), "headless");
+  EXPECT_DOUBLE_EQ(j.at("max_score").get<double>(), j.at("ball_scores")[0].at("score").get<double>());
   EXPECT_EQ(j.at("world"), "thesis");
   EXPECT_GT(j.at("steps").get<double>(), 0.0);
   EXPECT_GT(j.at("ball_scores")[0].at("duration_s").get<double>(), 0.0);

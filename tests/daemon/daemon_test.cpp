@@ -821,6 +821,29 @@ TEST(Daemon, TheTextReportRoundsTheScore) {
   EXPECT_DOUBLE_EQ(report_to_json(r)["mean_score_per_ball"].get<double>(), 12100.53);
 }
 
+// A run a signal ended says so, and how many balls it was to play; a run of
+// no ball has no mean (null), not a mean of 0.
+TEST(Daemon, TheReportSaysARunEndedBySignalAndHasNoMeanOfNoBall) {
+  DaemonReport r;
+  r.mode = "sim";
+  r.balls = 2;
+  r.balls_asked = 100;
+  r.stopped_by_signal = true;
+  r.mean_score = 5000.0;
+  r.score_ci95 = 300.0;
+  EXPECT_NE(report_to_text(r).find("balls 2 of 100 (stopped by a signal)  mean score per ball 5000 ± 300"),
+            std::string::npos)
+      << report_to_text(r);
+  EXPECT_TRUE(report_to_json(r)["stopped_by_signal"].get<bool>());
+  EXPECT_EQ(report_to_json(r)["balls_asked"], 100);
+  DaemonReport none;
+  none.mode = "sim";
+  const nlohmann::json j = nlohmann::json::parse(report_to_json(none).dump());
+  EXPECT_TRUE(j["mean_score_per_ball"].is_null());
+  EXPECT_TRUE(j["mean_ball_time_s"].is_null());
+  EXPECT_EQ(report_to_text(none).find("mean score"), std::string::npos) << report_to_text(none);
+}
+
 TEST(Daemon, UdpmInLockstepWarnsThatALoggerWouldLoseMessages) {
   DaemonConfig c = sim_config(1, 1);
   EXPECT_EQ(lcm_pace_warning(c), "");  // memq://

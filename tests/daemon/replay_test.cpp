@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -282,6 +283,14 @@ TEST(Replay, ALogOfAnotherTypeOnTheChannelIsSaidToBeMalformed) {
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("NOT reproduced: no PINBALL_OBSERVATION message decoded (5 malformed"), std::string::npos)
       << text;
+  // A script reads the same sentence under "verdict".
+  const int json_status =
+      std::system((std::string(PINBALL_EXE) + " replay " + log + " --json > " + text_out + " 2>/dev/null").c_str());
+  EXPECT_EQ(WEXITSTATUS(json_status), 3);
+  std::ifstream json_in(text_out);
+  const nlohmann::json j = nlohmann::json::parse(json_in);
+  EXPECT_EQ(j.at("verdict").get<std::string>().rfind("NOT reproduced: no PINBALL_OBSERVATION message decoded (5", 0), 0u)
+      << j.dump();
   std::remove(log.c_str());
   std::remove(text_out.c_str());
 }

@@ -53,6 +53,8 @@ struct DaemonReport {
   std::string world;                         ///< sim: the world that played it (thesis, event, twin)
   sim::WorldWarnings world_warnings;         ///< sim: the world's warnings (the twin's MuJoCo warnings)
   int balls = 0;                             ///< balls played (sim)
+  int balls_asked = 0;                       ///< balls the run was to play (sim with a world)
+  bool stopped_by_signal = false;            ///< SIGINT or SIGTERM (request_stop) ended the run
   double mean_score = 0.0;                   ///< mean score per ball (sim)
   double score_ci95 = 0.0;                   ///< half-width of its 95 % interval (sim)
   double mean_ball_time_s = 0.0;             ///< mean simulated ball time (s)
