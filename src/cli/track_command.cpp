@@ -20,7 +20,8 @@ CLI::App* add_track_command(CLI::App& app, TrackArgs& a) {
   CLI::App* cmd = app.add_subcommand("track", "run the tracker over an observation file (t,x,y)");
   cmd->add_option("--board", a.board, "board file: the flipper geometry")->required()->transform(data_file());
   cmd->add_option("--observations", a.observations,
-                  "CSV with header t,x,y (s, m, board frame), optionally ,left_contact,right_contact (0/1)")
+                  "CSV with header t,x,y (s, m, board frame), optionally ,left_contact,right_contact (0/1); "
+                  "or a sim --trace file")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--gravity", a.gravity_mps2, "gravity along the table (m/s^2); default: the board's")

@@ -47,25 +47,30 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
   std::string text;
   int line_no = 0;
   bool has_contacts = false;
+  std::size_t columns = 3;
   std::vector<ObservationRow> rows;
   while (std::getline(in, text)) {
     ++line_no;
     if (!text.empty() && text.back() == '\r') text.pop_back();
     if (line_no == 1) {
       const auto header = split(text);
-      const bool plain = header.size() == 3 && header[0] == "t" && header[1] == "x" && header[2] == "y";
-      has_contacts = header.size() == 5 && header[0] == "t" && header[1] == "x" && header[2] == "y" &&
-                     header[3] == "left_contact" && header[4] == "right_contact";
-      if (!plain && !has_contacts) {
-        fail(path, line_no, "header must be 't,x,y' or 't,x,y,left_contact,right_contact', got '" + text + "'");
+      const bool txy = header.size() >= 3 && header[0] == "t" && header[1] == "x" && header[2] == "y";
+      has_contacts = txy && header.size() == 5 && header[3] == "left_contact" && header[4] == "right_contact";
+      // `pinball sim --trace`: the true state each step; its velocity and events are not observed.
+      const bool sim_trace =
+          txy && header.size() == 6 && header[3] == "vx" && header[4] == "vy" && header[5] == "event";
+      if (!(txy && header.size() == 3) && !has_contacts && !sim_trace) {
+        fail(path, line_no,
+             "header must be 't,x,y', 't,x,y,left_contact,right_contact' or sim --trace's 't,x,y,vx,vy,event', "
+             "got '" + text + "'");
       }
+      columns = header.size();
       continue;
     }
     if (text.find_first_not_of(" \t") == std::string::npos) continue;  // blank line
     const auto f = split(text);
-    const std::size_t want = has_contacts ? 5 : 3;
-    if (f.size() != want) {
-      fail(path, line_no, "expected " + std::to_string(want) + " columns, got " + std::to_string(f.size()));
+    if (f.size() != columns) {
+      fail(path, line_no, "expected " + std::to_string(columns) + " columns, got " + std::to_string(f.size()));
     }
     ObservationRow row;
     row.observation.t_s = number(path, line_no, f[0], "t");

@@ -1,6 +1,8 @@
 #pragma once
 // Observation files: CSV with header t,x,y (s, m, board frame), optionally
-// followed by left_contact,right_contact (0/1 flipper contact sensors).
+// followed by left_contact,right_contact (0/1 flipper contact sensors), or
+// `pinball sim --trace`'s t,x,y,vx,vy,event (the true state each step: its
+// position is read, its velocity and events are not observations).
 
 #include <string>
 #include <vector>

@@ -1,0 +1,66 @@
+#include "pinball/track/observation_io.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+namespace pinball::track {
+namespace {
+
+std::string write_csv(const std::string& name, const std::string& text) {
+  const std::string path = (std::filesystem::path(::testing::TempDir()) / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string read_error(const std::string& path) {
+  try {
+    read_observations_csv(path);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(ObservationIo, ReadsPositionsAndContacts) {
+  const auto plain = read_observations_csv(write_csv("plain.csv", "t,x,y\n0,0.1,0.2\n0.005,0.1,0.19\n"));
+  ASSERT_EQ(plain.size(), 2u);
+  EXPECT_DOUBLE_EQ(plain[1].observation.t_s, 0.005);
+  EXPECT_DOUBLE_EQ(plain[1].observation.p_board.y(), 0.19);
+  EXPECT_FALSE(plain[1].contacts.left);
+  const auto contacts = read_observations_csv(
+      write_csv("contacts.csv", "t,x,y,left_contact,right_contact\n0,0.1,0.2,1,0\n"));
+  ASSERT_EQ(contacts.size(), 1u);
+  EXPECT_TRUE(contacts[0].contacts.left);
+  EXPECT_FALSE(contacts[0].contacts.right);
+}
+
+// `pinball sim --trace` feeds `pinball track` as it is: positions read,
+// velocity and events (one field, '|' between several) left out.
+TEST(ObservationIo, ReadsASimTrace) {
+  const auto rows = read_observations_csv(write_csv(
+      "trace.csv", "t,x,y,vx,vy,event\n0.0005,0.45,0.05,0,1.2,launch\n0.001,0.45,0.0506,0,1.19,hit:post|bank:b\n"));
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_DOUBLE_EQ(rows[1].observation.p_board.x(), 0.45);
+  EXPECT_DOUBLE_EQ(rows[1].observation.p_board.y(), 0.0506);
+}
+
+TEST(ObservationIo, BadFilesAreRefusedNamingTheLine) {
+  const std::string header = write_csv("header.csv", "time,x,y\n0,0,0\n");
+  EXPECT_NE(read_error(header).find(header + ":1: header must be 't,x,y'"), std::string::npos) << read_error(header);
+  const std::string short_row = write_csv("short.csv", "t,x,y,vx,vy,event\n0,0.1,0.2\n");
+  EXPECT_NE(read_error(short_row).find(short_row + ":2: expected 6 columns, got 3"), std::string::npos)
+      << read_error(short_row);
+  const std::string backwards = write_csv("backwards.csv", "t,x,y\n0.01,0,0\n0.005,0,0\n");
+  EXPECT_NE(read_error(backwards).find(backwards + ":3: time must increase"), std::string::npos);
+  const std::string nan = write_csv("nan.csv", "t,x,y\n0,nan,0\n");
+  EXPECT_NE(read_error(nan).find(nan + ":2: column 'x' is not a finite number"), std::string::npos);
+  const std::string empty = write_csv("empty.csv", "");
+  EXPECT_NE(read_error(empty).find(empty + ":1: empty file"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace pinball::track
