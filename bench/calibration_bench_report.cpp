@@ -26,7 +26,8 @@ nlohmann::json to_json(const CalibrationReport& r) {
                        {"median_impact_error_mm", t.median_impact_mm}, {"p90_impact_error_mm", t.p90_impact_mm},
                        {"median_dt_impact_ms", t.median_dt_ms}, {"median_abs_dh", t.median_abs_dh}});
   }
-  return {{"board", r.board},
+  return {{"benchmark", "calibration"},
+          {"board", r.board},
           {"seed", r.options.seed},
           {"true_g_mps2", r.true_g_mps2},
           {"camera",

@@ -64,7 +64,7 @@ nlohmann::json to_json(const CameraReport& r) {
             {"distortion_max_error_px", l.comparison.distortion_max_error_px},
             {"distortion_sensor_max_error_px", l.comparison.distortion_sensor_max_error_px}};
   }
-  return {{"bench", "camera"},
+  return {{"benchmark", "camera"},
           {"board", r.board},
           {"options",
            {{"seed", o.seed},

@@ -26,7 +26,7 @@ nlohmann::json to_json(const DetectorReport& r) {
                       {"render_fps", t.render_fps}});
   }
   return {
-      {"bench", "detector"},
+      {"benchmark", "detector"},
       {"board", r.board},
       {"options",
        {{"seed", o.seed},

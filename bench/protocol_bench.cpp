@@ -177,7 +177,8 @@ ProtocolBenchReport run_protocol_bench(const ProtocolBenchOptions& o,
 }
 
 nlohmann::json to_json(const ProtocolBenchReport& r) {
-  return {{"frames", r.frames},
+  return {{"benchmark", "protocol"},
+          {"frames", r.frames},
           {"mutated", r.mutated},
           {"noise", r.noise},
           {"valid_frames", r.valid_frames},

@@ -227,7 +227,7 @@ void play_world(PlannedWorld& w, const table::Board& belief, const TransferBench
     w.row.cells.push_back(cell);
   }
   set_ratios_to_spastic(w.row.cells);
-  w.row.world_warnings = w.world->warnings().total();
+  w.row.world_warnings = w.world->warnings();
 }
 
 void check_options(const TransferBenchOptions& o) {

@@ -28,6 +28,7 @@
 #include "pinball/learn/world_perturbation.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/firmware/flipper_actuation.h"
+#include "pinball/sim/world.h"
 #include "pinball/simlab/world_factory.h"
 #include "pinball/table/board.h"
 #include "pinball/track/camera_model.h"
@@ -162,7 +163,7 @@ struct TransferWorld {
   int balls = 0;              ///< balls per cell in this world
   bool played = false;        ///< false: skipped (the twin in a build without it)
   std::string skipped_reason; ///< why, when skipped
-  std::uint64_t world_warnings = 0;  ///< the world's own warnings (the twin's MuJoCo contacts; 0 for the model)
+  sim::WorldWarnings world_warnings;  ///< the world's own warnings (the twin's MuJoCo contacts; none for the model)
   double wall_s = 0.0;        ///< elapsed wall time of this world's balls
   std::vector<TransferCell> cells;   ///< spastic first, then the options' controllers
 };

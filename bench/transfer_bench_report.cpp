@@ -97,7 +97,7 @@ nlohmann::json to_json(const TransferReport& r) {
     for (const TransferCell& c : w.cells) cells[c.controller] = cell_json(c);
     nlohmann::json row = {{"name", w.name},       {"family", w.family}, {"value", w.value},
                           {"world", w.world},     {"played", w.played}, {"balls", w.balls},
-                          {"world_warnings", w.world_warnings},       {"wall_s", w.wall_s},
+                          {"world_warnings", to_json_value(w.world_warnings)},       {"wall_s", w.wall_s},
                           {"cells", cells}};
     if (!w.played) row["skipped_reason"] = w.skipped_reason;
     worlds.push_back(row);

@@ -152,9 +152,8 @@ struct Evaluation {
   double mean_ball_time_s = 0.0;       // simulated (s)
   double flips_per_ball = 0.0;
   int balls_cut_at_time_limit = 0;
-  std::int64_t balls_played = 0;       // by this run; the rest came from --checkpoint
   double wall_s = 0.0;
-  double balls_per_s = 0.0;            // balls played over the wall clock; NaN (null) when none was
+  double balls_per_s = 0.0;            // over the wall clock; NaN (null) when --checkpoint held every ball
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -165,7 +164,6 @@ struct Evaluation {
     a->Visit(PINBALL_NVP(mean_ball_time_s));
     a->Visit(PINBALL_NVP(flips_per_ball));
     a->Visit(PINBALL_NVP(balls_cut_at_time_limit));
-    a->Visit(PINBALL_NVP(balls_played));
     a->Visit(PINBALL_NVP(wall_s));
     a->Visit(PINBALL_NVP(balls_per_s));
   }
@@ -211,11 +209,11 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
   e.score_stddev = score.stddev();
   e.mean_ball_time_s = duration_s.mean();
   e.flips_per_ball = flips.mean();
-  e.balls_played = balls_done.done();
   e.wall_s = wall;
-  // A resumed run's balls replayed from the checkpoint took no time: no rate.
-  e.balls_per_s = e.balls_played > 0 && wall > 0.0 ? static_cast<double>(e.balls_played) / wall
-                                                   : std::numeric_limits<double>::quiet_NaN();
+  // A resumed run whose checkpoint held every ball played none in no time: no rate.
+  // (Under MPI this rank's count is its share; the rate is the job's, balls over the wall.)
+  e.balls_per_s = balls_done.done() > 0 && wall > 0.0 ? static_cast<double>(e.balls) / wall
+                                                      : std::numeric_limits<double>::quiet_NaN();
   return e;
 }
 
@@ -599,7 +597,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     result_spec.shot_table = im.table;
     nlohmann::json rounds = nlohmann::json::array();
     for (const learn::ImitationRound& r : im.rounds) {
-      rounds.push_back({{"round", r.round}, {"player", r.round == 0 ? "teacher" : "learner"}, {"balls", r.balls},
+      rounds.push_back({{"round", r.round + 1}, {"player", r.round == 0 ? "teacher" : "learner"}, {"balls", r.balls},
                         {"examples", r.shots}, {"mean_score_per_ball", r.mean_score},
                         {"mean_ball_time_s", r.mean_ball_time_s}, {"balls_cut_at_time_limit", r.cut}, {"fires", r.fires},
                         {"unmatched_fires", r.unmatched_fires}, {"wall_s", r.wall_s}});
@@ -647,7 +645,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     }
     if (j.contains("rounds")) {
       for (const auto& r : j["rounds"]) {
-        out << "round " << r["round"].get<int>() + 1 << " (" << r["player"].get<std::string>() << ")  "
+        out << "round " << r["round"].get<int>() << " (" << r["player"].get<std::string>() << ")  "
             << r["balls"] << " balls, " << num(r["mean_score_per_ball"], 4) << " per ball, " << r["examples"]
             << " shots so far, " << num(r["wall_s"]) << " s\n";
       }
@@ -670,8 +668,9 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
           << format_mean_ci(e["mean_score_per_ball"].get<double>(), e["score_ci95_half_width"].get<double>())
           << " per ball (95 %), " << num(e["mean_ball_time_s"]) << " s per ball, " << num(e["flips_per_ball"])
           << " flips per ball, "
-          << (e["balls_played"].get<int>() > 0 ? num(e["balls_per_s"]) + " balls/s\n"
-                                                : std::string("every ball from the checkpoint\n"));
+          << (e["balls_per_s"].is_number() && std::isfinite(e["balls_per_s"].get<double>())
+                  ? num(e["balls_per_s"]) + " balls/s\n"
+                  : std::string("every ball from the checkpoint\n"));
     }
   }
   return 0;

@@ -64,7 +64,7 @@ TEST(CameraBench, CorrectionsWinBackWhatTheFaultsCostAndTheReportSaysSo) {
 
   // Every figure as JSON and as text.
   const nlohmann::json j = to_json(quick_report());
-  EXPECT_EQ(j["bench"], "camera");
+  EXPECT_EQ(j["benchmark"], "camera");
   EXPECT_EQ(j["scenarios"].size(), quick_report().scenarios.size());
   EXPECT_TRUE(j["scenarios"][1]["camera"].contains("lens"));
   EXPECT_TRUE(j["scenarios"][0]["tracker"].contains("median_abs_dt_impact_ms"));

@@ -399,7 +399,6 @@ TEST_F(Cli, LearnDrainPenaltyPricesTheShotTableAndTheTeacher) {
   EXPECT_EQ(same.exit_code, 0) << same.err;
   // Every ball came from the file: no rate is made up from no time.
   const nlohmann::json replayed = nlohmann::json::parse(same.out).at("evaluation");
-  EXPECT_EQ(replayed.at("balls_played"), 0);
   EXPECT_TRUE(replayed.at("balls_per_s").is_null()) << same.out;
   EXPECT_GT(nlohmann::json::parse(same.out).at("wall_s").get<double>(), 0.0);
   for (const std::string& method : {"cem --budget-balls 2 --out " + learned, std::string("launcher")}) {

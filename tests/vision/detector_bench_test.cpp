@@ -49,7 +49,7 @@ TEST(DetectorBench, CountsFalseDetectionsOcclusionAndSpeed) {
 
 TEST(DetectorBench, JsonCarriesEveryFigure) {
   const nlohmann::json j = to_json(quick_report());
-  EXPECT_EQ(j.at("bench"), "detector");
+  EXPECT_EQ(j.at("benchmark"), "detector");
   for (const char* key : {"accuracy", "ball_free", "occlusion", "timing", "targets", "options", "wall_s"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
