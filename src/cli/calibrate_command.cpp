@@ -226,10 +226,9 @@ void run_camera(Context& c) {
   if (!c.lab && c.a.image.empty()) throw std::runtime_error("calibrate camera: give --image (or --sim BOARD)");
   const calibration::HomographyFit fit = camera(c);
   c.cal.camera = fit.calibration;
-  nlohmann::json j = {{"markers_detected", fit.detections},
-                      {"markers_used", fit.calibration.markers_used},
-                      {"reprojection_rms_px", fit.calibration.reprojection_rms_px},
-                      {"reprojection_max_px", fit.calibration.reprojection_max_px}};
+  // The section as the file writes it (homography, image size, markers, residuals), and the detections.
+  nlohmann::json j = to_json_value(fit.calibration);
+  j["markers_detected"] = fit.detections;
   if (c.lab) {
     const vision::CameraHomography h(fit.calibration.image_from_board);
     double worst = 0.0;

@@ -34,6 +34,10 @@ TEST_F(Calibrate, SimulatedLabEndToEnd) {
   ASSERT_EQ(r.exit_code, 0);
   nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("camera").at("markers_used"), 7);
+  // Every figure the file holds is in the JSON too: the homography and the image it was measured on.
+  EXPECT_EQ(j.at("camera").at("image_width_px"), 640);
+  EXPECT_EQ(j.at("camera").at("image_from_board").size(), 3u);
+  EXPECT_EQ(j.at("camera").at("markers_detected"), 7);
   EXPECT_LT(j.at("camera").at("truth").at("homography_max_error_mm").get<double>(), 1.0);
   EXPECT_TRUE(fs::exists(png));
 
