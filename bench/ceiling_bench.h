@@ -6,9 +6,10 @@
 // The ceiling player is not a controller: it reads the world's true state
 // and looks ahead in the belief's model, the thesis stepper on the board file
 // (in the default model world that is the world itself: a copy of the
-// GameState is a copy of the world; in the twin or another board it is not). Every 5 ms frame (what a 200 fps camera allows) while the ball is
-// falling within `zone_factor` ball radii of a flipper's rest position and no
-// flip is under way, it plays candidate plans ahead for the flipper nearest the
+// GameState is a copy of the world; in the twin or another board it is not).
+// Every 5 ms frame (what a 200 fps camera allows) while the ball is falling
+// within `zone_factor` ball radii of a flipper's rest position and no flip is
+// under way, it plays candidate plans ahead for the flipper nearest the
 // ball: "don't fire", and "fire at frame k (k = 0..K), hold H frames,
 // release" for each hold in `hold_frames`. A branch ends when the ball comes
 // back falling into a decision zone after having left every zone (the next

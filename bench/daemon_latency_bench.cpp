@@ -25,6 +25,12 @@ DaemonLatencyRun run_once(const DaemonLatencyOptions& o, bool realtime, const da
   std::thread stopper;
   if (realtime) {
     stopper = std::thread([&] {
+      // The window opens at the first frame, not at the call: a slow start-up (a sanitizer
+      // build on a loaded machine) once used the whole window and left no frame to measure.
+      const double give_up = steady_now_s() + 120.0;
+      while (!done.load() && d.snapshot().frames == 0 && steady_now_s() < give_up) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
       const double end = steady_now_s() + o.realtime_s;
       while (!done.load() && steady_now_s() < end) std::this_thread::sleep_for(std::chrono::milliseconds(10));
       d.request_stop();

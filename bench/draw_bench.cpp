@@ -136,7 +136,10 @@ DrawBenchReport run_draw_bench(const table::Board& board, const DrawBenchOptions
 }
 
 nlohmann::json to_json(const DrawBenchReport& r) {
-  return {{"benchmark", "draw"}, {"play", to_json(r.play)}, {"view", to_json(r.view)}, {"baseline_copy", to_json(r.copy)},
+  return {{"benchmark", "draw"},
+          {"play", to_json(r.play)},
+          {"view", to_json(r.view)},
+          {"baseline_copy", to_json(r.copy)},
           {"frames", r.frames},      {"repeats", r.repeats},    {"target_frames_per_s", 60}};
 }
 

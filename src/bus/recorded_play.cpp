@@ -7,6 +7,7 @@
 #include "pinball/bus/channels.h"
 #include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/message_convert.h"
+#include "pinball/core/format.h"
 #include "pinball/core/utime.h"
 #include "pinball_lcm/lcmt_pinball_flipper_command.hpp"
 #include "pinball_lcm/lcmt_pinball_observation.hpp"
@@ -32,12 +33,24 @@ bool decode(const LcmLogEvent& e, Message& m) {
 
 }  // namespace
 
+void check_one_run(const std::string& path, double& latest_s, double t_s, std::int64_t seq) {
+  // More than any interleaving of the daemon's threads, less than any run.
+  constexpr double kAppendedRunGap_s = 1.0;
+  if (t_s < latest_s - kAppendedRunGap_s) {
+    throw std::runtime_error(path + ": its clock goes back " + format_number(latest_s - t_s) +
+                             " s at the PINBALL_OBSERVATION of frame " + std::to_string(seq) +
+                             ": several runs appended to one log (mode=a)? Record each run to a file of its own");
+  }
+  latest_s = std::max(latest_s, t_s);
+}
+
 RecordedPlay read_recorded_play(const std::string& path) {
   const std::vector<LcmLogEvent> events = read_lcm_log(path);  // refuses empty, non-LCM and damaged logs
   RecordedPlay play;
   play.source = path;
   std::map<std::string, std::uint64_t> channel_counts;
   std::uint64_t observation_messages = 0, command_messages = 0, sightings = 0;
+  double latest_frame_s = -1e300;
   for (const LcmLogEvent& e : events) {
     ++channel_counts[e.channel];
     if (e.channel == kObservationChannel) {
@@ -51,6 +64,7 @@ RecordedPlay read_recorded_play(const std::string& path) {
         ++play.malformed;
         continue;
       }
+      check_one_run(path, latest_frame_s, o.t_s, m.seq);
       play.frames.push_back({o.t_s, m.seq, found, o.p_board, contacts.left, contacts.right});
       sightings += found ? 1 : 0;
     } else if (e.channel == kFlipperCommandChannel) {

@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <ostream>
 #include <stdexcept>
+#include <system_error>
 
 #include <nlohmann/json.hpp>
 
@@ -29,6 +31,38 @@ std::vector<bus::RecordedPlay> read_all(const std::vector<std::string>& paths) {
   std::vector<bus::RecordedPlay> plays;
   for (const std::string& path : paths) plays.push_back(bus::read_recorded_play(path));
   return plays;
+}
+
+// The same file twice would count its events twice (and a held-out log that
+// is fitted is no test); an --out that is an input would be replaced by the overlay.
+void check_distinct_files(const IdentifyArgs& a) {
+  const auto same = [](const std::string& x, const std::string& y) {
+    std::error_code ec;
+    return std::filesystem::equivalent(x, y, ec) && !ec;
+  };
+  for (std::size_t i = 0; i < a.logs.size(); ++i) {
+    for (std::size_t k = i + 1; k < a.logs.size(); ++k) {
+      if (same(a.logs[i], a.logs[k])) {
+        throw std::runtime_error("identify: " + a.logs[k] +
+                                 " is given twice among the logs: its events would count twice");
+      }
+    }
+    for (const std::string& held : a.held_out) {
+      if (same(a.logs[i], held)) {
+        throw std::runtime_error("identify: --held-out " + held + " is also a fitted log: a held-out log must be one "
+                                 "never fitted");
+      }
+    }
+  }
+  if (a.out.empty()) return;
+  std::vector<std::string> inputs = a.logs;
+  inputs.insert(inputs.end(), a.held_out.begin(), a.held_out.end());
+  inputs.push_back(find_data_file(a.board));
+  for (const std::string& in : inputs) {
+    if (same(a.out, in)) {
+      throw std::runtime_error("identify: --out " + a.out + " is the input " + in + "; it would be replaced");
+    }
+  }
 }
 
 std::string value_text(const table::IdentifiedValue& v, const char* unit) {
@@ -104,6 +138,7 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                    {"recorded_s", r.recorded_s},
                    {"frames", r.frames},
                    {"sightings", r.sightings},
+                   {"malformed_messages", r.malformed},
                    {"commands", r.commands},
                    {"free_flights", r.flights},
                    {"board_gravity_mps2", board.gravity_mps2},
@@ -142,6 +177,10 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
   out << "identify: " << a.logs.size() << " recording(s), " << format_number(r.recorded_s) << " s, " << r.frames
       << " frames (" << format_number(seen) << " % saw the ball), " << r.commands << " commands, " << r.flights
       << " free flights\n";
+  if (r.malformed > 0) {
+    out << "  " << r.malformed << " messages on PINBALL_OBSERVATION and PINBALL_FLIPPER_CMD left out: they do not "
+        << "decode, or hold numbers that are not finite\n";
+  }
   const learn::FlightGravity& g = r.gravity_no_drag;
   out << "  g along the table  " << value_text(*r.overlay.gravity_mps2, " m/s²") << " (board "
       << format_number(board.gravity_mps2) << "; " << g.flights << " flights, " << g.flights_dropped
@@ -263,6 +302,7 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
 int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
   const auto start = std::chrono::steady_clock::now();
   check_output_folder(a.out, "--out");
+  check_distinct_files(a);
   const table::Board board = table::load_board(find_data_file(a.board));  // the default too, from any folder
   const std::vector<bus::RecordedPlay> plays = read_all(a.logs);
   const std::vector<bus::RecordedPlay> held = read_all(a.held_out);
@@ -273,6 +313,17 @@ int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
   std::ostream* shown = progress_wanted(a.progress) ? &err : nullptr;
   std::optional<ProgressMeter> meter;
   std::string stage;
+  // The held-out moments first: a log too short to test on is said before the fit, not as a ratio of 0.
+  learn::PredictionOptions prediction;
+  prediction.sigma_m = a.sigma_m;
+  const std::vector<learn::PredictionStart> starts = learn::prediction_starts(held, prediction);
+  if (!held.empty() && starts.empty()) {
+    std::string names;
+    for (const std::string& h : a.held_out) names += (names.empty() ? "" : ", ") + h;
+    throw std::runtime_error("identify: --held-out " + names + " holds no moment to predict from (none with " +
+                             format_number(prediction.horizon_s * 1e3) +
+                             " ms of seen ball ahead); record more play to test on");
+  }
   const learn::IdentificationResult r =
       learn::identify_table(board, plays, options, [&](const std::string& name, int done, int total) {
         if (name != stage) meter.emplace(shown, "identify: " + name, total, "");
@@ -281,9 +332,6 @@ int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
       });
   std::optional<HeldOut> held_out;
   if (!held.empty()) {
-    learn::PredictionOptions prediction;
-    prediction.sigma_m = a.sigma_m;
-    const std::vector<learn::PredictionStart> starts = learn::prediction_starts(held, prediction);
     table::Board identified = board;
     table::apply_board_overlay(r.overlay, "(identified)", identified);
     held_out = HeldOut{starts.size(), learn::prediction_error(board, held, starts, prediction),

@@ -513,9 +513,10 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     }
     if (r.generations == 0) {
       // The seed search alone spent the budget: the "best" is an untrained prototype.
-      throw std::runtime_error("learn: --budget-balls " + std::to_string(a.budget_balls) + " ran out before the first " +
-                               a.method + " generation (" + std::to_string(r.balls_used) +
-                               " balls played; a generation needs " + std::to_string(r.generation_balls) +
+      throw std::runtime_error("learn: --budget-balls " + std::to_string(a.budget_balls) +
+                               " ran out before the first " + a.method + " generation (" +
+                               std::to_string(r.balls_used) + " balls played; a generation needs " +
+                               std::to_string(r.generation_balls) +
                                " left after the seed search); no controller written");
     }
     result_spec = r.best;

@@ -10,6 +10,7 @@
 #include "pinball/bus/channels.h"
 #include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/message_convert.h"
+#include "pinball/bus/recorded_play.h"
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/core/utime.h"
@@ -66,6 +67,7 @@ ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
   ControllerStage stage(*controller, bus, controller_stage_options_for(config, board));
 
   ReplayReport r;
+  double latest_observation_s = -1e300;
   std::vector<Decision> recorded, replayed;
   ProjectionRecord record;
   ControllerStage::Commands cmds;
@@ -81,6 +83,7 @@ ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
         ++r.malformed;
         continue;
       }
+      bus::check_one_run(log_path, latest_observation_s, o.t_s, m.seq);
       ++r.observations;
       if (layout == bus::ObservationLayout::kBeforeDelivery) ++r.observations_without_latency;
       camera.track(found, o, from_utime(m.delivered_utime), c, 0.0, record);

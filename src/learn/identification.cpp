@@ -430,6 +430,7 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
     const bus::RecordedPlay& play = recordings[r];
     result.overlay.recordings.push_back(play.source);
     result.frames += play.frames.size();
+    result.malformed += play.malformed;
     result.commands += play.commands.size();
     result.recorded_s += play.duration_s();
     for (const bus::RecordedFrame& f : play.frames) result.sightings += f.found ? 1 : 0;

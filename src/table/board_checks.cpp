@@ -91,7 +91,8 @@ void check_start(const LoadState& state) {
     }
   }
   if ((p - board.launcher.position).norm() < r && v.norm() < min_launch_speed_mps(board)) {
-    fail("a ball at fields X Y this slow (" + in_file_unit(state, v.norm(), "/s") + ") counts as resting in the launcher and "
+    fail("a ball at fields X Y this slow (" + in_file_unit(state, v.norm(), "/s") +
+         ") counts as resting in the launcher and "
          "would be served again for ever");
   }
 }

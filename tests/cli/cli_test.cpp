@@ -692,7 +692,8 @@ TEST_F(Cli, OutputsAreCheckedFirstAndARefusedRunWritesNothing) {
   const CommandResult jpg = run("learn boards/mit1993.board --method tournament --budget-balls 100 --threads 1 --out " +
                                 (dir_ / "c.json").string() + " --plot " + (dir_ / "curve.jpg").string());
   EXPECT_EQ(jpg.exit_code, 1);
-  EXPECT_NE(jpg.err.find("--plot " + (dir_ / "curve.jpg").string() + ": a PNG is written"), std::string::npos) << jpg.err;
+  EXPECT_NE(jpg.err.find("--plot " + (dir_ / "curve.jpg").string() + ": a PNG is written"), std::string::npos)
+      << jpg.err;
   EXPECT_FALSE(fs::exists(dir_ / "c.json"));
   const CommandResult precision = run("bench precision --quick --csv " + (dir_ / "p.csv").string() + " --png " +
                                       nowhere + "/p.png");
@@ -779,7 +780,8 @@ TEST_F(Cli, FindsTheShippedBoardsAndControllersFromAnyFolder) {
                                              "--balls 1 --max-ball-time 2");
   EXPECT_EQ(overlay.exit_code, 0) << overlay.err;
   // (found: the refusal is the method's, after the parse)
-  const CommandResult drawn = run_in(dir_, "learn boards/mit1993.board --method spastic --randomize config/randomize.yaml");
+  const CommandResult drawn =
+      run_in(dir_, "learn boards/mit1993.board --method spastic --randomize config/randomize.yaml");
   EXPECT_NE(drawn.err.find("--randomize is for a search"), std::string::npos) << drawn.err;
   // A board found nowhere is still refused, naming what was typed.
   const CommandResult missing = run_in(dir_, "sim boards/no_such.board");

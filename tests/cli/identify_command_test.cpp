@@ -118,10 +118,48 @@ TEST_F(IdentifyCommand, BadLogsAreRefusedNamingTheFileAndNothingIsWritten) {
     EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
     EXPECT_FALSE(std::filesystem::exists(overlay)) << log;
   }
+  // Two runs appended to one log (mode=a): the clock goes back, and sorting would shuffle the games.
+  const std::string appended = write("appended.lcm", good_log + good_log);
+  const pinball::testing::CommandResult twice = run("identify " + appended + " --out " + overlay);
+  EXPECT_EQ(twice.exit_code, 1);
+  EXPECT_NE(twice.err.find(appended + ": its clock goes back"), std::string::npos) << twice.err;
+  EXPECT_FALSE(std::filesystem::exists(overlay));
   const pinball::testing::CommandResult no_folder =
       run("identify " + write("ok.lcm", good_log) + " --out " + (dir_ / "no" / "such.yaml").string());
   EXPECT_EQ(no_folder.exit_code, 1);
   EXPECT_NE(no_folder.err.find("does not exist"), std::string::npos) << no_folder.err;
+}
+
+// What would count events twice, test on what was fitted, or replace an input
+// (or a device) is refused before the fit; the inputs are left as they were.
+TEST_F(IdentifyCommand, RefusesRepeatedInputsAndAnOutThatIsNoNewFile) {
+  const std::string log = record("one.lcm", 2, 5);
+  const std::string bytes = pinball::testing::slurp(log);
+  const pinball::testing::CommandResult twice = run("identify " + log + " " + log);
+  EXPECT_EQ(twice.exit_code, 1);
+  EXPECT_NE(twice.err.find("is given twice among the logs"), std::string::npos) << twice.err;
+  const pinball::testing::CommandResult held = run("identify " + log + " --held-out " + log);
+  EXPECT_EQ(held.exit_code, 1);
+  EXPECT_NE(held.err.find("is also a fitted log"), std::string::npos) << held.err;
+  const pinball::testing::CommandResult over = run("identify " + log + " --out " + log);
+  EXPECT_EQ(over.exit_code, 1);
+  EXPECT_NE(over.err.find("--out " + log + " is the input"), std::string::npos) << over.err;
+  EXPECT_EQ(pinball::testing::slurp(log), bytes);
+  const pinball::testing::CommandResult device = run("identify " + log + " --bootstrap 0 --out /dev/null");
+  EXPECT_EQ(device.exit_code, 1);
+  EXPECT_NE(device.err.find("/dev/null: is not a regular file"), std::string::npos) << device.err;
+  EXPECT_TRUE(std::filesystem::is_character_file("/dev/null"));
+}
+
+// A held-out log too short to test on is said so, not scored as a ratio of 0.
+TEST_F(IdentifyCommand, AHeldOutLogWithNoMomentIsRefused) {
+  const std::string log = record("fit.lcm", 2, 6);
+  bus::RecordedPlay tiny = pinball::testing::record_model_play(pinball::testing::thesis_board(), 1, 0.0005, 7);
+  tiny.frames.resize(20);
+  const std::string held = write("tiny.lcm", bus::recorded_play_log(tiny));
+  const pinball::testing::CommandResult r = run("identify " + log + " --held-out " + held);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--held-out " + held + " holds no moment to predict from"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <string>
 
@@ -49,8 +51,27 @@ TEST(TextFile, AWriteThatFailsLeavesTheOldFileAndNoTemporary) {
     write_text_file((dir / "nowhere" / "c.json").string(), "x\n");
     ADD_FAILURE() << "a write into a missing folder succeeded";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), (dir / "nowhere" / "c.json").string() + ": cannot write");
+    EXPECT_EQ(std::string(e.what()), (dir / "nowhere" / "c.json").string() + ": cannot write (No such file or directory)");
   }
+  fs::remove_all(dir);
+}
+
+// `--out /dev/null` (or /dev/full, a pipe): the rename would have put a file
+// where the device was. Refused, the device untouched.
+TEST(TextFile, AWriteOverSomethingThatIsNoFileIsRefused) {
+  const fs::path dir = fresh_folder("text_file_device");
+  const fs::path fifo = dir / "pipe";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    write_text_file(fifo.string(), "x\n");
+    ADD_FAILURE() << "a pipe was replaced";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(fifo.string() + ": is not a regular file"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_EQ(entries(dir), 1u);
+  EXPECT_THROW(write_text_file("/dev/null", "x\n"), std::runtime_error);
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
   fs::remove_all(dir);
 }
 

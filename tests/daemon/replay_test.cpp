@@ -289,10 +289,28 @@ TEST(Replay, ALogOfAnotherTypeOnTheChannelIsSaidToBeMalformed) {
   EXPECT_EQ(WEXITSTATUS(json_status), 3);
   std::ifstream json_in(text_out);
   const nlohmann::json j = nlohmann::json::parse(json_in);
-  EXPECT_EQ(j.at("verdict").get<std::string>().rfind("NOT reproduced: no PINBALL_OBSERVATION message decoded (5", 0), 0u)
-      << j.dump();
+  const std::string said = j.at("verdict").get<std::string>();
+  EXPECT_EQ(said.rfind("NOT reproduced: no PINBALL_OBSERVATION message decoded (5", 0), 0u) << said;
   std::remove(log.c_str());
   std::remove(text_out.c_str());
+}
+
+// Two runs in one log (lcm_url mode=a): the second's clock starts again.
+// Replayed as one run its decisions would meet the first run's ball: refused.
+TEST(Replay, TwoRunsAppendedToOneLogAreRefused) {
+  const std::string both = ::testing::TempDir() + "/pinball_replay_appended_" + std::to_string(getpid()) + ".lcmlog";
+  {
+    std::ifstream in(recorded_log(), std::ios::binary);
+    const std::string run((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(both, std::ios::binary) << run << run;
+  }
+  try {
+    replay_log(both, config_for_test());
+    FAIL() << "an appended log replayed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(both + ": its clock goes back"), std::string::npos) << e.what();
+  }
+  std::remove(both.c_str());
 }
 
 TEST(Replay, MissingLogIsNamed) {

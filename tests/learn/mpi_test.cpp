@@ -56,7 +56,8 @@ class Mpi : public testing::CommandTest {
 };
 
 TEST_F(Mpi, ASearchIsTheSameOnOneTwoAndThreeRanks) {
-  const std::string args = "learn boards/mit1993.board --method cem --budget-balls 96 --population 8 --seed 5 --eval-balls 24 --json --out ";
+  const std::string args =
+      "learn boards/mit1993.board --method cem --budget-balls 96 --population 8 --seed 5 --eval-balls 24 --json --out ";
   const testing::CommandResult one = run(args + file("one.json") + " --threads 2");
   ASSERT_EQ(one.exit_code, 0) << one.err;
   const testing::CommandResult two = run_shell(mpirun(2) + args + file("two.json") + " --threads 1");

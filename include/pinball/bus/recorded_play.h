@@ -44,8 +44,16 @@ struct RecordedPlay {
 /// unreadable, empty, not an LCM log or truncated (bus::require_lcm_log);
 /// a log with no PINBALL_OBSERVATION or no PINBALL_FLIPPER_CMD messages (the
 /// message lists the channels it has); a log whose messages on those channels
-/// are not pinball messages (none decodes); and one where no frame saw the ball.
+/// are not pinball messages (none decodes); one where no frame saw the ball;
+/// and one whose clock goes back more than a second (runs appended with
+/// lcm_url mode=a, which sorting by time would shuffle together).
 RecordedPlay read_recorded_play(const std::string& path);
+
+/// The readers' check that a log holds one run: an observation at `t_s` more
+/// than a second before `latest_s` (the latest so far, updated here) is a
+/// clock that started again, a second run appended (lcm_url mode=a). Throws
+/// std::runtime_error "path: its clock goes back ..." naming the frame.
+void check_one_run(const std::string& path, double& latest_s, double t_s, std::int64_t seq);
 
 /// `play` as the bytes of an LCM log (frames and commands interleaved in time
 /// order, stamped with their own times), which read_recorded_play reads back:

@@ -6,6 +6,8 @@
 
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -28,16 +30,26 @@ inline std::string read_text_file(const std::string& path) {
 
 /// Writes `bytes` to a temporary beside `path` and returns its name, for a
 /// rename over `path` once whole (write_text_file, or several files renamed
-/// together). Throws std::runtime_error "path: cannot write", leaving none.
+/// together). Throws std::runtime_error "path: cannot write (why)", leaving
+/// none; and "path: is not a regular file ..." when something other than a
+/// file is there (a device such as /dev/null, a pipe): the rename would
+/// replace it with a file.
 inline std::string write_temporary_beside(const std::string& path, const std::string& bytes) {
+  std::error_code ec;
+  const std::filesystem::file_status there = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(there) && !std::filesystem::is_regular_file(there)) {
+    throw std::runtime_error(path + ": is not a regular file (a device, a pipe or a folder); it would be replaced by "
+                                    "the file written, so it is refused");
+  }
   const std::string tmp = path + ".tmp" + std::to_string(::getpid());
   std::ofstream out(tmp, std::ios::binary);
+  const int open_errno = out.is_open() ? 0 : errno;
   out << bytes;
   out.close();
   if (!out) {
-    std::error_code ec;
     std::filesystem::remove(tmp, ec);
-    throw std::runtime_error(path + ": cannot write");
+    throw std::runtime_error(path + ": cannot write" +
+                             (open_errno != 0 ? " (" + std::string(std::strerror(open_errno)) + ")" : std::string()));
   }
   return tmp;
 }
