@@ -46,6 +46,15 @@ TEST(ObservationIo, ReadsASimTrace) {
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_DOUBLE_EQ(rows[1].observation.p_board.x(), 0.45);
   EXPECT_DOUBLE_EQ(rows[1].observation.p_board.y(), 0.0506);
+  // Balls after the first: the lost one and the next one served share a time; the served one stands.
+  const auto balls = read_observations_csv(write_csv(
+      "balls.csv", "t,x,y,vx,vy,event\n5.0,0.25,0.01,0,-1,\n5.0005,0.25,0.0,0,-1,lost\n5.0005,0.45,0.05,0,0,\n"
+                   "5.001,0.45,0.0506,0,1.2,launch\n"));
+  ASSERT_EQ(balls.size(), 3u);
+  EXPECT_DOUBLE_EQ(balls[1].observation.p_board.x(), 0.45);
+  // Observations proper keep the rule: a time twice is refused.
+  const std::string twice = write_csv("twice.csv", "t,x,y\n0.01,0,0\n0.01,0,0\n");
+  EXPECT_NE(read_error(twice).find(twice + ":3: time must increase"), std::string::npos);
 }
 
 TEST(ObservationIo, BadFilesAreRefusedNamingTheLine) {
