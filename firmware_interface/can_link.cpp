@@ -73,9 +73,13 @@ CanLinkVerdict judge_can_link(const CanLinkStatus& s, const std::string& interfa
   const auto refuse = [](std::string why) { return CanLinkVerdict{false, std::move(why)}; };
   if (!s.exists) {
     return refuse("no interface " + interface + (s.read_error.empty() ? "" : " (" + s.read_error + ")") +
-                  "; `ip -details link show type can` lists the CAN interfaces");
+                  "; `ip -details link show type can` lists the CAN interfaces (a virtual one for tests: "
+                  "`sudo modprobe vcan; sudo ip link add dev " + interface + " type vcan; sudo ip link set " +
+                  interface + " up`)");
   }
   if (!s.is_can) return refuse(interface + " is not a CAN interface; `ip -details link show type can` lists them");
+  // A virtual interface has no bit rate to set: it only needs to be up.
+  if (!s.up && s.is_virtual) return refuse(interface + " is down (sudo ip link set " + interface + " up)");
   if (!s.up) return refuse(interface + " is down" + fix);
   if (s.is_virtual) {
     return {true, interface + " is a virtual interface: no controller, no bit rate to check"};

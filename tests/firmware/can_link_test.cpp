@@ -75,7 +75,9 @@ TEST(CanLink, AVirtualInterfaceHasNoBitRateAndIsAccepted) {
   EXPECT_TRUE(v.ok);
   EXPECT_EQ(v.message, "vcan0 is a virtual interface: no controller, no bit rate to check");
   s.up = false;
-  EXPECT_FALSE(judge_can_link(s, "vcan0", 500000).ok);  // but it must be up
+  const CanLinkVerdict down = judge_can_link(s, "vcan0", 500000);
+  EXPECT_FALSE(down.ok);  // but it must be up, and bringing it up needs no bit rate
+  EXPECT_EQ(down.message, "vcan0 is down (sudo ip link set vcan0 up)");
 }
 
 TEST(CanLink, AMissingInterfaceIsNamed) {

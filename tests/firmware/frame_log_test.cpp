@@ -92,7 +92,9 @@ TEST(FrameLog, ANormalRunWritesEveryFrameByteForByte) {
       // Bursts of 1000, far faster than any CAN bus, each drained before the
       // next: a fixed 2 ms pause between them failed on a loaded 2-core
       // machine, where the writer thread can wait longer than that for a core.
-      if (i % 1000 == 999) ASSERT_TRUE(log.flush());
+      if (i % 1000 == 999) {
+        ASSERT_TRUE(log.flush());
+      }
     }
     log.close();
     c = log.counters();
