@@ -109,6 +109,7 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                                     {"why_not", t.identified ? nlohmann::json(nullptr) : nlohmann::json(t.why_not)},
                                     {"thickness_m", t.thickness_m},
                                     {"stderr_m", t.stderr_m},
+                                    {"at_scan_edge", t.at_scan_edge},
                                     {"moments", t.moments},
                                     {"error_at_zero_m", t.error_at_zero_m},
                                     {"error_fitted_m", t.error_fitted_m},
@@ -241,7 +242,9 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     out << "  wall thickness     " << format_number(r.wall_thickness.thickness_m * 1000.0) << " ± "
         << format_number(r.wall_thickness.stderr_m * 1000.0, 2) << " mm, every two-sided wall (" << r.wall_thickness.moments
         << " moments: the model's mean error 100 ms ahead " << format_number(r.wall_thickness.error_at_zero_m * 1000.0)
-        << " mm with the file's lines -> " << format_number(r.wall_thickness.error_fitted_m * 1000.0) << " mm)\n";
+        << " mm with the file's lines -> " << format_number(r.wall_thickness.error_fitted_m * 1000.0) << " mm"
+        << (r.wall_thickness.at_scan_edge ? "; least at the scan's edge: its uncertainty is half a scan step" : "")
+        << ")\n";
   for (const learn::NotIdentified& n : r.not_identified)
     out << "  not identified: " << n.parameter << ": " << n.why << "\n";
   if (held_out) {

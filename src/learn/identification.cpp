@@ -356,6 +356,11 @@ WallThicknessFit fit_wall_thickness(const table::Board& belief, std::span<const 
     spread.add(best_of(means(resample)));
   }
   fit.stderr_m = spread.stddev();
+  // At an edge of the scan every resample lands on the edge itself, a spread of 0 that
+  // claims a precision the scan does not have: no finer than half a step there.
+  const auto least = std::min_element(m.begin(), m.end()) - m.begin();
+  fit.at_scan_edge = least == 0 || least == kSteps - 1;
+  if (fit.at_scan_edge) fit.stderr_m = std::max(fit.stderr_m, 0.5 * kStep_m);
   fit.identified = true;
   return fit;
 }

@@ -81,6 +81,11 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   // The walls' thickness: the scan behind it, and the overlay's value.
   ASSERT_TRUE(j["wall_thickness"]["identified"].get<bool>()) << j["wall_thickness"].dump();
   EXPECT_EQ(j["wall_thickness"]["scan"].size(), 9u);
+  // A value on the scan's edge (this world's walls are lines: 0 mm) is known no finer than half a step, not ± 0.
+  EXPECT_GT(j["wall_thickness"]["stderr_m"].get<double>(), 0.0);
+  if (j["wall_thickness"]["at_scan_edge"].get<bool>()) {
+    EXPECT_GE(j["wall_thickness"]["stderr_m"].get<double>(), 0.00025);
+  }
   EXPECT_LE(j["wall_thickness"]["error_fitted_m"].get<double>(), j["wall_thickness"]["error_at_zero_m"].get<double>());
   ASSERT_TRUE(written.wall_thickness_m.has_value());
   EXPECT_DOUBLE_EQ(written.wall_thickness_m->value, j["wall_thickness"]["thickness_m"].get<double>());

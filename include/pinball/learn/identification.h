@@ -125,6 +125,7 @@ struct WallThicknessFit {
   std::string why_not;                 ///< when not identified
   double thickness_m = 0.0;            ///< the best thickness (m)
   double stderr_m = 0.0;               ///< its standard uncertainty: bootstrap over the moments (m)
+  bool at_scan_edge = false;           ///< least error at 0 or 4 mm: not bracketed, known no finer than a step
   std::size_t moments = 0;             ///< moments predicted at every thickness tried
   double error_at_zero_m = 0.0;        ///< mean 100 ms error with the walls the file's lines (m)
   double error_fitted_m = 0.0;         ///< ... with the best thickness (m)
