@@ -697,7 +697,9 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   nlohmann::json lat = nlohmann::json::object();
   for (int s = 0; s < kStageCount; ++s) {
     const LatencySummary& x = r.latency[static_cast<std::size_t>(s)];
-    lat[stage_name(s)] = {{"count", x.count}, {"p50_us", x.p50_us}, {"p99_us", x.p99_us}, {"max_us", x.max_us}};
+    // A stage that measured nothing has no quantiles: null, not 0 us.
+    const auto us = [&x](double v) { return x.count > 0 ? nlohmann::json(v) : nlohmann::json(); };
+    lat[stage_name(s)] = {{"count", x.count}, {"p50_us", us(x.p50_us)}, {"p99_us", us(x.p99_us)}, {"max_us", us(x.max_us)}};
   }
   j["latency"] = lat;
   j["frames"] = r.frames;
@@ -783,8 +785,13 @@ std::string report_to_text(const DaemonReport& r) {
     << "p50" << std::setw(10) << "p99" << std::setw(10) << "max" << "\n";
   for (int s = 0; s < kStageCount; ++s) {
     const LatencySummary& x = r.latency[static_cast<std::size_t>(s)];
-    o << std::left << std::setw(24) << stage_name(s) << std::right << std::setw(10) << x.count << std::setw(10)
-      << x.p50_us << std::setw(10) << x.p99_us << std::setw(10) << x.max_us << "\n";
+    o << std::left << std::setw(24) << stage_name(s) << std::right << std::setw(10) << x.count;
+    if (x.count > 0) {
+      o << std::setw(10) << x.p50_us << std::setw(10) << x.p99_us << std::setw(10) << x.max_us;
+    } else {
+      o << std::setw(10) << "-" << std::setw(10) << "-" << std::setw(10) << "-";
+    }
+    o << "\n";
   }
   o << "recordings: ";
   if (r.can_log) o << "CAN log " << r.can_log->written << " frames written, " << r.can_log->dropped() << " dropped; ";

@@ -842,6 +842,9 @@ TEST(Daemon, TheReportSaysARunEndedBySignalAndHasNoMeanOfNoBall) {
   EXPECT_TRUE(j["mean_score_per_ball"].is_null());
   EXPECT_TRUE(j["mean_ball_time_s"].is_null());
   EXPECT_EQ(report_to_text(none).find("mean score"), std::string::npos) << report_to_text(none);
+  // Nor latencies of no frame: a stage with count 0 has no quantiles.
+  EXPECT_EQ(j["latency"][stage_name(kFrameToCan)]["count"], 0);
+  EXPECT_TRUE(j["latency"][stage_name(kFrameToCan)]["p99_us"].is_null());
 }
 
 TEST(Daemon, UdpmInLockstepWarnsThatALoggerWouldLoseMessages) {
