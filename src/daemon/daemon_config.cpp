@@ -293,7 +293,7 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
             "is " + std::to_string(v.version) + ", this build reads " + std::to_string(kConfigVersion));
     YamlReadArchive(source_name).read(root, "", &c);
   } catch (const YamlSyntaxError& e) {
-    throw ConfigError(source_name + ":" + e.key() + ": not valid YAML: " + e.message());
+    throw ConfigError(source_name + ":" + e.key() + ": " + e.message());
   } catch (const KeyError& e) {
     // The archive says "file:key: message"; this file's errors say "file: key: message".
     throw ConfigError(source_name + ": " + e.key() + ": " + e.message());

@@ -444,10 +444,15 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
     if (progress) progress("free flights", static_cast<int>(r + 1), static_cast<int>(recordings.size()));
   }
   result.flights = flights.size();
-  if (flights.size() < 2)
-    throw std::runtime_error("the recordings hold " + std::to_string(flights.size()) +
-                             " free flights (at least " + std::to_string(options.flights.min_points) +
-                             " sightings in a row clear of everything); nothing can be identified");
+  if (flights.size() < 2) {
+    std::string names;
+    for (const bus::RecordedPlay& play : recordings) names += (names.empty() ? "" : ", ") + play.source;
+    throw std::runtime_error(names + ": " + std::to_string(flights.size()) + " free flights in " +
+                             format_number(result.recorded_s) + " s of play (a free flight: at least " +
+                             std::to_string(options.flights.min_points) +
+                             " sightings in a row clear of everything), 2 needed for g, the first parameter; "
+                             "nothing can be identified: record more play");
+  }
   const auto bootstrap_progress = [&](int done, int total) {
     if (progress) progress("gravity bootstrap", done, total);
   };

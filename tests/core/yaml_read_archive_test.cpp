@@ -103,7 +103,7 @@ TEST(YamlReadArchive, AFileHoldsOneDocument) {
     FAIL() << "a second document was accepted";
   } catch (const YamlSyntaxError& e) {
     EXPECT_EQ(e.key(), "3");  // the line where it starts
-    EXPECT_EQ(e.message(), "a second YAML document (after ---): a file holds one");
+    EXPECT_EQ(e.message(), "not valid YAML: a second YAML document (after ---): a file holds one");
   }
   EXPECT_THROW(load_yaml("count: 1\n---\n", "t.yaml"), YamlSyntaxError);
   EXPECT_TRUE(load_yaml("", "t.yaml").IsNull());

@@ -235,9 +235,10 @@ TEST(BoardOverlay, UnreadableOrUnparsableFilesNameTheFile) {
   try {
     read_board_overlay(bad);
     ADD_FAILURE() << "parsed bad YAML";
-  } catch (const KeyError& e) {  // YamlSyntaxError: "file:line: what yaml-cpp says"
+  } catch (const KeyError& e) {  // YamlSyntaxError: "file:line: not valid YAML: what yaml-cpp says"
     EXPECT_EQ(e.file(), bad);
     EXPECT_EQ(e.key(), "3") << e.what();
+    EXPECT_EQ(e.message().rfind("not valid YAML: ", 0), 0u) << e.what();
   }
   std::filesystem::remove(bad);
 }

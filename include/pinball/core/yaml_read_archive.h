@@ -68,18 +68,19 @@ class YamlSyntaxError : public KeyError {
 };
 
 /// Parses YAML text holding at most one document (none: a null node).
-/// Throws YamlSyntaxError, also for a second document after `---`: yaml-cpp's
-/// Load would keep the first and silently drop the rest.
+/// Throws YamlSyntaxError "file:line: not valid YAML: ...", also for a second
+/// document after `---`: yaml-cpp's Load would keep the first and silently
+/// drop the rest.
 inline YAML::Node load_yaml(const std::string& text, const std::string& file) {
   std::vector<YAML::Node> documents;
   try {
     documents = YAML::LoadAll(text);
   } catch (const YAML::ParserException& e) {
-    throw YamlSyntaxError(file, std::to_string(e.mark.line + 1), e.msg);
+    throw YamlSyntaxError(file, std::to_string(e.mark.line + 1), "not valid YAML: " + e.msg);
   }
   if (documents.size() > 1) {
     throw YamlSyntaxError(file, std::to_string(documents[1].Mark().line + 1),
-                          "a second YAML document (after ---): a file holds one");
+                          "not valid YAML: a second YAML document (after ---): a file holds one");
   }
   return documents.empty() ? YAML::Node() : documents.front();
 }

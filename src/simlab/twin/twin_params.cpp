@@ -96,12 +96,8 @@ TwinParams load_twin_params(const std::string& path) {
   std::stringstream text;
   text << in.rdbuf();
   TwinParams p;
-  try {
-    const YAML::Node root = load_yaml(text.str(), path);
-    YamlReadArchive(path, {.refuse_unknown_keys = true, .require_every_key = true}).read(root, "", &p);
-  } catch (const YamlSyntaxError& e) {
-    throw KeyError(path, e.key(), "not valid YAML: " + e.message());
-  }
+  const YAML::Node root = load_yaml(text.str(), path);  // "path:line: not valid YAML: ..."
+  YamlReadArchive(path, {.refuse_unknown_keys = true, .require_every_key = true}).read(root, "", &p);
   if (const RangeViolation bad = find_violation(p)) throw KeyError(path, bad.key, bad.rule);
   p.source = path;
   return p;
