@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <ostream>
 #include <stdexcept>
@@ -63,6 +64,19 @@ void check_distinct_files(const IdentifyArgs& a) {
       throw std::runtime_error("identify: --out " + a.out + " is the input " + in + "; it would be replaced");
     }
   }
+}
+
+// The standard uncertainty of the flippers' mean rise delay (the actuation
+// delay the model worlds play): independent flippers, sqrt(sum s^2) / n.
+double actuation_delay_stderr_s(const table::BoardOverlay& overlay) {
+  double sum_sq = 0.0;
+  int n = 0;
+  for (const table::FlipperOverlay& f : overlay.flippers) {
+    if (!f.rise_delay_s) continue;
+    sum_sq += f.rise_delay_s->stderr_ * f.rise_delay_s->stderr_;
+    ++n;
+  }
+  return n > 0 ? std::sqrt(sum_sq) / n : 0.0;
 }
 
 std::string value_text(const table::IdentifiedValue& v, const char* unit) {
@@ -154,6 +168,9 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                    {"actuation_delay_s", table::identified_actuation_delay_s(r.overlay)
                                              ? nlohmann::json(*table::identified_actuation_delay_s(r.overlay))
                                              : nlohmann::json(nullptr)},
+                   {"actuation_delay_stderr_s", table::identified_actuation_delay_s(r.overlay)
+                                                    ? nlohmann::json(actuation_delay_stderr_s(r.overlay))
+                                                    : nlohmann::json(nullptr)},
                    {"launcher", r.overlay.launcher ? to_json_value(*r.overlay.launcher) : nlohmann::json(nullptr)},
                    {"wall_thickness", thickness},
                    {"not_identified", not_identified},
@@ -194,6 +211,7 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
   if (r.gravity.drag_fitted)
     out << "  drag               " << format_number(r.gravity.drag_per_s) << " ± "
         << format_number(r.gravity.drag_stderr_per_s, 2) << " 1/s, with g " << format_number(r.gravity.g_mps2)
+        << " ± " << format_number(r.gravity.g_stderr_mps2, 2)
         << " (diagnostic: the model has no drag; its speed clamp stands in)\n";
   out << "  sliding friction   ";
   if (r.sliding.skidding > 0)
@@ -233,7 +251,8 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
         << format_number(f.velocity_error_fitted_mps) << " m/s\n";
   }
   if (const std::optional<double> delay = table::identified_actuation_delay_s(r.overlay))
-    out << "  actuation delay    " << format_number(*delay * 1000.0)
+    out << "  actuation delay    " << format_number(*delay * 1000.0) << " ± "
+        << format_number(actuation_delay_stderr_s(r.overlay) * 1000.0, 2)
         << " ms, the flippers' mean rise delay: the model worlds of learn and bench play it with --identified\n";
   if (r.overlay.launcher)
     out << "  launcher           pull " << value_text(r.overlay.launcher->pull, "") << ", noise "

@@ -54,6 +54,7 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   EXPECT_FALSE(j["flippers"][0]["identified"].get<bool>());
   EXPECT_EQ(j["flipper_shots"], 0);
   EXPECT_TRUE(j["actuation_delay_s"].is_null());
+  EXPECT_TRUE(j["actuation_delay_stderr_s"].is_null());
   EXPECT_GT(j["held_out"]["nominal"]["moments"].get<int>(), 50);
   EXPECT_LT(j["held_out"]["identified"]["mean_m"].get<double>(), j["held_out"]["nominal"]["mean_m"].get<double>());
   EXPECT_NEAR(j["held_out"]["error_ratio"].get<double>(),
