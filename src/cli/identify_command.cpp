@@ -95,6 +95,9 @@ struct HeldOut {
   learn::PredictionError nominal, identified;
 };
 
+// A figure of a fit that did not run is null, not 0 (which reads as a perfect fit).
+nlohmann::json when(bool measured, double value) { return measured ? nlohmann::json(value) : nlohmann::json(); }
+
 nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, const learn::IdentificationResult& r,
                            const std::optional<HeldOut>& held_out) {
   nlohmann::json groups = nlohmann::json::array();
@@ -109,24 +112,25 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                       {"outliers", g.outliers},
                       {"rho", g.identified ? to_json_value(g.overlay.rho) : nlohmann::json(nullptr)},
                       {"kick_mps", g.overlay.kick_mps ? to_json_value(*g.overlay.kick_mps) : nlohmann::json(nullptr)},
-                      {"rms_nominal_mps", g.rms_nominal_mps},
-                      {"rms_fitted_mps", g.rms_fitted_mps},
+                      {"rms_nominal_mps", when(g.rebounds > 0, g.rms_nominal_mps)},
+                      {"rms_fitted_mps", when(g.identified, g.rms_fitted_mps)},
                       {"friction", g.overlay.friction ? to_json_value(*g.overlay.friction) : nlohmann::json(nullptr)},
                       {"friction_outliers", g.friction.outliers},
-                      {"tangent_rms_frictionless_mps", g.friction.rms_frictionless_mps},
-                      {"tangent_rms_fitted_mps", g.friction.rms_fitted_mps}});
+                      {"tangent_rms_frictionless_mps",
+                       when(g.overlay.friction.has_value(), g.friction.rms_frictionless_mps)},
+                      {"tangent_rms_fitted_mps", when(g.overlay.friction.has_value(), g.friction.rms_fitted_mps)}});
   }
   const learn::WallThicknessFit& t = r.wall_thickness;
   nlohmann::json scan = nlohmann::json::array();
   for (const auto& [thickness_m, error_m] : t.scan) scan.push_back({{"thickness_m", thickness_m}, {"mean_error_m", error_m}});
   const nlohmann::json thickness = {{"identified", t.identified},
                                     {"why_not", t.identified ? nlohmann::json(nullptr) : nlohmann::json(t.why_not)},
-                                    {"thickness_m", t.thickness_m},
-                                    {"stderr_m", t.stderr_m},
+                                    {"thickness_m", when(t.identified, t.thickness_m)},
+                                    {"stderr_m", when(t.identified, t.stderr_m)},
                                     {"at_scan_edge", t.at_scan_edge},
                                     {"moments", t.moments},
-                                    {"error_at_zero_m", t.error_at_zero_m},
-                                    {"error_fitted_m", t.error_fitted_m},
+                                    {"error_at_zero_m", when(!t.scan.empty(), t.error_at_zero_m)},
+                                    {"error_fitted_m", when(t.identified, t.error_fitted_m)},
                                     {"scan", scan}};
   nlohmann::json strokes = nlohmann::json::array();
   for (const learn::FlipperStrokeFit& f : r.flipper_strokes) {
@@ -138,12 +142,12 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                        {"rise_delay_s", f.identified ? to_json_value(f.rise_delay_s) : nlohmann::json(nullptr)},
                        {"omega_rad_s", f.identified ? to_json_value(f.omega_rad_s) : nlohmann::json(nullptr)},
                        {"mu", f.mu ? to_json_value(*f.mu) : nlohmann::json(nullptr)},
-                       {"timing_rms_nominal_s", f.timing_rms_nominal_s},
-                       {"timing_rms_fitted_s", f.timing_rms_fitted_s},
-                       {"velocity_error_nominal_mps", f.velocity_error_nominal_mps},
-                       {"velocity_error_delay_only_mps", f.velocity_error_delay_only_mps},
+                       {"timing_rms_nominal_s", when(f.shots > 0, f.timing_rms_nominal_s)},
+                       {"timing_rms_fitted_s", when(f.identified, f.timing_rms_fitted_s)},
+                       {"velocity_error_nominal_mps", when(f.shots > 0, f.velocity_error_nominal_mps)},
+                       {"velocity_error_delay_only_mps", when(f.identified, f.velocity_error_delay_only_mps)},
                        {"stroke_laid_over_board", f.identified && f.stroke_replays_better()},
-                       {"velocity_error_fitted_mps", f.velocity_error_fitted_mps}});
+                       {"velocity_error_fitted_mps", when(f.identified, f.velocity_error_fitted_mps)}});
   }
   nlohmann::json not_identified = nlohmann::json::array();
   for (const learn::NotIdentified& n : r.not_identified)
@@ -283,6 +287,7 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     out << "  held out, where the ball hit something, by what the identified model hit first (mean error, board -> "
            "identified):\n";
     for (const learn::CollisionError& c : held_out->identified.collisions_by_model_hit) {
+      if (c.moments == 0) continue;  // a kind of hit the held-out play never had: no mean to give
       const auto& board_hits = held_out->nominal.collisions_by_model_hit;
       const auto same = std::find_if(board_hits.begin(), board_hits.end(),
                                      [&](const learn::CollisionError& b) { return b.model_hit == c.model_hit; });
