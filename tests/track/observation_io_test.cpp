@@ -2,16 +2,17 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <string>
+
+#include "common/temp_path.h"
 
 namespace pinball::track {
 namespace {
 
 std::string write_csv(const std::string& name, const std::string& text) {
-  const std::string path = (std::filesystem::path(::testing::TempDir()) / name).string();
+  const std::string path = pinball::testing::temp_path("observation_io", name);
   std::ofstream(path) << text;
   return path;
 }
