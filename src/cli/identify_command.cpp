@@ -190,6 +190,10 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                      {"error_ratio_ci95", ratio.ci95},
                      {"error_ratio_moments", ratio.moments}};
   }
+  if (r.sliding.skidding == 0) {  // no flight skidded: no friction was measured, not a friction of 0
+    j["sliding_friction"]["decel_mps2"] = nullptr;
+    j["sliding_friction"]["decel_stderr_mps2"] = nullptr;
+  }
   return j;
 }
 
