@@ -54,6 +54,13 @@ void check_lab_hardware(const DaemonConfig& config, ConfigCheck& out) {
     if (const std::string m = vision::missing_camera_device(config.camera.device); !m.empty()) {
       missing = "camera.device: " + m;
     }
+  } else if (config.camera.source == "file") {
+    // A recording is read, not a device opened: decoding it is the only way to know it is a video.
+    try {
+      const vision::CaptureSource probe(capture_config_for(config.camera));
+    } catch (const std::runtime_error& e) {
+      missing = "camera.device: " + std::string(e.what());
+    }
   }
   try {
     if (std::string note = check_can_link(config.can); !note.empty()) out.warnings.push_back(note);

@@ -76,6 +76,17 @@ TEST(ConfigCheck, InTheLabEveryMissingPieceOfHardwareIsNamedAtOnce) {
   EXPECT_NE(what.find("can.interface: no interface pbnosuch0"), std::string::npos) << what;
 }
 
+// A recording as the lab camera: a file that is no video is found out by
+// the check, as the start would find it.
+TEST(ConfigCheck, ARecordedCameraThatIsNoVideoFailsTheCheck) {
+  DaemonConfig c = lab_without_hardware();
+  c.camera.source = "file";
+  c.camera.device = kSourceTree + "/README.md";
+  const std::string what = check_error(c);
+  EXPECT_NE(what.find("camera.device: capture: cannot open video file '" + c.camera.device + "'"), std::string::npos)
+      << what;
+}
+
 // The command line's CAN log is checked as the file's would be, and a failed
 // check is still one JSON object.
 TEST(ConfigCheck, ACanLogThatCannotBeWrittenFailsTheCheck) {
