@@ -699,7 +699,8 @@ nlohmann::json report_to_json(const DaemonReport& r) {
     const LatencySummary& x = r.latency[static_cast<std::size_t>(s)];
     // A stage that measured nothing has no quantiles: null, not 0 us.
     const auto us = [&x](double v) { return x.count > 0 ? nlohmann::json(v) : nlohmann::json(); };
-    lat[stage_name(s)] = {{"count", x.count}, {"p50_us", us(x.p50_us)}, {"p99_us", us(x.p99_us)}, {"max_us", us(x.max_us)}};
+    lat[stage_name(s)] = {
+        {"count", x.count}, {"p50_us", us(x.p50_us)}, {"p99_us", us(x.p99_us)}, {"max_us", us(x.max_us)}};
   }
   j["latency"] = lat;
   j["frames"] = r.frames;

@@ -51,7 +51,8 @@ TEST(TextFile, AWriteThatFailsLeavesTheOldFileAndNoTemporary) {
     write_text_file((dir / "nowhere" / "c.json").string(), "x\n");
     ADD_FAILURE() << "a write into a missing folder succeeded";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), (dir / "nowhere" / "c.json").string() + ": cannot write (No such file or directory)");
+    EXPECT_EQ(std::string(e.what()),
+              (dir / "nowhere" / "c.json").string() + ": cannot write (No such file or directory)");
   }
   fs::remove_all(dir);
 }
