@@ -39,6 +39,7 @@
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/socketcan_transport.h"
 #include "pinball/plot/draw.h"
+#include "pinball/core/file_name.h"
 #include "pinball/plot/png_file.h"
 #include "pinball/simlab/sim_lab.h"
 #include "pinball/simlab/sim_latency_lab.h"
@@ -698,8 +699,7 @@ cv::Size parse_size(const std::string& text) {
 std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 bool is_image_name(const std::filesystem::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  const std::string ext = lowercase_extension(p);
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
 }
 

@@ -1,21 +1,19 @@
 #include "pinball/plot/png_file.h"
 
-#include <algorithm>
-#include <cctype>
-#include <filesystem>
 #include <stdexcept>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "pinball/core/file_name.h"
 #include "pinball/core/text_file.h"
 
 namespace pinball::plot {
 
 void check_png_name(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".png") throw std::runtime_error(path + ": a PNG is written; give the file name a .png extension");
+  if (lowercase_extension(path) != ".png") {
+    throw std::runtime_error(path + ": a PNG is written; give the file name a .png extension");
+  }
 }
 
 void write_png(const cv::Mat& image, const std::string& path) {

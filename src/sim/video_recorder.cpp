@@ -1,17 +1,16 @@
 #include "pinball/sim/video_recorder.h"
 
-#include <algorithm>
-#include <cctype>
-#include <filesystem>
 #include <sstream>
 #include <stdexcept>
+
+#include "pinball/core/file_name.h"
 
 namespace pinball::sim {
 
 void check_avi_name(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".avi") throw std::runtime_error(path + ": an MJPG AVI is written; give the file name an .avi extension");
+  if (lowercase_extension(path) != ".avi") {
+    throw std::runtime_error(path + ": an MJPG AVI is written; give the file name an .avi extension");
+  }
 }
 
 VideoRecorder::VideoRecorder(const std::string& path, double fps, cv::Size frame_size)
