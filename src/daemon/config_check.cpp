@@ -67,14 +67,14 @@ void check_lab_hardware(const DaemonConfig& config, ConfigCheck& out) {
   } catch (const ConfigError& e) {
     missing += (missing.empty() ? "" : "; ") + std::string(e.what());
   }
-  if (!missing.empty()) throw ConfigError("config: " + missing);
+  if (!missing.empty()) throw ConfigError(config.origin + ": " + missing);
 }
 
 }  // namespace
 
 ConfigCheck check_daemon_config(DaemonConfig config) {
-  validate_daemon_config(config, "configuration");
-  check_written_paths(config, "configuration");
+  validate_daemon_config(config, config.origin);
+  check_written_paths(config, config.origin);
   find_data_files(config);
   const bool sim = config.mode == "sim";
   ConfigCheck out;

@@ -512,8 +512,8 @@ void Daemon::Impl::publish_stats(lcm::LCM&) {
 
 Daemon::Daemon(const DaemonConfig& config) : impl_(std::make_unique<Impl>()) {
   impl_->config = config;
-  validate_daemon_config(config, "config");
-  check_written_paths(config, "config");
+  validate_daemon_config(config, config.origin);
+  check_written_paths(config, config.origin);
   impl_->build();
 }
 

@@ -314,7 +314,9 @@ DaemonConfig load_daemon_config(const std::string& path) {
   // The folder of the file as an absolute path: its relative paths mean the
   // same whatever the working directory.
   const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
-  return daemon_config_from_yaml(ss.str(), path, folder.string());
+  DaemonConfig c = daemon_config_from_yaml(ss.str(), path, folder.string());
+  c.origin = path;
+  return c;
 }
 
 std::vector<std::string> daemon_config_keys() {

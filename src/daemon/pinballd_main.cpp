@@ -180,6 +180,11 @@ int main(int argc, char** argv) {
     if (!lcm_url.empty()) config.lcm_url = lcm_url;
     if (realtime) config.sim.realtime = true;
     if (!can_log.empty()) config.can.log = can_log;
+    // A setting checked after this point is named by where it came from.
+    std::size_t settings_given = 0;
+    for (const CLI::Option* o : app.get_options()) settings_given += o->count();
+    settings_given -= app.count("--config") + app.count("--json") + app.count("--check");
+    if (!config_path.empty() && settings_given > 0) config.origin = config_path + " and the command line";
     if (check) {
       try {
         const ConfigCheck result = check_daemon_config(config);

@@ -161,12 +161,12 @@ DaemonInputs load_daemon_inputs(const DaemonConfig& config) {
   in.spec = control::load_controller(config.controller);
   in.setup = tracking_setup_for(config, in.board);
   if (!sim && config.camera.source != "lcm" && !in.setup.homography) {
-    throw ConfigError("config: calibration: the lab camera needs a calibration file with a camera section "
+    throw ConfigError(config.origin + ": calibration: the lab camera needs a calibration file with a camera section "
                       "(docs/calibration.md)");
   }
   if (!config.camera.occluder_mask.empty()) {
-    in.occluder_mask =
-        load_occluder_mask(config.camera.occluder_mask, cv::Size(config.camera.width_px, config.camera.height_px));
+    in.occluder_mask = load_occluder_mask(config.camera.occluder_mask,
+                                          cv::Size(config.camera.width_px, config.camera.height_px), config.origin);
   }
   return in;
 }
@@ -219,15 +219,15 @@ vision::CaptureConfig capture_config_for(const CameraSettings& camera) {
   return cc;
 }
 
-cv::Mat load_occluder_mask(const std::string& path, cv::Size frame_size) {
+cv::Mat load_occluder_mask(const std::string& path, cv::Size frame_size, const std::string& origin) {
   cv::Mat mask;
   try {
     mask = plot::read_gray_image(path);
   } catch (const std::runtime_error& e) {
-    throw ConfigError(std::string("config: camera.occluder_mask: ") + e.what());
+    throw ConfigError(origin + ": camera.occluder_mask: " + e.what());
   }
   if (mask.size() != frame_size) {
-    throw ConfigError("config: camera.occluder_mask: " + path + " is " + std::to_string(mask.cols) + "x" +
+    throw ConfigError(origin + ": camera.occluder_mask: " + path + " is " + std::to_string(mask.cols) + "x" +
                       std::to_string(mask.rows) + " px, the frames are " + std::to_string(frame_size.width) + "x" +
                       std::to_string(frame_size.height));
   }

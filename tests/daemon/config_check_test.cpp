@@ -71,6 +71,7 @@ TEST(ConfigCheck, TheTwinAndTheSpasticFileAreLoadedToo) {
 
 TEST(ConfigCheck, InTheLabEveryMissingPieceOfHardwareIsNamedAtOnce) {
   const std::string what = check_error(lab_without_hardware());
+  EXPECT_EQ(what.rfind(kSourceTree + "/config/lab.example.yaml: camera.device", 0), 0u) << what;
   EXPECT_NE(what.find("camera.device: /dev/pinball-check-no-such-video: no such camera device"), std::string::npos)
       << what;
   EXPECT_NE(what.find("can.interface: no interface pbnosuch0"), std::string::npos) << what;
@@ -93,7 +94,7 @@ TEST(ConfigCheck, ACanLogThatCannotBeWrittenFailsTheCheck) {
   DaemonConfig c;
   c.can.log = "/nonexistent-pinball-folder/can.log";
   const std::string what = check_error(c);
-  EXPECT_EQ(what, "configuration: can.log: '/nonexistent-pinball-folder/can.log': its folder "
+  EXPECT_EQ(what, "the command line: can.log: '/nonexistent-pinball-folder/can.log': its folder "
                   "/nonexistent-pinball-folder does not exist");
   const nlohmann::json j = config_check_failure_to_json(what);
   EXPECT_FALSE(j.at("ok").get<bool>());
@@ -108,14 +109,16 @@ TEST(ConfigCheck, ALabCameraNeedsTheCalibrationsHomographyAndAMaskOfItsSize) {
   calibration::write_calibration(no_camera, cal);
   DaemonConfig without = c;
   without.calibration = cal;
-  EXPECT_EQ(check_error(without),
-            "config: calibration: the lab camera needs a calibration file with a camera section (docs/calibration.md)");
+  // Checked after loading, and still named by the file they came from.
+  const std::string file = kSourceTree + "/config/lab.example.yaml";
+  EXPECT_EQ(check_error(without), file + ": calibration: the lab camera needs a calibration file with a camera "
+                                         "section (docs/calibration.md)");
   fs::remove(cal);
 
   const std::string mask = ::testing::TempDir() + "/config_check_mask.png";
   plot::write_png(cv::Mat(240, 320, CV_8UC1, cv::Scalar(0)), mask);
   c.camera.occluder_mask = mask;
-  EXPECT_EQ(check_error(c), "config: camera.occluder_mask: " + mask + " is 320x240 px, the frames are 640x480");
+  EXPECT_EQ(check_error(c), file + ": camera.occluder_mask: " + mask + " is 320x240 px, the frames are 640x480");
   fs::remove(mask);
 }
 

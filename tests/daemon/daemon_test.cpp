@@ -565,8 +565,14 @@ TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
                          "can: {interface: pbnosuch0}\n");
   std::string lab;
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " 2>&1", lab), 1) << lab;
+  EXPECT_EQ(lab.rfind("pinballd: " + config + ": camera.device: ", 0), 0u) << "names the file it checked: " << lab;
   EXPECT_NE(lab.find("no such camera device"), std::string::npos) << lab;
   EXPECT_NE(lab.find("no interface pbnosuch0"), std::string::npos) << lab;
+  std::string overridden;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " --can-log /nonexistent-dir/x 2>&1",
+                      overridden),
+            1);
+  EXPECT_EQ(overridden.rfind("pinballd: " + config + " and the command line: can.log: ", 0), 0u) << overridden;
   // With --json a script reads one object on stdout either way.
   std::string failed;
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --json --config " + config + " 2>/dev/null", failed), 1);

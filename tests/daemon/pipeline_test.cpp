@@ -296,21 +296,21 @@ TEST(LabCamera, TheOccluderMaskMustBeAnImageOfTheFramesSize) {
   cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(0));
   mask(cv::Rect(100, 50, 40, 30)).setTo(255);
   plot::write_png(mask, path);
-  const cv::Mat back = load_occluder_mask(path, cv::Size(640, 480));
+  const cv::Mat back = load_occluder_mask(path, cv::Size(640, 480), "lab.yaml");
   EXPECT_EQ(cv::norm(back, mask, cv::NORM_INF), 0.0);
   try {
-    load_occluder_mask(path, cv::Size(1280, 1024));
+    load_occluder_mask(path, cv::Size(1280, 1024), "lab.yaml");
     FAIL() << "a 640x480 mask for 1280x1024 frames was accepted";
   } catch (const ConfigError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "config: camera.occluder_mask: " + path + " is 640x480 px, the frames are 1280x1024");
+              "lab.yaml: camera.occluder_mask: " + path + " is 640x480 px, the frames are 1280x1024");
   }
   std::remove(path.c_str());
   try {
-    load_occluder_mask(path, cv::Size(640, 480));
+    load_occluder_mask(path, cv::Size(640, 480), "lab.yaml");
     FAIL() << "a missing mask was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("config: camera.occluder_mask: " + path + ": cannot be read", 0), 0u)
+    EXPECT_EQ(std::string(e.what()).rfind("lab.yaml: camera.occluder_mask: " + path + ": cannot be read", 0), 0u)
         << e.what();
   }
 }

@@ -181,6 +181,9 @@ struct DaemonConfig {
   std::string controller = kDefaultController;       ///< controller file (docs/learning.md)
   std::string lcm_url = "memq://";                   ///< LCM provider URL
   ThreadSettings threads;                            ///< scheduling
+  /// Where these settings came from, for the messages of checks made after
+  /// loading: the file, "the command line", or both. Not a key.
+  std::string origin = "the command line";
 
   template <class Archive>
   void Serialize(Archive* a) {

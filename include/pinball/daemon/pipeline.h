@@ -206,9 +206,9 @@ void apply_camera_corrections(const std::optional<vision::CameraIntrinsics>& len
 /// as it is).
 vision::CaptureConfig capture_config_for(const CameraSettings& camera);
 /// The occluder mask camera.occluder_mask names, white where plastics hide
-/// the playfield. Throws ConfigError naming the key and the file when it is
-/// not an image or not `frame_size`.
-cv::Mat load_occluder_mask(const std::string& path, cv::Size frame_size);
+/// the playfield. Throws ConfigError naming the configuration (`origin`), the
+/// key and the file when it is not an image or not `frame_size`.
+cv::Mat load_occluder_mask(const std::string& path, cv::Size frame_size, const std::string& origin);
 
 /// What a configuration names, loaded and checked as pinballd starts, before
 /// it opens anything: the belief board with its overlay, the controller file,
