@@ -630,22 +630,25 @@ TEST(Pinballd, ACanLogPipeNobodyReadsHoldsNeitherHeartbeatsNorSigint) {
     execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
-  // Wait for the pipe to fill, not for a fixed time: a slow start (ThreadSanitizer on a
-  // loaded machine) once let 3 s pass before the pipe was full, and nothing stalled.
-  // Full: within 64 bytes of its size (seen stopping 20 bytes short: the last bytes of a
-  // pipe page need not take a write).
-  const int full_bytes = pipe_bytes - 64;
+  // Wait for the log's writer to stall, not for a fixed time: a slow start (ThreadSanitizer on a
+  // loaded machine) once let 3 s pass before the pipe was full, and nothing stalled. Stalled: bytes
+  // queued and none added for half a second while the heartbeats go on. Not "within so many bytes
+  // of the pipe's size": the writer hands the pipe several lines at once, and a write that does not
+  // fit in the room left blocks with the pipe up to a kilobyte short of full (seen 3128 of 4096).
   int queued_bytes = 0;
-  for (int i = 0; i < 600 && queued_bytes <= full_bytes; ++i) {  // 60 s
+  int unchanged_polls = 0;
+  for (int i = 0; i < 600 && unchanged_polls < 5; ++i) {  // 60 s
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const int before = queued_bytes;
     ASSERT_EQ(ioctl(reader, FIONREAD, &queued_bytes), 0);
+    unchanged_polls = queued_bytes > 0 && queued_bytes == before ? unchanged_polls + 1 : 0;
   }
-  if (queued_bytes <= full_bytes) {
+  if (unchanged_polls < 5) {
     kill(pid, SIGKILL);
     waitpid(pid, nullptr, 0);
   }
-  ASSERT_GT(queued_bytes, full_bytes) << "the CAN log did not fill its pipe within 60 s";
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // stalled behind the full pipe for a second
+  ASSERT_GE(unchanged_polls, 5) << "the CAN log's writer did not stall on its pipe within 60 s";
+  std::this_thread::sleep_for(std::chrono::milliseconds(2000));  // stalled behind the full pipe
   ASSERT_EQ(kill(pid, SIGINT), 0);
   int status = 0;
   pid_t done = 0;
@@ -662,7 +665,13 @@ TEST(Pinballd, ACanLogPipeNobodyReadsHoldsNeitherHeartbeatsNorSigint) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), kExitRecordingIncomplete) << read_text(base + ".err");
   const nlohmann::json j = nlohmann::json::parse(read_text(base + ".json"));
-  EXPECT_EQ(j["board"]["watchdog_trips"].get<int>(), 0);  // the heartbeats went on
+  // The heartbeats went on through the stall: over the run, less than 2 s of them missing, of
+  // which the log's 1 s grace at the end is one (the heartbeats stop with the coils, before the
+  // log closes); the stall alone lasted 2.5 s. Not "no watchdog trip": on a loaded 2-core machine
+  // the driver thread is at times starved past the board's 100 ms, with or without a log (seen
+  // once in 8 plain runs), and the board then rightly trips.
+  const double period_s = DaemonConfig{}.can.heartbeat_period_s;
+  EXPECT_GT(j["can"]["heartbeats"].get<double>(), (j["wall_s"].get<double>() - 2.0) / period_s) << j["can"];
   EXPECT_TRUE(j["coils_off_at_exit"].get<bool>());
   EXPECT_GT(j["can_log"]["written"].get<int>(), 0);
   EXPECT_GT(j["can_log"]["dropped"].get<int>(), 0);
