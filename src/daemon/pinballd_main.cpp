@@ -69,11 +69,20 @@ nlohmann::json thread_table_json() {
 
 int main(int argc, char** argv) {
   using namespace pinball::daemon;
+  // First of all, so that no signal finds the default action (death with the coils as they are).
+  std::set_terminate(on_terminate);
+  // Every signal whose default would end the daemon ends it the way SIGINT does: coils off,
+  // report, exit 0. SIGHUP is the terminal or ssh session that started it closing.
+  for (const int stop : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR2, SIGALRM}) install(stop, on_stop_signal);
+  install(SIGUSR1, on_stats_signal);
+  // A reader of a recording (or of stdout) that leaves makes a write fail with EPIPE, which the
+  // recorders count; the signal would kill the daemon before it released the coils and reported.
+  install(SIGPIPE, SIG_IGN);
   CLI::App app("pinballd: the real-time pinball controller (camera -> tracker -> controller -> CAN)");
   app.set_version_flag("--version", std::string("pinballd ") + PINBALL_VERSION);
   app.footer(
-      "Exit status: 0 ran (every ball played, or SIGINT/SIGTERM); 1 bad configuration or file, or a thread "
-      "failed; 2 bad argument; "
+      "Exit status: 0 ran (every ball played, or stopped by SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR2 or "
+      "SIGALRM); 1 bad configuration or file, or a thread failed; 2 bad argument; "
       "3 ran, but a recording is incomplete (the --can-log file dropped frames, or LCM refused messages, e.g. a "
       "file:// log on a full disk): the report says what was lost.");
   std::string config_path, sim_board, world_board, world_kind, twin_params, stepper, controller, lcm_url, can_log,
@@ -152,13 +161,6 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  std::set_terminate(on_terminate);
-  install(SIGINT, on_stop_signal);
-  install(SIGTERM, on_stop_signal);
-  install(SIGUSR1, on_stats_signal);
-  // A reader of a recording (or of stdout) that leaves makes a write fail with EPIPE, which the
-  // recorders count; the signal would kill the daemon before it released the coils and reported.
-  install(SIGPIPE, SIG_IGN);
   try {
     DaemonConfig config;
     if (!config_path.empty()) config = load_daemon_config(config_path);

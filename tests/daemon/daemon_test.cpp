@@ -492,6 +492,36 @@ TEST(Pinballd, SigintReleasesCoilsAndExitsZero) {
   EXPECT_NE(err_text.find("frame->can_written"), std::string::npos) << err_text;
 }
 
+// Every signal whose default would kill it (SIGHUP: the terminal that started it closing)
+// ends pinballd as SIGINT does: coils released, a report, exit 0.
+TEST(Pinballd, EverySignalThatWouldKillItReleasesTheCoilsFirst) {
+  for (const int sig : {SIGHUP, SIGQUIT, SIGUSR2, SIGALRM}) {
+    const std::string out = ::testing::TempDir() + "/pinballd_signal_" + std::to_string(sig) + ".json";
+    const std::string cmd = std::string(PINBALLD_EXE) + " --balls 1000 --json > " + out + " 2>/dev/null";
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    for (int i = 0; i < 600 && !catches_signal(pid, SIGUSR1); ++i) {  // installed last: all are
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    ASSERT_TRUE(catches_signal(pid, sig)) << strsignal(sig) << " is not caught";
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    ASSERT_EQ(kill(pid, sig), 0);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status)) << strsignal(sig) << " killed it";
+    EXPECT_EQ(WEXITSTATUS(status), 0) << strsignal(sig);
+    const nlohmann::json j = nlohmann::json::parse(read_text(out));
+    EXPECT_TRUE(j["coils_off_at_exit"].get<bool>()) << strsignal(sig);
+    EXPECT_TRUE(j["stopped_by_signal"].get<bool>()) << strsignal(sig);
+    EXPECT_GE(j["can"]["release_alls"].get<int>(), 1) << strsignal(sig);
+    std::remove(out.c_str());
+  }
+}
+
 // Runs `cmd` through the shell; returns its exit status and what it printed.
 int run_shell(const std::string& cmd, std::string& output) {
   FILE* p = popen(cmd.c_str(), "r");
