@@ -61,6 +61,19 @@ void subscribe_raw(lcm::LCM& lcm, const char* channel, RawHandler& handler) {
   lcm_subscribe(lcm.getUnderlyingLCM(), channel, &raw_callback, &handler);
 }
 
+int handle_lcm_timeout(lcm_t* lcm, int timeout_ms) {
+  if (lcm_get_fileno(lcm) < 0) return -1;
+  return lcm_handle_timeout(lcm, timeout_ms);
+}
+
+void require_lcm_connected(lcm_t* lcm, const std::string& url) {
+  if (lcm_get_fileno(lcm) < 0) {
+    throw std::runtime_error("lcm: cannot open '" + url +
+                             "': the provider has no connection (tcpq://: is the server listening? "
+                             "udpm://: is the port a real one, and multicast routed?)");
+  }
+}
+
 LcmBus::LcmBus(const std::string& url)
     : lcm_(std::make_unique<lcm::LCM>(lcm_log_target(url) ? std::string("memq://") : url)),
       url_(url),
@@ -72,6 +85,7 @@ LcmBus::LcmBus(const std::string& url)
       games_{{}, kGameChannel} {
   log_anchor_us_ = to_utime(epoch_now_s() - steady_now_s());
   if (!lcm_->good()) throw std::runtime_error("lcm: cannot open '" + url + "'");
+  require_lcm_connected(lcm_->getUnderlyingLCM(), url);
 }
 
 LcmBus::~LcmBus() { stop(); }
@@ -239,20 +253,22 @@ void LcmBus::run(const std::function<void(lcm::LCM&)>& periodic, double period_s
   while (running_.load(std::memory_order_acquire)) {
     const int n = drain();
     // Dispatch what arrived (and, for memq://, empty its queue of our own messages).
-    while (lcm_->handleTimeout(0) > 0) {
+    while (handle_lcm_timeout(lcm_->getUnderlyingLCM(), 0) > 0) {
     }
     if (periodic && clock::now() >= next) {
       periodic(*lcm_);
       next += std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(period_s));
     }
     // Publishing is not on anyone's critical path: a short nap when idle.
-    if (n == 0 && lcm_->handleTimeout(1) < 0) {
-      std::this_thread::sleep_for(std::chrono::microseconds(500));  // a provider that cannot receive (file://...?mode=w)
+    if (n == 0 && handle_lcm_timeout(lcm_->getUnderlyingLCM(), 1) < 0) {
+      // A provider that cannot receive (file://...?mode=w), or whose connection is gone: what
+      // it is given is refused and counted (publish_failed).
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
     }
   }
   drain();
   if (periodic) periodic(*lcm_);
-  while (lcm_->handleTimeout(0) > 0) {
+  while (handle_lcm_timeout(lcm_->getUnderlyingLCM(), 0) > 0) {
   }
 }
 

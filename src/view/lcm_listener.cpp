@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "pinball/bus/channels.h"
+#include "pinball/bus/lcm_bus.h"
 #include "pinball/bus/message_convert.h"
 
 namespace pinball::view {
@@ -19,6 +20,12 @@ void on_lcm_message(const lcm_recv_buf_t* rbuf, const char* channel, void* user)
 LcmListener::LcmListener(const std::string& url, ViewState& state) : state_(state) {
   lcm_ = lcm_create(url.c_str());
   if (lcm_ == nullptr) throw std::runtime_error("lcm: cannot open '" + url + "'");
+  try {
+    bus::require_lcm_connected(lcm_, url);
+  } catch (...) {
+    lcm_destroy(lcm_);
+    throw;
+  }
   for (const char* channel : {bus::kObservationChannel, bus::kProjectionChannel, bus::kFlipperCommandChannel,
                               bus::kDriverStatusChannel, bus::kGameChannel, bus::kStatsChannel}) {
     if (lcm_subscribe(lcm_, channel, &on_lcm_message, this) == nullptr) {
@@ -36,7 +43,7 @@ int LcmListener::poll(int timeout_ms) {
   constexpr int kMaxPerPoll = 20000;
   handled_in_poll_ = 0;
   for (int i = 0; i < kMaxPerPoll; ++i) {
-    const int r = lcm_handle_timeout(lcm_, i == 0 ? timeout_ms : 0);
+    const int r = bus::handle_lcm_timeout(lcm_, i == 0 ? timeout_ms : 0);
     if (r < 0) return handled_in_poll_ > 0 ? handled_in_poll_ : -1;
     if (r == 0) break;
   }

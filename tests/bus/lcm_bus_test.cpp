@@ -73,6 +73,24 @@ void publish_projections(LcmBus& bus, int n) {
 }
 
 
+// A provider with no connection has no descriptor; liblcm's handle would select on -1, which
+// glibc aborts (found with tcpq:// and no server): refused at start instead, and handled as an
+// error, not a crash, if it happens later.
+TEST(LcmBus, AProviderWithNoConnectionIsRefusedNotSelectedOn) {
+  try {
+    LcmBus bus("tcpq://127.0.0.1:1");  // nothing listens on port 1
+    FAIL() << "a tcpq:// URL with no server was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("lcm: cannot open 'tcpq://127.0.0.1:1': the provider has no connection", 0),
+              0u)
+        << e.what();
+  }
+  lcm_t* unconnected = lcm_create("tcpq://127.0.0.1:1");
+  ASSERT_NE(unconnected, nullptr);
+  EXPECT_EQ(handle_lcm_timeout(unconnected, 1), -1);
+  lcm_destroy(unconnected);
+}
+
 TEST(LcmBus, FileUrlsThatWriteAreFoundAndOthersLeftToLiblcm) {
   const auto w = lcm_log_target("file:///tmp/game.lcmlog?mode=w");
   ASSERT_TRUE(w.has_value());

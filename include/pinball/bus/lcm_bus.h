@@ -62,6 +62,14 @@ struct LcmLogTarget {
 /// URL (other providers, file:// in read mode, which is liblcm's default).
 std::optional<LcmLogTarget> lcm_log_target(const std::string& url);
 
+/// lcm_handle_timeout for a provider that may have no descriptor (a tcpq://
+/// server that is gone, a udpm:// socket that failed): liblcm would select on
+/// -1, which glibc's checks abort. Returns -1 then, as for an error.
+int handle_lcm_timeout(lcm_t* lcm, int timeout_ms);
+/// Throws "lcm: cannot open 'url': ..." when `lcm` has no descriptor to
+/// receive on, so a provider that failed to connect is refused at start.
+void require_lcm_connected(lcm_t* lcm, const std::string& url);
+
 /// A handler of raw messages: the encoded bytes of one message.
 using RawHandler = std::function<void(const void* data, int size)>;
 
