@@ -122,7 +122,15 @@ template <class T, std::size_t N>
 bool LcmBus::push(Outbox<T, N>& box, const T& m) {
   if (box.ring.try_push(m)) return true;
   overflows_.fetch_add(1, std::memory_order_relaxed);
+  dropped_queue_full_.fetch_add(1, std::memory_order_relaxed);
   return false;
+}
+
+double LcmBus::outbox_fill() const {
+  const auto fill = [](const auto& box) {
+    return static_cast<double>(box.ring.size()) / static_cast<double>(box.ring.capacity());
+  };
+  return std::max({fill(observations_), fill(projections_), fill(commands_), fill(statuses_), fill(games_)});
 }
 
 bool LcmBus::try_publish(const pinball_lcm::lcmt_pinball_observation& m) { return push(observations_, m); }
@@ -252,6 +260,14 @@ void LcmBus::run(const std::function<void(lcm::LCM&)>& periodic, double period_s
   auto next = clock::now() + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(period_s));
   while (running_.load(std::memory_order_acquire)) {
     const int n = drain();
+    // Said here, on this ordinary thread: the producers that drop are real-time ones.
+    if (!said_dropped_ && dropped_queue_full_.load(std::memory_order_relaxed) > 0) {
+      said_dropped_ = true;
+      std::fprintf(stderr,
+                   "lcm: the LCM thread fell behind on '%s' (an outbox was full); the messages that do not fit are "
+                   "dropped (counted, dropped_queue_full)\n",
+                   url_.c_str());
+    }
     // Dispatch what arrived (and, for memq://, empty its queue of our own messages).
     while (handle_lcm_timeout(lcm_->getUnderlyingLCM(), 0) > 0) {
     }
@@ -277,6 +293,7 @@ LcmBusCounters LcmBus::counters() const {
   c.published = published_.load(std::memory_order_relaxed);
   c.publish_failed = publish_failed_.load(std::memory_order_relaxed);
   c.overflows = overflows_.load(std::memory_order_relaxed);
+  c.dropped_queue_full = dropped_queue_full_.load(std::memory_order_relaxed);
   c.received = received_.load(std::memory_order_relaxed);
   c.malformed = malformed_.load(std::memory_order_relaxed);
   if (has_first_failure_.load(std::memory_order_acquire)) c.first_failure = first_failure_;

@@ -658,6 +658,10 @@ std::string recording_problems(const DaemonReport& r) {
     if (!lost.empty()) lost += "; ";
     lost += std::to_string(r.lcm.publish_failed) + " LCM messages refused, first: " + r.lcm.first_failure;
   }
+  if (r.lcm.dropped_queue_full > 0) {
+    if (!lost.empty()) lost += "; ";
+    lost += std::to_string(r.lcm.dropped_queue_full) + " LCM messages dropped: the LCM thread fell behind";
+  }
   return lost;
 }
 
@@ -717,7 +721,8 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["fires_deferred"] = r.fires_deferred;
   j["ring_overflows"] = r.ring_overflows;
   j["lcm"] = {{"published", r.lcm.published}, {"publish_failed", r.lcm.publish_failed},
-              {"first_failure", r.lcm.first_failure}, {"overflows", r.lcm.overflows}, {"received", r.lcm.received},
+              {"first_failure", r.lcm.first_failure}, {"overflows", r.lcm.overflows},
+              {"dropped_queue_full", r.lcm.dropped_queue_full}, {"received", r.lcm.received},
               {"malformed", r.lcm.malformed}};
   j["can_log"] = nullptr;
   if (const auto& c = r.can_log) {
@@ -796,7 +801,8 @@ std::string report_to_text(const DaemonReport& r) {
   }
   o << "recordings: ";
   if (r.can_log) o << "CAN log " << r.can_log->written << " frames written, " << r.can_log->dropped() << " dropped; ";
-  o << "LCM " << r.lcm.published << " published, " << r.lcm.publish_failed << " refused\n";
+  o << "LCM " << r.lcm.published << " published, " << r.lcm.publish_failed << " refused, " << r.lcm.dropped_queue_full
+    << " dropped\n";
   if (const std::string lost = recording_problems(r); !lost.empty()) o << "recording INCOMPLETE: " << lost << "\n";
   o << "threads: " << r.cpus << "\n";
   const firmware::DriverBusCounters& k = r.driver;

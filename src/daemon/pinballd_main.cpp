@@ -83,8 +83,8 @@ int main(int argc, char** argv) {
   app.footer(
       "Exit status: 0 ran (every ball played, or stopped by SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR2 or "
       "SIGALRM); 1 bad configuration or file, or a thread failed; 2 bad argument; "
-      "3 ran, but a recording is incomplete (the --can-log file dropped frames, or LCM refused messages, e.g. a "
-      "file:// log on a full disk): the report says what was lost.");
+      "3 ran, but a recording is incomplete (the --can-log file dropped frames, or LCM refused or dropped "
+      "messages, e.g. a file:// log on a full disk): the report says what was lost.");
   std::string config_path, sim_board, world_board, world_kind, twin_params, stepper, controller, lcm_url, can_log,
       sim_camera, identified;
   int balls = -1;

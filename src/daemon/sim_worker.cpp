@@ -46,10 +46,31 @@ void SimWorker::run() {
       while (h_.driver_done.load(std::memory_order_acquire) < pushed && !h_.stop.load(std::memory_order_acquire)) {
         h_.sim_bell.wait(0.1);
       }
+      wait_for_lcm_backlog();
     }
   }
   h_.producer_done.store(true, std::memory_order_release);
   h_.camera_bell.ring();
+}
+
+void SimWorker::wait_for_lcm_backlog() {
+  constexpr double kHalfFull = 0.5;
+  constexpr double kLcmStallS = 0.5;
+  if (lcm_stalled_) return;
+  double fill = lcm_.outbox_fill();
+  double progress_s = steady_now_s();
+  while (fill > kHalfFull && !h_.stop.load(std::memory_order_acquire)) {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    const double now_fill = lcm_.outbox_fill();
+    const double now_s = steady_now_s();
+    if (now_fill < fill) {
+      progress_s = now_s;
+    } else if (now_s - progress_s > kLcmStallS) {
+      lcm_stalled_ = true;  // from here on what does not fit is dropped, and counted
+      return;
+    }
+    fill = now_fill;
+  }
 }
 
 }  // namespace pinball::daemon

@@ -3,7 +3,7 @@
 // delivers a frame, hands the frame to the camera thread, publishes the game's
 // events, closes the latency chain at the virtual board's coils, and paces
 // itself to the wall clock or, in lockstep, waits for the chain to finish the
-// frame. Sim mode only.
+// frame and for the LCM thread to keep up. Sim mode only.
 
 #include <cstdint>
 
@@ -23,12 +23,18 @@ class SimWorker {
   void run();
 
  private:
+  // Lockstep: waits while the LCM thread's outboxes are over half full, so that a
+  // recording keeps up with the virtual clock; gives up waiting for the rest of the
+  // run once they stop emptying for kLcmStallS (a sink that blocks).
+  void wait_for_lcm_backlog();
+
   Handoffs& h_;
   simlab::SimWorld& world_;
   bus::LcmBus& lcm_;
   bool lockstep_;
   int drivers_;
   std::uint64_t last_coil_on_count_ = 0;
+  bool lcm_stalled_ = false;
 };
 
 }  // namespace pinball::daemon

@@ -624,6 +624,49 @@ TEST(Pinballd, AnLcmFileLogOnAFullDiskExitsThree) {
   EXPECT_NE(text.find(" LCM messages refused, first: lcm: publishing"), std::string::npos) << text;
 }
 
+// On the lockstep clock a recording loses nothing to the clock's speed: the world waits for
+// the LCM thread (found with a log read at 800 KB/s, which lost 5492 of 15018 messages while
+// the run said complete). Messages that still do not fit (a reader that never reads) are
+// counted as lost: exit 3.
+TEST(Pinballd, ALockstepRunWaitsForASlowLcmLogAndCountsWhatAStuckOneDrops) {
+  const std::string base = ::testing::TempDir() + "/pinballd_slow_lcm_" + std::to_string(getpid());
+  const std::string fifo = base + ".fifo";
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::size_t read_bytes = 0;
+  std::thread slow_reader([&] {
+    const int fd = open(fifo.c_str(), O_RDONLY);  // blocks until pinballd opens the log
+    if (fd < 0) return;
+    char buf[16384];
+    for (ssize_t n; (n = read(fd, buf, sizeof buf)) > 0;) {
+      read_bytes += static_cast<std::size_t>(n);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // about 800 KB/s
+    }
+    close(fd);
+  });
+  std::string out;
+  const int status = run_shell(std::string(PINBALLD_EXE) + " --balls 2 --seed 3 --json --lcm-url 'file://" + fifo +
+                                   "?mode=w' 2>/dev/null",
+                               out);
+  slow_reader.join();
+  EXPECT_EQ(status, 0) << out;
+  const nlohmann::json slow = nlohmann::json::parse(out);
+  EXPECT_EQ(slow["lcm"]["dropped_queue_full"].get<int>(), 0) << slow["lcm"];
+  EXPECT_TRUE(slow["recording_complete"].get<bool>());
+  EXPECT_GT(read_bytes, 0u);
+
+  const int stuck = open(fifo.c_str(), O_RDONLY | O_NONBLOCK);  // there, and never reads
+  ASSERT_GE(stuck, 0);
+  std::string err;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --balls 2 --seed 3 --lcm-url 'file://" + fifo +
+                          "?mode=w' 2>&1 >/dev/null",
+                      err),
+            kExitRecordingIncomplete);
+  close(stuck);
+  EXPECT_NE(err.find("LCM messages dropped: the LCM thread fell behind"), std::string::npos) << err;
+  std::remove(fifo.c_str());
+}
+
 // The CAN log's reader leaves mid-run (`--can-log /dev/stdout | head -c 100`): the daemon
 // neither dies of SIGPIPE (exit 141, no ReleaseAll) nor hangs; the log's frames are counted.
 TEST(Pinballd, ACanLogReaderThatLeavesCostsTheLogNotTheRun) {

@@ -46,7 +46,8 @@ namespace pinball::bus {
 struct LcmBusCounters {
   std::uint64_t published = 0;       ///< messages liblcm accepted
   std::uint64_t publish_failed = 0;  ///< messages refused (a send error, a full disk under file://): lost
-  std::uint64_t overflows = 0;       ///< messages dropped because their ring was full
+  std::uint64_t overflows = 0;       ///< messages dropped because their ring was full (to publish or received)
+  std::uint64_t dropped_queue_full = 0;  ///< of those, messages to publish: lost to every recording
   std::uint64_t received = 0;        ///< messages received and accepted
   std::uint64_t malformed = 0;       ///< messages received that failed to decode or check, ignored
   std::string first_failure;         ///< the first refused publish, for people ("" when none)
@@ -139,6 +140,9 @@ class LcmBus {
 
   /// Counters so far.
   LcmBusCounters counters() const;
+  /// How full the fullest outbox is, 0..1: how far the bus thread is behind.
+  /// Any thread.
+  double outbox_fill() const;
   /// The LCM instance (subscriptions; for a file:// URL that writes, an
   /// in-process memq:// one that nothing reaches the log through).
   lcm::LCM& lcm() { return *lcm_; }
@@ -183,6 +187,8 @@ class LcmBus {
   std::string first_failure_;                  // written once by the bus thread, before...
   std::atomic<bool> has_first_failure_{false};  // ...this is set
   std::atomic<std::uint64_t> overflows_{0};
+  std::atomic<std::uint64_t> dropped_queue_full_{0};
+  bool said_dropped_ = false;  // bus thread: the first dropped message is said on stderr
   std::atomic<std::uint64_t> received_{0};
   std::atomic<std::uint64_t> malformed_{0};
   std::atomic<bool> running_{false};

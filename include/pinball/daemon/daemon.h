@@ -101,8 +101,8 @@ struct DaemonReport {
 inline constexpr std::size_t kMaxReportedFaults = 100;
 
 /// pinballd's exit status when it ran but a recording is incomplete: the CAN
-/// log dropped frames or LCM refused messages (0: ran, 1: bad configuration
-/// or file, or a thread failed, 2: bad argument).
+/// log dropped frames or LCM refused or dropped messages (0: ran, 1: bad
+/// configuration or file, or a thread failed, 2: bad argument).
 constexpr int kExitRecordingIncomplete = 3;
 
 /// What the run's recordings lost (the CAN log, LCM), for people; "" when
