@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -33,6 +34,19 @@ void consume_sigpipe() {
 }
 
 }  // namespace
+
+bool write_if_ready(int fd, std::string_view text) {
+  while (!text.empty()) {
+    pollfd p{fd, POLLOUT, 0};
+    if (::poll(&p, 1, 0) != 1 || (p.revents & POLLOUT) == 0) return false;
+    const std::size_t piece = std::min<std::size_t>(text.size(), PIPE_BUF);
+    const ssize_t n = ::write(fd, text.data(), piece);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    text.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return true;
+}
 
 void block_sigpipe_in_this_thread() {
   const sigset_t s = sigpipe_set();

@@ -1,6 +1,8 @@
 #include "pinball/core/json_write_archive.h"
 #include "pinball/daemon/daemon.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -20,6 +22,7 @@
 #include "pinball/core/format.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/core/clock.h"
+#include "pinball/core/file_sink.h"
 #include "pinball/daemon/doorbell.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/daemon/thread_table.h"
@@ -384,19 +387,24 @@ void Daemon::Impl::fail_thread(ThreadId id, const std::string& what) {
 
 // The main thread's watch: every CAN fault on stderr at once, and in the
 // report; a failing camera raises the alarm at 1, 10, 100, ... failed reads.
+// What stderr does not take at once is dropped (the report keeps every
+// fault): a stderr nobody drains must not hold up the release and the exit.
 void Daemon::Impl::report_faults() {
   firmware::BusFault f;
   while (bus->pop_fault(f)) {
     const std::string line = firmware::describe(f, liveness.get());
-    std::fprintf(stderr, "pinballd: t=%.3f s: %s\n", f.t_s, line.c_str());
+    char stamp[48];
+    std::snprintf(stamp, sizeof stamp, "pinballd: t=%.3f s: ", f.t_s);
+    write_if_ready(STDERR_FILENO, stamp + line + "\n");
     const std::lock_guard<std::mutex> lock(warnings_mutex);
     ++fault_count;
     if (faults.size() < kMaxReportedFaults) faults.push_back(line);
   }
   const std::uint64_t failed = h.camera_read_failures.load(std::memory_order_relaxed);
   if (failed > 0 && failed >= camera_failures_reported * 10) {
-    std::fprintf(stderr, "pinballd: camera: %llu failed reads (%s); retrying with back-off up to 0.1 s\n",
-                 static_cast<unsigned long long>(failed), capture ? capture->describe().c_str() : "?");
+    write_if_ready(STDERR_FILENO, "pinballd: camera: " + std::to_string(failed) + " failed reads (" +
+                                      (capture ? capture->describe() : std::string("?")) +
+                                      "); retrying with back-off up to 0.1 s\n");
     camera_failures_reported = std::max<std::uint64_t>(failed, 1);
   }
 }
@@ -594,10 +602,9 @@ DaemonReport Daemon::run() {
   while (!d.h.stop.load(std::memory_order_acquire) && !d.h.controller_done.load(std::memory_order_acquire)) {
     d.h.main_bell.wait(0.1);
     d.report_faults();
-    if (d.stats_requested.exchange(false)) std::fputs(report_to_text(d.report()).c_str(), stderr);
+    if (d.stats_requested.exchange(false)) write_if_ready(STDERR_FILENO, report_to_text(d.report()));
     live.tick([&d] { return d.report(); });
   }
-  live.finish();
   d.h.stop.store(true, std::memory_order_release);
   for (Doorbell* b : {&d.h.camera_bell, &d.h.controller_bell, &d.h.driver_bell, &d.h.sim_bell}) b->ring();
   if (world.joinable()) world.join();
@@ -605,6 +612,7 @@ DaemonReport Daemon::run() {
   controller.join();
   driver.join();
   d.shutdown();
+  live.finish();  // after the coils are off: it writes to stderr
   d.report_faults();
   // The CAN log's last frame is the shutdown's ReleaseAll: closed (what the sink takes within its
   // grace, the rest counted) before the LCM thread's last PINBALL_STATS, which carries its counters.

@@ -103,5 +103,22 @@ TEST(FileSink, APipeWhoseReaderLeftIsGoneWithoutKillingTheProcess) {
   ::close(fds[1]);
 }
 
+// stderr's messages on a pipe nobody drains: dropped at once, never waited on.
+TEST(WriteIfReady, TakesWhatTheDescriptorTakesAtOnceAndDropsTheRest) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  EXPECT_TRUE(write_if_ready(fds[1], "one line\n"));
+  const std::string page(1 << 20, 'x');  // more than any pipe holds
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(write_if_ready(fds[1], page));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1)) << "it waited";
+  EXPECT_FALSE(write_if_ready(fds[1], "another\n")) << "a full pipe takes nothing";
+  char head[9] = {};
+  ASSERT_EQ(read(fds[0], head, 9), 9);
+  EXPECT_EQ(std::string(head, 9), "one line\n");
+  close(fds[0]);
+  close(fds[1]);
+}
+
 }  // namespace
 }  // namespace pinball

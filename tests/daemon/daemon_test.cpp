@@ -522,6 +522,59 @@ TEST(Pinballd, EverySignalThatWouldKillItReleasesTheCoilsFirst) {
   }
 }
 
+// A stderr nobody drains (a pipe whose reader sleeps) holds neither the release nor the exit:
+// what stderr cannot take at once is dropped, and the report keeps it. Found with a camera at
+// 2 frames/s, whose frame gaps the board's watchdog reports as faults all along: stdio, blocked
+// on the full pipe, went on retrying each partial write after SIGINT, and the daemon never
+// reached its shutdown.
+TEST(Pinballd, AStderrNobodyReadsHoldsNeitherTheReleaseNorTheExit) {
+  const std::string base = ::testing::TempDir() + "/pinballd_stuck_stderr_" + std::to_string(getpid());
+  write_file(base + ".yaml", "version: 1\nmode: sim\ncamera:\n  fps: 2\n");
+  int err_pipe[2];
+  ASSERT_EQ(pipe(err_pipe), 0);
+  ASSERT_GT(fcntl(err_pipe[1], F_SETPIPE_SZ, 4096), 0);  // full after a few dozen faults
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    dup2(err_pipe[1], STDERR_FILENO);
+    close(err_pipe[0]);
+    const std::string cmd =
+        std::string(PINBALLD_EXE) + " --config " + base + ".yaml --balls 1000 --realtime --json > " + base + ".json";
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  close(err_pipe[1]);
+  // Until stderr takes no more: bytes queued, and none added for a second while faults go on.
+  int queued_bytes = 0;
+  int unchanged_polls = 0;
+  for (int i = 0; i < 600 && unchanged_polls < 10; ++i) {  // 60 s
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const int before = queued_bytes;
+    ASSERT_EQ(ioctl(err_pipe[0], FIONREAD, &queued_bytes), 0);
+    unchanged_polls = queued_bytes > 0 && queued_bytes == before ? unchanged_polls + 1 : 0;
+  }
+  ASSERT_EQ(kill(pid, SIGINT), 0);
+  int status = 0;
+  pid_t done = 0;
+  for (int i = 0; i < 100 && done == 0; ++i) {  // 10 s
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    done = waitpid(pid, &status, WNOHANG);
+  }
+  if (done == 0) {
+    kill(pid, SIGKILL);
+    waitpid(pid, &status, 0);
+  }
+  close(err_pipe[0]);
+  ASSERT_NE(done, 0) << "pinballd did not end within 10 s of SIGINT with its stderr full";
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const nlohmann::json j = nlohmann::json::parse(read_text(base + ".json"));
+  EXPECT_TRUE(j["coils_off_at_exit"].get<bool>());
+  EXPECT_TRUE(j["stopped_by_signal"].get<bool>());
+  EXPECT_GT(j["faults"]["count"].get<int>(), 0) << "the faults that filled stderr are in the report";
+  for (const char* ext : {".yaml", ".json"}) std::remove((base + ext).c_str());
+}
+
 // Runs `cmd` through the shell; returns its exit status and what it printed.
 int run_shell(const std::string& cmd, std::string& output) {
   FILE* p = popen(cmd.c_str(), "r");

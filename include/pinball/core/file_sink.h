@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <string_view>
 
 namespace pinball {
 
@@ -51,6 +52,14 @@ class FileSink {
   int fd_ = -1;
   bool gone_ = false;
 };
+
+/// Writes `text` to `fd` (stderr) only while it takes it at once: before each
+/// piece of at most PIPE_BUF bytes, a poll without waiting; what does not go
+/// is dropped and the answer is false. For messages on a descriptor the
+/// process does not own and nobody may be draining (a stderr pipe whose
+/// reader sleeps): stdio would block there, and go on blocking after a
+/// signal, since it retries a partial write.
+bool write_if_ready(int fd, std::string_view text);
 
 /// Blocks SIGPIPE in the calling thread, so that a write there to a pipe
 /// without a reader returns EPIPE even where the process has not ignored
