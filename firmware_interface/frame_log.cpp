@@ -97,14 +97,6 @@ constexpr auto kIdle = std::chrono::milliseconds(5);  // the writer's nap when t
 constexpr int kQueueFullKind = -1;  // report kinds beside errno values
 constexpr int kCloseKind = -2;
 
-FileSink open_sink(const std::string& path) {
-  try {
-    return FileSink(path);
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(std::string("FrameLog: ") + e.what());
-  }
-}
-
 }  // namespace
 
 // The lines of one write(2): text, and where each line ends in it.
@@ -117,7 +109,7 @@ struct FrameLog::Batch {
 FrameLog::FrameLog(const std::string& path, std::string interface, double close_timeout_s)
     : interface_(std::move(interface)),
       close_timeout_s_(close_timeout_s),
-      sink_(open_sink(path)),
+      sink_(FileSink(path)),
       queue_(std::make_unique<Queue>()) {
   check_input(close_timeout_s >= 0.0, "FrameLog", "close_timeout_s must be >= 0");
   writer_ = std::thread([this] { run(); });

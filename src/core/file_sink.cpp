@@ -54,11 +54,15 @@ void block_sigpipe_in_this_thread() {
 }
 
 FileSink::FileSink(const std::string& path, bool append) : path_(path) {
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | (append ? O_APPEND : O_TRUNC), 0666);
+  // Non-blocking from the open on: a named pipe nobody reads yet is refused (ENXIO) rather
+  // than waited on for good, and a full pipe makes write(2) return EAGAIN instead of holding
+  // the thread.
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | O_NONBLOCK | (append ? O_APPEND : O_TRUNC), 0666);
+  if (fd_ < 0 && errno == ENXIO) {
+    throw std::runtime_error("cannot open " + path + " for writing: a named pipe that nobody reads yet (start its "
+                             "reader first)");
+  }
   if (fd_ < 0) throw std::runtime_error("cannot open " + path + " for writing: " + std::strerror(errno));
-  // Non-blocking from here on: a full pipe makes write(2) return EAGAIN instead of holding the thread.
-  const int flags = ::fcntl(fd_, F_GETFL);
-  if (flags >= 0) ::fcntl(fd_, F_SETFL, flags | O_NONBLOCK);
 }
 
 FileSink::~FileSink() { close(); }

@@ -328,8 +328,12 @@ void Daemon::Impl::learn_background() {
 // a start that fails leaves the last run's log as it was.
 void Daemon::Impl::open_can_log() {
   if (config.can.log.empty()) return;
-  frame_log = std::make_unique<firmware::FrameLog>(config.can.log,
-                                                   config.can.interface == "sim" ? "simcan" : config.can.interface);
+  try {
+    frame_log = std::make_unique<firmware::FrameLog>(config.can.log,
+                                                     config.can.interface == "sim" ? "simcan" : config.can.interface);
+  } catch (const std::runtime_error& e) {
+    throw ConfigError(config.origin + ": can.log: " + e.what());
+  }
   frame_log->stamp_with([this] { return can_log_stamp_s(); });
   bus->attach_log(frame_log.get());
 }

@@ -1,7 +1,11 @@
 #include "pinball/daemon/daemon_config.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -196,13 +200,17 @@ bool file_gives(const YAML::Node& map, const std::string& dotted) {
 }
 
 // Why the daemon could not create the file `path` ("": it can try): ": its
-// folder F does not exist", or ", which is a folder, not a file".
+// folder F does not exist", ", which is a folder, not a file", or the system's
+// reason it may not write there (a read-only folder, ProtectSystem=strict).
 std::string unwritable_path_problem(const std::filesystem::path& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_directory(path, ec)) return ", which is a folder, not a file";
   const fs::path folder = fs::absolute(path, ec).parent_path();
+  if (fs::exists(folder, ec) && !fs::is_directory(folder, ec)) return ": " + folder.string() + " is a file, not a folder";
   if (!fs::is_directory(folder, ec)) return ": its folder " + folder.string() + " does not exist";
+  const fs::path written = fs::exists(path, ec) ? path : folder;
+  if (::access(written.c_str(), W_OK) != 0) return ": " + written.string() + ": " + std::strerror(errno);
   return "";
 }
 

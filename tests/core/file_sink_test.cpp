@@ -1,6 +1,8 @@
 #include "pinball/core/file_sink.h"
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -101,6 +103,24 @@ TEST(FileSink, APipeWhoseReaderLeftIsGoneWithoutKillingTheProcess) {
   EXPECT_EQ(second.error, EPIPE);
   EXPECT_TRUE(gone);
   ::close(fds[1]);
+}
+
+// A named pipe with no reader is refused at once: opening it would wait for one for good.
+TEST(FileSink, ANamedPipeNobodyReadsIsRefusedNotWaitedOn) {
+  const std::string fifo = ::testing::TempDir() + "/file_sink_fifo_" + std::to_string(getpid());
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    FileSink sink(fifo);
+    ADD_FAILURE() << "a named pipe with no reader was opened";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("a named pipe that nobody reads yet"), std::string::npos) << e.what();
+  }
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(reader, 0);
+  EXPECT_NO_THROW(FileSink sink(fifo));
+  ::close(reader);
+  std::remove(fifo.c_str());
 }
 
 // stderr's messages on a pipe nobody drains: dropped at once, never waited on.

@@ -366,6 +366,15 @@ TEST(DaemonConfig, WrittenFilesAndTheLcmProviderAreCheckedWhereverTheyCameFrom) 
   }
   c.can.log = dir.string();
   EXPECT_THROW(check_written_paths(c, "config"), ConfigError) << "a folder is not a log";
+  std::ofstream(dir / "plain.txt") << "x";
+  c.can.log = (dir / "plain.txt" / "can.log").string();
+  try {
+    check_written_paths(c, "config");
+    ADD_FAILURE() << "a CAN log under a regular file was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "config: can.log: '" + c.can.log + "': " + (dir / "plain.txt").string() + " is a file, not a folder");
+  }
   c.can.log.clear();
   c.lcm_url = "file://" + (dir / "nowhere" / "run.lcmlog").string() + "?mode=w";
   EXPECT_THROW(check_written_paths(c, "config"), ConfigError);

@@ -23,8 +23,8 @@ struct SinkWrite {
 class FileSink {
  public:
   /// Opens `path` (truncated, or appended to with `append`); throws
-  /// std::runtime_error naming the file when it cannot. A named pipe waits
-  /// here, as with any open, until its reader comes.
+  /// std::runtime_error naming the file when it cannot, and for a named pipe
+  /// that no reader has open yet (start the reader first).
   explicit FileSink(const std::string& path, bool append = false);
   /// Closes (errors ignored: call close() to see them).
   ~FileSink();
