@@ -839,6 +839,12 @@ TEST(Pinballd, BadConfigExitsOneNamingTheKey) {
   std::string text;
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --config " + path + " 2>&1", text), 1);
   EXPECT_NE(text.find("camera.fsp: unknown key"), std::string::npos) << text;
+  // --check --json answers a bad configuration file with one object too.
+  std::string out;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --json --config " + path + " 2>/dev/null", out), 1);
+  const nlohmann::json j = nlohmann::json::parse(out);
+  EXPECT_FALSE(j.at("ok").get<bool>());
+  EXPECT_NE(j.at("error").get<std::string>().find("camera.fsp: unknown key"), std::string::npos) << out;
 }
 
 // An ordinary user (no CAP_SYS_NICE, RLIMIT_RTPRIO 0) asking for real-time
