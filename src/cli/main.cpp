@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "pinball/core/file_sink.h"
 #include "pinball/learn/team.h"
 
 int main(int argc, char** argv) {
@@ -11,7 +12,9 @@ int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
   // Under mpirun every rank runs the same command (docs/learning.md, "Across machines").
   const pinball::learn::TeamSession team(argc, argv);
-  if (pinball::learn::team_root()) return pinball::cli::run_pinball(argc, argv, std::cout, std::cerr);
+  if (pinball::learn::team_root()) {
+    return pinball::exit_status_after_stdout("pinball", pinball::cli::run_pinball(argc, argv, std::cout, std::cerr));
+  }
   // The other ranks print nothing: rank 0 has the same figures. Their errors
   // are shown, marked, should one fail where rank 0 did not.
   std::ostringstream quiet_out;

@@ -10,7 +10,9 @@
 #include <cerrno>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <iostream>
 #include <stdexcept>
 
 namespace pinball {
@@ -46,6 +48,16 @@ bool write_if_ready(int fd, std::string_view text) {
     text.remove_prefix(static_cast<std::size_t>(n));
   }
   return true;
+}
+
+int exit_status_after_stdout(const char* program, int code) {
+  std::cout.flush();
+  const bool written = std::cout.good() && std::fflush(stdout) == 0 && std::ferror(stdout) == 0;
+  if (written) return code;
+  // The failed write was earlier, its errno long gone: the likely causes instead.
+  std::fprintf(stderr, "%s: the output did not all reach standard output (a full disk, or its reader left)\n",
+               program);
+  return code == 0 ? 1 : code;
 }
 
 void block_sigpipe_in_this_thread() {

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pinball/core/data_file_option.h"
+#include "pinball/core/file_sink.h"
 #include "pinball/core/number_option.h"
 #include "pinball/daemon/config_check.h"
 #include "pinball/daemon/daemon.h"
@@ -67,7 +68,7 @@ nlohmann::json thread_table_json() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run_pinballd(int argc, char** argv) {
   using namespace pinball::daemon;
   // First of all, so that no signal finds the default action (death with the coils as they are).
   std::set_terminate(on_terminate);
@@ -231,4 +232,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pinballd: %s\n", e.what());
     return 1;
   }
+}
+
+int main(int argc, char** argv) {
+  return pinball::exit_status_after_stdout("pinballd", run_pinballd(argc, argv));
 }

@@ -78,6 +78,13 @@ TEST_F(Play, WithoutADisplayItSaysSoAndWritesNothing) {
   EXPECT_FALSE(fs::exists(csv()));
 }
 
+// A report that did not reach stdout (a full disk) is not a success for a script.
+TEST_F(Play, AnOutputThatDidNotReachStdoutExitsOne) {
+  const CommandResult r = run_shell(PINBALL_EXE " --version > /dev/full");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("pinball: the output did not all reach standard output"), std::string::npos) << r.err;
+}
+
 TEST_F(Play, BadInputIsRefusedBeforeTheGameAndWritesNothing) {
   const std::string to_csv = " --csv " + csv();
   const struct {

@@ -824,6 +824,12 @@ TEST(Pinballd, BadArgumentsAreOneLineAndCheckJsonStillAnswers) {
   EXPECT_NE(j.at("error").get<std::string>().find("/nonexistent/c.json"), std::string::npos) << out;
 }
 
+TEST(Pinballd, AReportThatDidNotReachStdoutExitsOne) {
+  std::string text;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --threads 2>&1 >/dev/full", text), 1);
+  EXPECT_EQ(text, "pinballd: the output did not all reach standard output (a full disk, or its reader left)\n");
+}
+
 TEST(Pinballd, TheThreadTableAsJson) {
   std::string out;
   ASSERT_EQ(run_shell(std::string(PINBALLD_EXE) + " --threads --json", out), 0);

@@ -61,6 +61,12 @@ class FileSink {
 /// signal, since it retries a partial write.
 bool write_if_ready(int fd, std::string_view text);
 
+/// A program's exit status once its standard output is flushed: `code`, or 1
+/// with a line on stderr naming `program` when the output did not all get
+/// there (a full disk, a reader that left): a script must not take a missing
+/// or cut report for a success.
+int exit_status_after_stdout(const char* program, int code);
+
 /// Blocks SIGPIPE in the calling thread, so that a write there to a pipe
 /// without a reader returns EPIPE even where the process has not ignored
 /// the signal (FileSink::write takes back the pending signal). For the
