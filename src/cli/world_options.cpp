@@ -39,7 +39,7 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
   cmd.add_option("--dt", world.dt_s,
                  "the world's time step in seconds (default: the board's, the twin's own for --world twin); for --stepper event the rate at which "
                  "the flipper commands may change")
-      ->check(finite_positive())
+      ->check(finite_range(table::kMinDt_s, table::kMaxDt_s))
       ->default_str("");  // 0: the board's
 }
 

@@ -26,10 +26,6 @@ constexpr double kMaxBallRadius_m = 0.1;     // a pinball is 13.5 mm
 constexpr double kMaxSpeed_mps = 100.0;      // SPEED_MAX, kick, kickout: twenty times a hard shot
 constexpr double kMaxGravity_mps2 = 10.0;    // along the table: at most g itself (9.81), with rounding
 constexpr double kMaxRho = 2.0;              // reflectivity: > 1 kicks; 2 already doubles the normal speed
-// Below 1 µs a ball takes millions of steps a second of play (1e-12: never
-// ends); above 10 ms a 5 m/s ball jumps 5 cm, through any post.
-constexpr double kMinDt_s = 1e-6;
-constexpr double kMaxDt_s = 0.01;
 
 /// Requires `v`, read in the file's length unit (per second with per = "/s",
 /// ...), to be at most `max_si`; the message states the bound in the file's unit.

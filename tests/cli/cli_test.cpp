@@ -495,10 +495,21 @@ TEST_F(Cli, BadArgumentsExitWithUsageError) {
   }
 }
 
+// A flipper ten times as fast as the thesis's: 5 ms, within --dt's range, is too long for them.
 TEST_F(Cli, TimeStepThatBreaksTheFlipperConditionIsRefused) {
-  const CommandResult r = run("sim boards/mit1993.board --dt 0.02");
+  const fs::path fast = variant_board(dir_, "-25 30 2000 ", "-25 30 20000 ");  // the left flipper
+  const CommandResult r = run("sim " + fast.string() + " --dt 0.005");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("l*sin(omega*dt/2)"), std::string::npos) << r.err;
+}
+
+// --dt has the board's own range: 1e-12 would never end a ball, 0.3 s jumps through posts.
+TEST_F(Cli, TimeStepOutsideTheBoardsRangeIsABadArgument) {
+  for (const char* dt : {"1e-9", "0.3"}) {
+    const CommandResult r = run(std::string("sim boards/mit1993.board --dt ") + dt);
+    EXPECT_EQ(r.exit_code, 2) << dt;
+    EXPECT_NE(r.err.find("is not a finite number in [1e-06, 0.01]"), std::string::npos) << r.err;
+  }
 }
 
 TEST_F(Cli, RenderWritesAPng) {

@@ -43,6 +43,12 @@ struct Action {
 /// The largest wall friction a board or an overlay may give: no surface a ball rolls on has more.
 inline constexpr double kMaxWallFriction = 2.0;
 
+/// The time steps a board's `dt` line, and a command's --dt, may give (s).
+/// Below 1 µs a ball takes millions of steps a second of play (1e-12: never
+/// ends); above 10 ms a 5 m/s ball jumps 5 cm, through any post.
+inline constexpr double kMinDt_s = 1e-6;
+inline constexpr double kMaxDt_s = 0.01;
+
 /// A reflecting obstacle: shape, reflectivity and action (thesis 3.2.3).
 struct Obstacle {
   double rho = 1.0;       ///< reflectivity: normal speed out = rho x normal speed in; > 1 kicks
