@@ -3,27 +3,73 @@
 // finds the shipped data from any folder (pinball/core/data_file_option.h,
 // as pinballd does), and the check that an output's folder exists.
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pinball/core/data_file_option.h"
 #include "pinball/plot/png_file.h"
 
 namespace pinball::cli {
 
-/// A file a command writes when it has finished: its folder must exist now,
-/// and it must not be a folder itself, so that a long run (or a lab's flipper
-/// fired twenty times) does not end in a write error. Throws
-/// std::runtime_error "OPTION PATH: the folder F does not exist" or
-/// "OPTION PATH: is a folder, not a file".
-inline void check_output_folder(const std::string& path, const char* option) {
+/// A file a command writes when it has finished: its folder must exist now
+/// and take a new file, and it must not be a folder itself, so that a long
+/// run (or a lab's flipper fired twenty times) does not end in a write
+/// error. A file written whole (write_text_file: renamed into place) must
+/// not be a device or a pipe either, which the rename would replace;
+/// `streamed` outputs (a trace) may be. Throws std::runtime_error "OPTION
+/// PATH: the folder F does not exist", "OPTION PATH: is a folder, not a
+/// file", "OPTION PATH: is not a regular file ..." or "OPTION PATH: cannot
+/// write in F (why)".
+inline void check_output_folder(const std::string& path, const char* option, bool streamed = false) {
+  namespace fs = std::filesystem;
   if (path.empty()) return;
-  if (std::filesystem::is_directory(path))
-    throw std::runtime_error(std::string(option) + " " + path + ": is a folder, not a file");
-  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
-  if (!folder.empty() && !std::filesystem::is_directory(folder))
-    throw std::runtime_error(std::string(option) + " " + path + ": the folder " + folder.string() + " does not exist");
+  const std::string said = std::string(option) + " " + path;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw std::runtime_error(said + ": is a folder, not a file");
+  const fs::path folder = fs::path(path).parent_path();
+  if (!folder.empty() && !fs::is_directory(folder, ec))
+    throw std::runtime_error(said + ": the folder " + folder.string() + " does not exist");
+  if (fs::exists(path, ec)) {
+    if (!streamed && !fs::is_regular_file(path, ec)) {
+      throw std::runtime_error(said + ": is not a regular file (a device, a pipe); it would be replaced by the file "
+                                      "written, so it is refused");
+    }
+    return;
+  }
+  // The folder takes a new file (not /proc, not a read-only mount): a probe, made and removed.
+  const fs::path probe = (folder.empty() ? fs::path(".") : folder) / (".pinball-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    throw std::runtime_error(said + ": cannot write in " + (folder.empty() ? std::string(".") : folder.string()) +
+                             " (" + std::strerror(errno) + ")");
+  }
+  ::close(fd);
+  fs::remove(probe, ec);
+}
+
+/// Outputs of one command that name the same file would overwrite each
+/// other: refused, naming both options.
+inline void check_distinct_outputs(const std::vector<std::pair<const char*, std::string>>& outputs) {
+  namespace fs = std::filesystem;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    for (std::size_t k = i + 1; k < outputs.size(); ++k) {
+      const std::string& a = outputs[i].second;
+      const std::string& b = outputs[k].second;
+      if (a.empty() || b.empty()) continue;
+      if (fs::weakly_canonical(a) == fs::weakly_canonical(b)) {
+        throw std::runtime_error(std::string(outputs[i].first) + " and " + outputs[k].first + " both name " + a +
+                                 ": each would overwrite the other");
+      }
+    }
+  }
 }
 
 /// check_output_folder, and the writer's own check of the file's name

@@ -388,6 +388,13 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   check_output_folder(args.out, "--out");
   check_output_folder(args.curve, "--curve");
   check_png_output(args.plot, "--plot");
+  const std::string cycle_path = args.out.empty() ? std::string() : args.out + ".cycle.json";
+  check_output_folder(cycle_path, "--out's cycle file");
+  check_distinct_outputs({{"--out", args.out},
+                          {"--curve", args.curve},
+                          {"--plot", args.plot},
+                          {"--checkpoint", args.checkpoint},
+                          {"--out's cycle file", cycle_path}});
   LearnArgs a = args;
   a.actuation_delay_s = world_actuation_delay_s(
       args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,
@@ -486,7 +493,6 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     sc.seed = a.seed;
     sc.threads = a.threads;
     sc.progress = progress_wanted(a.progress) ? &err : nullptr;
-    const std::string cycle_path = a.out + ".cycle.json";
     double cycle_score = -1e300;  // keep the highest-scoring cycle (a stuck ball scores little)
     sc.on_cycle = [&](const control::ControllerSpec& spec, const learn::BallOutcome& o) {
       if (o.score <= cycle_score) return;
@@ -571,7 +577,6 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
                             : learn::TeacherWorlds(board, learn::draw_worlds(board, ec, learn::load_randomization(a.randomize)),
                                                    ec.dt_s);
     if (!teacher_worlds.drawn().empty()) j["randomize"] = randomization_report(a.randomize, teacher_worlds.drawn());
-    const std::string cycle_path = a.out + ".cycle.json";
     double cycle_score = -1e300;  // keep the highest-scoring cycle, as the searches do
     const learn::ImitationResult im = learn::learn_by_imitation(
         board, ic, a.budget_balls, a.seed, a.threads,
@@ -590,8 +595,6 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
         },
         &teacher_worlds);
     const learn::SearchResult curve = learn::imitation_curve(im);
-    if (writer && !a.curve.empty()) learn::write_curve_csv(curve, a.curve);
-    if (writer && !a.plot.empty()) plot::write_png(learn::draw_curve(curve), a.plot);
     j["cycle_found"] = curve.cycle_found;
     j["balls_used"] = curve.balls_used;
     result_spec = objective.prototype();
@@ -609,7 +612,10 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
                        " --rounds " + std::to_string(a.rounds) + " --seed " + std::to_string(a.seed) + ": " +
                        std::to_string(im.table->examples().size()) +
                        " shots of a looking-ahead teacher on the true state";
+    // The controller first, as the searches write it: a curve that fails must not cost it.
     if (writer) control::save_controller(result_spec, a.out);
+    if (writer && !a.curve.empty()) learn::write_curve_csv(curve, a.curve);
+    if (writer && !a.plot.empty()) plot::write_png(learn::draw_curve(curve), a.plot);
     eval_spec = &result_spec;
     j["out"] = a.out;
   }

@@ -78,7 +78,7 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
 }
 
 int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
-  check_output_folder(a.trace, "--trace");
+  check_output_folder(a.trace, "--trace", /*streamed=*/true);
   check_named_output(a.video, "--video", sim::check_avi_name);
   const table::Board board = table::load_belief_board(a.board, a.identified);
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);

@@ -1,21 +1,20 @@
 #include "pinball/learn/learning_curve.h"
 
-#include <fstream>
-#include <stdexcept>
+#include <sstream>
 
+#include "pinball/core/text_file.h"
 #include "pinball/plot/chart.h"
 
 namespace pinball::learn {
 
 void write_curve_csv(const SearchResult& r, const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot open for writing");
+  std::ostringstream f;
   f << "method,generation,balls,population_mean,generation_best,best_so_far,wall_s,population_ci95\n";
   for (const CurvePoint& p : r.curve) {
     f << r.method << ',' << p.generation << ',' << p.balls << ',' << p.population_mean << ',' << p.generation_best
       << ',' << p.best_so_far << ',' << p.wall_s << ',' << p.population_ci95 << '\n';
   }
-  if (!f) throw std::runtime_error(path + ": write failed");
+  write_text_file(path, f.str());  // whole or not at all: a full disk is an error, not a cut file
 }
 
 cv::Mat draw_curve(const SearchResult& r) {

@@ -727,6 +727,33 @@ TEST_F(Cli, OutputsAreCheckedFirstAndARefusedRunWritesNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "v.avi"));
 }
 
+// What a whole-file output cannot become is found before the work too: a device (the rename
+// would replace it), a folder that takes no file, two outputs on one file.
+TEST_F(Cli, OutputsThatCannotBeWrittenWholeAreRefusedFirst) {
+  const std::string learn = "learn boards/mit1993.board --method tournament --budget-balls 100 --threads 1 ";
+  const std::string out = (dir_ / "c.json").string();
+  const struct {
+    std::string args;
+    std::string says;
+  } cases[] = {
+      {"--out /dev/null", "--out /dev/null: is not a regular file"},
+      {"--out /proc/c.json", "--out /proc/c.json: cannot write in /proc"},
+      {"--out " + out + " --curve " + out, "--out and --curve both name " + out},
+      {"--out " + out + " --checkpoint " + out, "--out and --checkpoint both name " + out},
+      {"--out " + out + " --curve " + out + ".cycle.json", "--curve and --out's cycle file both name"},
+      {"--out " + out + " --curve /dev/full", "--curve /dev/full: is not a regular file"},
+  };
+  for (const auto& c : cases) {
+    const CommandResult r = run(learn + c.args);
+    EXPECT_EQ(r.exit_code, 1) << c.args;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("tournament"), std::string::npos) << "no search ran: " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  // A trace is streamed, not renamed into place: a pipe or a device is its reader's business.
+  EXPECT_EQ(run("sim boards/mit1993.board --balls 1 --max-ball-time 1 --trace /dev/null").exit_code, 0);
+}
+
 // A budget the seed search spends whole leaves no generation: refused, not an
 // untrained controller written as if learned.
 TEST_F(Cli, LearnWithABudgetTooSmallForOneGenerationWritesNothing) {
