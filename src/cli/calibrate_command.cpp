@@ -62,14 +62,14 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--board", a.board, "the machine's board file (flipper names, sides, rough places)")
       ->transform(data_file())
       ->excludes(sim);
-  cmd->add_option("--image", a.image, "camera: image of the markers")->check(CLI::ExistingFile);
+  cmd->add_option("--image", a.image, "camera: image of the markers")->check(input_file());
   cmd->add_option("--markers", a.markers, "camera: marker positions, CSV x,y (m); default: the board's default layout")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   cmd->add_option("--down", a.down, "flippers: image of the pivot and tip markers, flippers down")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--up", a.up, "flippers: the same with the flippers held up")->check(CLI::ExistingFile);
+      ->check(input_file());
+  cmd->add_option("--up", a.up, "flippers: the same with the flippers held up")->check(input_file());
   cmd->add_option("--sweep", a.sweeps, "flippers: video of one flipper swept stop to stop (repeat, board order)")
-      ->check(CLI::ExistingFile)
+      ->check(input_file())
       ->default_str("");
   cmd->add_option("--method", a.method, "flippers: method written to the file when both ran")
       ->check(CLI::IsMember({"markers", "markerless"}));
@@ -112,7 +112,7 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--print-target", a.print_target,
                   "intrinsics: write the printable target (PNG, 10 px/mm: print at 254 dpi, 100 %) and stop");
   cmd->add_option("--roll", a.rolls, "gravity: observation CSV (t,x,y) of one roll from rest (repeat)")
-      ->check(CLI::ExistingFile)
+      ->check(input_file())
       ->default_str("");
   cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")->check(finite_range(1, 1000));
   cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")

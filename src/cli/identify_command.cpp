@@ -311,9 +311,9 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
                   "PINBALL_FLIPPER_CMD) and write a board overlay (docs/identification.md)");
   cmd->add_option("logs", a.logs, "LCM logs of recorded play (pinballd --lcm-url file://...?mode=w, lcm-logger)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   cmd->add_option("--held-out", a.held_out, "LCM logs never fitted: the 100 ms prediction error of board and overlay")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   cmd->add_option("--board", a.board, "board file of the recorded table (its geometry; the values it guesses are fitted)")
       ->transform(data_file());
   cmd->add_option("--out", a.out, "overlay file to write (YAML); none: report only");

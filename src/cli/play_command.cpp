@@ -43,6 +43,9 @@ std::string default_player() {
 
 // The script's text: the file it names, or the argument itself.
 std::string key_script_text(const std::string& keys) {
+  if (const std::string device = device_input_problem(keys); !device.empty()) {
+    throw std::invalid_argument("play: --keys " + device);
+  }
   std::ifstream in(keys);
   if (!in) return keys;
   std::ostringstream s;
@@ -87,7 +90,8 @@ CLI::App* add_play_command(CLI::App& app, PlayArgs& a) {
   CLI::App* cmd = app.add_subcommand(
       "play", "play the simulated table at the keyboard in real time; --stats FILE: the players' means (docs/play.md)");
   cmd->add_option("board", a.board, "board file (docs/board-format.md); not with --stats");
-  cmd->add_option("--stats", a.stats, "print balls and mean score per ball (95 % interval) per player of this score CSV");
+  cmd->add_option("--stats", a.stats, "print balls and mean score per ball (95 % interval) per player of this score CSV")
+      ->check(input_file());
   cmd->add_option("--player", a.player, "the player's name in the score file (default: $USER, else 'player')");
   cmd->add_option("--csv", a.csv, "score file each ball is appended to (created with its header)");
   cmd->add_option("--balls", a.balls, "stop after this many balls (default 0: play until Esc or q)")

@@ -16,7 +16,7 @@ namespace pinball::cli {
 CLI::App* add_replay_command(CLI::App& app, ReplayArgs& a) {
   CLI::App* cmd = app.add_subcommand(
       "replay", "replay the observations of an LCM log (lcm-logger, pinballd) through the tracker and controller");
-  cmd->add_option("log", a.log, "LCM log file")->required()->check(CLI::ExistingFile);
+  cmd->add_option("log", a.log, "LCM log file")->required()->check(input_file());
   cmd->add_option("--config", a.config, "the pinballd configuration the log was recorded with (default: none)")
       ->transform(data_file());
   cmd->add_option("--board", a.board, "board file (default: the configuration's)")->transform(data_file());

@@ -23,7 +23,7 @@ CLI::App* add_track_command(CLI::App& app, TrackArgs& a) {
                   "CSV with header t,x,y (s, m, board frame), optionally ,left_contact,right_contact (0/1); "
                   "or a sim --trace file")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   cmd->add_option("--gravity", a.gravity_mps2, "gravity along the table (m/s^2); default: the board's")
       ->check(finite_range(0.0, 100.0))
       ->default_str("");  // -1: the board's

@@ -237,7 +237,7 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
   CLI::App* cmd = app.add_subcommand(
       "view", "watch pinballd: live over LCM, or a recorded LCM log with pause, seek and frame stepping");
   cmd->add_option("log", a.log, "LCM log to play (pinballd --lcm-url file://...?mode=w, lcm-logger); none: live")
-      ->check(CLI::ExistingFile);
+      ->check(input_file());
   cmd->add_option("--lcm-url", a.lcm_url, "live: the LCM URL pinballd publishes on (default: --config's, else udpm)");
   cmd->add_option("--config", a.config, "the pinballd configuration: board, calibration, controller, LCM URL")
       ->transform(data_file());

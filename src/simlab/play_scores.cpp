@@ -93,6 +93,7 @@ void check_play_csv_appendable(const std::string& path) {
   std::error_code ec;
   if (fs::exists(path, ec)) {
     if (fs::is_directory(path, ec)) throw std::runtime_error(path + ": is a folder, not a score file");
+    if (!fs::is_regular_file(path, ec)) throw std::runtime_error(path + ": is not a regular file (a device, a pipe)");
     if (::access(path.c_str(), W_OK) != 0) throw std::runtime_error(path + ": cannot write the score file: " + errno_text());
     const std::string header = first_line(path);
     if (!header.empty() && header != kPlayCsvHeader) {
@@ -127,8 +128,14 @@ void append_play_rows(const std::string& path, const std::vector<PlayRow>& rows)
     if (ok) done += static_cast<std::size_t>(n);
   }
   const std::string why = ok ? "" : errno_text();
+  // A failed append (a full disk) takes back what it wrote: half a row would break the file for
+  // every later session and for --stats.
+  const bool part_left = !ok && done > 0 && ::ftruncate(fd, st.st_size) != 0;
   const bool closed = ::close(fd) == 0;  // releases the lock
-  if (!ok || !closed) throw std::runtime_error(path + ": cannot append to the score file: " + (ok ? errno_text() : why));
+  if (!ok || !closed) {
+    throw std::runtime_error(path + ": cannot append to the score file: " + (ok ? errno_text() : why) +
+                             (part_left ? " (part of a row is left at its end: remove it)" : ""));
+  }
 }
 
 std::vector<PlayRow> read_play_csv(const std::string& path) {

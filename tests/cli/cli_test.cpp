@@ -754,6 +754,24 @@ TEST_F(Cli, OutputsThatCannotBeWrittenWholeAreRefusedFirst) {
   EXPECT_EQ(run("sim boards/mit1993.board --balls 1 --max-ball-time 1 --trace /dev/null").exit_code, 0);
 }
 
+// A device given as an input would be read for ever (/dev/zero: found filling 24 GB of memory):
+// refused at the parse, naming the option.
+TEST_F(Cli, ADeviceIsNoInputFile) {
+  for (const std::string& args : {std::string("sim /dev/zero"), std::string("render /dev/zero --out x.png"),
+                                  std::string("learn boards/mit1993.board --method evaluate --controller /dev/zero"),
+                                  std::string("play --stats /dev/zero"), std::string("replay /dev/zero")}) {
+    const CommandResult r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_NE(r.err.find("/dev/zero is a device, not a file"), std::string::npos) << args << "\n" << r.err;
+  }
+  const CommandResult keys = run("play boards/mit1993.board --headless --keys /dev/zero --balls 1");
+  EXPECT_EQ(keys.exit_code, 1);
+  EXPECT_NE(keys.err.find("--keys /dev/zero is a device, not a file"), std::string::npos) << keys.err;
+  const CommandResult csv = run("play boards/mit1993.board --headless --keys 0.1:launch --balls 1 --csv /dev/full");
+  EXPECT_EQ(csv.exit_code, 1);
+  EXPECT_NE(csv.err.find("/dev/full: is not a regular file"), std::string::npos) << csv.err;
+}
+
 // A budget the seed search spends whole leaves no generation: refused, not an
 // untrained controller written as if learned.
 TEST_F(Cli, LearnWithABudgetTooSmallForOneGenerationWritesNothing) {

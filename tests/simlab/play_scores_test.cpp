@@ -1,6 +1,11 @@
 #include "pinball/simlab/play_scores.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 
 #include <cmath>
 #include <cstdio>
@@ -25,6 +30,11 @@ PlayRow row(const std::string& player, int ball, double score) {
   r.score = score;
   r.duration_s = 12.25;
   return r;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 std::string error_of(const std::string& path) {
@@ -61,6 +71,35 @@ TEST(PlayScores, RowsRoundTripAndTheHeaderIsWrittenOnce) {
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_EQ(text.find(kPlayCsvHeader), 0u);
   EXPECT_EQ(text.find(kPlayCsvHeader, 1), std::string::npos);
+  std::remove(path.c_str());
+}
+
+// A disk that fills in the middle of a row (here a file size limit, EFBIG): the append fails
+// and takes back what it wrote, so the file stays readable for the next session and --stats.
+TEST(PlayScores, AFailedAppendLeavesNoHalfRow) {
+  const std::string path = temp_path("play_scores", "full_disk.csv");
+  std::remove(path.c_str());
+  append_play_rows(path, {row("ada", 1, 1234.5)});
+  const std::string before = read_text(path);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {  // the limit and the signal in a child: the test process keeps its own
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{static_cast<rlim_t>(before.size() + 20), static_cast<rlim_t>(before.size() + 20)};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      append_play_rows(path, {row("bob", 1, 8388.0), row("bob", 2, 99.0)});
+    } catch (const std::runtime_error&) {
+      _exit(3);
+    }
+    _exit(0);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 3) << "the append past the limit did not fail";
+  EXPECT_EQ(read_text(path), before) << "half a row was left";
+  EXPECT_EQ(read_play_csv(path).size(), 1u);
   std::remove(path.c_str());
 }
 

@@ -5,7 +5,9 @@
 // `pinballd --controller controllers/spastic.json` outside the source tree.
 // Header-only, for the programs' main code, which links CLI11.
 
+#include <filesystem>
 #include <string>
+#include <system_error>
 
 #include <CLI/CLI.hpp>
 
@@ -13,12 +15,33 @@
 
 namespace pinball {
 
-/// A transform for a file option: the path through find_data_file, which must then exist.
+/// Why `path`, an input, is not one to read: "" for a file or a pipe; a
+/// device (/dev/zero, /dev/full) would be read for ever, or fail as no file.
+inline std::string device_input_problem(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (!ec && (std::filesystem::is_character_file(st) || std::filesystem::is_block_file(st)))
+    return path + " is a device, not a file";
+  return "";
+}
+
+/// A check for an input file option: it must exist, and be no folder and no device.
+inline CLI::Validator input_file() {
+  return CLI::Validator(
+      [](std::string& path) {
+        const std::string missing = CLI::ExistingFile(path);
+        return missing.empty() ? device_input_problem(path) : missing;
+      },
+      "FILE");
+}
+
+/// A transform for a file option: the path through find_data_file, which must then be an input_file().
 inline CLI::Validator data_file() {
   return CLI::Validator(
       [](std::string& path) {
         path = find_data_file(path);
-        return CLI::ExistingFile(path);
+        const std::string missing = CLI::ExistingFile(path);
+        return missing.empty() ? device_input_problem(path) : missing;
       },
       "FILE");
 }
