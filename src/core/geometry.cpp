@@ -33,6 +33,30 @@ double distance_segment_segment(const Vec2& p0, const Vec2& p1, const Vec2& q0, 
                    distance_point_segment(q0, p0, p1), distance_point_segment(q1, p0, p1)});
 }
 
+bool point_in_polygon(const Vec2& p, const std::vector<Vec2>& vertices) {
+  bool inside = false;
+  for (std::size_t i = 0, j = vertices.size() - 1; i < vertices.size(); j = i++) {
+    const Vec2& a = vertices[i];
+    const Vec2& b = vertices[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) {
+      inside = !inside;
+    }
+  }
+  return inside;
+}
+
+std::pair<int, int> polygon_self_crossing(const std::vector<Vec2>& vertices) {
+  const std::size_t n = vertices.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = i + 2; k < n; ++k) {
+      if (i == 0 && k == n - 1) continue;  // the last edge ends where the first begins
+      const double d = distance_segment_segment(vertices[i], vertices[(i + 1) % n], vertices[k], vertices[(k + 1) % n]);
+      if (d == 0.0) return {static_cast<int>(i), static_cast<int>(k)};
+    }
+  }
+  return {-1, -1};
+}
+
 double distance_point_box(const Vec2& p, const Vec2& lo, const Vec2& hi) {
   const double dx = std::max({lo.x() - p.x(), 0.0, p.x() - hi.x()});
   const double dy = std::max({lo.y() - p.y(), 0.0, p.y() - hi.y()});

@@ -62,6 +62,19 @@ double distance_to_shape(const Shape& shape, const Vec2& p) {
   return (p - shape.p0).norm() - shape.radius_m;
 }
 
+std::optional<BallOverlap> ball_overlap(const Board& board, const Vec2& p) {
+  const double r = board.ball.radius_m;
+  for (std::size_t i = 0; i < board.shapes.size(); ++i) {
+    const double d = distance_to_shape(board.shapes[i], p);
+    if (d < r) return BallOverlap{"'" + board.obstacles[i].name + "'", d};
+  }
+  for (const Flipper& f : board.flippers) {
+    const double d = distance_point_segment(p, f.pivot, flipper_tip(f, f.theta_min_rad));
+    if (d < r) return BallOverlap{"flipper '" + f.name + "' in its down position", d};
+  }
+  return std::nullopt;
+}
+
 std::array<int, 2> flippers_by_side(const Board& board) {
   std::array<int, 2> index{-1, -1};
   for (std::size_t i = 0; i < board.flippers.size(); ++i)

@@ -13,23 +13,41 @@ namespace {
 
 constexpr std::string_view kRequired[] = {"pinball-board", "size", "ball", "gravity", "dt", "balls", "launcher"};
 
-void check_launcher_clear(const LoadState& state) {
+// Why a ball put at `p` (the launch position, the start, a hole's kick-out) would begin inside
+// something: off the table, overlapping an obstacle or a flipper down, or inside a polygon's
+// solid; "" when it is clear.
+std::string ball_placement_problem(const LoadState& state, const Vec2& p) {
   const Board& board = state.board;
-  const Vec2 p = board.launcher.position;
-  const double r = board.ball.radius_m;
-  const int line = state.seen.at("launcher");
-  const auto overlap = [&](const std::string& what, double d) {
-    throw BoardError(state.file, line,
-                     "launcher: ball at the launch position overlaps " + what + " (distance " +
-                         in_file_unit(state, d) + ", ball radius " + in_file_unit(state, r) + ")");
-  };
-  for (std::size_t i = 0; i < board.shapes.size(); ++i) {
-    const double d = distance_to_shape(board.shapes[i], p);
-    if (d < r) overlap("'" + board.obstacles[i].name + "'", d);
+  if (!(p.x() >= 0.0 && p.x() <= board.width_m && p.y() >= 0.0 && p.y() <= board.height_m)) {
+    return "lies outside the table (0..W, 0..H = " + fmt(board.width_m / state.length_scale) + ", " +
+           in_file_unit(state, board.height_m) + ")";
   }
-  for (const Flipper& f : board.flippers) {
-    const double d = distance_point_segment(p, f.pivot, flipper_tip(f, f.theta_min_rad));
-    if (d < r) overlap("flipper '" + f.name + "' in its down position", d);
+  if (const std::optional<BallOverlap> o = ball_overlap(board, p)) {
+    return "overlaps " + o->what + " (distance " + in_file_unit(state, o->distance_m) + ", ball radius " +
+           in_file_unit(state, board.ball.radius_m) + ")";
+  }
+  for (const LoadState::Polygon& solid : state.polygons) {
+    if (point_in_polygon(p, solid.vertices_m)) return "lies inside polygon '" + solid.name + "'";
+  }
+  return "";
+}
+
+void check_launcher_clear(const LoadState& state) {
+  const std::string problem = ball_placement_problem(state, state.board.launcher.position);
+  if (!problem.empty()) {
+    throw BoardError(state.file, state.seen.at("launcher"), "launcher: ball at the launch position " + problem);
+  }
+}
+
+// A hole that kicks the ball out puts it at the hole's centre: clear of everything, or the ball
+// starts inside a post or a wall (found: through a closed box, in the twin).
+void check_kickouts_clear(const LoadState& state) {
+  for (const Sensor& hole : state.board.sensors) {
+    if (hole.kind != SensorKind::kHole || !hole.has_kickout) continue;
+    const std::string problem = ball_placement_problem(state, hole.shape.p0);
+    if (!problem.empty()) {
+      throw BoardError(state.file, hole.source_line, "hole: the ball kicked out at its centre " + problem);
+    }
   }
 }
 
@@ -62,28 +80,13 @@ void check_start(const LoadState& state) {
   const double r = board.ball.radius_m;
   const int line = state.seen.at("start");
   const auto fail = [&](const std::string& what) { throw BoardError(state.file, line, "start: " + what); };
-  if (!(p.x() >= 0.0 && p.x() <= board.width_m && p.y() >= 0.0 && p.y() <= board.height_m)) {
-    fail("fields X Y (" + fmt(p.x() / state.length_scale) + ", " + fmt(p.y() / state.length_scale) + ") " +
-         unit_name(state) + " lie outside the table (0..W, 0..H = " + fmt(board.width_m / state.length_scale) + ", " +
-         in_file_unit(state, board.height_m) + ")");
-  }
   if (!(v.norm() <= board.ball.speed_max_mps)) {
     fail("speed of fields VX VY (" + in_file_unit(state, v.norm(), "/s") + ") exceeds the ball's SPEED_MAX (" +
          in_file_unit(state, board.ball.speed_max_mps, "/s") + ")");
   }
-  for (std::size_t i = 0; i < board.shapes.size(); ++i) {
-    const double d = distance_to_shape(board.shapes[i], p);
-    if (d < r) {
-      fail("ball at fields X Y overlaps '" + board.obstacles[i].name + "' (distance " + in_file_unit(state, d) +
-           ", ball radius " + in_file_unit(state, r) + ")");
-    }
-  }
-  for (const Flipper& f : board.flippers) {
-    const double d = distance_point_segment(p, f.pivot, flipper_tip(f, f.theta_min_rad));
-    if (d < r) {
-      fail("ball at fields X Y overlaps flipper '" + f.name + "' in its down position (distance " +
-           in_file_unit(state, d) + ", ball radius " + in_file_unit(state, r) + ")");
-    }
+  if (const std::string problem = ball_placement_problem(state, p); !problem.empty()) {
+    fail("ball at fields X Y (" + fmt(p.x() / state.length_scale) + ", " + fmt(p.y() / state.length_scale) + ") " +
+         unit_name(state) + " " + problem);
   }
   for (const Sensor& sensor : board.sensors) {
     if (sensor.kind == SensorKind::kHole && (p - sensor.shape.p0).norm() <= sensor.shape.radius_m) {
@@ -126,6 +129,7 @@ void check_whole_file(const LoadState& state) {
   check_launcher_clear(state);
   check_launch_speed(state);
   check_start(state);
+  check_kickouts_clear(state);
 }
 
 }  // namespace pinball::table::loader

@@ -88,6 +88,11 @@ struct LoadState {
   int first_dimensioned_line = 0;   // first statement using a length or angle
   std::map<std::string, int> seen;  // singleton keyword -> its line
   std::vector<int> bank_lines;      // same index as board.banks
+  struct Polygon {
+    std::vector<Vec2> vertices_m;
+    std::string name;
+  };
+  std::vector<Polygon> polygons;    // solid outlines: a ball must not start inside one
 };
 
 /// The file's length unit as messages spell it: "m" or "mm".

@@ -3,6 +3,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pinball/core/format.h"
 #include "pinball/core/text_file.h"
 #include "pinball/core/utc_date.h"
 #include "pinball/core/yaml_read_archive.h"
@@ -163,6 +164,26 @@ void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, B
   } catch (const std::invalid_argument& e) {
     throw KeyError(name, overlay.launcher ? "launcher.pull" : "gravity_mps2",
                    std::string(e.what()) + " (on the board " + board.source + ")");
+  }
+  // Thicker walls move their faces: the board loader's placements must stay clear of them, or
+  // the ball begins inside a wall (found: out through the chute's wall at 0.05 m).
+  if (overlay.wall_thickness_m) {
+    const auto require_clear = [&](const Vec2& p, const std::string& where) {
+      if (const std::optional<BallOverlap> o = ball_overlap(b, p)) {
+        throw KeyError(name, "wall_thickness_m",
+                       "with walls " + format_number(overlay.wall_thickness_m->value) + " m thick the ball " + where +
+                           " overlaps " + o->what + " (distance " + format_number(o->distance_m) + " m, ball radius " +
+                           format_number(b.ball.radius_m) + " m) on the board " + board.source);
+      }
+    };
+    if (b.start) {
+      require_clear(b.start->position, "at the start");
+    } else {
+      require_clear(b.launcher.position, "at the launch position");
+    }
+    for (const Sensor& hole : b.sensors) {
+      if (hole.kind == SensorKind::kHole && hole.has_kickout) require_clear(hole.shape.p0, "kicked out of " + hole.name);
+    }
   }
   board = std::move(b);
 }

@@ -258,10 +258,22 @@ void polyline(LoadState& state, const Reader& r) {
 }
 
 void polygon(LoadState& state, const Reader& r) {
+  // Its edges are checked pairwise for crossings: a longer outline is a polyline.
+  constexpr std::size_t kMaxPolygonVertices = 10000;
   std::vector<Vec2> v = path(state, r, 3, true);
+  if (v.size() > kMaxPolygonVertices) {
+    r.fail("a polygon has at most " + std::to_string(kMaxPolygonVertices) + " vertices, got " +
+           std::to_string(v.size()));
+  }
   double twice_area = 0.0;
   for (std::size_t i = 0; i < v.size(); ++i) twice_area += cross(v[i], v[(i + 1) % v.size()]);
   if (twice_area == 0.0) r.fail("the vertices enclose no area");
+  // A crossing outline (a bow tie) has no outside: one lobe's edges would face in, and a ball
+  // would be trapped in the solid.
+  if (const auto [a, b] = polygon_self_crossing(v); a >= 0) {
+    r.fail("edges " + std::to_string(a + 1) + " and " + std::to_string(b + 1) +
+           " cross: a polygon's outline must not cross itself (draw each lobe as its own polygon)");
+  }
   // Clockwise traversal puts each edge's left normal outside.
   if (twice_area > 0.0) std::reverse(v.begin(), v.end());
   const Obstacle o = obstacle_attributes(state, r);
@@ -269,6 +281,9 @@ void polygon(LoadState& state, const Reader& r) {
     add(state.board, make_line_shape(v[i] * state.length_scale, v[(i + 1) % v.size()] * state.length_scale), o);
   }
   for (const Vec2& p : v) add(state.board, make_circle_shape(p * state.length_scale, 0.0), o);
+  LoadState::Polygon solid{{}, o.name};
+  for (const Vec2& p : v) solid.vertices_m.push_back(p * state.length_scale);
+  state.polygons.push_back(std::move(solid));
 }
 
 // ---- flippers and sensors ----

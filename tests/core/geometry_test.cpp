@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <utility>
+#include <vector>
+
 #include <cmath>
 
 namespace pinball {
@@ -139,6 +142,21 @@ TEST(Geometry, DistanceSegmentBox) {
   EXPECT_EQ(distance_segment_box({-1.0, 0.5}, {2.0, 0.5}, lo, hi), 0.0);    // passes through
   EXPECT_DOUBLE_EQ(distance_segment_box({2.0, -1.0}, {2.0, 3.0}, lo, hi), 1.0);
   EXPECT_NEAR(distance_segment_box({1.5, 2.0}, {2.0, 1.5}, lo, hi), std::sqrt(2.0) * 0.75 - 0.0, 1e-15);
+}
+
+TEST(PointInPolygon, InsideOutsideAndAConcaveNotch) {
+  const std::vector<Vec2> u = {{0, 0}, {3, 0}, {3, 3}, {2, 3}, {2, 1}, {1, 1}, {1, 3}, {0, 3}};  // a U
+  EXPECT_TRUE(point_in_polygon({0.5, 2.0}, u));
+  EXPECT_TRUE(point_in_polygon({1.5, 0.5}, u));
+  EXPECT_FALSE(point_in_polygon({1.5, 2.0}, u)) << "in the notch";
+  EXPECT_FALSE(point_in_polygon({4.0, 1.0}, u));
+}
+
+TEST(PolygonSelfCrossing, ABowTieCrossesASquareDoesNot) {
+  EXPECT_EQ(polygon_self_crossing({{0, 0}, {1, 0}, {1, 1}, {0, 1}}), std::make_pair(-1, -1));
+  EXPECT_EQ(polygon_self_crossing({{0, 0}, {1, 1}, {1, 0}, {0, 1}}), std::make_pair(0, 2));
+  // Two lobes that touch at one point are no simple outline either.
+  EXPECT_NE(polygon_self_crossing({{0, 0}, {1, 1}, {2, 0}, {2, 2}, {1, 1}, {0, 2}}).first, -1);
 }
 
 }  // namespace

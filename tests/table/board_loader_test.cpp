@@ -320,16 +320,34 @@ TEST(BoardLoaderErrors, StartIsOnTheTableClearAndFinite) {
   expect_body_error("start 0.1 0.9 inf 0\n", 8, "start: field VX is not a finite number: 'inf'");
   expect_body_error("start 0.1 0.9 1000 0\n", 8, "start: speed of fields VX VY must be at most 100 m/s, got 1000");
   expect_body_error("start 0.1 0.9 1 0\nstart 0.2 0.9 1 0\n", 9, "duplicate 'start' statement (first at line 8)");
-  expect_body_error("start 0.1 1.2 0 0\n", 8, "start: fields X Y (0.1, 1.2) m lie outside the table");
-  expect_body_error("start -0.01 0.5 0 0\n", 8, "start: fields X Y (-0.01, 0.5) m lie outside the table");
+  expect_body_error("start 0.1 1.2 0 0\n", 8, "start: ball at fields X Y (0.1, 1.2) m lies outside the table");
+  expect_body_error("start -0.01 0.5 0 0\n", 8, "start: ball at fields X Y (-0.01, 0.5) m lies outside the table");
   expect_body_error("start 0.1 0.9 6 0\n", 8, "start: speed of fields VX VY (6 m/s) exceeds the ball's SPEED_MAX (5 m/s)");
   expect_body_error("start 0.1 0.5 0 0\ncircle 0.1 0.52 0.01 name=post\n", 8,
-                    "start: ball at fields X Y overlaps 'post' (distance 0.01 m, ball radius 0.0135 m)");
+                    "start: ball at fields X Y (0.1, 0.5) m overlaps 'post' (distance 0.01 m, ball radius 0.0135 m)");
   expect_body_error("start 0.1 0.5 0 0\nflipper left 0.05 0.505 0.076 0 0.5 35 name=lf\n", 8,
-                    "start: ball at fields X Y overlaps flipper 'lf' in its down position");
+                    "start: ball at fields X Y (0.1, 0.5) m overlaps flipper 'lf' in its down position");
   expect_body_error("start 0.1 0.5 0 0\nhole 0.1 0.51 0.02 eat name=drain\n", 8,
                     "start: ball at fields X Y starts inside hole 'drain'");
   expect_body_error("start 0.45 0.055 0 0.1\n", 8, "counts as resting in the launcher");
+  // Inside a solid, clear of its edges: the distance test alone passed it.
+  expect_body_error("start 0.2 0.5 0 0\npolygon 0.1 0.4 0.3 0.4 0.3 0.6 0.1 0.6 name=block\n", 8,
+                    "start: ball at fields X Y (0.2, 0.5) m lies inside polygon 'block'");
+}
+
+// Found by a helper: each of these loaded, and the ball then began, or went, inside a solid.
+TEST(BoardLoaderErrors, NoBallBeginsInsideASolid) {
+  // A bow tie: one lobe's edges faced in, and a ball was trapped in it for good.
+  expect_body_error("polygon 0.05 0.4 0.4 0.7 0.4 0.5 0.05 0.7 name=bowtie\n", 8,
+                    "polygon: edges 1 and 3 cross: a polygon's outline must not cross itself");
+  // A hole kicks the ball out at its centre: not onto a post, not into a wall.
+  expect_body_error("circle 0.25 0.5 0.01 name=post\nhole 0.25 0.5 0.05 kickout=0,2 name=saucer\n", 9,
+                    "hole: the ball kicked out at its centre overlaps 'post'");
+  expect_body_error("polygon 0.2 0.4 0.3 0.4 0.3 0.6 0.2 0.6 name=block\nhole 0.25 0.5 0.01 kickout=0,2\n", 9,
+                    "hole: the ball kicked out at its centre lies inside polygon 'block'");
+  // The launcher (line 7) inside a solid.
+  expect_body_error("polygon 0.4 0.0 0.5 0.0 0.5 0.2 0.4 0.2 name=block\n", 7,
+                    "launcher: ball at the launch position lies inside polygon 'block'");
 }
 
 TEST(BoardLoaderErrors, LaunchTooSlowToLeaveTheLauncher) {

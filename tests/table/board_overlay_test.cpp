@@ -416,6 +416,22 @@ TEST(BoardOverlay, ALaunchThatCannotLeaveTheLauncherIsRefused) {
   }
 }
 
+// Walls so thick that the launch position lies inside the chute's wall: the ball would start
+// in it and leave the table through it (found at 0.05 m, the key's own upper bound).
+TEST(BoardOverlay, WallsThatReachTheBallsFirstPositionAreRefused) {
+  BoardOverlay o;
+  o.wall_thickness_m = value(0.05, 0.001, 500);
+  Board b = load_board(kBoard);
+  try {
+    apply_board_overlay(o, "over.yaml", b);
+    ADD_FAILURE() << "walls 5 cm thick left the launch position clear";
+  } catch (const KeyError& e) {
+    EXPECT_EQ(e.key(), "wall_thickness_m");
+    EXPECT_NE(e.message().find("the ball at the launch position overlaps 'right_wall'"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(BoardOverlay, TheBeliefIsTheBoardFileWithTheOverlay) {
   const Board file = load_board(kBoard);
   const Board plain = load_belief_board(kBoard, "");

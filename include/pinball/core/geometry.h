@@ -2,6 +2,9 @@
 // Plane geometry in the board frame (metres): the handful of primitives that
 // the simulator, the tracker and the renderer share.
 
+#include <utility>
+#include <vector>
+
 #include <Eigen/Core>
 
 namespace pinball {
@@ -26,6 +29,15 @@ double distance_point_segment(const Vec2& p, const Vec2& a, const Vec2& b);
 
 /// Smallest distance between segments [p0, p1] and [q0, q1] (0 when they cross).
 double distance_segment_segment(const Vec2& p0, const Vec2& p1, const Vec2& q0, const Vec2& q1);
+
+/// Whether p lies inside the closed polygon `vertices` (even-odd rule; on an
+/// edge counts either way).
+bool point_in_polygon(const Vec2& p, const std::vector<Vec2>& vertices);
+
+/// The first two non-adjacent edges of the closed polygon `vertices` that
+/// cross or touch, as edge indices (edge i runs from vertex i to i + 1), or
+/// {-1, -1} when it is simple. O(n²).
+std::pair<int, int> polygon_self_crossing(const std::vector<Vec2>& vertices);
 
 /// Distance from point p to the axis-aligned box [lo, hi] (0 inside).
 double distance_point_box(const Vec2& p, const Vec2& lo, const Vec2& hi);

@@ -179,6 +179,17 @@ void set_wall_thickness(Board& board, double thickness_m);
 /// either side; circles: to the rim, negative inside).
 double distance_to_shape(const Shape& shape, const Vec2& p);
 
+/// What a ball of the board's radius centred at `p` would overlap: an
+/// obstacle (by name) or a flipper in its down position ("flipper 'name'
+/// in its down position"), and the distance from `p` to it (m).
+struct BallOverlap {
+  std::string what;
+  double distance_m = 0.0;
+};
+/// The first overlap of a ball centred at `p`; std::nullopt when it is clear
+/// of every obstacle and flipper (down).
+std::optional<BallOverlap> ball_overlap(const Board& board, const Vec2& p);
+
 /// "left" or "right": how board and calibration files spell a side.
 std::string_view side_name(Side side);
 
