@@ -66,7 +66,7 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
   for (std::size_t i = 0; i < o.flippers.size(); ++i) {
     const std::string key = "flippers[" + std::to_string(i) + "]";
     if (o.flippers[i].name.empty()) r.fail(key + ".name", "is empty");
-    if (o.flippers[i].mu) check_value(*o.flippers[i].mu, kZero, {10.0, false}, "", key + ".mu", r);
+    if (o.flippers[i].mu) check_value(*o.flippers[i].mu, kZero, {kMaxFlipperMu, false}, "", key + ".mu", r);
     if (o.flippers[i].omega_rad_s)
       check_value(*o.flippers[i].omega_rad_s, kAboveZero, {200.0, false}, " rad/s", key + ".omega_rad_s", r);
     if (o.flippers[i].rise_delay_s)

@@ -152,12 +152,21 @@ int bank_index(const Board& board, std::string_view name) {
   return -1;
 }
 
+/// Points (score=, contact=, bonus=): 0 to kMaxPoints.
+double points_attribute(const Reader& r, std::string_view key) {
+  const double points = r.attribute(key, 0.0);
+  const std::string label = "attribute " + std::string(key);
+  r.require(points >= 0, label, ">= 0", points);
+  r.require(points <= kMaxPoints, label, "at most " + fmt(kMaxPoints), points);
+  return points;
+}
+
 void bank(LoadState& state, const Reader& r) {
   if (r.arg_count() != 1) r.fail("expected one NAME, got " + std::to_string(r.arg_count()));
   const std::string name(r.arg(0));
   if (bank_index(state.board, name) >= 0) r.fail("bank '" + name + "' is declared twice");
   if (!r.flag("bonus")) r.fail("needs bonus=POINTS");
-  state.board.banks.push_back(Bank{name, r.attribute("bonus", 0.0), {}});
+  state.board.banks.push_back(Bank{name, points_attribute(r, "bonus"), {}});
   state.bank_lines.push_back(r.line());
 }
 
@@ -172,12 +181,12 @@ Obstacle obstacle_attributes(const LoadState& state, const Reader& r) {
   o.friction = r.attribute("friction", 0.0);
   r.require(o.friction >= 0, "attribute friction", ">= 0", o.friction);
   r.require(o.friction <= kMaxWallFriction, "attribute friction", "at most " + fmt(kMaxWallFriction), o.friction);
-  o.action.score = r.attribute("score", 0.0);
+  o.action.score = points_attribute(r, "score");
   const double kick = r.attribute("kick", 0.0);
   r.require(kick >= 0, "attribute kick", ">= 0", kick);
   require_at_most(state, r, kick, "attribute kick", kMaxSpeed_mps, "/s");
   o.action.kick_mps = kick * state.length_scale;
-  o.action.contact_score_per_s = r.attribute("contact", 0.0);
+  o.action.contact_score_per_s = points_attribute(r, "contact");
   o.action.eats_ball = r.flag("eat");
   o.visible = !r.flag("hidden");
   if (r.flag("bank")) {
@@ -307,13 +316,14 @@ void flipper(LoadState& state, const Reader& r) {
   f.rho = rho_attribute(r, state.default_rho);
   f.mu = r.attribute("mu", 1.0);
   r.require(f.mu >= 0, "attribute mu", ">= 0", f.mu);
+  r.require(f.mu <= kMaxFlipperMu, "attribute mu", "at most " + fmt(kMaxFlipperMu), f.mu);
   f.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
   f.source_line = r.line();
   state.board.flippers.push_back(f);
 }
 
 void finish_sensor(LoadState& state, const Reader& r, Sensor& s) {
-  s.action.score = r.attribute("score", 0.0);
+  s.action.score = points_attribute(r, "score");
   s.action.eats_ball = r.flag("eat");
   s.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
   s.source_line = r.line();

@@ -335,6 +335,16 @@ TEST(BoardLoaderErrors, StartIsOnTheTableClearAndFinite) {
                     "start: ball at fields X Y (0.2, 0.5) m lies inside polygon 'block'");
 }
 
+// Found by a helper: mu=1e300 overflowed the speed clamp to a stopped ball, and score=1e308
+// a game's sum to inf (the report's mean: nan).
+TEST(BoardLoaderErrors, FrictionAndPointsHaveUpperBounds) {
+  expect_body_error("flipper left 0.15 0.16 0.076 -25 30 35 mu=1e300\n", 8, "attribute mu must be at most 10");
+  expect_body_error("circle 0.2 0.5 0.01 score=1e308\n", 8, "attribute score must be at most 1e+06");
+  expect_body_error("circle 0.2 0.5 0.01 score=-5\n", 8, "attribute score must be >= 0");
+  expect_body_error("circle 0.2 0.5 0.01 contact=-1\n", 8, "attribute contact must be >= 0");
+  expect_body_error("bank b bonus=1e9\n", 8, "attribute bonus must be at most 1e+06");
+}
+
 // Found by a helper: each of these loaded, and the ball then began, or went, inside a solid.
 TEST(BoardLoaderErrors, NoBallBeginsInsideASolid) {
   // A bow tie: one lobe's edges faced in, and a ball was trapped in it for good.

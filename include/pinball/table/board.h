@@ -43,6 +43,13 @@ struct Action {
 /// The largest wall friction a board or an overlay may give: no surface a ball rolls on has more.
 inline constexpr double kMaxWallFriction = 2.0;
 
+/// The largest flipper friction coefficient a board or an overlay may give
+/// (rubber on a ball is about 1; 1e154 overflowed the clamp to a stopped ball).
+inline constexpr double kMaxFlipperMu = 10.0;
+/// The most points one hit, one second of contact or one bank may give: a
+/// score summed over a long game stays far from overflow, and none is negative.
+inline constexpr double kMaxPoints = 1e6;
+
 /// The time steps a board's `dt` line, and a command's --dt, may give (s).
 /// Below 1 µs a ball takes millions of steps a second of play (1e-12: never
 /// ends); above 10 ms a 5 m/s ball jumps 5 cm, through any post.
