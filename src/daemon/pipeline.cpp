@@ -179,16 +179,24 @@ TrackingSetup tracking_setup_for(const DaemonConfig& config, const table::Board&
     const calibration::Calibration c = calibration::read_calibration(config.calibration);
     calibration::check_calibration_matches_board(c, config.calibration, board);  // a misnamed flipper is refused
     calibration::apply_calibration(c, config.calibration, s.tracker, s.geometry);
-    if (c.camera) s.homography = calibration::camera_homography(c, config.calibration);
+    // A section measured on images of another size maps nothing onto these frames: the game
+    // would play blind (found: a 640x480 homography with 320x240 frames, exit 0, no ball seen).
+    const auto require_frame_size = [&](const std::string& key, const std::string& what, int width_px,
+                                        int height_px) {
+      if (width_px == config.camera.width_px && height_px == config.camera.height_px) return;
+      throw std::runtime_error(config.calibration + ":" + key + ": " + what + " was calibrated on " +
+                               std::to_string(width_px) + "x" + std::to_string(height_px) +
+                               " images but camera.width_px x camera.height_px is " +
+                               std::to_string(config.camera.width_px) + "x" + std::to_string(config.camera.height_px));
+    };
+    if (c.camera) {
+      require_frame_size("camera.image_width_px", "the camera's homography", c.camera->image_width_px,
+                         c.camera->image_height_px);
+      s.homography = calibration::camera_homography(c, config.calibration);
+    }
     if (c.intrinsics) {
       const vision::CameraIntrinsics& lens = c.intrinsics->lens;
-      if (lens.width_px != config.camera.width_px || lens.height_px != config.camera.height_px) {
-        throw std::runtime_error(config.calibration + ":intrinsics.lens.width_px: the lens was calibrated on " +
-                                 std::to_string(lens.width_px) + "x" + std::to_string(lens.height_px) +
-                                 " images but camera.width_px x camera.height_px is " +
-                                 std::to_string(config.camera.width_px) + "x" +
-                                 std::to_string(config.camera.height_px));
-      }
+      require_frame_size("intrinsics.lens.width_px", "the lens", lens.width_px, lens.height_px);
       s.lens = lens;
     }
     s.timing = c.camera_timing;

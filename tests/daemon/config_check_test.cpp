@@ -101,6 +101,21 @@ TEST(ConfigCheck, ACanLogThatCannotBeWrittenFailsTheCheck) {
   EXPECT_EQ(j.at("error"), what);
 }
 
+// A homography or a lens measured on images of another size would map nothing onto these
+// frames: the game played blind, exit 0 (found in sim with 320x240 frames).
+TEST(ConfigCheck, TheCalibrationMustBeOfTheFramesSize) {
+  DaemonConfig c;
+  c.calibration = kSourceTree + "/calibration/lab.example.yaml";  // measured on 640x480
+  c.camera.width_px = 320;
+  c.camera.height_px = 240;
+  EXPECT_EQ(check_error(c), c.calibration +
+                                ":camera.image_width_px: the camera's homography was calibrated on 640x480 images but "
+                                "camera.width_px x camera.height_px is 320x240");
+  c.camera.width_px = 640;
+  c.camera.height_px = 480;
+  EXPECT_EQ(check_error(c), "");
+}
+
 TEST(ConfigCheck, ALabCameraNeedsTheCalibrationsHomographyAndAMaskOfItsSize) {
   DaemonConfig c = lab_without_hardware();
   calibration::Calibration no_camera = calibration::read_calibration(c.calibration);
