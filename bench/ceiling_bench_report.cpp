@@ -61,11 +61,15 @@ nlohmann::json to_json(const CeilingReport& r) {
           {"controller", o.controller_name},
           {"ceiling_over_spastic", r.ceiling_over_spastic},
           {"ceiling_over_tracker_spastic", r.ceiling_over_tracker_spastic},
-          {"controller_over_tracker_spastic", r.controller_over_tracker_spastic},
+          // null when no controller was played (not a ratio of 0)
+          {"controller_over_tracker_spastic",
+           r.controller ? nlohmann::json(r.controller_over_tracker_spastic) : nlohmann::json(nullptr)},
           {"true_state_feed", o.true_state_feed ? nlohmann::json{{"position_noise_m", o.true_state_feed->position_noise_m},
                                                                  {"velocity_noise_mps", o.true_state_feed->velocity_noise_mps}}
                                                 : nlohmann::json(nullptr)},
-          {"controller_true_state_over_tracker_spastic", r.controller_true_state_over_tracker_spastic}};
+          {"controller_true_state_over_tracker_spastic",
+           r.controller_true_state ? nlohmann::json(r.controller_true_state_over_tracker_spastic)
+                                   : nlohmann::json(nullptr)}};
 }
 
 std::string to_text(const CeilingReport& r) {

@@ -110,7 +110,9 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
       ->check(finite_range(1, 1000));
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "seconds after which a ball is cut (a cycle)")
       ->check(finite_positive());
-  cmd->add_option("--loss-penalty", a.loss_penalty, "reward of a flip opportunity that lost the ball (6.3.1)");
+  cmd->add_option("--loss-penalty", a.loss_penalty,
+                  "points taken from a flip opportunity that lost the ball (6.3.1)")
+      ->check(finite_non_negative());
   cmd->add_option_function<double>(
          "--actuation-delay",
          [&a](const double& v) {

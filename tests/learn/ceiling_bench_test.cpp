@@ -84,6 +84,8 @@ TEST(CeilingBench, ReportCountsEveryBallAndPrintsOneJsonObject) {
     EXPECT_TRUE(j.contains(k)) << k;
   }
   EXPECT_EQ(j.at("controller"), "early.json");
+  EXPECT_DOUBLE_EQ(j.at("controller_over_tracker_spastic").get<double>(), r.controller_over_tracker_spastic);
+  EXPECT_TRUE(j.at("controller_true_state_over_tracker_spastic").is_null()) << "not played: no ratio of 0";
   for (const char* p : {"ceiling", "spastic", "no_flipping", "tracker_spastic", "controller"}) {
     for (const char* k : {"mean_score_per_ball", "score_ci95_half_width", "mean_ball_time_s", "flips_per_ball",
                           "balls_cut_at_time_limit", "drains_left_outlane", "drains_elsewhere", "drains_centre", "wall_s"}) {
