@@ -404,6 +404,21 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   if (a.drain_penalty >= 0.0 && a.method != "imitate" && a.method != "shot-values")
     throw std::invalid_argument("learn: --drain-penalty is for imitate (its teacher) or shot-values, not --method " +
                                 a.method);
+  // Options a method does not read are refused, not ignored: launcher prints its pulls and
+  // writes nothing; shot-values writes its table, with no curve and no checkpoint.
+  if (a.method == "launcher" || a.method == "shot-values") {
+    const std::vector<std::pair<const char*, std::string>> unread =
+        a.method == "launcher"
+            ? std::vector<std::pair<const char*, std::string>>{{"--out", a.out},
+                                                               {"--curve", a.curve},
+                                                               {"--plot", a.plot},
+                                                               {"--checkpoint", a.checkpoint}}
+            : std::vector<std::pair<const char*, std::string>>{
+                  {"--curve", a.curve}, {"--plot", a.plot}, {"--checkpoint", a.checkpoint}};
+    for (const auto& [option, value] : unread) {
+      if (!value.empty()) throw std::invalid_argument("learn: --method " + a.method + " does not read " + option);
+    }
+  }
   if (a.method == "launcher") return run_launcher_search(a, out, err);
   if (a.method == "shot-values") return run_shot_values(a, out, err);
   const bool search = a.method == "tournament" || a.method == "relay" || a.method == "cem";
@@ -415,8 +430,8 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   if (a.method == "evaluate" || a.method == "none" || a.method == "spastic") {
     if (!a.out.empty()) {
       throw std::invalid_argument("learn: --method " + a.method +
-                                  " writes no controller (--out is for tournament, relay, cem, imitate, launcher "
-                                  "and shot-values)");
+                                  " writes no controller (--out is for tournament, relay, cem, imitate and "
+                                  "shot-values)");
     }
     if (a.eval_balls == 0) {
       throw std::invalid_argument("learn: --eval-balls 0 leaves --method " + a.method +

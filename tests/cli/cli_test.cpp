@@ -772,6 +772,21 @@ TEST_F(Cli, ADeviceIsNoInputFile) {
   EXPECT_NE(csv.err.find("/dev/full: is not a regular file"), std::string::npos) << csv.err;
 }
 
+// A method refuses the options it would not read: launcher wrote none of its --out, --curve
+// or --checkpoint and exited 0; shot-values kept no checkpoint.
+TEST_F(Cli, LearnMethodsRefuseOptionsTheyDoNotRead) {
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--method launcher --out l.json", "--method launcher does not read --out"},
+           {"--method launcher --checkpoint l.ckpt", "--method launcher does not read --checkpoint"},
+           {"--method shot-values --out sv.yaml --curve sv.csv", "--method shot-values does not read --curve"},
+           {"--method shot-values --out sv.yaml --checkpoint sv.ckpt", "--method shot-values does not read --checkpoint"},
+       }) {
+    const CommandResult r = run("learn boards/mit1993.board " + args);
+    EXPECT_EQ(r.exit_code, 1) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << "\n" << r.err;
+  }
+}
+
 // A budget the seed search spends whole leaves no generation: refused, not an
 // untrained controller written as if learned.
 TEST_F(Cli, LearnWithABudgetTooSmallForOneGenerationWritesNothing) {
