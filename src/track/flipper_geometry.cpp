@@ -33,8 +33,15 @@ FlipperGeometry flipper_geometry_from_board(const table::Board& board) {
     slot = &f;
   }
   if (!left || !right) throw std::invalid_argument("board '" + board.source + "' needs a left and a right flipper");
-  return make_flipper_geometry({left->pivot, table::flipper_tip(*left, left->theta_min_rad)},
-                               {right->pivot, table::flipper_tip(*right, right->theta_min_rad)});
+  try {
+    return make_flipper_geometry({left->pivot, table::flipper_tip(*left, left->theta_min_rad)},
+                                 {right->pivot, table::flipper_tip(*right, right->theta_min_rad)});
+  } catch (const std::invalid_argument& e) {
+    // Named by the file and its flipper lines: the tracker and the controllers need the V.
+    throw std::invalid_argument(board.source + ":" + std::to_string(left->source_line) + ": flipper '" + left->name +
+                                "' (and '" + right->name + "' at line " + std::to_string(right->source_line) +
+                                ") at rest: " + e.what() + " (the left flipper points right, the right one left)");
+  }
 }
 
 bool above_flippers(const FlipperGeometry& g, const Vec2& p) {

@@ -87,6 +87,22 @@ TEST(FlipperGeometryFromBoard, NeedsOneFlipperPerSide) {
   EXPECT_THROW(flipper_geometry_from_board(three), std::invalid_argument);
 }
 
+// Flippers whose rest lines form no V are named by the board file and their lines.
+TEST(FlipperGeometryFromBoard, NoVNamesTheFileAndTheFlippers) {
+  table::Board swapped = thesis_board();
+  std::swap(swapped.flippers[0].pivot, swapped.flippers[1].pivot);  // each points away from the other
+  try {
+    flipper_geometry_from_board(swapped);
+    FAIL() << "flippers pointing apart formed a V";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(swapped.source + ":" + std::to_string(swapped.flippers[0].source_line) + ": flipper '", 0),
+              0u)
+        << what;
+    EXPECT_NE(what.find("they form no 'V'"), std::string::npos) << what;
+  }
+}
+
 TEST(AboveFlippers, PointsAboveAndBelowTheV) {
   const FlipperGeometry g = flipper_geometry_from_board(thesis_board());
   EXPECT_TRUE(above_flippers(g, {0.255, 0.5}));              // high on the centre line
