@@ -6,6 +6,7 @@
 #include "pinball/daemon/can_link_check.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/learn/planning_controller.h"
+#include "pinball/sim/world.h"
 #include "pinball/simlab/twin_params.h"
 #include "pinball/simlab/world_factory.h"
 #include "pinball/table/board_loader.h"
@@ -98,7 +99,7 @@ ConfigCheck check_daemon_config(DaemonConfig config) {
       out.world = "model on the " + std::string(sim::stepper_kind_name(config.sim.stepper)) + " stepper";
     }
     if (!config.sim.world_board.empty()) {
-      table::load_board(config.sim.world_board);
+      sim::check_same_flippers(table::load_board(config.sim.world_board), inputs.board);  // as the start does
       out.world += ", board " + config.sim.world_board;
     }
   }

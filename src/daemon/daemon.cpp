@@ -247,6 +247,7 @@ void Daemon::Impl::build() {
     cc.width_px = config.camera.width_px;
     cc.height_px = config.camera.height_px;
     cc.fps = config.camera.fps;
+    cc.exposure_s = std::min(cc.exposure_s, 1.0 / cc.fps);  // a faster camera exposes for at most its frame period
     cc.seed = config.sim.seed;
     if (config.sim.camera == "typical") cc.realism = simlab::SimCameraRealism::typical(cc.width_px, cc.height_px);
     simlab::SimWorldOptions wo;
@@ -255,6 +256,7 @@ void Daemon::Impl::build() {
     wo.actuation_delay_s = config.sim.actuation_delay_s;
     wo.max_ball_time_s = config.sim.max_ball_time_s;
     wo.launcher_pull = spec.launcher_pull;
+    wo.board_id = config.can.board_id;
     simlab::WorldSpec ws;
     ws.kind = config.sim.world;
     ws.twin_params_path = config.sim.twin_params;

@@ -130,6 +130,8 @@ void check_mode(const DaemonConfig& c, const std::string& s) {
     require(c.camera.source == "sim" || c.camera.source == "lcm", s, "camera.source", "must be sim or lcm in mode sim");
     require(c.can.interface == "sim", s, "can.interface", "must be sim in mode sim");
     require(!c.sim.board.empty(), s, "sim.board", "is required in mode sim");
+    require(c.camera.source != "sim" || (c.camera.width_px >= 32 && c.camera.height_px >= 32), s, "camera.width_px",
+            "and camera.height_px must be at least 32 px for the simulated camera");
   } else {
     require(c.camera.source != "sim", s, "camera.source", "cannot be sim in mode lab");
     require(c.camera.source == "lcm" || !c.camera.device.empty(), s, "camera.device", "is required in mode lab");

@@ -9,12 +9,13 @@
 namespace pinball::simlab {
 namespace {
 
-firmware::VirtualDriverBoardOptions board_options(const table::Board& board) {
+firmware::VirtualDriverBoardOptions board_options(const table::Board& board, int board_id) {
   if (board.flippers.empty() || board.flippers.size() > static_cast<std::size_t>(firmware::kMaxDrivers)) {
     throw std::invalid_argument("sim: the board needs 1 to 8 flippers (one driver each)");
   }
   firmware::VirtualDriverBoardOptions o;
   o.driver_count = static_cast<int>(board.flippers.size());
+  o.board_id = static_cast<std::uint8_t>(board_id);  // the id the host addresses (can.board_id)
   return o;
 }
 
@@ -37,7 +38,7 @@ SimWorld::SimWorld(const sim::World& world, firmware::CanTransport& board_link, 
       options_(options),
       state_(sim::make_game_state(board_, options.seed)),
       camera_(board_, camera),
-      driver_board_(board_options(board_)) {
+      driver_board_(board_options(board_, options.board_id)) {
   const table::Board& board = board_;
   if (options.balls < 0) throw std::invalid_argument("sim: balls must be >= 0");
   if (!(options.max_ball_time_s > 0.0)) throw std::invalid_argument("sim: max ball time must be > 0 s");

@@ -346,6 +346,18 @@ TEST(DaemonConfig, AMissingFileNamesTheConfigurationTheKeyAndThePath) {
                                      "(the world's sim.world_board)");
 }
 
+TEST(DaemonConfig, TheSimulatedCameraRendersAtLeast32Pixels) {
+  DaemonConfig c;
+  c.camera.width_px = 31;
+  try {
+    validate_daemon_config(c, "x.yaml");
+    ADD_FAILURE() << "a 31 px wide simulated camera was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "x.yaml: camera.width_px: and camera.height_px must be at least 32 px for the simulated camera");
+  }
+}
+
 // What the command line gives never passed the loader: the files the daemon
 // writes are checked on the configuration it runs with, and an LCM URL must
 // name a provider liblcm has.

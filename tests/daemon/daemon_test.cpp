@@ -60,6 +60,20 @@ DaemonConfig short_sim_config(int balls, std::uint64_t seed) {
   return c;
 }
 
+// Values inside the documented ranges that the simulation used to refuse at start: a board id
+// other than 0 (its virtual board answered only to 0: "did not answer within 2 s") and a camera
+// faster than 500 frames/s (its 2 ms exposure was longer than the frame).
+TEST(Daemon, TheSimulationTakesAnyBoardIdAndAFastCamera) {
+  DaemonConfig c = short_sim_config(1, 3);
+  c.can.board_id = 15;
+  c.camera.fps = 600;
+  Daemon d(c);
+  const DaemonReport r = d.run();
+  EXPECT_EQ(r.balls, 1);
+  EXPECT_GT(r.commands, 0);
+  EXPECT_TRUE(r.coils_off_at_exit);
+}
+
 TEST(Daemon, LockstepRunsAreDeterminedByTheSeed) {
   DaemonReport a, b;
   {

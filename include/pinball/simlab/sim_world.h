@@ -30,6 +30,7 @@ struct SimWorldOptions {
   double max_ball_time_s = 60.0;      ///< a ball alive this long is cut (a cycle)
   double launcher_pull = -1.0;        ///< pull fraction; negative: the board's
   int background_frames = 30;         ///< ball-free frames rendered first for the detector's background
+  int board_id = 0;                   ///< the simulated driver board's CAN id (can.board_id), 0..15
 };
 
 /// One played ball.
