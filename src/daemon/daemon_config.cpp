@@ -367,7 +367,28 @@ void check_written_paths(const DaemonConfig& c, const std::string& source_name) 
     require(problem.empty(), source_name, key, "'" + path + "'" + problem);
   };
   check("can.log", c.can.log);
-  if (const std::optional<bus::LcmLogTarget> log = bus::lcm_log_target(c.lcm_url)) check("lcm_url", log->path);
+  const std::optional<bus::LcmLogTarget> lcm_log = bus::lcm_log_target(c.lcm_url);
+  if (lcm_log) check("lcm_url", lcm_log->path);
+  // A recording must not replace what the run reads, nor the other recording (found: --can-log
+  // naming the controller file replaced it with the log, exit 0).
+  namespace fs = std::filesystem;
+  const auto same_file = [](const std::string& a, const std::string& b) {
+    std::error_code ec;
+    return !a.empty() && !b.empty() && fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
+  };
+  DaemonConfig inputs = c;
+  const std::vector<std::pair<const char*, std::string>> written = {
+      {"can.log", c.can.log}, {"lcm_url", lcm_log ? lcm_log->path : std::string()}};
+  for (const auto& [key, path] : written) {
+    for (const PathField& f : path_fields(inputs)) {
+      if (f.use == PathUse::kRead) {
+        require(!same_file(path, *f.value), source_name, key,
+                "'" + path + "' is the file " + f.key + " names: it would be replaced by the recording");
+      }
+    }
+  }
+  require(!same_file(c.can.log, written[1].second), source_name, "can.log",
+          "'" + c.can.log + "' is the lcm_url's log too: the two recordings would write into one file");
 }
 
 void find_data_files(DaemonConfig& c) {

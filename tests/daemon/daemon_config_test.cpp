@@ -346,6 +346,26 @@ TEST(DaemonConfig, AMissingFileNamesTheConfigurationTheKeyAndThePath) {
                                      "(the world's sim.world_board)");
 }
 
+// A recording must not replace an input, nor the other recording (found: --can-log naming the
+// controller file replaced it with the log, exit 0).
+TEST(DaemonConfig, ARecordingReplacesNoInputAndNotTheOtherRecording) {
+  DaemonConfig c;
+  c.controller = ::testing::TempDir() + "/config_victim.json";
+  c.can.log = c.controller;
+  try {
+    check_written_paths(c, "x.yaml");
+    ADD_FAILURE() << "a CAN log over the controller file was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "x.yaml: can.log: '" + c.controller +
+                                         "' is the file controller names: it would be replaced by the recording");
+  }
+  c.can.log = ::testing::TempDir() + "/config_both.log";
+  c.lcm_url = "file://" + c.can.log + "?mode=w";
+  EXPECT_THROW(check_written_paths(c, "x.yaml"), ConfigError) << "two recordings into one file";
+  c.lcm_url = "file://" + c.controller + "?mode=w";
+  EXPECT_THROW(check_written_paths(c, "x.yaml"), ConfigError) << "an LCM log over the controller";
+}
+
 TEST(DaemonConfig, TheSimulatedCameraRendersAtLeast32Pixels) {
   DaemonConfig c;
   c.camera.width_px = 31;
