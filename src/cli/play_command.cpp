@@ -90,7 +90,8 @@ CLI::App* add_play_command(CLI::App& app, PlayArgs& a) {
   CLI::App* cmd = app.add_subcommand(
       "play", "play the simulated table at the keyboard in real time; --stats FILE: the players' means (docs/play.md)");
   cmd->add_option("board", a.board, "board file (docs/board-format.md); not with --stats");
-  cmd->add_option("--stats", a.stats, "print balls and mean score per ball (95 % interval) per player of this score CSV")
+  cmd->add_option("--stats", a.stats,
+                  "print balls and mean score per ball (95 % interval) per player of this score CSV")
       ->check(input_file());
   cmd->add_option("--player", a.player, "the player's name in the score file (default: $USER, else 'player')");
   cmd->add_option("--csv", a.csv, "score file each ball is appended to (created with its header)");

@@ -209,7 +209,9 @@ std::string unwritable_path_problem(const std::filesystem::path& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) return ", which is a folder, not a file";
   const fs::path folder = fs::absolute(path, ec).parent_path();
-  if (fs::exists(folder, ec) && !fs::is_directory(folder, ec)) return ": " + folder.string() + " is a file, not a folder";
+  if (fs::exists(folder, ec) && !fs::is_directory(folder, ec)) {
+    return ": " + folder.string() + " is a file, not a folder";
+  }
   if (!fs::is_directory(folder, ec)) return ": its folder " + folder.string() + " does not exist";
   const fs::path written = fs::exists(path, ec) ? path : folder;
   if (::access(written.c_str(), W_OK) != 0) return ": " + written.string() + ": " + std::strerror(errno);

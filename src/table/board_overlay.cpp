@@ -182,7 +182,9 @@ void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, B
       require_clear(b.launcher.position, "at the launch position");
     }
     for (const Sensor& hole : b.sensors) {
-      if (hole.kind == SensorKind::kHole && hole.has_kickout) require_clear(hole.shape.p0, "kicked out of " + hole.name);
+      if (hole.kind == SensorKind::kHole && hole.has_kickout) {
+        require_clear(hole.shape.p0, "kicked out of " + hole.name);
+      }
     }
   }
   board = std::move(b);

@@ -779,7 +779,8 @@ TEST_F(Cli, LearnMethodsRefuseOptionsTheyDoNotRead) {
            {"--method launcher --out l.json", "--method launcher does not read --out"},
            {"--method launcher --checkpoint l.ckpt", "--method launcher does not read --checkpoint"},
            {"--method shot-values --out sv.yaml --curve sv.csv", "--method shot-values does not read --curve"},
-           {"--method shot-values --out sv.yaml --checkpoint sv.ckpt", "--method shot-values does not read --checkpoint"},
+           {"--method shot-values --out sv.yaml --checkpoint sv.ckpt",
+            "--method shot-values does not read --checkpoint"},
        }) {
     const CommandResult r = run("learn boards/mit1993.board " + args);
     EXPECT_EQ(r.exit_code, 1) << args;
