@@ -153,7 +153,11 @@ std::vector<Vec2> Reader::vertices(std::size_t first, std::size_t min_count) con
 }
 
 void Reader::require(bool ok, const std::string& label, const std::string& rule, double got) const {
-  if (!ok) fail(label + " must be " + rule + ", got " + fmt(got));
+  if (ok) return;
+  // What the file gave, to the last digit: rounded, 10.0000001 read "at most 10, got 10".
+  char exact[32];
+  const std::to_chars_result r = std::to_chars(exact, exact + sizeof exact, got);
+  fail(label + " must be " + rule + ", got " + std::string(exact, r.ptr));
 }
 
 const Attribute* Reader::find(std::string_view key) const {

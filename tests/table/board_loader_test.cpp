@@ -343,6 +343,8 @@ TEST(BoardLoaderErrors, FrictionAndPointsHaveUpperBounds) {
   expect_body_error("circle 0.2 0.5 0.01 score=-5\n", 8, "attribute score must be >= 0");
   expect_body_error("circle 0.2 0.5 0.01 contact=-1\n", 8, "attribute contact must be >= 0");
   expect_body_error("bank b bonus=1e9\n", 8, "attribute bonus must be at most 1e+06");
+  // The value refused is shown to its last digit: rounded, it read "at most 2, got 2".
+  expect_body_error("circle 0.2 0.5 0.01 rho=2.0000001\n", 8, "attribute rho must be at most 2, got 2.0000001");
 }
 
 // Found by a helper: each of these loaded, and the ball then began, or went, inside a solid.
@@ -487,7 +489,7 @@ TEST(BoardLoaderErrors, SizesSpeedsAndGravityAreBounded) {
   expect_error("pinball-board 1\nsize 20 1\n", 2, "size: field W (width) must be at most 10 m, got 20");
   // The bound is stated in the file's unit.
   expect_error("pinball-board 1\nunits mm\nsize 510 1070000\n", 3,
-               "size: field H (height) must be at most 10000 mm, got 1.07e+06");
+               "size: field H (height) must be at most 10000 mm, got 1070000");
   expect_error("pinball-board 1\nball 0.5 5\n", 2, "ball: field R (radius) must be at most 0.1 m, got 0.5");
   expect_error("pinball-board 1\nball 0.0135 500\n", 2, "ball: field SPEED_MAX must be at most 100 m/s, got 500");
   expect_error("pinball-board 1\ngravity 11\n", 2, "gravity: field G must be at most 10 m/s^2, got 11");
