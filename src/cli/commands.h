@@ -210,6 +210,7 @@ struct ReplayArgs {
   std::string board;       ///< board override
   std::string controller;  ///< controller override
   bool json = false;       ///< one JSON object on stdout
+  bool progress = false;   ///< progress on stderr even when it is not a terminal
 };
 CLI::App* add_replay_command(CLI::App& app, ReplayArgs& args);
 /// Exit 0 when reproduced, 3 when the decisions differ, 1 for bad input.

@@ -9,6 +9,8 @@
 
 #include "commands.h"
 #include "data_file.h"
+#include "progress_option.h"
+#include "pinball/core/progress.h"
 #include "pinball/daemon/replay.h"
 
 namespace pinball::cli {
@@ -23,6 +25,7 @@ CLI::App* add_replay_command(CLI::App& app, ReplayArgs& a) {
   cmd->add_option("--controller", a.controller, "controller file (default: the configuration's)")
       ->transform(data_file());
   cmd->add_flag("--json", a.json, "print one JSON object");
+  add_progress_flag(*cmd, a.progress);
   return cmd;
 }
 
@@ -51,7 +54,9 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
   }
   if (!a.controller.empty()) config.controller = a.controller;
   const daemon::ReplayReport r =
-      daemon::replay_log(a.log, config, [&](const std::string& line) { err << "replay: " << line << "\n"; });
+      daemon::replay_log(a.log, config, [&](const std::string& line) {
+        if (progress_wanted(a.progress)) err << "replay: " << line << "\n";  // stderr stays quiet for a script
+      });
   if (a.json) {
     out << nlohmann::json{{"events", r.events},
                           {"observations", r.observations},
