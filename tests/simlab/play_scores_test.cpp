@@ -14,6 +14,7 @@
 #include <string>
 
 #include "common/temp_path.h"
+#include "pinball/core/text_file.h"
 
 namespace pinball::simlab {
 namespace {
@@ -30,11 +31,6 @@ PlayRow row(const std::string& player, int ball, double score) {
   r.score = score;
   r.duration_s = 12.25;
   return r;
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 std::string error_of(const std::string& path) {
@@ -80,7 +76,7 @@ TEST(PlayScores, AFailedAppendLeavesNoHalfRow) {
   const std::string path = temp_path("play_scores", "full_disk.csv");
   std::remove(path.c_str());
   append_play_rows(path, {row("ada", 1, 1234.5)});
-  const std::string before = read_text(path);
+  const std::string before = read_text_file(path);
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {  // the limit and the signal in a child: the test process keeps its own
@@ -98,7 +94,7 @@ TEST(PlayScores, AFailedAppendLeavesNoHalfRow) {
   ASSERT_EQ(waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 3) << "the append past the limit did not fail";
-  EXPECT_EQ(read_text(path), before) << "half a row was left";
+  EXPECT_EQ(read_text_file(path), before) << "half a row was left";
   EXPECT_EQ(read_play_csv(path).size(), 1u);
   std::remove(path.c_str());
 }
