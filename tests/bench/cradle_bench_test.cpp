@@ -94,12 +94,20 @@ TEST(CradleBench, TenMinutesAtOnePercentNeedsTheReturnShareToThePowerOfTheCycles
   EXPECT_EQ(none.projected_share_at_10_min(), 0.0);
 }
 
-TEST(CradleBench, TheTextMarksTheBestDropAndLeavesOutThePeriodOfADropWithNoReturn) {
-  CradleReport report;
-  report.world = "twin";
+// A drop of 230 ms whose 2 shots never came back: no period, no points per cycle.
+CradleDropResult drop_with_no_return() {
   CradleDropResult none;
   none.drop_s = 0.230;
   none.shots = 2;
+  none.mean_period_s = std::numeric_limits<double>::quiet_NaN();
+  none.points_per_cycle = std::numeric_limits<double>::quiet_NaN();
+  return none;
+}
+
+TEST(CradleBench, TheTextMarksTheBestDropAndLeavesOutThePeriodOfADropWithNoReturn) {
+  CradleReport report;
+  report.world = "twin";
+  const CradleDropResult none = drop_with_no_return();
   CradleDropResult good;
   good.drop_s = 0.240;
   good.shots = 10;
@@ -123,12 +131,7 @@ TEST(CradleBench, TheTextMarksTheBestDropAndLeavesOutThePeriodOfADropWithNoRetur
 TEST(CradleBench, ADropWithNoReturnHasNoPeriod) {
   CradleReport report;
   report.world = "twin";
-  CradleDropResult none;
-  none.drop_s = 0.230;
-  none.shots = 2;
-  none.mean_period_s = std::numeric_limits<double>::quiet_NaN();
-  none.points_per_cycle = std::numeric_limits<double>::quiet_NaN();
-  report.drops = {none};
+  report.drops = {drop_with_no_return()};
   const nlohmann::json j = nlohmann::json::parse(to_json(report).dump());
   EXPECT_TRUE(j.at("drops")[0].at("mean_period_s").is_null());
   EXPECT_TRUE(j.at("drops")[0].at("points_per_cycle").is_null());

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "common/error_text.h"
 #include "pinball/core/rng.h"
 #include "pinball/simlab/sim_camera_source.h"
 #include "pinball/table/board_loader.h"
@@ -85,12 +86,7 @@ TEST(CameraCalibration, DegenerateLayoutsAreRefused) {
 
 // The message must name what to fix: the layout, or the spots that are no marker.
 std::string fit_error(const std::vector<DetectedMarker>& det, const std::vector<Vec2>& layout) {
-  try {
-    fit_homography(det, layout, cv::Size(640, 480));
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "no error";
+  return pinball::testing::error_text([&] { fit_homography(det, layout, cv::Size(640, 480)); });
 }
 
 TEST(CameraCalibration, SymmetricLayoutIsNamedAsTheCause) {

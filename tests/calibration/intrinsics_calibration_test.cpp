@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/error_text.h"
 #include "common/figure_check.h"
 #include "common/temp_path.h"
 #include "pinball/core/rng.h"
@@ -61,12 +62,7 @@ Views& charuco_views() {
 cv::Mat blank(int value = 90) { return cv::Mat(480, 640, CV_8UC1, cv::Scalar(value)); }
 
 std::string failure(std::span<const TargetImage> images, const TargetSpec& target, const IntrinsicsFitConfig& c = {}) {
-  try {
-    (void)calibrate_intrinsics(images, target, c);
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "no error";
+  return pinball::testing::error_text([&] { (void)calibrate_intrinsics(images, target, c); });
 }
 
 // The target: reprojection <= 0.3 px, focal lengths within 0.5 %,

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/error_text.h"
 #include "common/temp_path.h"
 #include "pinball/core/text_file.h"
 
@@ -34,12 +35,7 @@ PlayRow row(const std::string& player, int ball, double score) {
 }
 
 std::string error_of(const std::string& path) {
-  try {
-    read_play_csv(path);
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "no error";
+  return pinball::testing::error_text([&] { read_play_csv(path); });
 }
 
 TEST(PlayScores, RowsRoundTripAndTheHeaderIsWrittenOnce) {

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/error_text.h"
 #include "common/temp_path.h"
 
 namespace pinball::track {
@@ -18,12 +19,7 @@ std::string write_csv(const std::string& name, const std::string& text) {
 }
 
 std::string read_error(const std::string& path) {
-  try {
-    read_observations_csv(path);
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "no error";
+  return pinball::testing::error_text([&] { read_observations_csv(path); });
 }
 
 TEST(ObservationIo, ReadsPositionsAndContacts) {
