@@ -1,6 +1,7 @@
 #include "pinball/core/format.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 
@@ -46,6 +47,12 @@ std::string format_mean_ci(double mean, double half_width, int digits) {
   if (!(half_width > 0.0)) return format_number(mean, digits) + " ± 0";
   const int d = decimals_for(half_width, 2);
   return fixed(mean, d) + " ± " + fixed(half_width, d);
+}
+
+std::string format_exact(double x) {
+  char buf[32];  // the longest double, -2.2250738585072014e-308, is 24 characters
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, r.ptr);
 }
 
 }  // namespace pinball

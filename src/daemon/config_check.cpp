@@ -4,6 +4,7 @@
 
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/daemon/can_link_check.h"
+#include "pinball/daemon/daemon.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/learn/planning_controller.h"
 #include "pinball/sim/world.h"
@@ -80,6 +81,7 @@ ConfigCheck check_daemon_config(DaemonConfig config) {
   const bool sim = config.mode == "sim";
   ConfigCheck out;
   out.mode = config.mode;
+  out.warnings = config_warnings(config);  // as the start prints them
   const DaemonInputs inputs = load_daemon_inputs(config);
   learn::make_controller(inputs.spec, inputs.board);  // fits the board's flippers, or says why not
   out.board = sim ? config.sim.board : config.board;

@@ -201,7 +201,7 @@ void Daemon::Impl::build() {
   cpus = plan_cpus(config.threads.chain_cpu);
   find_data_files(config);
   lockstep = plays_world && !config.sim.realtime;
-  if (const std::string w = lcm_pace_warning(config); !w.empty()) {
+  for (const std::string& w : config_warnings(config)) {
     std::fprintf(stderr, "pinballd: warning: %s\n", w.c_str());
     warnings.push_back(w);
   }
@@ -686,6 +686,24 @@ std::string lcm_pace_warning(const DaemonConfig& config) {
          "' with the lockstep clock: the run publishes many times faster than real time and a logger on the "
          "network loses messages it cannot keep up with; record with --lcm-url 'file:///PATH?mode=w' (every "
          "message, stamped on the game's clock) or run --realtime";
+}
+
+std::string sim_watchdog_warning(const DaemonConfig& config) {
+  const bool plays_world = config.mode == "sim" && config.camera.source == "sim";
+  const double frame_period_s = 1.0 / config.camera.fps;
+  if (!plays_world || frame_period_s < config.can.watchdog_timeout_s) return "";
+  return "camera.fps " + format_number(config.camera.fps) + ": the simulated board hears the host only between " +
+         "frames, so its " + format_number(config.can.watchdog_timeout_s) + " s watchdog trips every " +
+         format_number(frame_period_s) + " s frame and drops the coils (a real board would not); for play, raise " +
+         "camera.fps above " + format_number(1.0 / config.can.watchdog_timeout_s);
+}
+
+std::vector<std::string> config_warnings(const DaemonConfig& config) {
+  std::vector<std::string> warnings;
+  for (std::string w : {lcm_pace_warning(config), sim_watchdog_warning(config)}) {
+    if (!w.empty()) warnings.push_back(std::move(w));
+  }
+  return warnings;
 }
 
 nlohmann::json report_to_json(const DaemonReport& r) {

@@ -14,6 +14,7 @@
 
 #include "pinball/bus/lcm_bus.h"
 #include "pinball/core/data_path.h"
+#include "pinball/core/format.h"
 #include "pinball/core/yaml_read_archive.h"
 #include "pinball/daemon/thread_table.h"
 #include "pinball/firmware/codec.h"
@@ -49,6 +50,15 @@ void check_camera(const CameraSettings& c, const std::string& s) {
   // no stall guard at all (the default, 20 ms, is four frames at 200 fps).
   require(positive(c.stall_timeout_s) && c.stall_timeout_s < 1.0, s, "camera.stall_timeout_s",
           "must be in (0, 1) s");
+  // Shorter than two frame periods, every frame a little late reads as a
+  // stall and lets the flippers go: the controller would play blind.
+  const double two_periods_s = 2.0 / c.fps;
+  require(c.stall_timeout_s >= two_periods_s, s, "camera.stall_timeout_s",
+          "must be at least two frame periods (2 / camera.fps = " + format_number(two_periods_s) +
+              " s), or every late frame releases the flippers" +
+              (two_periods_s >= 1.0 ? "; at " + format_number(c.fps) + " frames/s no stall timeout under 1 s does: "
+                                      "camera.fps must be above 2"
+                                    : ""));
   // 10000 frames is 50 s at 200 fps of keeping the ball off the table: more is a typo.
   require(c.background_frames >= 1 && c.background_frames <= 10000, s, "camera.background_frames",
           "must be in [1, 10000]");

@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "pinball/core/format.h"
 #include "pinball/core/running_stats.h"
 
 namespace pinball::simlab {
@@ -49,16 +50,9 @@ double finite_number(const std::string& path, int line, const std::string& text,
   return v;
 }
 
-// The shortest text that reads back as the same double.
-std::string exact(double v) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return ec == std::errc() ? std::string(buf, end) : std::string("nan");
-}
-
 std::string csv_line(const PlayRow& r) {
-  return r.player + ',' + r.date + ',' + r.board + ',' + r.world + ',' + std::to_string(r.ball) + ',' + exact(r.score) +
-         ',' + exact(r.duration_s) + ',' + (r.cut ? "1" : "0") + '\n';
+  return r.player + ',' + r.date + ',' + r.board + ',' + r.world + ',' + std::to_string(r.ball) + ',' +
+         format_exact(r.score) + ',' + format_exact(r.duration_s) + ',' + (r.cut ? "1" : "0") + '\n';
 }
 
 // The first line of an existing file, or "" for an empty one.

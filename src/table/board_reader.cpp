@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "pinball/core/format.h"
 #include "pinball/table/board_loader.h"
 
 namespace pinball::table {
@@ -155,9 +156,7 @@ std::vector<Vec2> Reader::vertices(std::size_t first, std::size_t min_count) con
 void Reader::require(bool ok, const std::string& label, const std::string& rule, double got) const {
   if (ok) return;
   // What the file gave, to the last digit: rounded, 10.0000001 read "at most 10, got 10".
-  char exact[32];
-  const std::to_chars_result r = std::to_chars(exact, exact + sizeof exact, got);
-  fail(label + " must be " + rule + ", got " + std::string(exact, r.ptr));
+  fail(label + " must be " + rule + ", got " + format_exact(got));
 }
 
 const Attribute* Reader::find(std::string_view key) const {

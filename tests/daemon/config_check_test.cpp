@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 
 #include "pinball/calibration/calibration_file.h"
+#include "pinball/daemon/daemon.h"
 #include "pinball/plot/png_file.h"
 
 namespace pinball::daemon {
@@ -56,6 +57,17 @@ TEST(ConfigCheck, TheEmbeddedSimulationIsWhatPinballdRunsWithNoArguments) {
   const std::string text = config_check_to_text(c);
   EXPECT_NE(text.find("controller       " + c.controller + " (imitation)\n"), std::string::npos) << text;
   EXPECT_NE(text.find("ok: the configuration and every file it names load\n"), std::string::npos) << text;
+}
+
+// What the start would warn of, the check says first.
+TEST(ConfigCheck, SaysTheWarningsTheStartWouldPrint) {
+  DaemonConfig slow;
+  slow.camera.fps = 5.0;
+  slow.camera.stall_timeout_s = 0.5;
+  const ConfigCheck c = check_daemon_config(slow);
+  ASSERT_EQ(c.warnings.size(), 1u);
+  EXPECT_EQ(c.warnings[0], sim_watchdog_warning(slow));
+  EXPECT_NE(config_check_to_text(c).find("warning          camera.fps 5: "), std::string::npos);
 }
 
 TEST(ConfigCheck, TheTwinAndTheSpasticFileAreLoadedToo) {

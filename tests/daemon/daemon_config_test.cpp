@@ -133,6 +133,14 @@ TEST(DaemonConfig, ErrorsNameTheKey) {
   EXPECT_EQ(error_of("coils: {hold_duty_pct: 150}"),
             "t.yaml: coils.hold_duty_pct: must be in [0, 50] % (the protocol's absolute hold duty)");
   EXPECT_EQ(error_of("camera: {fps: 0}"), "t.yaml: camera.fps: must be in (0, 10000]");
+  // A camera slower than the stall guard: every frame gap would let the flippers go.
+  EXPECT_EQ(error_of("camera: {fps: 60}"),
+            "t.yaml: camera.stall_timeout_s: must be at least two frame periods (2 / camera.fps = 0.0333 s), or "
+            "every late frame releases the flippers");
+  EXPECT_EQ(error_of("camera: {fps: 2, stall_timeout_s: 0.9}"),
+            "t.yaml: camera.stall_timeout_s: must be at least two frame periods (2 / camera.fps = 1 s), or every "
+            "late frame releases the flippers; at 2 frames/s no stall timeout under 1 s does: camera.fps must be "
+            "above 2");
   EXPECT_EQ(error_of("can: {watchdog_timeout_s: 0.03}"),
             "t.yaml: can.watchdog_timeout_s: must be at least 3 heartbeat periods");
   EXPECT_EQ(error_of("mode: arcade"), "t.yaml: mode: must be sim or lab");

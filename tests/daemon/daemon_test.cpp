@@ -537,13 +537,14 @@ TEST(Pinballd, EverySignalThatWouldKillItReleasesTheCoilsFirst) {
 }
 
 // A stderr nobody drains (a pipe whose reader sleeps) holds neither the release nor the exit:
-// what stderr cannot take at once is dropped, and the report keeps it. Found with a camera at
-// 2 frames/s, whose frame gaps the board's watchdog reports as faults all along: stdio, blocked
-// on the full pipe, went on retrying each partial write after SIGINT, and the daemon never
-// reached its shutdown.
+// what stderr cannot take at once is dropped, and the report keeps it. Found with a simulated
+// camera at 2 frames/s, whose frame gaps the simulated board's watchdog reports as faults all
+// along (sim_watchdog_warning; 3 frames/s here, the slowest a stall timeout allows): stdio,
+// blocked on the full pipe, went on retrying each partial write after SIGINT, and the daemon
+// never reached its shutdown.
 TEST(Pinballd, AStderrNobodyReadsHoldsNeitherTheReleaseNorTheExit) {
   const std::string base = ::testing::TempDir() + "/pinballd_stuck_stderr_" + std::to_string(getpid());
-  write_file(base + ".yaml", "version: 1\nmode: sim\ncamera:\n  fps: 2\n");
+  write_file(base + ".yaml", "version: 1\nmode: sim\ncamera:\n  fps: 3\n  stall_timeout_s: 0.9\n");
   int err_pipe[2];
   ASSERT_EQ(pipe(err_pipe), 0);
   ASSERT_GT(fcntl(err_pipe[1], F_SETPIPE_SZ, 4096), 0);  // full after a few dozen faults
@@ -1024,6 +1025,26 @@ TEST(Daemon, UdpmInLockstepWarnsThatALoggerWouldLoseMessages) {
   c.sim.realtime = false;
   c.mode = "lab";
   EXPECT_EQ(lcm_pace_warning(c), "");
+}
+
+// The simulated world hands its board the host's frames between camera frames:
+// at 10 frames/s or fewer a 0.1 s watchdog trips every frame. Said at the start
+// and by --check, with the rate that plays.
+TEST(Daemon, ASimulatedCameraSlowerThanTheWatchdogIsWarnedOf) {
+  DaemonConfig c = sim_config(1, 1);
+  EXPECT_TRUE(config_warnings(c).empty());  // 200 frames/s
+  c.camera.fps = 10.0;
+  c.camera.stall_timeout_s = 0.5;
+  EXPECT_EQ(sim_watchdog_warning(c),
+            "camera.fps 10: the simulated board hears the host only between frames, so its 0.1 s watchdog trips "
+            "every 0.1 s frame and drops the coils (a real board would not); for play, raise camera.fps above 10");
+  ASSERT_EQ(config_warnings(c).size(), 1u);
+  c.camera.fps = 12.0;  // 83 ms frames: the board hears every heartbeat in time
+  EXPECT_EQ(sim_watchdog_warning(c), "");
+  c.camera.fps = 10.0;
+  c.mode = "lab";  // the lab's board has its own clock
+  c.camera.source = "v4l2";
+  EXPECT_EQ(sim_watchdog_warning(c), "");
 }
 
 }  // namespace

@@ -17,4 +17,9 @@ std::string format_number(double x, int digits = 3);
 /// an infinite half-width (one sample: no bound) is "812 ± ∞".
 std::string format_mean_ci(double mean, double half_width, int digits = 3);
 
+/// The shortest text that reads back as the same double ("0.1", "2.0000001",
+/// "1e+300"): for files written to be read again, and for a refused value,
+/// which rounding would hide ("at most 2, got 2").
+std::string format_exact(double x);
+
 }  // namespace pinball

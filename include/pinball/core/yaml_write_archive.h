@@ -6,12 +6,12 @@
 // 0.59999999999999998). Header-only so that pinball_core links Eigen alone;
 // a target that includes it links yaml-cpp.
 
-#include <charconv>
 #include <string>
 #include <type_traits>
 
 #include <yaml-cpp/yaml.h>
 
+#include "pinball/core/format.h"
 #include "pinball/core/name_value.h"
 
 namespace pinball {
@@ -40,9 +40,7 @@ class YamlWriteArchive {
     } else if constexpr (std::is_integral_v<T>) {
       e << std::to_string(value);  // as text: yaml-cpp writes an int8_t as a character
     } else if constexpr (std::is_floating_point_v<T>) {
-      char buf[32];
-      const auto end = std::to_chars(buf, buf + sizeof buf, value).ptr;
-      e << std::string(buf, end);
+      e << format_exact(value);
     } else if constexpr (std::is_same_v<T, std::string>) {
       // Text that YAML would read as null (or nothing) is quoted: it must read back as text.
       const bool null_like = value.empty() || value == "~" || value == "null" || value == "Null" || value == "NULL";

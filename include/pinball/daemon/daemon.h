@@ -115,6 +115,15 @@ std::string recording_problems(const DaemonReport& report);
 /// loses messages it cannot keep up with, without a word.
 std::string lcm_pace_warning(const DaemonConfig& config);
 
+/// Why the simulated driver board's watchdog will trip in `config` ("" when
+/// it will not): the simulated world hands the board what the host sent only
+/// between camera frames, so a frame period of can.watchdog_timeout_s or more
+/// starves it of heartbeats every frame. A real board hears the host at once.
+std::string sim_watchdog_warning(const DaemonConfig& config);
+
+/// Every warning the configuration alone gives: lcm_pace_warning, sim_watchdog_warning.
+std::vector<std::string> config_warnings(const DaemonConfig& config);
+
 /// The tracker measured the camera noisier than track::kNoiseOverCalibration
 /// times its calibration (and so weighed its fits by the measured noise).
 bool camera_noisier_than_calibrated(const DaemonReport& report);
