@@ -57,9 +57,10 @@ void check_lab_hardware(const DaemonConfig& config, ConfigCheck& out) {
       missing = "camera.device: " + m;
     }
   } else if (config.camera.source == "file") {
-    // A recording is read, not a device opened: decoding it is the only way to know it is a video.
+    // A recording is read, not a device opened: decoding it is the only way to know it is a video
+    // of the configured frame size.
     try {
-      const vision::CaptureSource probe(capture_config_for(config.camera));
+      open_lab_camera(config.camera);
     } catch (const std::runtime_error& e) {
       missing = "camera.device: " + std::string(e.what());
     }

@@ -301,7 +301,7 @@ void Daemon::Impl::build() {
   // The camera before the LCM bus, whose file:// log replaces an old one of
   // its name: a camera that is missing or busy fails the start before that.
   if (config.camera.source == "file" || config.camera.source == "v4l2") {
-    capture = std::make_unique<vision::CaptureSource>(capture_config_for(config.camera));
+    capture = open_lab_camera(config.camera);
   }
   lcm = std::make_unique<bus::LcmBus>(config.lcm_url);
   if (config.camera.source == "lcm") lcm->subscribe_observations(lcm_observations);

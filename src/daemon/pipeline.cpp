@@ -227,6 +227,18 @@ vision::CaptureConfig capture_config_for(const CameraSettings& camera) {
   return cc;
 }
 
+std::unique_ptr<vision::CaptureSource> open_lab_camera(const CameraSettings& camera) {
+  auto capture = std::make_unique<vision::CaptureSource>(capture_config_for(camera));
+  const cv::Size wanted(camera.width_px, camera.height_px);
+  if (capture->frame_size() != wanted) {
+    throw std::runtime_error(capture->describe() + ": not the " + std::to_string(wanted.width) + "x" +
+                             std::to_string(wanted.height) +
+                             " px of camera.width_px x camera.height_px; the detector, the mask and the "
+                             "calibration take frames of that size");
+  }
+  return capture;
+}
+
 cv::Mat load_occluder_mask(const std::string& path, cv::Size frame_size, const std::string& origin) {
   cv::Mat mask;
   try {

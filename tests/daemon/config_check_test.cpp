@@ -9,7 +9,10 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/daemon/daemon.h"
@@ -98,6 +101,25 @@ TEST(ConfigCheck, ARecordedCameraThatIsNoVideoFailsTheCheck) {
   const std::string what = check_error(c);
   EXPECT_NE(what.find("camera.device: capture: cannot open video file '" + c.camera.device + "'"), std::string::npos)
       << what;
+}
+
+// A recording of another frame size than the configuration's: the check says
+// so, as the start does (it was found only at the start).
+TEST(ConfigCheck, ARecordedCameraOfAnotherFrameSizeFailsTheCheck) {
+  DaemonConfig c = lab_without_hardware();
+  c.camera.source = "file";
+  c.camera.device = ::testing::TempDir() + "/config_check_320x240_" + std::to_string(::getpid()) + ".avi";
+  {
+    cv::VideoWriter writer(c.camera.device, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30.0, cv::Size(320, 240));
+    ASSERT_TRUE(writer.isOpened());
+    const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(40, 40, 40));
+    for (int i = 0; i < 3; ++i) writer.write(grey);
+  }
+  const std::string what = check_error(c);
+  EXPECT_NE(what.find("camera.device: video file " + c.camera.device + " 320x240 at 30 fps"), std::string::npos)
+      << what;
+  EXPECT_NE(what.find(": not the 640x480 px of camera.width_px x camera.height_px"), std::string::npos) << what;
+  fs::remove(c.camera.device);
 }
 
 // The command line's CAN log is checked as the file's would be, and a failed

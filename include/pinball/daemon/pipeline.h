@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 
 #include "pinball/calibration/calibration_file.h"
@@ -205,6 +206,11 @@ void apply_camera_corrections(const std::optional<vision::CameraIntrinsics>& len
 /// exposure (camera.exposure_s < 0: the driver's automatic exposure, left
 /// as it is).
 vision::CaptureConfig capture_config_for(const CameraSettings& camera);
+/// The lab camera, opened as capture_config_for asks. Throws runtime_error
+/// when its frames are not camera.width_px x camera.height_px (a recording
+/// of another size, or a device that would not take the size): the detector,
+/// the mask and the homography all take frames of the configured size.
+std::unique_ptr<vision::CaptureSource> open_lab_camera(const CameraSettings& camera);
 /// The occluder mask camera.occluder_mask names, white where plastics hide
 /// the playfield. Throws ConfigError naming the configuration (`origin`), the
 /// key and the file when it is not an image or not `frame_size`.
