@@ -1,11 +1,15 @@
 #include "pinball/daemon/config_check.h"
 
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/daemon/can_link_check.h"
 #include "pinball/daemon/daemon.h"
 #include "pinball/daemon/pipeline.h"
+#include "pinball/daemon/thread_table.h"
 #include "pinball/learn/planning_controller.h"
 #include "pinball/sim/world.h"
 #include "pinball/simlab/twin_params.h"
@@ -30,6 +34,22 @@ std::vector<std::string> calibration_sections(const calibration::Calibration& c)
   if (c.camera_timing) out.emplace_back("camera_timing");
   if (!c.flippers.empty()) out.emplace_back("flippers");
   if (c.gravity) out.emplace_back("gravity");
+  return out;
+}
+
+// What the start's real-time requests (threads.realtime, threads.cpu_dma_latency_us)
+// would be refused, asked of the system as the start asks, and given back.
+std::vector<std::string> realtime_refusals(const ThreadSettings& t) {
+  std::vector<std::string> out;
+  if (t.realtime) {
+    for (std::string why : {probe_lock_memory(), probe_sched_fifo(kDriverThread, t.priorities[kDriverThread])}) {
+      if (!why.empty()) out.push_back(std::move(why));
+    }
+  }
+  if (t.cpu_dma_latency_us >= 0) {
+    const CpuLatencyRequest request(t.cpu_dma_latency_us);
+    if (!request.ok()) out.push_back(request.why());
+  }
   return out;
 }
 
@@ -83,6 +103,12 @@ ConfigCheck check_daemon_config(DaemonConfig config) {
   ConfigCheck out;
   out.mode = config.mode;
   out.warnings = config_warnings(config);  // as the start prints them
+  for (const std::string& why : realtime_refusals(config.threads)) {
+    if (config.threads.enforce) {
+      throw ConfigError(config.origin + ": threads.enforce: true, and the system refuses: " + why);
+    }
+    out.warnings.push_back(why + "; the start runs without it");
+  }
   const DaemonInputs inputs = load_daemon_inputs(config);
   learn::make_controller(inputs.spec, inputs.board);  // fits the board's flippers, or says why not
   out.board = sim ? config.sim.board : config.board;

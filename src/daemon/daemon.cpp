@@ -542,10 +542,7 @@ DaemonReport Daemon::run() {
     std::string why;
     if (!lock_memory(why)) d.warnings.push_back(why);  // before any thread starts
     // Probe SCHED_FIFO on a throw-away thread, so that `enforce` refuses before anything runs.
-    std::string probe_why;
-    std::thread([&] {
-      configure_current_thread(kDriverThread, true, probe_why, d.config.threads.priorities[kDriverThread]);
-    }).join();
+    const std::string probe_why = probe_sched_fifo(kDriverThread, d.config.threads.priorities[kDriverThread]);
     if (!probe_why.empty()) {
       d.warnings.push_back(probe_why);
       d.fifo_allowed = false;

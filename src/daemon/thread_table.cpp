@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <thread>
 
 #include "pinball/daemon/daemon_config.h"
 
@@ -116,6 +117,18 @@ CpuLatencyRequest::CpuLatencyRequest(int limit_us) {
 
 CpuLatencyRequest::~CpuLatencyRequest() {
   if (fd_ >= 0) ::close(fd_);
+}
+
+std::string probe_sched_fifo(ThreadId id, int priority) {
+  std::string why;
+  std::thread([&] { configure_current_thread(id, true, why, priority); }).join();
+  return why;
+}
+
+std::string probe_lock_memory() {
+  std::string why;
+  if (lock_memory(why)) munlockall();
+  return why;
 }
 
 bool lock_memory(std::string& why) {

@@ -870,6 +870,7 @@ TEST(Pinballd, BadConfigExitsOneNamingTheKey) {
 
 // An ordinary user (no CAP_SYS_NICE, RLIMIT_RTPRIO 0) asking for real-time
 // scheduling: refused, pinballd warns once and plays; with enforce it exits 1.
+// --check says the same before anything runs.
 TEST(Pinballd, RealTimeRefusedWarnsAndPlaysOrWithEnforceExitsOne) {
   if (geteuid() != 0) GTEST_SKIP() << "needs root to drop to an unprivileged user";
   if (access("/usr/bin/setpriv", X_OK) != 0) GTEST_SKIP() << "no /usr/bin/setpriv (util-linux)";
@@ -898,6 +899,27 @@ TEST(Pinballd, RealTimeRefusedWarnsAndPlaysOrWithEnforceExitsOne) {
     } else {
       EXPECT_EQ(status, 1) << err;
       EXPECT_NE(err.find("real-time scheduling refused (threads.enforce: true)"), std::string::npos) << err;
+    }
+    // --check asks the system the same, and says it before the start does.
+    std::string check;
+    const int check_status =
+        run_shell("sh -c '" + unprivileged + PINBALLD_EXE + " --check --json --config " + path + "' 2>/dev/null", check);
+    const nlohmann::json c = nlohmann::json::parse(check);
+    if (!enforce) {
+      EXPECT_EQ(check_status, 0) << check;
+      int fifo_warnings = 0;
+      for (const auto& w : c["warnings"]) {
+        fifo_warnings += w.get<std::string>().find("; the start runs without it") != std::string::npos &&
+                                 w.get<std::string>().find("SCHED_FIFO") == 0
+                             ? 1
+                             : 0;
+      }
+      EXPECT_EQ(fifo_warnings, 1) << check;
+    } else {
+      EXPECT_EQ(check_status, 1) << check;
+      EXPECT_NE(c["error"].get<std::string>().find(": threads.enforce: true, and the system refuses: "),
+                std::string::npos)
+          << check;
     }
   }
 }

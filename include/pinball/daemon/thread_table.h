@@ -52,6 +52,11 @@ std::string thread_table_markdown();
 /// 0 leaves it SCHED_OTHER). Returns false (with `why`) when the system refuses.
 bool configure_current_thread(ThreadId id, bool realtime, std::string& why, int priority = -1);
 
+/// Whether the system gives `id`'s thread SCHED_FIFO at `priority` (see
+/// configure_current_thread): tried on a throw-away thread, so that a refusal
+/// is known before anything runs. "" when allowed, else why not.
+std::string probe_sched_fifo(ThreadId id, int priority);
+
 /// Which CPUs the threads may use (empty: not pinned).
 struct CpuPlan {
   std::vector<int> chain;   ///< the chain's threads (ThreadSpec::chain)
@@ -87,5 +92,9 @@ class CpuLatencyRequest {
 
 /// Locks all current and future memory (mlockall). False (with `why`) when refused.
 bool lock_memory(std::string& why);
+
+/// Whether lock_memory would succeed, leaving memory unlocked: "" when it
+/// would, else why not (pinballd --check).
+std::string probe_lock_memory();
 
 }  // namespace pinball::daemon
