@@ -42,7 +42,7 @@ bool decided_by_observations(int cause) {
 }  // namespace
 
 ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
-                        const std::function<void(const std::string&)>& progress) {
+                        const std::function<void(const std::string&)>& progress, std::uint64_t progress_every) {
   find_data_files(config);  // the defaults name the shipped data from any folder, as pinballd's do
   try {
     bus::require_lcm_log(log_path);
@@ -95,7 +95,11 @@ ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
         }
       }
       bus.poll_once(record.t_s);  // keeps its queue empty
-      if (progress && r.observations % 20000 == 0) {
+      // Nobody reads the far end: drained here, or each send backs off on a full socket (4 s of sleeps a log).
+      firmware::CanFrame sent;
+      while (far->receive(sent, 0) == firmware::RxStatus::kFrame) {
+      }
+      if (progress && r.observations % progress_every == 0) {
         progress(std::to_string(r.observations) + " observations replayed");
       }
     } else if (e->channel == bus::kFlipperCommandChannel) {

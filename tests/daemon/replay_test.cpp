@@ -229,6 +229,23 @@ constexpr BadLog kBadLogs[] = {
 
 std::string bad_log(const BadLog& b) { return kSource + "/tests/bad_input/lcm/" + b.file; }
 
+// Progress comes as observations are replayed; `pinball replay` prints it only
+// on a terminal or with --progress, so a script's stderr stays quiet.
+TEST(Replay, ProgressComesEveryStepAndOnlyWhenAsked) {
+  std::vector<std::string> lines;
+  const ReplayReport r =
+      replay_log(recorded_log(), config_for_test(), [&](const std::string& line) { lines.push_back(line); }, 500);
+  ASSERT_EQ(lines.size(), r.observations / 500);
+  EXPECT_EQ(lines.front(), "500 observations replayed");
+  const std::string err = ::testing::TempDir() + "/pinball_replay_quiet_" + std::to_string(getpid()) + ".err";
+  const std::string cmd = std::string(PINBALL_EXE) + " replay " + recorded_log() + " --controller " + kSource +
+                          "/controllers/best.json > /dev/null 2> " + err;
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  std::ifstream in(err);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), "");
+  std::remove(err.c_str());
+}
+
 TEST(Replay, DamagedLogsAreRefusedBeforeLiblcmReadsThem) {
   for (const BadLog& b : kBadLogs) {
     try {

@@ -32,9 +32,10 @@ struct ReplayReport {
 
 /// Replays `log_path` with the board and controller of `config` (looked up
 /// as pinballd does, find_data_files). Throws std::runtime_error naming the
-/// file when it cannot be read. `progress` (may be empty) gets a line now
-/// and then.
+/// file when it cannot be read. `progress` (may be empty) gets a line every
+/// `progress_every` observations (about half a second of replay at 20000).
 ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
-                        const std::function<void(const std::string&)>& progress = {});
+                        const std::function<void(const std::string&)>& progress = {},
+                        std::uint64_t progress_every = 20000);
 
 }  // namespace pinball::daemon
