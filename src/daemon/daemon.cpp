@@ -420,13 +420,13 @@ void Daemon::Impl::shutdown() {
   // stays as the second line of defence.
   ControllerStage::Commands cmds;
   const int n = controller_stage->release_all(CommandCause::kShutdown, clock->now_s(), steady_now_s(), cmds);
+  // The queue alone (ReleaseAll first): a poll would add a heartbeat after it when one is due.
   if (world) {
-    const double t = world->time_s();
-    bus->poll_once(t);
+    bus->send_queued(world->time_s());
     world->idle(0.001);  // the board reads the ReleaseAll
     coils_off_at_exit.store(world->all_coils_off(), std::memory_order_release);
   } else {
-    bus->poll_once(steady_now_s());
+    bus->send_queued(steady_now_s());
   }
   // Then report it: PINBALL_FLIPPER_CMD promises the shutdown's release (cause "shutdown")
   // like every other command; the LCM thread still runs and publishes it before it stops.

@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <thread>
 #include <variant>
@@ -309,16 +310,25 @@ TEST(Daemon, ACanLogHoldsEveryFrameAndTheReportAndStatsSaySo) {
   const std::string text = read_text(path);
   std::uint64_t lines = 0;
   std::size_t start = 0;
+  std::optional<firmware::MessageKind> last_host_kind;  // the host's last word to the board
   for (std::size_t end = text.find('\n'); end != std::string::npos; start = end + 1, end = text.find('\n', start)) {
     const std::string line = text.substr(start, end - start);
     const auto e = firmware::parse_log_line(line);
     ASSERT_TRUE(e.has_value()) << line;
     EXPECT_EQ(e->interface, "simcan");
     EXPECT_EQ(firmware::format_log_line(e->frame, e->time_s, "simcan"), line);  // candump's format, to the byte
+    const firmware::DecodeResult m = firmware::decode(e->frame);
+    const bool from_board = m.ok() && (std::holds_alternative<firmware::Status>(m.message.payload) ||
+                                       std::holds_alternative<firmware::Fault>(m.message.payload) ||
+                                       std::holds_alternative<firmware::HelloAck>(m.message.payload));
+    if (m.ok() && !from_board) last_host_kind = firmware::kind_of(m.message.payload);
     ++lines;
   }
   EXPECT_EQ(start, text.size());  // nothing after the last newline
   EXPECT_EQ(lines, r.can_log->written);
+  // The shutdown's ReleaseAll is the last frame the host sends: no heartbeat after it.
+  ASSERT_TRUE(last_host_kind.has_value());
+  EXPECT_EQ(*last_host_kind, firmware::MessageKind::kReleaseAll);
   std::remove(path.c_str());
 }
 
