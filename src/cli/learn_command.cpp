@@ -2,6 +2,7 @@
 // fast learning loop (docs/learning.md), writes it, its learning curve and a
 // plot; or evaluates a baseline or a controller file on fresh balls.
 
+#include <csignal>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include "camera_options.h"
 #include "data_file.h"
@@ -304,6 +306,52 @@ struct CheckpointScope {
   CheckpointScope& operator=(const CheckpointScope&) = delete;
 };
 
+// A run stopped by SIGINT, SIGTERM or SIGHUP says what it keeps, then dies of
+// the signal as it would have: the checkpoint's finished batches and how to go
+// on, or that nothing is kept. The text is made before the handlers go in; the
+// handler only writes it (async-signal-safe).
+class InterruptNote {
+ public:
+  explicit InterruptNote(std::string text) {
+    text_ = std::move(text);
+    struct sigaction on{};
+    on.sa_handler = &InterruptNote::on_signal;
+    sigemptyset(&on.sa_mask);
+    for (std::size_t i = 0; i < kSignals.size(); ++i) {
+      sigaction(kSignals[i], &on, &previous_[i]);
+      // An ignored signal stays ignored (a background job's SIGINT, nohup's SIGHUP).
+      if (previous_[i].sa_handler == SIG_IGN) sigaction(kSignals[i], &previous_[i], nullptr);
+    }
+  }
+  ~InterruptNote() {
+    for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &previous_[i], nullptr);
+  }
+  InterruptNote(const InterruptNote&) = delete;
+  InterruptNote& operator=(const InterruptNote&) = delete;
+
+ private:
+  static constexpr std::array<int, 3> kSignals{SIGINT, SIGTERM, SIGHUP};
+  static void on_signal(int sig) {
+    if (!text_.empty()) (void)!::write(STDERR_FILENO, text_.data(), text_.size());
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+  }
+  static inline std::string text_;
+  std::array<struct sigaction, kSignals.size()> previous_{};
+};
+
+// What an interrupted run keeps (rank 0 says it; the others say nothing).
+std::string interrupt_text(const LearnArgs& a, bool writer) {
+  if (!writer) return "";
+  if (a.checkpoint.empty()) {
+    return "\nlearn: interrupted; nothing is kept (--checkpoint FILE records a run as it goes, and --resume goes on "
+           "from it)\n";
+  }
+  return "\nlearn: interrupted; " + a.checkpoint +
+         " keeps every batch of balls finished so far (an imitation round is one batch): the same command with "
+         "--resume goes on from there\n";
+}
+
 }  // namespace
 
 int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err) {
@@ -494,6 +542,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   const CheckpointScope checkpoint(learn::CheckpointOptions{a.checkpoint, a.resume, run_fingerprint(a)});
   // Every rank runs the whole command; rank 0 alone writes files.
   const bool writer = learn::team_root();
+  const InterruptNote interrupt_note(interrupt_text(a, writer));
 
   nlohmann::json j = {{"board", a.board},
                       {"method", a.method},

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -407,6 +408,30 @@ TEST_F(Cli, LearnDrainPenaltyPricesTheShotTableAndTheTeacher) {
     EXPECT_NE(refused.err.find("--drain-penalty is for imitate"), std::string::npos) << refused.err;
   }
   EXPECT_EQ(run(imitate + learned + " --drain-penalty -1").exit_code, 2) << "below the range";
+}
+
+// A learn stopped by a signal says what its checkpoint keeps, dies of the
+// signal, writes no half result, and --resume goes on from the batches kept.
+TEST_F(Cli, AnInterruptedLearnSaysWhatItsCheckpointKeepsAndResumes) {
+  const std::string out = (dir_ / "cem.json").string();
+  const std::string ckpt = (dir_ / "cem.ckpt").string();
+  const std::string err = (dir_ / "cem.err").string();
+  const std::string learn = "learn boards/mit1993.board --method cem --budget-balls 1200 --population 8 --seed 3 "
+                            "--threads 1 --eval-balls 8 --out " + out + " --checkpoint " + ckpt;
+  // Once a batch or two are in the file (about 1.7 kB each), SIGTERM.
+  const CommandResult stopped = run_shell(
+      "cd " PINBALL_SOURCE_DIR " && { " PINBALL_EXE " " + learn + " 2> " + err + " & pid=$!; i=0; while [ $(stat -c %s " +
+      ckpt + " 2>/dev/null || echo 0) -lt 3000 ] && [ $i -lt 1200 ]; do sleep 0.05; i=$((i+1)); done; kill -TERM "
+      "$pid; wait $pid; echo $?; }");
+  EXPECT_EQ(stopped.out, std::to_string(128 + SIGTERM) + "\n") << "died of the signal, as before";
+  EXPECT_NE(slurp(err).find("learn: interrupted; " + ckpt + " keeps every batch of balls finished so far"),
+            std::string::npos)
+      << slurp(err);
+  EXPECT_FALSE(std::filesystem::exists(out)) << "no result from half a run";
+  const CommandResult resumed = run(learn + " --resume --json");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_GT(nlohmann::json::parse(resumed.out).at("team").at("checkpoint").at("replayed").get<int>(), 0);
+  EXPECT_TRUE(std::filesystem::exists(out));
 }
 
 // The overlay `pinball identify` writes (docs/identification.md) is part of
