@@ -42,7 +42,7 @@ std::string format_count(double x) {
 }  // namespace
 
 std::string format_progress(std::string_view label, double done, double total, std::string_view unit,
-                            double elapsed_s, std::string_view note) {
+                            double elapsed_s, std::string_view note, double done_in_no_time) {
   // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on "a" + b + "c" chains here.
   std::string line(label);
   line.append(": ").append(format_count(done)).append("/").append(format_count(total));
@@ -52,8 +52,9 @@ std::string format_progress(std::string_view label, double done, double total, s
     line.append(" (").append(format_count(pct)).append(" %)");
   }
   line.append(", ").append(format_duration(elapsed_s)).append(" elapsed");
-  if (done > 0.0 && total > done) {
-    line.append(", ETA ").append(format_duration(elapsed_s / done * (total - done)));
+  const double done_in_time = done - done_in_no_time;
+  if (done_in_time > 0.0 && total > done) {
+    line.append(", ETA ").append(format_duration(elapsed_s / done_in_time * (total - done)));
   }
   if (!note.empty()) line.append("; ").append(note);
   return line;

@@ -158,6 +158,7 @@ bool checkpoint_replay(std::size_t count, std::vector<Blob>& out) {
   out.assign(std::make_move_iterator(message.begin() + 1), std::make_move_iterator(message.end()));
   ++t.next;
   ++t.status.replayed;
+  t.status.replayed_items += count;
   return true;
 }
 

@@ -300,10 +300,12 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
   const auto start = std::chrono::steady_clock::now();
   // Across the job: each rank plays its share (progress counts this rank's balls).
   const int share = std::max<int>(1, balls / team_size());
-  SharedProgress balls_done(share, share / 10, [&](long d, double) {
+  // "teacher: 30/300 balls (10 %), 41 s elapsed, ETA 6 min 09 s" (the round's ETA).
+  SharedProgress balls_done(share, share / 10, [&](long d, double elapsed_s) {
     if (!progress) return;
-    progress(std::string(learner != nullptr ? "learner, teacher judging: " : "teacher: ") + std::to_string(d) + "/" +
-             std::to_string(share) + " balls" + (team_size() > 1 ? " (this rank's share)" : ""));
+    progress(format_progress(learner != nullptr ? "learner, teacher judging" : "teacher", static_cast<double>(d),
+                             static_cast<double>(share), "balls", elapsed_s,
+                             team_size() > 1 ? "this rank's share" : ""));
   });
   const std::vector<Blob> blobs = distributed_map(n, threads, [&](std::size_t i) {
     const std::uint64_t b = ball_seed(seed, i);

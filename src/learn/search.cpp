@@ -5,6 +5,7 @@
 
 #include "pinball/core/format.h"
 #include "pinball/core/progress.h"
+#include "pinball/learn/checkpoint.h"
 
 namespace pinball::learn {
 
@@ -52,14 +53,17 @@ void SearchRun::end_generation(double population_mean, double generation_best, d
   p.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   result_.curve.push_back(p);
   if (config_.progress) {
+    // Balls a resumed run took from its checkpoint took no time: rate and ETA are the played balls'.
+    const auto replayed = static_cast<double>(checkpoint_status().replayed_items);
+    const double played = static_cast<double>(balls_) - replayed;
     // "tournament: 1200/6000 balls (20 %), 41 s elapsed, ETA 2 min 44 s; generation 3, ..."
     const std::string note = "generation " + std::to_string(p.generation) + ", population mean " +
                              format_number(population_mean, 4) + ", generation best " +
                              format_number(generation_best, 4) + ", best so far " + format_number(p.best_so_far, 4) +
-                             ", " + format_number(p.wall_s > 0 ? static_cast<double>(balls_) / p.wall_s : 0.0) +
+                             ", " + format_number(p.wall_s > 0 ? played / p.wall_s : 0.0) +
                              " balls/s";
     *config_.progress << format_progress(result_.method, static_cast<double>(balls_),
-                                         static_cast<double>(config_.budget_balls), "balls", p.wall_s, note)
+                                         static_cast<double>(config_.budget_balls), "balls", p.wall_s, note, replayed)
                       << "\n";
   }
 }

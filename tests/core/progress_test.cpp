@@ -30,6 +30,15 @@ TEST(FormatProgress, ShowsPercentElapsedAndTimeLeft) {
   EXPECT_NE(format_progress("x", 999, 1000, "", 1.0).find("(99 %)"), std::string::npos);
 }
 
+// A resumed run takes its first balls from a checkpoint in no time: they count
+// as done, not in the rate (3000 from the file, 1000 played in 10 s: 20 s left).
+TEST(FormatProgress, UnitsDoneInNoTimeAreNotInTheRate) {
+  EXPECT_EQ(format_progress("cem", 4000, 6000, "balls", 10.0, "", 3000),
+            "cem: 4000/6000 balls (66 %), 10 s elapsed, ETA 20 s");
+  // Only those so far: no rate yet, so no estimate.
+  EXPECT_EQ(format_progress("cem", 3000, 6000, "balls", 0.1, "", 3000), "cem: 3000/6000 balls (50 %), 100 ms elapsed");
+}
+
 TEST(ProgressMeter, ShowsAtMostOncePerIntervalAndAlwaysTheEnd) {
   std::ostringstream out;
   ProgressMeter meter(&out, "sim", 4, "balls", false, 1.0);

@@ -20,9 +20,11 @@ std::string format_duration(double s);
 
 /// The progress line for `done` of `total` `unit` after `elapsed_s`, with an
 /// optional note after a semicolon. The ETA is left out until something is
-/// done; the percent is rounded down, so 100 % means finished.
+/// done; the percent is rounded down, so 100 % means finished. `done_in_no_time`
+/// of the done units took none of the time (taken from a checkpoint): the ETA
+/// comes from the rate of the others.
 std::string format_progress(std::string_view label, double done, double total, std::string_view unit,
-                            double elapsed_s, std::string_view note = {});
+                            double elapsed_s, std::string_view note = {}, double done_in_no_time = 0.0);
 
 /// Whether to show progress: asked for (--progress), or stderr is a terminal.
 bool progress_wanted(bool asked);

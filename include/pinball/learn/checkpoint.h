@@ -32,6 +32,7 @@ struct CheckpointStatus {
   bool open = false;
   std::uint64_t batches_in_file = 0;  ///< whole batches found when the run started (resume)
   std::uint64_t replayed = 0;         ///< batches taken from the file
+  std::uint64_t replayed_items = 0;   ///< what those batches held (balls): taken in no time, no part of a rate
   std::uint64_t recorded = 0;         ///< batches appended by this run
   std::uint64_t dropped_bytes = 0;    ///< a cut-off last record removed on resume
 };
