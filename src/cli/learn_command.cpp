@@ -173,6 +173,10 @@ struct Evaluation {
   }
 };
 
+// An evaluation's balls gathered (and checkpointed) at a time; fixed, so that a checkpoint
+// resumes on any count of ranks. Evaluations up to this size are one batch, as before.
+constexpr std::size_t kEvaluationBatchBalls = 10000;
+
 // Plays `balls` fresh balls (seeds apart from any search's) with one controller.
 Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const control::ControllerSpec* spec,
                     const std::function<std::unique_ptr<control::FlipperController>()>& make_controller, int balls,
@@ -182,8 +186,13 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
   ProgressMeter meter(progress_wanted(a.progress) ? &err : nullptr, "learn evaluation", balls, "balls",
                       !a.progress && progress_wanted(false));
   SharedProgress balls_done(balls, 1, [&](long d, double) { meter.update(static_cast<double>(d)); });
-  const std::vector<learn::Blob> blobs =
-      learn::distributed_map(static_cast<std::size_t>(balls), a.threads, [&](std::size_t i) {
+  RunningStats score, duration_s, flips;
+  Evaluation e;
+  const std::uint64_t replayed_before = learn::checkpoint_status().replayed_items;
+  // Batches of kEvaluationBatchBalls: memory for one batch's outcomes, however many balls.
+  learn::distributed_batches(
+      static_cast<std::size_t>(balls), kEvaluationBatchBalls, a.threads,
+      [&](std::size_t i) {
         const std::uint64_t seed = ball_seed(a.seed ^ 0xE7A1E7A1E7A1E7A1ull, i);
         learn::Blob blob;
         if (spec != nullptr) {
@@ -194,19 +203,17 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
         }
         balls_done.one_done();
         return blob;
+      },
+      [&](std::size_t, std::vector<learn::Blob>& blobs) {
+        for (const learn::Blob& b : blobs) {
+          const learn::BallOutcome o = learn::ball_outcome_from_blob(b);
+          score.add(o.score);
+          duration_s.add(o.duration_s);
+          flips.add(o.flips);
+          e.balls_cut_at_time_limit += o.cut ? 1 : 0;
+        }
       });
-  std::vector<learn::BallOutcome> out;
-  out.reserve(blobs.size());
-  for (const learn::Blob& b : blobs) out.push_back(learn::ball_outcome_from_blob(b));
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  RunningStats score, duration_s, flips;
-  Evaluation e;
-  for (const auto& o : out) {
-    score.add(o.score);
-    duration_s.add(o.duration_s);
-    flips.add(o.flips);
-    e.balls_cut_at_time_limit += o.cut ? 1 : 0;
-  }
   e.balls = score.count();
   e.mean_score_per_ball = score.mean();
   e.score_ci95_half_width = score.ci95_half_width();
@@ -214,10 +221,11 @@ Evaluation evaluate(const learn::PinballEvaluator& ev, const LearnArgs& a, const
   e.mean_ball_time_s = duration_s.mean();
   e.flips_per_ball = flips.mean();
   e.wall_s = wall;
-  // A resumed run whose checkpoint held every ball played none in no time: no rate.
-  // (Under MPI this rank's count is its share; the rate is the job's, balls over the wall.)
-  e.balls_per_s = balls_done.done() > 0 && wall > 0.0 ? static_cast<double>(e.balls) / wall
-                                                      : std::numeric_limits<double>::quiet_NaN();
+  // Balls taken from a checkpoint took no time: the rate is the job's played balls over the wall,
+  // and none when the checkpoint held every ball.
+  const auto played = static_cast<double>(e.balls) -
+                      static_cast<double>(learn::checkpoint_status().replayed_items - replayed_before);
+  e.balls_per_s = played > 0.0 && wall > 0.0 ? played / wall : std::numeric_limits<double>::quiet_NaN();
   return e;
 }
 
@@ -348,7 +356,7 @@ std::string interrupt_text(const LearnArgs& a, bool writer) {
            "from it)\n";
   }
   return "\nlearn: interrupted; " + a.checkpoint +
-         " keeps every batch of balls finished so far (an imitation round is one batch): the same command with "
+         " keeps every batch of balls finished so far: the same command with "
          "--resume goes on from there\n";
 }
 

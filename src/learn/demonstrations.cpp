@@ -296,7 +296,6 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
   std::optional<TeacherWorlds> home;  // the belief's own model
   if (worlds == nullptr) worlds = &home.emplace(board, nullptr);
   const auto n = static_cast<std::size_t>(balls);
-  std::vector<DemonstrationBall> played(n);
   const auto start = std::chrono::steady_clock::now();
   // Across the job: each rank plays its share (progress counts this rank's balls).
   const int share = std::max<int>(1, balls / team_size());
@@ -307,7 +306,24 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
                              static_cast<double>(share), "balls", elapsed_s,
                              team_size() > 1 ? "this rank's share" : ""));
   });
-  const std::vector<Blob> blobs = distributed_map(n, threads, [&](std::size_t i) {
+  Demonstrations out;
+  out.balls = balls;
+  double score = 0.0;
+  double time = 0.0;
+  auto take = [&](std::size_t, std::vector<Blob>& blobs) {
+    for (const Blob& blob : blobs) {
+      const DemonstrationBall b = demonstration_ball_from_blob(blob);
+      out.shots.insert(out.shots.end(), b.shots.begin(), b.shots.end());
+      score += b.score;
+      time += b.duration_s;
+      out.cut += b.cut ? 1 : 0;
+      if (b.cut) out.best_cut_score = std::max(out.best_cut_score, b.score);
+      out.teacher_fires += b.teacher_fires;
+      out.unmatched_fires += b.unmatched_fires;
+    }
+  };
+  // Batches of kDemonstrationBatchBalls: memory for one batch, however large the round.
+  distributed_batches(n, kDemonstrationBatchBalls, threads, [&](std::size_t i) {
     const std::uint64_t b = ball_seed(seed, i);
     const TeacherWorlds::Place& place = worlds->place_of(b);
     DemonstrationConfig c = config;  // the world's own delay and camera, when it has them
@@ -319,21 +335,7 @@ Demonstrations record_demonstrations(const table::Board& board, const Demonstrat
                                        : record_demonstration(board, *ball_world, *place.teacher_model, c, b);
     balls_done.one_done();
     return to_blob(ball);
-  });
-  for (std::size_t i = 0; i < n; ++i) played[i] = demonstration_ball_from_blob(blobs[i]);
-  Demonstrations out;
-  out.balls = balls;
-  double score = 0.0;
-  double time = 0.0;
-  for (const DemonstrationBall& b : played) {
-    out.shots.insert(out.shots.end(), b.shots.begin(), b.shots.end());
-    score += b.score;
-    time += b.duration_s;
-    out.cut += b.cut ? 1 : 0;
-    if (b.cut) out.best_cut_score = std::max(out.best_cut_score, b.score);
-    out.teacher_fires += b.teacher_fires;
-    out.unmatched_fires += b.unmatched_fires;
-  }
+  }, take);
   out.mean_teacher_score = score / balls;
   out.mean_ball_time_s = time / balls;
   out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -61,6 +61,17 @@ std::vector<Blob> distributed_map(std::size_t count, int threads, const std::fun
   return all;
 }
 
+void distributed_batches(std::size_t count, std::size_t batch, int threads,
+                         const std::function<Blob(std::size_t)>& task,
+                         const std::function<void(std::size_t first, std::vector<Blob>& results)>& take) {
+  if (batch == 0) throw std::invalid_argument("distributed_batches: batch must be >= 1");
+  for (std::size_t first = 0; first < count; first += batch) {
+    const std::size_t n = std::min(batch, count - first);
+    std::vector<Blob> results = distributed_map(n, threads, [&](std::size_t k) { return task(first + k); });
+    take(first, results);
+  }
+}
+
 Blob to_blob(const BallOutcome& o) {
   BlobWriter w;
   w.put(o.score).put(o.duration_s).put(o.flips).put(o.cut);

@@ -50,24 +50,30 @@ ShotValueTable collect_shot_values(const table::Board& belief, const ShotValueCo
   SharedProgress balls_done(balls, balls / 20, [&](long d, double elapsed_s) {
     if (progress) progress(format_progress("shot values", d, balls, "balls", elapsed_s));
   });
-  const std::vector<Blob> blobs = distributed_map(static_cast<std::size_t>(balls), threads, [&](std::size_t i) {
-    ShotValueTable table = make_shot_value_table(flippers);
-    const std::unique_ptr<sim::World> world = prototype->fork();
-    play_collecting(model, *world, config, ball_seed(seed, i), table);
-    balls_done.one_done();
-    BlobWriter w;
-    w.put_vector(table.sum).put_vector(table.count);
-    return w.take();
-  });
-  for (const Blob& b : blobs) {
-    BlobReader r(b);
-    const std::vector<double> sum = r.get_vector<double>();
-    const std::vector<double> count = r.get_vector<double>();
-    for (std::size_t k = 0; k < total.sum.size(); ++k) {
-      total.sum[k] += sum[k];
-      total.count[k] += count[k];
-    }
-  }
+  // Each ball's table is a blob: batches of kShotValueBatchBalls keep memory to one batch's.
+  constexpr std::size_t kShotValueBatchBalls = 500;
+  distributed_batches(
+      static_cast<std::size_t>(balls), kShotValueBatchBalls, threads,
+      [&](std::size_t i) {
+        ShotValueTable table = make_shot_value_table(flippers);
+        const std::unique_ptr<sim::World> world = prototype->fork();
+        play_collecting(model, *world, config, ball_seed(seed, i), table);
+        balls_done.one_done();
+        BlobWriter w;
+        w.put_vector(table.sum).put_vector(table.count);
+        return w.take();
+      },
+      [&](std::size_t, std::vector<Blob>& blobs) {
+        for (const Blob& b : blobs) {
+          BlobReader r(b);
+          const std::vector<double> sum = r.get_vector<double>();
+          const std::vector<double> count = r.get_vector<double>();
+          for (std::size_t k = 0; k < total.sum.size(); ++k) {
+            total.sum[k] += sum[k];
+            total.count[k] += count[k];
+          }
+        }
+      });
   smooth(total);
   return total;
 }

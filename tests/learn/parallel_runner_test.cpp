@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <stdexcept>
+#include <vector>
+
 #include "pinball/table/board_loader.h"
 
 namespace pinball::learn {
@@ -39,6 +42,23 @@ TEST(ParallelRunner, RethrowsATaskError) {
   std::vector<BallTask> tasks;
   for (std::uint64_t i = 0; i < 10; ++i) tasks.push_back({&s, i});
   EXPECT_THROW(play_balls(t, tasks, 2), std::runtime_error);
+}
+
+// A long map in batches: every item once, in order, a batch at a time, and
+// the same results as one distributed_map.
+TEST(ParallelRunner, BatchesTakeEveryItemInOrderAndMatchOneMap) {
+  auto task = [](std::size_t i) { return Blob{static_cast<std::uint8_t>(i % 251), static_cast<std::uint8_t>(i / 251)}; };
+  std::vector<std::size_t> firsts, sizes;
+  std::vector<Blob> all;
+  distributed_batches(1050, 500, 2, task, [&](std::size_t first, std::vector<Blob>& results) {
+    firsts.push_back(first);
+    sizes.push_back(results.size());
+    all.insert(all.end(), results.begin(), results.end());
+  });
+  EXPECT_EQ(firsts, (std::vector<std::size_t>{0, 500, 1000}));
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{500, 500, 50}));
+  EXPECT_EQ(all, distributed_map(1050, 2, task));
+  EXPECT_THROW(distributed_batches(1, 0, 1, task, [](std::size_t, std::vector<Blob>&) {}), std::invalid_argument);
 }
 
 }  // namespace

@@ -115,6 +115,12 @@ struct Demonstrations {
   double wall_s = 0.0;
 };
 
+/// Balls gathered (and checkpointed) at a time by record_demonstrations: a
+/// round of more is several batches, so memory holds one batch's balls and a
+/// long round is kept in parts. Fixed, not per rank, so that a checkpoint
+/// resumes on any count of ranks; rounds up to this size are one batch, as before.
+inline constexpr std::size_t kDemonstrationBatchBalls = 500;
+
 /// Records `balls` balls (ball i plays ball_seed(seed, i)) on `threads`
 /// threads; the result depends only on the seed. With `learner` null the
 /// teacher plays (record_demonstration); otherwise the imitation controller of

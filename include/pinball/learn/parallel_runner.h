@@ -34,6 +34,16 @@ void parallel_for(std::size_t count, int threads, const std::function<void(std::
 /// the other ranks would wait for this one forever.
 std::vector<Blob> distributed_map(std::size_t count, int threads, const std::function<Blob(std::size_t)>& task);
 
+/// distributed_map over [0, count) in batches of at most `batch` items, in
+/// order: `take(first, results)` gets each batch's results (items first ..
+/// first + results.size() - 1) before the next batch runs. Memory holds one
+/// batch, however many items; each batch is one checkpoint batch. The batch
+/// size must not depend on the ranks or threads, or a checkpoint would not
+/// resume on other counts.
+void distributed_batches(std::size_t count, std::size_t batch, int threads,
+                         const std::function<Blob(std::size_t)>& task,
+                         const std::function<void(std::size_t first, std::vector<Blob>& results)>& take);
+
 /// Plays every task across the job (distributed_map) and returns the
 /// outcomes in task order.
 std::vector<BallOutcome> play_balls(const BallObjective& objective, const std::vector<BallTask>& tasks, int threads);
