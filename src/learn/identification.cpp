@@ -276,6 +276,17 @@ void fit_material_group(std::span<const Rebound> rebounds, const IdentifyOptions
   }
   // speed out ≈ ρ·speed in (+ kick)
   const TrimmedLineFit fit = fit_line_trimmed(in_out, !with_kick);
+  // What an overlay may hold (table/board.h): a fit outside it is no one material's rebounds, and
+  // a file holding it would be refused by every command that reads it.
+  if (!(fit.line.slope >= 0.0 && fit.line.slope <= table::kMaxRho) ||
+      (with_kick && !(fit.line.intercept >= 0.0 && fit.line.intercept <= table::kMaxOverlayKick_mps))) {
+    group.why_not = "the clean rebounds fit rho " + format_number(fit.line.slope) +
+                    (with_kick ? " and kick " + format_number(fit.line.intercept) + " m/s" : std::string()) +
+                    ", outside the overlay's range (rho in [0, " + format_number(table::kMaxRho) + "]" +
+                    (with_kick ? ", kick in [0, " + format_number(table::kMaxOverlayKick_mps) + "] m/s" : "") +
+                    "): they are not one material's; the board's value is kept";
+    return;
+  }
   group.identified = true;
   group.outliers = fit.outliers;
   group.overlay.rho = {fit.line.slope, fit.slope_stderr, fit.used};
@@ -444,10 +455,13 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
     if (progress) progress("free flights", static_cast<int>(r + 1), static_cast<int>(recordings.size()));
   }
   result.flights = flights.size();
-  if (flights.size() < 2) {
+  const auto recording_names = [&recordings] {
     std::string names;
     for (const bus::RecordedPlay& play : recordings) names += (names.empty() ? "" : ", ") + play.source;
-    throw std::runtime_error(names + ": " + std::to_string(flights.size()) + " free flights in " +
+    return names;
+  };
+  if (flights.size() < 2) {
+    throw std::runtime_error(recording_names() + ": " + std::to_string(flights.size()) + " free flights in " +
                              format_number(result.recorded_s) + " s of play (a free flight: at least " +
                              std::to_string(options.flights.min_points) +
                              " sightings in a row clear of everything), 2 needed for g, the first parameter; "
@@ -464,6 +478,13 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
   else
     result.gravity = result.gravity_no_drag;
   const FlightGravity& g = result.gravity_no_drag;
+  if (!(g.g_mps2 > 0.0 && g.g_mps2 <= table::kMaxGravity_mps2)) {
+    throw std::runtime_error(recording_names() + ": the " + std::to_string(g.flights) + " free flights give g " +
+                             format_number(g.g_mps2) + " m/s^2 along the table, outside (0, " +
+                             format_number(table::kMaxGravity_mps2) +
+                             "]: they are not free flights on this board (its calibration or geometry?); "
+                             "nothing can be identified");
+  }
   result.sliding = fit_sliding_friction(recordings, flights, g, options.flights.sigma_m);
   result.overlay.gravity_mps2 = table::IdentifiedValue{g.g_mps2, g.g_stderr_mps2, g.flights};
   identify_groups(board, flights, options, result);

@@ -51,7 +51,8 @@ constexpr Bound kAboveZero{0.0, true};
 
 // The checks a type cannot express, after reading (header: the ranges).
 void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
-  if (o.gravity_mps2) check_value(*o.gravity_mps2, kAboveZero, {20.0, false}, " m/s^2", "gravity_mps2", r);
+  // g and ρ in the board format's ranges: an overlay gives no world a board file could not.
+  if (o.gravity_mps2) check_value(*o.gravity_mps2, kAboveZero, {kMaxGravity_mps2, false}, " m/s^2", "gravity_mps2", r);
   if (o.wall_thickness_m) check_value(*o.wall_thickness_m, kZero, {0.05, false}, " m", "wall_thickness_m", r);
   for (std::size_t i = 0; i < o.obstacle_groups.size(); ++i) {
     const ObstacleGroupOverlay& g = o.obstacle_groups[i];
@@ -59,8 +60,8 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
     check_at_least_zero(g.board_rho, "", key + ".board_rho", r);
     check_at_least_zero(g.board_kick_mps, " m/s", key + ".board_kick_mps", r);
     if (g.obstacles.empty()) r.fail(key + ".obstacles", "names no obstacle");
-    check_value(g.rho, kZero, {3.0, false}, "", key + ".rho", r);
-    if (g.kick_mps) check_value(*g.kick_mps, kZero, {10.0, false}, " m/s", key + ".kick_mps", r);
+    check_value(g.rho, kZero, {kMaxRho, false}, "", key + ".rho", r);
+    if (g.kick_mps) check_value(*g.kick_mps, kZero, {kMaxOverlayKick_mps, false}, " m/s", key + ".kick_mps", r);
     if (g.friction) check_value(*g.friction, kZero, {kMaxWallFriction, false}, "", key + ".friction", r);
   }
   for (std::size_t i = 0; i < o.flippers.size(); ++i) {

@@ -24,8 +24,6 @@ constexpr double kMaxLength_m = 10.0;        // size W and H, every radius and f
 constexpr double kMaxCoordinate_m = 100.0;   // every position, either axis
 constexpr double kMaxBallRadius_m = 0.1;     // a pinball is 13.5 mm
 constexpr double kMaxSpeed_mps = 100.0;      // SPEED_MAX, kick, kickout: twenty times a hard shot
-constexpr double kMaxGravity_mps2 = 10.0;    // along the table: at most g itself (9.81), with rounding
-constexpr double kMaxRho = 2.0;              // reflectivity: > 1 kicks; 2 already doubles the normal speed
 
 /// Requires `v`, read in the file's length unit (per second with per = "/s",
 /// ...), to be at most `max_si`; the message states the bound in the file's unit.

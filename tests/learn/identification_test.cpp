@@ -176,6 +176,18 @@ TEST(MaterialGroupFit, ReboundsThatLeftAtTheSpeedClampAreLeftOut) {
   fit_material_group(std::span<const Rebound>(rebounds.data(), 8), IdentifyOptions{}, 0.1, few);
   EXPECT_FALSE(few.identified);
   EXPECT_EQ(few.why_not, "0 clean rebounds (both flights seen, one obstacle near, below the speed clamp), needs 10");
+
+  // Rebounds no material gives (out at 2.5 times in, a kick taken away): not identified, and no
+  // overlay a command would refuse to read.
+  std::vector<Rebound> wild = rebounds;
+  for (Rebound& r : wild) r.speed_out_mps = 2.5 * r.speed_in_mps - 0.4;
+  GroupResult out_of_range;
+  out_of_range.overlay = group.overlay;
+  fit_material_group(wild, IdentifyOptions{}, 1e9, out_of_range);
+  EXPECT_FALSE(out_of_range.identified);
+  EXPECT_EQ(out_of_range.why_not,
+            "the clean rebounds fit rho 2.5 and kick -0.4 m/s, outside the overlay's range (rho in [0, 2], kick in "
+            "[0, 10] m/s): they are not one material's; the board's value is kept");
 }
 
 TEST(WallFrictionFit, RecoversTheFrictionExactlyWithoutNoiseAndWithinItsUncertaintyWithNoise) {

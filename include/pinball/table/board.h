@@ -43,6 +43,14 @@ struct Action {
 /// The largest wall friction a board or an overlay may give: no surface a ball rolls on has more.
 inline constexpr double kMaxWallFriction = 2.0;
 
+/// The largest reflectivity ρ a board or an overlay may give: > 1 kicks, and 2
+/// already doubles the normal speed.
+inline constexpr double kMaxRho = 2.0;
+
+/// The largest g along the table a board or an overlay may give (m/s²): at
+/// most g itself (9.81), with rounding.
+inline constexpr double kMaxGravity_mps2 = 10.0;
+
 /// The largest flipper friction coefficient a board or an overlay may give
 /// (rubber on a ball is about 1; 1e154 overflowed the clamp to a stopped ball).
 inline constexpr double kMaxFlipperMu = 10.0;

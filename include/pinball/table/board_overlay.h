@@ -21,6 +21,9 @@ namespace pinball::table {
 /// The version this code writes and reads.
 inline constexpr int kBoardOverlayVersion = 1;
 
+/// The largest kick an overlay's obstacle group may give (m/s): a hard shot's speed.
+inline constexpr double kMaxOverlayKick_mps = 10.0;
+
 /// One identified number: its value, its standard uncertainty, and how many
 /// recorded events it rests on.
 struct IdentifiedValue {
