@@ -87,6 +87,7 @@ struct LoadState {
   double default_rho = 1.0;         // `defaults rho=`
   int first_dimensioned_line = 0;   // first statement using a length or angle
   std::map<std::string, int> seen;  // singleton keyword -> its line
+  std::map<std::string, int> names;  // statement name -> its line
   std::vector<int> bank_lines;      // same index as board.banks
   struct Polygon {
     std::vector<Vec2> vertices_m;

@@ -170,10 +170,21 @@ void bank(LoadState& state, const Reader& r) {
 
 // ---- obstacles ----
 
-std::string default_name(const Reader& r) { return std::string(r.keyword()) + "@" + std::to_string(r.line()); }
+/// The statement's name (`name=`, or keyword@line), one per statement in the
+/// whole board: an overlay and a trace name obstacles, flippers and sensors by it.
+std::string statement_name(LoadState& state, const Reader& r) {
+  std::string name =
+      r.flag("name") ? std::string(r.text("name")) : std::string(r.keyword()) + "@" + std::to_string(r.line());
+  const auto [it, fresh] = state.names.emplace(name, r.line());
+  if (!fresh) {
+    r.fail("attribute name '" + name + "' is already line " + std::to_string(it->second) +
+           "'s: an overlay names obstacles, flippers and sensors by it, so each must be the board's only one");
+  }
+  return name;
+}
 
 /// The attributes every shape of one obstacle statement shares.
-Obstacle obstacle_attributes(const LoadState& state, const Reader& r) {
+Obstacle obstacle_attributes(LoadState& state, const Reader& r) {
   Obstacle o;
   o.rho = rho_attribute(r, state.default_rho);
   o.friction = r.attribute("friction", 0.0);
@@ -192,7 +203,7 @@ Obstacle obstacle_attributes(const LoadState& state, const Reader& r) {
     o.bank = bank_index(state.board, bank);
     if (o.bank < 0) r.fail("attribute bank names an undeclared bank '" + std::string(bank) + "'");
   }
-  o.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  o.name = statement_name(state, r);
   o.source_line = r.line();
   return o;
 }
@@ -315,7 +326,7 @@ void flipper(LoadState& state, const Reader& r) {
   f.mu = r.attribute("mu", 1.0);
   r.require(f.mu >= 0, "attribute mu", ">= 0", f.mu);
   r.require(f.mu <= kMaxFlipperMu, "attribute mu", "at most " + fmt(kMaxFlipperMu), f.mu);
-  f.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  f.name = statement_name(state, r);
   f.source_line = r.line();
   state.board.flippers.push_back(f);
 }
@@ -323,7 +334,7 @@ void flipper(LoadState& state, const Reader& r) {
 void finish_sensor(LoadState& state, const Reader& r, Sensor& s) {
   s.action.score = points_attribute(r, "score");
   s.action.eats_ball = r.flag("eat");
-  s.name = r.flag("name") ? std::string(r.text("name")) : default_name(r);
+  s.name = statement_name(state, r);
   s.source_line = r.line();
   state.board.sensors.push_back(s);
 }

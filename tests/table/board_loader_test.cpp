@@ -418,6 +418,19 @@ TEST(BoardLoaderErrors, AttributeNotAllowedOnThisKind) {
   expect_body_error("flipper left 0.1 0.2 0.076 -0.5 0.5 35 score=1\n", 8, "attribute 'score' does not apply");
 }
 
+// An overlay names what it changes (obstacle_groups[].obstacles, flippers[].name): two statements
+// of one name were both changed, or the one meant was not.
+TEST(BoardLoaderErrors, TwoStatementsOfOneNameAreRefusedAtTheSecond) {
+  const std::string taken = "' is already line 8's: an overlay names obstacles, flippers and sensors by it";
+  expect_body_error("circle 0.1 0.5 0.01 name=post\ncircle 0.2 0.5 0.01 name=post\n", 9,
+                    "circle: attribute name 'post" + taken);
+  expect_body_error("circle 0.1 0.5 0.01 name=left\nflipper left 0.1 0.2 0.076 -0.5 0.5 35 name=left\n", 9,
+                    "attribute name 'left" + taken);
+  expect_body_error("circle 0.1 0.5 0.01\nsensor circle 0.3 0.5 0.01 name=circle@8\n", 9,
+                    "attribute name 'circle@8" + taken);
+  EXPECT_EQ(parse("circle 0.1 0.5 0.01 name=a\ncircle 0.2 0.5 0.01 name=b\n").obstacles.size(), 2u);
+}
+
 TEST(BoardLoaderErrors, AttributeMisuse) {
   expect_body_error("circle 0.1 0.5 0.01 rho=1 rho=2\n", 8, "attribute 'rho' given twice");
   expect_body_error("circle 0.1 0.5 0.01 eat=1\n", 8, "attribute 'eat' is a flag and takes no value");
