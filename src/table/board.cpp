@@ -154,11 +154,15 @@ void check_launch_pull(const Board& board, double pull) {
   }
 }
 
+double flipper_step_chord_m(const Flipper& flipper, double dt_s) {
+  const double half_sweep = flipper.omega_rad_s * dt_s / 2.0;
+  // sin is only monotonic up to π/2; beyond it the sweep is certainly too large.
+  return half_sweep >= M_PI / 2.0 ? flipper.length_m : flipper.length_m * std::sin(half_sweep);
+}
+
 void check_flipper_time_step(const Board& board, double dt_s) {
   for (const Flipper& f : board.flippers) {
-    const double half_sweep = f.omega_rad_s * dt_s / 2.0;
-    // sin is only monotonic up to π/2; beyond it the sweep is certainly too large.
-    const double chord = half_sweep >= M_PI / 2.0 ? f.length_m : f.length_m * std::sin(half_sweep);
+    const double chord = flipper_step_chord_m(f, dt_s);
     if (!(chord < board.ball.radius_m)) {
       std::ostringstream msg;
       msg << "flipper '" << f.name << "': l*sin(omega*dt/2) = " << chord << " m is not below the ball radius "

@@ -30,6 +30,9 @@ struct Statement {
 /// The statements of `text`, comments and blank lines dropped.
 std::vector<Statement> tokenize(std::string_view text);
 
+/// The line (from 1, as tokenize counts them) that holds byte `offset` of `text`.
+int line_of(std::string_view text, std::size_t offset);
+
 struct Attribute {
   std::string_view key;
   std::string_view value;

@@ -60,14 +60,34 @@ std::string fmt(double v) {
   return s.str();
 }
 
+namespace {
+
+// The first line of `text` and what follows it. A line ends at LF, CRLF or a
+// lone CR (an old Mac editor's): each is one line end.
+std::pair<std::string_view, std::string_view> split_first_line(std::string_view text) {
+  const std::size_t end = text.find_first_of("\r\n");
+  if (end == std::string_view::npos) return {text, {}};
+  const bool crlf = text[end] == '\r' && end + 1 < text.size() && text[end + 1] == '\n';
+  return {text.substr(0, end), text.substr(end + (crlf ? 2 : 1))};
+}
+
+}  // namespace
+
+int line_of(std::string_view text, std::size_t offset) {
+  int line = 1;
+  for (std::string_view rest = text;; ++line) {
+    rest = split_first_line(rest).second;
+    if (rest.empty() || offset < text.size() - rest.size()) return line;
+  }
+}
+
 std::vector<Statement> tokenize(std::string_view text) {
   std::vector<Statement> statements;
   int line = 0;
   while (!text.empty()) {
     ++line;
-    const std::size_t nl = text.find('\n');
-    std::string_view rest = text.substr(0, nl);
-    text = nl == std::string_view::npos ? std::string_view{} : text.substr(nl + 1);
+    auto [rest, following] = split_first_line(text);
+    text = following;
     rest = rest.substr(0, rest.find('#'));
     Statement st{line, {}};
     while (true) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -403,6 +404,25 @@ TEST(BoardLoader, CommentsBlankLinesTabsAndCrlf) {
   EXPECT_EQ(b.obstacles[0].source_line, 11);
 }
 
+// What editors write: a byte-order mark first, CR alone at each line end (old
+// Mac). Both read as the plain file, with its line numbers. A NUL byte is no
+// text: refused at its line (it read as a silent end of a statement).
+TEST(BoardLoader, AByteOrderMarkAndLoneCrLineEndsReadLikeThePlainFile) {
+  const std::string body = "circle 0.1 0.5 0.01\ncircle 0.2 0.5 0.01 name=c\n";
+  const Board plain = parse(body);
+  std::string mac = std::string(kHead) + body;
+  std::replace(mac.begin(), mac.end(), '\n', '\r');
+  for (const std::string& text : {"\xEF\xBB\xBF" + std::string(kHead) + body, mac}) {
+    const Board b = parse_board(text, "t.board");
+    ASSERT_EQ(b.obstacles.size(), plain.obstacles.size());
+    EXPECT_EQ(b.obstacles[1].source_line, 9);
+    EXPECT_EQ(b.obstacles[1].name, "c");
+  }
+  expect_error(std::string(kHead) + "circle 0.1 0.5\r\n0.01\n" + std::string(1, '\0') + "\n", 10,
+               "a NUL byte (at byte ");
+  expect_error(mac + std::string(1, '\0'), 10, "a board file is text");
+}
+
 // ---- errors: each names the file, the line and what is wrong ----
 
 TEST(BoardLoaderErrors, UnknownKeyword) { expect_body_error("cirle 0.1 0.1 0.01\n", 8, "unknown keyword 'cirle'"); }
@@ -558,6 +578,10 @@ TEST(BoardLoaderErrors, FlipperTooFastForTheTimeStep) {
       "flipper left 0.1 0.2 0.076 -0.5 0.5 200\n"
       "dt 0.002\n",
       7, "l*sin(omega*dt/2)");
+  // Said in the file's unit.
+  expect_error("pinball-board 1\nunits mm\nsize 510 1070\nball 13.5 5000\ngravity 1110\nballs 3\nlauncher 450 50\n"
+               "dt 0.0005\nflipper left 100 200 76 -0.5 0.5 800 name=lf\n",
+               9, "l*sin(omega*dt/2) = 15.0989 mm is not below the ball radius 13.5 mm at dt = 0.0005 s");
 }
 
 TEST(BoardLoaderErrors, BallAtTheLauncherOverlaps) {

@@ -251,6 +251,11 @@ double slowest_launch_mps(const Board& board, double pull);
 /// A board with a `start` never launches: any pull passes.
 void check_launch_pull(const Board& board, double pull);
 
+/// How far a flipper's tip region sweeps across in one step: l·sin(θ̇₀·dt/2)
+/// (m), its length once the half sweep passes π/2. It must stay below the
+/// ball's radius, or the bat can jump over the ball.
+double flipper_step_chord_m(const Flipper& flipper, double dt_s);
+
 /// Throws std::invalid_argument naming the flipper if dt_s violates
 /// l·sin(θ̇₀·dt/2) < r for any flipper.
 void check_flipper_time_step(const Board& board, double dt_s);
