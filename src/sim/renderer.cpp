@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "pinball/core/format.h"
 #include "pinball/plot/draw.h"
 
 namespace pinball::sim {
@@ -266,6 +267,17 @@ cv::Point2d board_to_pixel(const table::Board& board, const RenderOptions& optio
 cv::Mat render_board(const table::Board& board, const GameState* state, const RenderOptions& options) {
   if (!(options.px_per_m > 0.0) || options.margin_px < 0 || !(board.width_m > 0.0) || !(board.height_m > 0.0)) {
     throw std::invalid_argument("render_board: needs px_per_m > 0, margin_px >= 0 and a board of positive size");
+  }
+  // In doubles, before render_size's int conversion could overflow.
+  const double extra_px = 2.0 * options.margin_px + (options.draw_scale_bar ? kScaleBarStrip_px : 0);
+  const double longest_m = std::max(board.width_m, board.height_m);
+  if (longest_m * options.px_per_m + extra_px > kMaxRenderSide_px) {
+    throw std::invalid_argument(
+        "render: " + format_number(options.px_per_m) + " px per metre draws this " + format_number(board.width_m) +
+        " x " + format_number(board.height_m) + " m board at more than " + std::to_string(kMaxRenderSide_px) +
+        " px a side; use at most " +
+        format_number(std::floor((kMaxRenderSide_px - extra_px) / longest_m)) +
+        " px per metre");
   }
   const cv::Size size = render_size(board, options);
   cv::Mat image(size, CV_8UC3, kBackground);

@@ -127,6 +127,24 @@ TEST(RendererTest, RenderBoardReturnsBgrImageOfRenderSize) {
   EXPECT_EQ(image.type(), CV_8UC3);
 }
 
+// A 10 m board at 10 000 px/m asked for a 30 GB image: refused, with the scale that fits.
+TEST(RendererTest, AnImageOverTheLargestSideIsRefusedWithTheScaleThatFits) {
+  table::Board big;
+  big.width_m = 10.0;
+  big.height_m = 10.0;
+  RenderOptions o;  // 12 px margin, no scale bar
+  o.px_per_m = 10000.0;
+  try {
+    render_board(big, nullptr, o);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "render: 10000 px per metre draws this 10 x 10 m board at more than 16384 px a "
+                                     "side; use at most 1636 px per metre");
+  }
+  o.px_per_m = 1636.0;
+  EXPECT_LE(render_size(big, o).width, kMaxRenderSide_px);
+}
+
 TEST(RendererTest, BoardToPixelFlipsYAndAddsMargin) {
   const table::Board b = empty_board();
   const RenderOptions o = test_options();

@@ -28,8 +28,14 @@ cv::Size render_size(const table::Board& board, const RenderOptions& options);
 /// Board point (m) to image pixel (u right, v down) under `options`.
 cv::Point2d board_to_pixel(const table::Board& board, const RenderOptions& options, const Vec2& p_board);
 
+/// The longest side render_board draws (px): a 10 m board at 10 000 px/m
+/// needed a 30 GB image. 16384 is also what image viewers and codecs take.
+inline constexpr int kMaxRenderSide_px = 16384;
+
 /// Draws the board; with a state also draws flippers at their angles, hidden
 /// flags greyed out, the ball and the HUD. Returns an 8-bit BGR image.
+/// Throws std::invalid_argument, with the largest scale that fits, when a
+/// side would exceed kMaxRenderSide_px.
 cv::Mat render_board(const table::Board& board, const GameState* state, const RenderOptions& options);
 
 /// What render_board's colours mean (walls, kickers, ball eaters, hidden
