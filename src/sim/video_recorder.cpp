@@ -46,7 +46,27 @@ void VideoRecorder::write(const cv::Mat& frame_bgr) {
 }
 
 void VideoRecorder::close() {
-  if (writer_.isOpened()) writer_.release();
+  if (!writer_.isOpened()) return;
+  writer_.release();
+  const int readable = avi_frame_count(path_);
+  // An AVI of no frames does not open as a video: nothing to check.
+  if (readable != frames_ && !(frames_ == 0 && readable <= 0)) {
+    throw std::runtime_error(path_ + ": the video was not written whole: " +
+                             (readable < 0 ? std::string("it does not open as a video")
+                                           : std::to_string(readable) + " of its " + std::to_string(frames_) +
+                                                 " frames are in its index") +
+                             " (a full disk?)");
+  }
+}
+
+int avi_frame_count(const std::string& path) {
+  cv::VideoCapture reader;
+  try {
+    if (!reader.open(path, cv::CAP_OPENCV_MJPEG)) return -1;
+  } catch (const cv::Exception&) {
+    return -1;
+  }
+  return static_cast<int>(reader.get(cv::CAP_PROP_FRAME_COUNT));
 }
 
 // No destructor of our own: cv::VideoWriter's destructor releases the file,

@@ -1,9 +1,14 @@
 #include "pinball/sim/video_recorder.h"
 
+#include <csignal>
 #include <filesystem>
 #include <random>
 #include <stdexcept>
 #include <string>
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -73,6 +78,46 @@ TEST_F(VideoRecorderTest, WritesFramesThatVideoCaptureReadsBack) {
     ++read;
   }
   EXPECT_EQ(read, n);
+}
+
+// OpenCV's writer reports no write error: a disk that filled left a cut AVI
+// and exit 0. close() reads the index back and says so.
+TEST_F(VideoRecorderTest, AVideoTheDiskCutShortIsAnErrorAtClose) {
+  const cv::Size size{160, 120};
+  const std::string whole = path("whole.avi");
+  {
+    VideoRecorder rec(whole, 25.0, size);
+    for (int i = 0; i < 10; ++i) rec.write(test_frame(size, i));
+    rec.close();
+  }
+  EXPECT_EQ(avi_frame_count(whole), 10);
+  const std::string cut = path("cut.avi");
+  fs::copy_file(whole, cut);
+  fs::resize_file(cut, fs::file_size(whole) / 2);
+  EXPECT_NE(avi_frame_count(cut), 10);
+  EXPECT_EQ(avi_frame_count(path("none.avi")), -1);
+
+  // A file that may not grow past 64 kB (RLIMIT_FSIZE, as a full disk): in a child process.
+  const std::string full = path("full.avi");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);  // a write past the limit fails with EFBIG instead
+    const rlimit limit{65536, 65536};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      VideoRecorder rec(full, 25.0, size);
+      for (int i = 0; i < 200; ++i) rec.write(test_frame(size, i % 20));
+      rec.close();
+    } catch (const std::runtime_error& e) {
+      _exit(std::string(e.what()).rfind(full + ": the video was not written whole: ", 0) == 0 ? 3 : 4);
+    }
+    _exit(0);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 3) << "0: close() took the cut file for whole; 4: another message";
 }
 
 TEST_F(VideoRecorderTest, RecordsRenderedBoardFrames) {

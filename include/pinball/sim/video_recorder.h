@@ -13,6 +13,10 @@ namespace pinball::sim {
 /// MJPEG writer opens nothing else.
 void check_avi_name(const std::string& path);
 
+/// Frames an AVI's index says it holds, as OpenCV's MJPEG reader opens it;
+/// -1 when it cannot be opened as a video.
+int avi_frame_count(const std::string& path);
+
 /// An open AVI file receiving frames of one fixed size.
 class VideoRecorder {
  public:
@@ -29,7 +33,10 @@ class VideoRecorder {
   /// Frames written so far.
   int frames_written() const { return frames_; }
 
-  /// Finishes the file (also done by the destructor).
+  /// Finishes the file and reads its index back: throws std::runtime_error
+  /// naming the path when it does not hold every frame written (OpenCV's
+  /// writer reports no write error: a full disk left a cut file and exit 0).
+  /// The destructor finishes the file without the check.
   void close();
 
  private:
