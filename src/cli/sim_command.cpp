@@ -183,7 +183,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     flips += static_cast<std::uint64_t>(r.flips);
     cut += r.cut ? 1 : 0;
     left_table += r.left_table ? 1 : 0;
-    run_hash = sim::hash_combine_state(run_hash, state);
+    run_hash = sim::hash_combine_ball_end(sim::hash_combine_state(run_hash, state), r);
     progress.update(ball + 1, "mean score " + format_number(score.mean(), 4));
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

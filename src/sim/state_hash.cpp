@@ -40,4 +40,14 @@ std::uint64_t hash_combine_state(std::uint64_t seed, const GameState& s) {
 
 std::uint64_t hash_state(const GameState& state) { return hash_combine_state(kFnvOffset, state); }
 
+std::uint64_t hash_combine_ball_end(std::uint64_t seed, const BallResult& ball) {
+  std::uint64_t h = seed;
+  mix(h, ball.end_position_m.x());
+  mix(h, ball.end_position_m.y());
+  mix(h, ball.end_velocity_mps.x());
+  mix(h, ball.end_velocity_mps.y());
+  mix(h, ball.cut);
+  return h;
+}
+
 }  // namespace pinball::sim

@@ -75,7 +75,10 @@ TEST(PlayBall, BouncyFloorWithoutDrainIsCut) {
   GameState s = make_game_state(b, 5);
   BallLimits limits;
   limits.max_ball_time_s = 3.0;
-  const BallResult r = play_ball(*world, s, limits, none_policy, no_observer);
+  GameState last;  // the state the last step left, before the cut
+  const BallResult r = play_ball(*world, s, limits, none_policy, [&](const GameState& st, const StepEvents&) {
+    last = st;
+  });
   EXPECT_TRUE(r.cut);
   EXPECT_FALSE(r.left_table);
   EXPECT_NEAR(r.duration_s, 3.0, world->dt_s() + 1e-9);
@@ -83,6 +86,10 @@ TEST(PlayBall, BouncyFloorWithoutDrainIsCut) {
   EXPECT_FALSE(s.ball_in_play);
   EXPECT_EQ(s.balls_left, b.balls_per_game - 1);
   EXPECT_EQ(s.ball.position_m, b.launcher.position);
+  // Where the ball was when it was cut, not where the cut put it.
+  EXPECT_EQ(r.end_position_m, last.ball.position_m);
+  EXPECT_EQ(r.end_velocity_mps, last.ball.velocity_mps);
+  EXPECT_NE(r.end_position_m, b.launcher.position);
 }
 
 TEST(PlayBall, WeakLaunchRollsBackAndIsRelaunched) {

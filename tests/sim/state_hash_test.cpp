@@ -39,5 +39,25 @@ TEST(StateHash, CombiningIsOrderSensitive) {
   EXPECT_NE(hash_combine_state(hash_state(a), c), hash_combine_state(hash_state(c), a));
 }
 
+// A cut puts the ball back in the launcher: two runs cut at the same moment
+// with the same score left the same state, and `sim` printed one hash for
+// every seed. The ball's end tells them apart.
+TEST(StateHash, TheBallsEndTellsApartBallsCutAtTheSameMoment) {
+  BallResult a;
+  a.cut = true;
+  a.end_position_m = {0.3, 0.5};
+  a.end_velocity_mps = {1.0, -0.5};
+  BallResult b = a;
+  EXPECT_EQ(hash_combine_ball_end(1, a), hash_combine_ball_end(1, b));
+  b.end_position_m.y() = std::nextafter(0.5, 1.0);
+  EXPECT_NE(hash_combine_ball_end(1, a), hash_combine_ball_end(1, b));
+  b = a;
+  b.end_velocity_mps.x() += 1e-12;
+  EXPECT_NE(hash_combine_ball_end(1, a), hash_combine_ball_end(1, b));
+  b = a;
+  b.cut = false;
+  EXPECT_NE(hash_combine_ball_end(1, a), hash_combine_ball_end(1, b));
+}
+
 }  // namespace
 }  // namespace pinball::sim

@@ -26,6 +26,8 @@ struct BallResult {
   int flips = 0;             ///< flipper activations (button presses)
   bool cut = false;          ///< stopped at max_ball_time_s, not lost
   bool left_table = false;   ///< lost by leaving the table's bounds rather than by a drain
+  Vec2 end_position_m = Vec2::Zero();    ///< the ball when it was lost or cut (before a cut puts it back)
+  Vec2 end_velocity_mps = Vec2::Zero();  ///< the same, its velocity
 };
 
 /// Starts the next ball: a new game if the last one is over, then the world's
@@ -59,11 +61,15 @@ BallResult play_ball(World& world, GameState& state, const BallLimits& limits, P
     observer(static_cast<const GameState&>(state), events);
     if (events.has(StepEvents::kBallLost)) {
       result.left_table = events.has(StepEvents::kLeftTable);
+      result.end_position_m = state.ball.position_m;
+      result.end_velocity_mps = state.ball.velocity_mps;
       break;
     }
     // Half a step of slack: time is a sum of steps and may fall just short.
     if (state.time_s - t0 >= limits.max_ball_time_s - 0.5 * world.dt_s()) {
       result.cut = true;
+      result.end_position_m = state.ball.position_m;
+      result.end_velocity_mps = state.ball.velocity_mps;
       cut_ball(board, state);
       break;
     }
