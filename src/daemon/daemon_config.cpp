@@ -258,7 +258,7 @@ void resolve_paths(DaemonConfig& c, const YAML::Node& root, const std::string& s
     if (!file_gives(root, f.key)) continue;  // a default: looked up as pinballd always did (find_data_file)
     resolve_one(source, f.key, f.value, f.use, base_dir);
   }
-  // lcm_url: file://PATH?mode=w writes a log there; file://PATH (mode=r) plays one.
+  // lcm_url: file://PATH?mode=w writes a log there; file://PATH (mode=r, refused by the checks) would read one.
   const LcmFilePart lcm = lcm_file_part(c.lcm_url);
   if (file_gives(root, "lcm_url") && !lcm.path.empty()) {
     std::string path = lcm.path;
@@ -367,6 +367,12 @@ void validate_daemon_config(const DaemonConfig& c, const std::string& s) {
   static const std::set<std::string> kLcmProviders = {"udpm", "mpudpm", "file", "memq", "tcpq"};
   require(scheme_end != std::string::npos && kLcmProviders.count(c.lcm_url.substr(0, scheme_end)) == 1, s, "lcm_url",
           "'" + c.lcm_url + "' names no LCM provider: it starts with udpm://, mpudpm://, file://, memq:// or tcpq://");
+  // A file:// URL without mode=w or mode=a reads a log, where liblcm refuses every publish; and
+  // pinballd publishes every frame's projection and command: it would run blind to LCM and exit 3.
+  require(c.lcm_url.rfind("file://", 0) != 0 || bus::lcm_log_target(c.lcm_url).has_value(), s, "lcm_url",
+          "'" + c.lcm_url + "' reads a log (no ?mode=w), and liblcm refuses every message pinballd publishes there: "
+          "record with '" + c.lcm_url + "?mode=w'; replay a recorded game with `pinball replay LOG`, or play it "
+          "onto the bus with `lcm-logplayer LOG` and a udpm:// lcm_url");
   check_sim(c.sim, s);
   check_threads(c.threads, s);
   check_mode(c, s);

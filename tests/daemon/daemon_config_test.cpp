@@ -434,6 +434,19 @@ TEST(DaemonConfig, WrittenFilesAndTheLcmProviderAreCheckedWhereverTheyCameFrom) 
     bad_url.lcm_url = url;
     EXPECT_NO_THROW(validate_daemon_config(bad_url, "config")) << url;
   }
+  // A log read, not written: every publish refused, and exit 3 after the run.
+  bad_url.lcm_url = "file:///tmp/x.lcmlog";
+  try {
+    validate_daemon_config(bad_url, "config");
+    ADD_FAILURE() << "a file:// URL that reads was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("config: lcm_url: 'file:///tmp/x.lcmlog' reads a log (no ?mode=w), and "
+                                          "liblcm refuses every message pinballd publishes there: record with "
+                                          "'file:///tmp/x.lcmlog?mode=w'; replay",
+                                          0),
+              0u)
+        << e.what();
+  }
 }
 
 // `identified:` names the overlay laid over the belief (docs/identification.md):
