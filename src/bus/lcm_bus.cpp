@@ -74,6 +74,13 @@ void require_lcm_connected(lcm_t* lcm, const std::string& url) {
   }
 }
 
+void check_lcm_url_connects(const std::string& url) {
+  if (url.rfind("file://", 0) == 0 || url.rfind("memq://", 0) == 0) return;
+  lcm::LCM probe(url);
+  if (!probe.good()) throw std::runtime_error("lcm: cannot open '" + url + "'");
+  require_lcm_connected(probe.getUnderlyingLCM(), url);
+}
+
 LcmBus::LcmBus(const std::string& url)
     : lcm_(std::make_unique<lcm::LCM>(lcm_log_target(url) ? std::string("memq://") : url)),
       url_(url),

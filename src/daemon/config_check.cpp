@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "pinball/bus/lcm_bus.h"
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/daemon/can_link_check.h"
 #include "pinball/daemon/daemon.h"
@@ -138,6 +139,11 @@ ConfigCheck check_daemon_config(DaemonConfig config) {
                                           : config.can.interface + " at " + std::to_string(config.can.bitrate_bps) +
                                                 " bit/s";
   out.lcm_url = config.lcm_url;
+  try {
+    bus::check_lcm_url_connects(config.lcm_url);  // found only at the start before
+  } catch (const std::runtime_error& e) {
+    throw ConfigError(config.origin + ": lcm_url: " + e.what());
+  }
   if (!sim) check_lab_hardware(config, out);
   return out;
 }

@@ -103,6 +103,20 @@ TEST(ConfigCheck, ARecordedCameraThatIsNoVideoFailsTheCheck) {
       << what;
 }
 
+// An LCM provider with no connection (a tcpq:// server that is not listening)
+// failed only the start; the check opens it too (a file:// log it leaves alone).
+TEST(ConfigCheck, AnLcmServerThatIsNotListeningFailsTheCheck) {
+  DaemonConfig c;
+  c.lcm_url = "tcpq://127.0.0.1:1";  // port 1: nobody listens there
+  EXPECT_EQ(check_error(c), "the command line: lcm_url: lcm: cannot open 'tcpq://127.0.0.1:1': the provider has no "
+                            "connection (tcpq://: is the server listening? udpm://: is the port a real one, and "
+                            "multicast routed?)");
+  const std::string log = ::testing::TempDir() + "/config_check_lcm_" + std::to_string(::getpid()) + ".lcmlog";
+  c.lcm_url = "file://" + log + "?mode=w";
+  EXPECT_EQ(check_error(c), "");
+  EXPECT_FALSE(fs::exists(log)) << "the check wrote the log";
+}
+
 // A recording of another frame size than the configuration's: the check says
 // so, as the start does (it was found only at the start).
 TEST(ConfigCheck, ARecordedCameraOfAnotherFrameSizeFailsTheCheck) {

@@ -70,6 +70,11 @@ int handle_lcm_timeout(lcm_t* lcm, int timeout_ms);
 /// Throws "lcm: cannot open 'url': ..." when `lcm` has no descriptor to
 /// receive on, so a provider that failed to connect is refused at start.
 void require_lcm_connected(lcm_t* lcm, const std::string& url);
+/// Opens `url` as the start would and closes it again, throwing as LcmBus
+/// does when it cannot connect (a tcpq:// server that is not listening). A
+/// file:// URL is not opened (that would create or replace the log); memq://
+/// has nothing to connect to.
+void check_lcm_url_connects(const std::string& url);
 
 /// A handler of raw messages: the encoded bytes of one message.
 using RawHandler = std::function<void(const void* data, int size)>;
