@@ -419,10 +419,12 @@ TEST_F(Cli, AnInterruptedLearnSaysWhatItsCheckpointKeepsAndResumes) {
   const std::string learn = "learn boards/mit1993.board --method cem --budget-balls 1200 --population 8 --seed 3 "
                             "--threads 1 --eval-balls 8 --out " + out + " --checkpoint " + ckpt;
   // Once a batch or two are in the file (about 1.7 kB each), SIGTERM.
-  const CommandResult stopped = run_shell(
-      "cd " PINBALL_SOURCE_DIR " && { " PINBALL_EXE " " + learn + " 2> " + err + " & pid=$!; i=0; while [ $(stat -c %s " +
-      ckpt + " 2>/dev/null || echo 0) -lt 3000 ] && [ $i -lt 1200 ]; do sleep 0.05; i=$((i+1)); done; kill -TERM "
-      "$pid; wait $pid; echo $?; }");
+  const std::string wait_for_batches = "i=0; while [ $(stat -c %s " + ckpt +
+                                       " 2>/dev/null || echo 0) -lt 3000 ] && [ $i -lt 1200 ]; do sleep 0.05; "
+                                       "i=$((i+1)); done";
+  const CommandResult stopped =
+      run_shell("cd " PINBALL_SOURCE_DIR " && { " PINBALL_EXE " " + learn + " 2> " + err + " & pid=$!; " +
+                wait_for_batches + "; kill -TERM $pid; wait $pid; echo $?; }");
   EXPECT_EQ(stopped.out, std::to_string(128 + SIGTERM) + "\n") << "died of the signal, as before";
   EXPECT_NE(slurp(err).find("learn: interrupted; " + ckpt + " keeps every batch of balls finished so far"),
             std::string::npos)

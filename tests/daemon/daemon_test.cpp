@@ -912,8 +912,8 @@ TEST(Pinballd, RealTimeRefusedWarnsAndPlaysOrWithEnforceExitsOne) {
     }
     // --check asks the system the same, and says it before the start does.
     std::string check;
-    const int check_status =
-        run_shell("sh -c '" + unprivileged + PINBALLD_EXE + " --check --json --config " + path + "' 2>/dev/null", check);
+    const int check_status = run_shell(
+        "sh -c '" + unprivileged + PINBALLD_EXE + " --check --json --config " + path + "' 2>/dev/null", check);
     const nlohmann::json c = nlohmann::json::parse(check);
     if (!enforce) {
       EXPECT_EQ(check_status, 0) << check;

@@ -47,7 +47,9 @@ TEST(ParallelRunner, RethrowsATaskError) {
 // A long map in batches: every item once, in order, a batch at a time, and
 // the same results as one distributed_map.
 TEST(ParallelRunner, BatchesTakeEveryItemInOrderAndMatchOneMap) {
-  auto task = [](std::size_t i) { return Blob{static_cast<std::uint8_t>(i % 251), static_cast<std::uint8_t>(i / 251)}; };
+  auto task = [](std::size_t i) {
+    return Blob{static_cast<std::uint8_t>(i % 251), static_cast<std::uint8_t>(i / 251)};
+  };
   std::vector<std::size_t> firsts, sizes;
   std::vector<Blob> all;
   distributed_batches(1050, 500, 2, task, [&](std::size_t first, std::vector<Blob>& results) {
