@@ -554,7 +554,10 @@ TEST(Pinballd, EverySignalThatWouldKillItReleasesTheCoilsFirst) {
 // never reached its shutdown.
 TEST(Pinballd, AStderrNobodyReadsHoldsNeitherTheReleaseNorTheExit) {
   const std::string base = ::testing::TempDir() + "/pinballd_stuck_stderr_" + std::to_string(getpid());
-  write_file(base + ".yaml", "version: 1\nmode: sim\ncamera:\n  fps: 3\n  stall_timeout_s: 0.9\n");
+  // The LCM log shows the game going on (every frame publishes), whatever a slow build's start costs.
+  const std::string lcm_log = base + ".lcmlog";
+  write_file(base + ".yaml", "version: 1\nmode: sim\ncamera:\n  fps: 3\n  stall_timeout_s: 0.9\nlcm_url: \"file://" +
+                                 lcm_log + "?mode=w\"\n");
   int err_pipe[2];
   ASSERT_EQ(pipe(err_pipe), 0);
   ASSERT_GT(fcntl(err_pipe[1], F_SETPIPE_SZ, 4096), 0);  // full after a few dozen faults
@@ -569,14 +572,26 @@ TEST(Pinballd, AStderrNobodyReadsHoldsNeitherTheReleaseNorTheExit) {
     _exit(127);
   }
   close(err_pipe[1]);
-  // Until stderr takes no more: bytes queued, and none added for a second while faults go on.
+  // Until the game has gone on for a second and a half (its log growing all along: a frame gap is
+  // a watchdog fault every third of a second) and stderr takes no more: bytes queued, none added
+  // for a second.
   int queued_bytes = 0;
   int unchanged_polls = 0;
-  for (int i = 0; i < 600 && unchanged_polls < 10; ++i) {  // 60 s
+  int polls_in_play = -1;  // since the log first grew
+  std::uintmax_t log_bytes = 0;
+  for (int i = 0; i < 600 && (unchanged_polls < 10 || polls_in_play < 15); ++i) {  // 60 s
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const int before = queued_bytes;
     ASSERT_EQ(ioctl(err_pipe[0], FIONREAD, &queued_bytes), 0);
     unchanged_polls = queued_bytes > 0 && queued_bytes == before ? unchanged_polls + 1 : 0;
+    std::error_code ec;
+    const std::uintmax_t now_bytes = std::filesystem::file_size(lcm_log, ec);
+    if (polls_in_play >= 0) {
+      ++polls_in_play;
+    } else if (!ec && log_bytes > 0 && now_bytes > log_bytes) {
+      polls_in_play = 0;
+    }
+    if (!ec) log_bytes = now_bytes;
   }
   ASSERT_EQ(kill(pid, SIGINT), 0);
   int status = 0;
@@ -597,7 +612,7 @@ TEST(Pinballd, AStderrNobodyReadsHoldsNeitherTheReleaseNorTheExit) {
   EXPECT_TRUE(j["coils_off_at_exit"].get<bool>());
   EXPECT_TRUE(j["stopped_by_signal"].get<bool>());
   EXPECT_GT(j["faults"]["count"].get<int>(), 0) << "the faults that filled stderr are in the report";
-  for (const char* ext : {".yaml", ".json"}) std::remove((base + ext).c_str());
+  for (const char* ext : {".yaml", ".json", ".lcmlog"}) std::remove((base + ext).c_str());
 }
 
 // Runs `cmd` through the shell; returns its exit status and what it printed.
