@@ -1,5 +1,7 @@
 #include "pinball/calibration/calibration_file.h"
 
+#include "pinball/core/format.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -60,7 +62,10 @@ void check_calibration(const Calibration& c, const YamlReadArchive& r) {
   }
   if (c.gravity) {
     const GravityEstimate& g = *c.gravity;
-    if (!(g.g_mps2 > 0.0)) r.fail("gravity.g_mps2", "must be > 0");
+    if (!(g.g_mps2 > 0.0 && g.g_mps2 <= table::kMaxGravity_mps2)) {
+      r.fail("gravity.g_mps2", "must be in (0, " + format_exact(table::kMaxGravity_mps2) +
+                                   "] m/s^2, as a board's g along the table");
+    }
     if (!(g.ci_low_mps2 <= g.g_mps2 && g.g_mps2 <= g.ci_high_mps2)) {
       r.fail("gravity.ci_low_mps2", "the interval must hold g_mps2");
     }

@@ -9,6 +9,7 @@
 
 #include "pinball/core/format.h"
 #include "pinball/core/statistics.h"
+#include "pinball/table/board.h"
 
 namespace pinball::calibration {
 namespace {
@@ -76,6 +77,9 @@ double student_t_quantile(double confidence, int dof) {
          (3 * z7 + 19 * z5 + 17 * z3 - 15 * z) / (384 * n * n * n);
 }
 
+// What noise may add to a roll's starting speed (m/s) before it counts as no start from rest.
+constexpr double kStartSpeedSlack_mps = 0.05;
+
 RollFit fit_roll(const GravityRoll& roll, const GravityOptions& o) {
   RollFit f;
   f.source = roll.source;
@@ -134,6 +138,25 @@ RollFit fit_roll(const GravityRoll& roll, const GravityOptions& o) {
   if (!(f.accel_mps2 > 0.0)) {
     f.usable = false;
     f.why = "the ball did not speed up down the table";
+    return f;
+  }
+  if (f.accel_mps2 > table::kMaxGravity_mps2) {
+    f.usable = false;
+    f.why = "the ball sped up at " + format_number(f.accel_mps2) + " m/s^2 down the table, more than g itself (" +
+            format_number(table::kMaxGravity_mps2) + " at most): not a ball rolling on this table";
+    return f;
+  }
+  // Let go from rest, the ball has only the speed its short way gave it; a launch or a
+  // shot (a whole game's trace) has far more, and its parabola is no roll's.
+  const double t_first = obs[first].t_s - y.t0;
+  const double start_speed_mps = std::hypot(x.c(1) + 2.0 * x.c(2) * t_first, y.c(1) + 2.0 * y.c(2) * t_first);
+  const double moved_m = (obs[first].p_board - rest).norm();
+  const double from_rest_mps = std::sqrt(2.0 * f.accel_mps2 * moved_m);
+  if (start_speed_mps > 3.0 * from_rest_mps + kStartSpeedSlack_mps) {
+    f.usable = false;
+    f.why = "the ball moved at " + format_number(start_speed_mps) + " m/s once it had gone " +
+            format_number(moved_m * 1e3) + " mm (from rest: about " + format_number(from_rest_mps) +
+            " m/s): a roll starts from rest, let go, not launched";
   }
   return f;
 }
@@ -154,8 +177,10 @@ GravityCalibration calibrate_gravity(std::span<const GravityRoll> rolls, const G
   }
   if (a.empty()) {
     std::string why = "gravity calibration: no usable roll of " + std::to_string(rolls.size());
-    if (!out.rolls.empty()) why += " (" + out.rolls.front().source + ": " + out.rolls.front().why + ")";
-    throw std::runtime_error(why);
+    for (std::size_t i = 0; i < out.rolls.size(); ++i) {
+      why += (i == 0 ? " (" : "; ") + out.rolls[i].source + ": " + out.rolls[i].why;
+    }
+    throw std::runtime_error(why + (out.rolls.empty() ? "" : ")"));
   }
   // Outliers by median/MAD, from 3 rolls on; the robust σ never falls below
   // what the rolls' own fits allow (identical rolls must not reject each other).

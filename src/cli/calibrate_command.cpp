@@ -248,6 +248,7 @@ void run_flippers(Context& c) {
   const bool markers = c.lab || (!c.a.down.empty() && !c.a.up.empty());
   const bool sweeps = c.lab || !c.a.sweeps.empty();
   if (!markers && !sweeps) throw std::runtime_error("calibrate flippers: give --down and --up, or --sweep (or --sim)");
+  check_distinct_inputs(c.a.sweeps, "calibrate flippers: --sweep", "one video sweeps one flipper");
   if (!c.lab && !c.a.sweeps.empty() && c.a.sweeps.size() != c.board.flippers.size()) {
     throw std::runtime_error("calibrate flippers: " + std::to_string(c.a.sweeps.size()) + " sweep videos for " +
                              std::to_string(c.board.flippers.size()) + " flippers");
@@ -346,6 +347,7 @@ void run_gravity(Context& c) {
     rolls = c.lab->rolls(c.a.sim_rolls);
   } else {
     if (c.a.rolls.empty()) throw std::runtime_error("calibrate gravity: give --roll FILE.csv (or --sim BOARD)");
+    check_distinct_inputs(c.a.rolls, "calibrate gravity: --roll", "one roll would count twice");
     for (const std::string& path : c.a.rolls) {
       calibration::GravityRoll r;
       r.source = path;
@@ -809,7 +811,9 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
         << size_text(size.width, size.height) << " lens\n";
   } else {
     if (a.images.empty()) throw std::runtime_error("calibrate intrinsics: give --images FILES or DIR (or --sim BOARD)");
-    for (const std::string& path : image_paths(a.images)) images.push_back({path, plot::read_gray_image(path)});
+    const std::vector<std::string> paths = image_paths(a.images);
+    check_distinct_inputs(paths, "calibrate intrinsics: image", "one view would count twice");
+    for (const std::string& path : paths) images.push_back({path, plot::read_gray_image(path)});
     if (!a.out.empty()) check_camera_size(cal, a.out, images.front().gray.size());
   }
   err << "calibrate intrinsics: " << images.size() << " images of the " << target.describe() << "\n";

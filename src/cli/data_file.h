@@ -72,6 +72,20 @@ inline void check_distinct_outputs(const std::vector<std::pair<const char*, std:
   }
 }
 
+/// One file given twice to an option that takes many (the same path, a link
+/// or a hard link) would count its data twice and narrow every interval:
+/// refused, "OPTION PATH is given twice: WHY".
+inline void check_distinct_inputs(const std::vector<std::string>& paths, const char* option, const char* why) {
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    for (std::size_t k = i + 1; k < paths.size(); ++k) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(paths[i], paths[k], ec) && !ec) {
+        throw std::runtime_error(std::string(option) + " " + paths[k] + " is given twice: " + why);
+      }
+    }
+  }
+}
+
 /// check_output_folder, and the writer's own check of the file's name
 /// (its extension), its error prefixed with the option.
 inline void check_named_output(const std::string& path, const char* option, void (*check_name)(const std::string&)) {

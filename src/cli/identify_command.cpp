@@ -41,13 +41,9 @@ void check_distinct_files(const IdentifyArgs& a) {
     std::error_code ec;
     return std::filesystem::equivalent(x, y, ec) && !ec;
   };
+  check_distinct_inputs(a.logs, "identify: log", "its events would count twice");
+  check_distinct_inputs(a.held_out, "identify: --held-out", "its moments would count twice");
   for (std::size_t i = 0; i < a.logs.size(); ++i) {
-    for (std::size_t k = i + 1; k < a.logs.size(); ++k) {
-      if (same(a.logs[i], a.logs[k])) {
-        throw std::runtime_error("identify: " + a.logs[k] +
-                                 " is given twice among the logs: its events would count twice");
-      }
-    }
     for (const std::string& held : a.held_out) {
       if (same(a.logs[i], held)) {
         throw std::runtime_error("identify: --held-out " + held + " is also a fitted log: a held-out log must be one "

@@ -98,6 +98,14 @@ TEST_F(Calibrate, BadInputsExitWithOne) {
                 " --calibration " + bad)
                 .exit_code,
             1);
+  // One roll given twice counted twice and narrowed the interval to nothing.
+  const std::string roll = (dir_ / "roll.csv").string();
+  std::ofstream(roll) << "t,x,y\n0,0.2,0.9\n";
+  const Result twice = run("calibrate gravity --board boards/mit1993.board --roll " + roll + " --roll " + roll);
+  EXPECT_EQ(twice.exit_code, 1);
+  EXPECT_NE(twice.err.find("calibrate gravity: --roll " + roll + " is given twice: one roll would count twice"),
+            std::string::npos)
+      << twice.err;
 }
 
 // What is written at the end is checked before any work: in the lab,

@@ -111,6 +111,14 @@ TEST(CalibrationFile, ErrorsNameFileAndKey) {
   std::string bad = good;
   bad.replace(bad.find("length_m: 0.078"), 15, "length_m: long");
   expect_error(bad, "lab.yaml:flippers[0].length_m: expected a number (double), got 'long'");
+  // A g no table has (a wild gravity roll once wrote 1e6): refused as the board format refuses it.
+  std::string steep = good;
+  steep.replace(steep.find("g_mps2: 1.1083"), 14, "g_mps2: 1000000");
+  const std::size_t low = steep.find("ci_low_mps2: ");
+  steep.replace(low, steep.find('\n', low) - low, "ci_low_mps2: 999999");
+  const std::size_t high = steep.find("ci_high_mps2: ");
+  steep.replace(high, steep.find('\n', high) - high, "ci_high_mps2: 1000001");
+  expect_error(steep, "lab.yaml:gravity.g_mps2: must be in (0, 10] m/s^2, as a board's g along the table");
   expect_error("version: 2\ndate: x\nboard: b\n", "lab.yaml:version: 2 is not the supported version");
   expect_error("version: [1\n", "lab.yaml:");
   expect_error("just text", "lab.yaml:version");

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -65,6 +67,37 @@ TEST(GravityCalibration, UnusableRollsAreReportedNotFatal) {
   const GravityCalibration c = calibrate_gravity(mixed);
   EXPECT_EQ(c.estimate.rolls_used, 2);
   EXPECT_EQ(c.estimate.rolls_rejected, 1);
+}
+
+// What no roll down this table gives: more than g itself, or a ball that was
+// launched, not let go (a whole game's trace fitted its launch). Every roll's
+// reason is in the error.
+TEST(GravityCalibration, ImpossibleAccelerationsAndLaunchesAreNoRolls) {
+  const RollFit steep = fit_roll(roll(1e6, 0.0, 4));
+  EXPECT_FALSE(steep.usable);
+  EXPECT_EQ(steep.why, "the ball sped up at 1000000 m/s^2 down the table, more than g itself (10 at most): not a ball "
+                       "rolling on this table");
+  GravityRoll launched;  // shot up the table at 3 m/s, falling back at 1.11
+  launched.source = "launched";
+  for (int k = 0; k < 200; ++k) {
+    const double t = k / 200.0;
+    launched.observations.push_back({t, Vec2{0.2, 0.1 + 3.0 * t - 0.5 * 1.11 * t * t}, 1.0});
+  }
+  const RollFit shot = fit_roll(launched);
+  EXPECT_FALSE(shot.usable);
+  EXPECT_NE(shot.why.find("a roll starts from rest, let go, not launched"), std::string::npos) << shot.why;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    EXPECT_TRUE(fit_roll(roll(1.11, 0.001, seed)).usable) << "a noisy roll from rest is still one";
+  }
+  const std::vector<GravityRoll> bad{roll(1e6, 0.0, 4), launched};
+  try {
+    calibrate_gravity(bad);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no usable roll of 2 (roll 4: the ball sped up"), std::string::npos) << what;
+    EXPECT_NE(what.find("; launched: the ball moved at "), std::string::npos) << what;
+  }
 }
 
 TEST(GravityCalibration, StudentT) {

@@ -147,7 +147,14 @@ TEST_F(IdentifyCommand, RefusesRepeatedInputsAndAnOutThatIsNoNewFile) {
   const std::string bytes = pinball::testing::slurp(log);
   const pinball::testing::CommandResult twice = run("identify " + log + " " + log);
   EXPECT_EQ(twice.exit_code, 1);
-  EXPECT_NE(twice.err.find("is given twice among the logs"), std::string::npos) << twice.err;
+  EXPECT_NE(twice.err.find("identify: log " + log + " is given twice: its events would count twice"),
+            std::string::npos)
+      << twice.err;
+  const std::string other = record("two.lcm", 2, 6);
+  const pinball::testing::CommandResult held_twice = run("identify " + other + " --held-out " + log + " " + log);
+  EXPECT_EQ(held_twice.exit_code, 1);
+  EXPECT_NE(held_twice.err.find("identify: --held-out " + log + " is given twice"), std::string::npos)
+      << held_twice.err;
   const pinball::testing::CommandResult held = run("identify " + log + " --held-out " + log);
   EXPECT_EQ(held.exit_code, 1);
   EXPECT_NE(held.err.find("is also a fitted log"), std::string::npos) << held.err;
