@@ -333,6 +333,9 @@ int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
   const table::Board board = table::load_board(find_data_file(a.board));  // the default too, from any folder
   const std::vector<bus::RecordedPlay> plays = read_all(a.logs);
   const std::vector<bus::RecordedPlay> held = read_all(a.held_out);
+  for (const std::vector<bus::RecordedPlay>* logs : {&plays, &held}) {
+    for (const bus::RecordedPlay& play : *logs) learn::check_recording_fits_board(play, board);
+  }
   learn::IdentifyOptions options;
   options.flights.sigma_m = a.sigma_m;
   options.bootstrap = a.bootstrap;

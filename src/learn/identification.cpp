@@ -437,6 +437,51 @@ std::vector<table::ObstacleGroupOverlay> material_groups(const table::Board& boa
   return groups;
 }
 
+void check_recording_fits_board(const bus::RecordedPlay& play, const table::Board& board) {
+  constexpr double kMargin_m = 0.05;
+  constexpr double kMostOff = 0.05;
+  std::size_t found = 0;
+  std::size_t off = 0;
+  for (const bus::RecordedFrame& f : play.frames) {
+    if (!f.found) continue;
+    ++found;
+    const Vec2& p = f.p_board;
+    const bool on = p.x() >= -kMargin_m && p.x() <= board.width_m + kMargin_m && p.y() >= -kMargin_m &&
+                    p.y() <= board.height_m + kMargin_m;
+    off += on ? 0 : 1;
+  }
+  if (found > 0 && static_cast<double>(off) > kMostOff * static_cast<double>(found)) {
+    throw std::runtime_error(play.source + ": " + std::to_string(off) + " of its " + std::to_string(found) +
+                             " sightings lie more than " + format_number(kMargin_m * 1e2) + " cm off the " +
+                             format_number(board.width_m) + " x " + format_number(board.height_m) + " m board " +
+                             board.source + ": a log of another table, or a camera calibration in other units?");
+  }
+  const int flippers = static_cast<int>(board.flippers.size());
+  for (const bus::RecordedCommand& c : play.commands) {
+    if (c.flipper >= flippers) {
+      throw std::runtime_error(play.source + ": its commands fire flipper " + std::to_string(c.flipper) + ", and " +
+                               board.source + " has " + std::to_string(flippers) +
+                               " flippers: a log of another table?");
+    }
+  }
+  // A game's log (10 s and more) with not one command among its frames: another clock. A log
+  // of a few frames may just hold no command.
+  constexpr double kGameLog_s = 10.0;
+  if (play.commands.empty() || play.duration_s() < kGameLog_s) return;
+  const double first_s = play.frames.front().t_s;
+  const double last_s = play.frames.back().t_s;
+  const bool any_within = std::any_of(play.commands.begin(), play.commands.end(), [&](const bus::RecordedCommand& c) {
+    return c.t_s >= first_s && c.t_s <= last_s;
+  });
+  if (!any_within) {
+    throw std::runtime_error(play.source + ": none of its " + std::to_string(play.commands.size()) +
+                             " commands lies within its frames' time (" + format_number(first_s) + " to " +
+                             format_number(last_s) + " s; the commands " + format_number(play.commands.front().t_s) +
+                             " to " + format_number(play.commands.back().t_s) +
+                             " s): the two were recorded on different clocks, and no shot can be matched");
+  }
+}
+
 IdentificationResult identify_table(const table::Board& board, std::span<const bus::RecordedPlay> recordings,
                                     const IdentifyOptions& options,
                                     const std::function<void(const std::string&, int, int)>& progress) {

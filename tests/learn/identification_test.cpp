@@ -362,5 +362,39 @@ TEST(Identification, RefusesRecordingsWithoutFreeFlights) {
   EXPECT_THROW(identify_table(pinball::testing::thesis_board(), plays), std::runtime_error);
 }
 
+// A log that cannot be of the board was fitted all the same (sightings 1 km
+// off gave g and a wall thickness, exit 0): refused, naming the log.
+TEST(RecordingFitsBoard, SightingsOffTheBoardForeignFlippersAndAnotherClockAreRefused) {
+  const table::Board& board = pinball::testing::thesis_board();
+  bus::RecordedPlay play;
+  play.source = "game.lcm";
+  for (int k = 0; k < 100; ++k) play.frames.push_back({k * 0.2, k, true, Vec2{0.2, 0.5}, false, false});  // 20 s
+  play.commands.push_back({0.1, 0, true, 0});
+  EXPECT_NO_THROW(check_recording_fits_board(play, board));
+  const auto error_of = [&](const bus::RecordedPlay& p) -> std::string {
+    try {
+      check_recording_fits_board(p, board);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  bus::RecordedPlay far = play;
+  for (int k = 0; k < 6; ++k) far.frames[static_cast<std::size_t>(k)].p_board.x() = 1000.0;
+  EXPECT_EQ(error_of(far).rfind("game.lcm: 6 of its 100 sightings lie more than 5 cm off the 0.51 x 1.07 m board", 0),
+            0u)
+      << error_of(far);
+  far.frames[5].p_board.x() = 0.2;  // 5 %: a few stray detections are no other table
+  EXPECT_EQ(error_of(far), "");
+  bus::RecordedPlay foreign = play;
+  foreign.commands.push_back({0.2, 2, true, 0});
+  EXPECT_NE(error_of(foreign).find("game.lcm: its commands fire flipper 2, and "), std::string::npos);
+  bus::RecordedPlay late = play;
+  late.commands[0].t_s = 3600.0;
+  EXPECT_NE(error_of(late).find("the two were recorded on different clocks"), std::string::npos) << error_of(late);
+  late.frames.resize(20);  // 4 s: a short log may hold no command of its own
+  EXPECT_EQ(error_of(late), "");
+}
+
 }  // namespace
 }  // namespace pinball::learn

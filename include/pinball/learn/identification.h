@@ -176,6 +176,14 @@ std::vector<table::ObstacleGroupOverlay> material_groups(const table::Board& boa
 /// Each board obstacle's index into `groups` (-1: in none, e.g. a ball eater).
 std::vector<int> material_group_of(const table::Board& board, const std::vector<table::ObstacleGroupOverlay>& groups);
 
+/// Throws std::runtime_error naming the log when `play` cannot be of the
+/// table `board` describes: more than 5 % of its sightings off the board by
+/// more than 5 cm (another board, or a calibration in other units), commands
+/// for a flipper the board lacks, or, in a log of 10 s or more, commands that
+/// all lie outside the span of its frames (recorded on another clock). Said
+/// instead of fitting nonsense.
+void check_recording_fits_board(const bus::RecordedPlay& play, const table::Board& board);
+
 /// Identifies what `recordings` show of the table `board` describes (the
 /// belief: its geometry must be the recorded table's). `progress(stage,
 /// done, total)` reports long stages. Throws std::runtime_error when the
