@@ -89,6 +89,11 @@ ShotTable shot_table_from_json(const json& j, JsonReadArchive& r) {
   for (const char* key : {"neighbours", "angle_scale_rad", "h_scale", "speed_scale_mps"}) {
     need(r, j, "imitation", key);
   }
+  // The rows' order is this build's (kShotFields); a file that names another was read as if it
+  // named this one. It is for a reader: when given, it must be this order.
+  if (j.is_object() && j.contains("shot_fields") && j["shot_fields"] != json(kShotFields)) {
+    r.fail("imitation.shot_fields", "must be " + json(kShotFields).dump() + ", the order of each shot's numbers");
+  }
   ImitationConfig c;
   json settings = j;  // the table's settings; its shots are rows, read below
   settings.erase("shots");
@@ -166,6 +171,10 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
     }
     mc.flipper = f.get<std::string>() == "left" ? track::kLeftFlipper : track::kRightFlipper;
     refuse_unknown_keys(r, m, where, {"partition", "name", "a", "flipper"});  // partition, name: for a reader
+    // The list's order places each minicontroller; a partition number that says otherwise misleads.
+    if (m.contains("partition") && m["partition"] != json(i)) {
+      r.fail(where + ".partition", "must be " + std::to_string(i) + ": its place in the list decides its partition");
+    }
     refuse(r, where, check_minicontroller(mc));
   }
   if (j.contains("imitation")) s.shot_table = std::make_shared<const ShotTable>(shot_table_from_json(j["imitation"], r));
@@ -257,7 +266,9 @@ std::string controller_to_json(const ControllerSpec& s) {
 ControllerSpec controller_from_json(const std::string& text, const std::string& src) {
   try {
     const json j = parse_json(text, src);  // refuses a repeated key too
-    JsonReadArchive r(src);  // an unknown key is refused, as in every other file
+    // An unknown key is refused, as in every other file, and so is a missing one (docs/learning.md): a
+    // dropped key must not play the default.
+    JsonReadArchive r(src, ReadOptions{.refuse_unknown_keys = true, .require_every_key = true});
     return spec_from_json(j, r);
   } catch (const KeyError& e) {
     // The archive says "file:key: message"; controller files say "file: field: message".

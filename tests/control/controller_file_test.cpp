@@ -76,10 +76,24 @@ TEST(ControllerFile, BadFilesGiveClearErrors) {
   std::string missing = good;
   missing.replace(missing.find("\"minicontrollers\""), 17, "\"minis\"");
   expect_error(missing, "minicontrollers: missing");
-  // A misspelt optional key kept its default in silence; every file refuses it now.
+  // A misspelt key kept its default in silence; every file refuses it now, by the key it lacks.
   std::string pul = good;
   pul.replace(pul.find("\"pull\""), 6, "\"pul\"");
-  expect_error(pul, "launcher.pul: unknown key");
+  expect_error(pul, "launcher.pull: missing");
+  std::string pul_too = good;
+  pul_too.replace(pul_too.find("\"pull\""), 6, "\"pul\": 1, \"pull\"");
+  expect_error(pul_too, "launcher.pul: unknown key");
+  // A dropped key, or a section that is null, played the defaults (a planner with every default).
+  nlohmann::json dropped = nlohmann::json::parse(good);
+  ASSERT_EQ(dropped.at("actuator").erase("max_hold_s"), 1u);
+  expect_error(dropped.dump(), "actuator.max_hold_s: missing");
+  std::string null_section = good;
+  null_section.replace(null_section.find("\"note\""), 6, "\"planner\": null, \"note\"");
+  expect_error(null_section, "bad.json: planner: expected a mapping, got null");
+  // minicontrollers[i].partition is for a reader; one that contradicts the order misled it.
+  nlohmann::json reordered = nlohmann::json::parse(good);
+  reordered["minicontrollers"][0]["partition"] = 5;
+  expect_error(reordered.dump(), "minicontrollers[0].partition: must be 0: its place in the list decides");
   std::string extra = good;
   extra.replace(extra.find("\"note\""), 6, "\"bogus\": 1, \"note\"");
   expect_error(extra, "bad.json: bogus: unknown key");
@@ -139,6 +153,10 @@ TEST(ControllerFile, BadShotTablesNameTheField) {
   std::string k = good;
   k.replace(k.find("\"neighbours\": 5"), 15, "\"neighbours\": 0");
   expect_error(k, "imitation.neighbours: must be in [1, 32]");
+  // The rows are read in this build's order, whatever shot_fields says: another order is refused.
+  nlohmann::json reversed = nlohmann::json::parse(good);
+  std::swap(reversed["imitation"]["shot_fields"][0], reversed["imitation"]["shot_fields"][1]);
+  expect_error(reversed.dump(), "imitation.shot_fields: must be [\"flipper\",\"rolling\",");
 }
 
 // `text` with its first `from` replaced by `to`.
