@@ -145,9 +145,14 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
 
 namespace {
 
+// Whether the command line gave `flag` ("--frames"): a value given wins over --quick's.
+bool given(const BenchArgs& a, std::string_view flag) {
+  return std::find(a.flags_given.begin(), a.flags_given.end(), flag) != a.flags_given.end();
+}
+
 int run_tracker(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   bench::TrackerBenchOptions options = a.quick ? bench::quick_tracker_bench_options() : bench::TrackerBenchOptions{};
-  if (!a.quick) options.approaches = a.approaches;
+  if (!a.quick || given(a, "--approaches")) options.approaches = a.approaches;  // given, it wins over --quick
   options.seed = a.seed;
   const bench::TrackerReport report = bench::run_tracker_bench(
       board, options, [&](const std::string& line) { err << "bench tracker: " << line << "\n"; });
@@ -344,8 +349,13 @@ int run_cradle(const BenchArgs& a, const table::Board& board, std::ostream& out,
                                   ": the cradle player sees the true ball at rest and acts on the world's step, so "
                                   "the solenoid's delay and the camera do not apply");
     }
+    const std::string name(learn::perturbation_name(p));
+    if (perturbations.contains(name)) {
+      // Applied twice, the two compounded while the report showed the last alone.
+      throw std::invalid_argument("bench cradle: --perturb " + name + " is given twice: give one value");
+    }
     table = learn::perturb(table, p, value);
-    perturbations[std::string(learn::perturbation_name(p))] = value;
+    perturbations[name] = value;
   }
   if (!a.perturb.empty() && (world_spec.kind != simlab::WorldKind::kModel || !world_spec.board_path.empty())) {
     throw std::invalid_argument("bench cradle: --perturb changes the model world's table; not with --world twin or "
@@ -439,7 +449,7 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
 
 int run_protocol(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   bench::ProtocolBenchOptions o;
-  o.frames = a.quick ? 100'000 : a.frames;
+  o.frames = a.quick && !given(a, "--frames") ? 100'000 : a.frames;  // given, it wins over --quick
   if (a.quick) o.release_cycles = 100;
   o.seed = a.seed;
   o.seeds = a.seeds;

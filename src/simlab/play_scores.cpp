@@ -106,13 +106,17 @@ void check_play_csv_appendable(const std::string& path) {
 
 void append_play_rows(const std::string& path, const std::vector<PlayRow>& rows) {
   for (const PlayRow& r : rows) check_play_row(r);
-  const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  const int fd = ::open(path.c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644);  // read: its last byte
   if (fd < 0) throw std::runtime_error(path + ": cannot open the score file: " + errno_text());
   std::string text;
   bool ok = ::flock(fd, LOCK_EX) == 0;
   struct stat st {};
   ok = ok && ::fstat(fd, &st) == 0;
   if (ok && st.st_size == 0) text = std::string(kPlayCsvHeader) + "\n";
+  // A file whose last row has no line end (an editor's save) would get the new row glued to it.
+  char last = '\n';
+  if (ok && st.st_size > 0) ok = ::pread(fd, &last, 1, st.st_size - 1) == 1;
+  if (last != '\n') text = "\n";
   for (const PlayRow& r : rows) text += csv_line(r);
   std::size_t done = 0;
   while (ok && done < text.size()) {

@@ -63,6 +63,8 @@ TEST_F(CradleCommand, RefusesWhatItCannotUse) {
         Refusal{"bench cradle --quick --perturb gravity_pct=lots", 1, "not a finite number"},
         Refusal{"bench cradle --quick --perturb camera_noise_px=2", 1, "camera do not apply"},
         Refusal{"bench cradle --quick --perturb gravity_pct=-100", 1, "g must stay > 0"},
+        Refusal{"bench cradle --quick --perturb gravity_pct=1 --perturb gravity_pct=2", 1,
+                "--perturb gravity_pct is given twice"},
         Refusal{"bench cradle --quick --world twin --perturb gravity_pct=-3", 1, "not with --world twin"},
         Refusal{"bench aim --quick --perturb gravity_pct=-3", 1, "cradle only"}}) {
     expect_refused("", refusal);

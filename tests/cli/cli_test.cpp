@@ -631,6 +631,14 @@ TEST_F(Cli, BenchRefusesAFlagTheChosenBenchWouldNotRead) {
   }
 }
 
+// --quick sets a short run's sizes; a size given on the command line wins over it (the
+// protocol bench ran 100000 frames for --frames 1000).
+TEST_F(Cli, ASizeGivenWinsOverQuick) {
+  const CommandResult r = run("bench protocol --quick --frames 1000 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("frames").get<int>(), 1000);
+}
+
 TEST_F(Cli, BenchLatencyPlaysTheControllerGivenAndRefusesTwo) {
   const CommandResult given = run("bench latency --quick --controller controllers/spastic.json --json");
   ASSERT_EQ(given.exit_code, 0) << given.err;

@@ -66,6 +66,22 @@ TEST(PlayScores, RowsRoundTripAndTheHeaderIsWrittenOnce) {
   std::remove(path.c_str());
 }
 
+// A file whose last row lacks its line end (saved by an editor) took the next row on the same
+// line, and --stats refused it for good; the append ends that row first.
+TEST(PlayScores, AnAppendAfterARowWithoutALineEndStartsANewLine) {
+  const std::string path = temp_path("play_scores", "no_newline.csv");
+  {
+    std::ofstream out(path, std::ios::trunc);
+    out << kPlayCsvHeader << "\nada,2026-12-02T13:45:21Z,b,thesis,1,100,3,0";
+  }
+  append_play_rows(path, {row("bob", 1, 250.0)});
+  const auto rows = read_play_csv(path);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].player, "ada");
+  EXPECT_EQ(rows[1].player, "bob");
+  std::remove(path.c_str());
+}
+
 // A disk that fills in the middle of a row (here a file size limit, EFBIG): the append fails
 // and takes back what it wrote, so the file stays readable for the next session and --stats.
 TEST(PlayScores, AFailedAppendLeavesNoHalfRow) {
