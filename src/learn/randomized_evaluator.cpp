@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "pinball/core/format.h"
 #include "pinball/core/rng.h"
 #include "pinball/core/text_file.h"
 #include "pinball/core/yaml_read_archive.h"
@@ -67,6 +68,20 @@ Randomization load_randomization(const std::string& path) { return parse_randomi
 std::vector<DrawnWorld> draw_worlds(const table::Board& belief, const EvaluatorConfig& config,
                                     const Randomization& randomization) {
   const WorldSettings nominal{belief, config.actuation_delay_s, config.camera};
+  // Both ends of every range, before any draw: whether a bad range is refused must not
+  // depend on which values the seed happens to draw.
+  for (const Perturbation p : kAllPerturbations) {
+    const PerturbationRange& range = randomization.range(p);
+    if (!range) continue;
+    for (const double end : *range) {
+      try {
+        (void)perturb(nominal, p, end);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(randomization.source + ": ranges." + std::string(perturbation_name(p)) +
+                                    ": its end " + format_number(end) + ": " + e.what());
+      }
+    }
+  }
   std::vector<DrawnWorld> worlds;
   Rng rng(randomization.seed);
   const auto event_worlds = static_cast<int>(std::lround(randomization.event_stepper_share * randomization.variants));

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "pinball/core/format.h"
 #include "pinball/core/read_archive.h"
 
 namespace pinball::learn {
@@ -80,6 +81,8 @@ WorldSettings perturb(const WorldSettings& nominal, Perturbation p, double value
   table::Board& b = w.board;
   switch (p) {
     case Perturbation::kPivotY_mm:
+      // A perturbation is a calibration error; 10 cm moves the bats onto another table.
+      if (!(std::abs(value) <= 100.0)) throw std::invalid_argument("perturbation: pivot_y must be in [-100, 100] mm");
       for (table::Flipper& f : b.flippers) f.pivot.y() += value * 1e-3;
       break;
     case Perturbation::kThetaMin_deg:
@@ -95,6 +98,10 @@ WorldSettings perturb(const WorldSettings& nominal, Perturbation p, double value
       for (table::Flipper& f : b.flippers) {
         f.mu *= 1.0 + value / 100.0;
         if (!(f.mu > 0.0)) throw std::invalid_argument("perturbation: flipper mu must stay > 0 (mu -100 % or less)");
+        if (!(f.mu <= table::kMaxFlipperMu)) {
+          throw std::invalid_argument("perturbation: flipper mu must stay at most " +
+                                      format_number(table::kMaxFlipperMu) + ", a board's largest");
+        }
       }
       break;
     case Perturbation::kWallRho:
@@ -106,17 +113,25 @@ WorldSettings perturb(const WorldSettings& nominal, Perturbation p, double value
     case Perturbation::kGravity_pct:
       b.gravity_mps2 *= 1.0 + value / 100.0;
       if (!(b.gravity_mps2 > 0.0)) throw std::invalid_argument("perturbation: g must stay > 0 (g -100 % or less)");
+      if (!(b.gravity_mps2 <= table::kMaxGravity_mps2)) {
+        throw std::invalid_argument("perturbation: g must stay at most " + format_number(table::kMaxGravity_mps2) +
+                                    " m/s^2 along the table, a board's largest");
+      }
       break;
     case Perturbation::kActuationDelay_ms:
       if (!(value >= 0.0 && value < 1000.0)) throw std::invalid_argument("perturbation: actuation delay must be in [0, 1000) ms");
       w.actuation_delay_s = value * 1e-3;
       break;
     case Perturbation::kCameraLatency_ms:
-      if (!(value >= 0.0)) throw std::invalid_argument("perturbation: camera latency must be >= 0 ms");
+      if (!(value >= 0.0 && value < 1000.0)) {
+        throw std::invalid_argument("perturbation: camera latency must be in [0, 1000) ms");
+      }
       w.camera.latency_s = value * 1e-3;
       break;
     case Perturbation::kCameraNoise_px:
-      if (!(value >= 0.0)) throw std::invalid_argument("perturbation: camera noise must be >= 0 px");
+      if (!(value >= 0.0 && value <= 100.0)) {
+        throw std::invalid_argument("perturbation: camera noise must be in [0, 100] px");
+      }
       w.camera.noise_px = value;
       break;
   }
