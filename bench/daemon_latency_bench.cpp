@@ -77,13 +77,12 @@ void doorbell_baseline(int samples, double& p50_us, double& p99_us) {
 nlohmann::json run_json(const DaemonLatencyRun& r) {
   nlohmann::json stages = nlohmann::json::object();
   for (int s = 0; s < daemon::kStageCount; ++s) {
-    const daemon::LatencySummary& x = r.stages[static_cast<std::size_t>(s)];
-    stages[daemon::stage_name(s)] = {
-        {"count", x.count}, {"p50_us", x.p50_us}, {"p99_us", x.p99_us}, {"max_us", x.max_us}};
+    stages[daemon::stage_name(s)] = daemon::latency_to_json(r.stages[static_cast<std::size_t>(s)]);
   }
-  const daemon::LatencySummary& e2e = r.stages[daemon::kFrameToCan];
-  return {{"frame_to_can_p50_us", e2e.p50_us}, {"frame_to_can_p99_us", e2e.p99_us},
-          {"frame_to_can_max_us", e2e.max_us}, {"frame_to_can_samples", e2e.count},
+  // No command, no latency: null, not 0 us.
+  const nlohmann::json e2e = daemon::latency_to_json(r.stages[daemon::kFrameToCan]);
+  return {{"frame_to_can_p50_us", e2e["p50_us"]}, {"frame_to_can_p99_us", e2e["p99_us"]},
+          {"frame_to_can_max_us", e2e["max_us"]}, {"frame_to_can_samples", e2e["count"]},
           {"frames", r.frames}, {"frames_dropped", r.dropped}, {"wall_s", r.wall_s}, {"sim_s", r.sim_s},
           {"cpus", r.cpus}, {"warnings", r.warnings}, {"stages", stages}};
 }

@@ -254,9 +254,13 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
       {"real-time, idle cores polling", &d.realtime_idle_poll}}};
   for (const auto& [name, run] : runs) {
     const daemon::LatencySummary& e2e = run->stages[daemon::kFrameToCan];
-    out << "pinballd " << name << " at " << d.fps << " fps, " << run->frames
-        << " frames: frame -> CAN written p50 " << e2e.p50_us << " us, p99 " << e2e.p99_us << " us, max "
-        << e2e.max_us << " us (" << e2e.count << " commands; " << run->cpus << ")\n";
+    out << "pinballd " << name << " at " << d.fps << " fps, " << run->frames << " frames: frame -> CAN written ";
+    if (e2e.count > 0) {
+      out << "p50 " << e2e.p50_us << " us, p99 " << e2e.p99_us << " us, max " << e2e.max_us << " us (" << e2e.count
+          << " commands; " << run->cpus << ")\n";
+    } else {
+      out << "not measured: the controller gave no command (" << run->cpus << ")\n";
+    }
     for (const std::string& w : run->warnings) out << "  warning: " << w << "\n";
   }
   out << "  baseline eventfd wake-up of another thread: p50 " << d.wake_p50_us << " us, p99 " << d.wake_p99_us

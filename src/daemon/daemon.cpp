@@ -703,6 +703,11 @@ std::vector<std::string> config_warnings(const DaemonConfig& config) {
   return warnings;
 }
 
+nlohmann::json latency_to_json(const LatencySummary& x) {
+  const auto us = [&x](double v) { return x.count > 0 ? nlohmann::json(v) : nlohmann::json(); };
+  return {{"count", x.count}, {"p50_us", us(x.p50_us)}, {"p99_us", us(x.p99_us)}, {"max_us", us(x.max_us)}};
+}
+
 nlohmann::json report_to_json(const DaemonReport& r) {
   nlohmann::json j;
   j["mode"] = r.mode;
@@ -729,11 +734,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["ball_scores"] = scores;
   nlohmann::json lat = nlohmann::json::object();
   for (int s = 0; s < kStageCount; ++s) {
-    const LatencySummary& x = r.latency[static_cast<std::size_t>(s)];
-    // A stage that measured nothing has no quantiles: null, not 0 us.
-    const auto us = [&x](double v) { return x.count > 0 ? nlohmann::json(v) : nlohmann::json(); };
-    lat[stage_name(s)] = {
-        {"count", x.count}, {"p50_us", us(x.p50_us)}, {"p99_us", us(x.p99_us)}, {"max_us", us(x.max_us)}};
+    lat[stage_name(s)] = latency_to_json(r.latency[static_cast<std::size_t>(s)]);
   }
   j["latency"] = lat;
   j["frames"] = r.frames;

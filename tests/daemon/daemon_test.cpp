@@ -1062,6 +1062,18 @@ TEST(Daemon, TheReportSaysARunEndedBySignalAndHasNoMeanOfNoBall) {
   EXPECT_TRUE(j["latency"][stage_name(kFrameToCan)]["p99_us"].is_null());
 }
 
+// One JSON for a latency stage, the report's and the latency bench's: a stage with no
+// sample has no quantiles (the bench printed 0 us for a controller that never fired).
+TEST(Daemon, ALatencyStageWithNoSampleHasNullQuantiles) {
+  const nlohmann::json none = latency_to_json(LatencySummary{});
+  EXPECT_EQ(none["count"], 0);
+  EXPECT_TRUE(none["p50_us"].is_null());
+  EXPECT_TRUE(none["p99_us"].is_null());
+  EXPECT_TRUE(none["max_us"].is_null());
+  const nlohmann::json some = latency_to_json(LatencySummary{3, 120.0, 300.0, 310.0});
+  EXPECT_EQ(some["p99_us"].get<double>(), 300.0);
+}
+
 TEST(Daemon, UdpmInLockstepWarnsThatALoggerWouldLoseMessages) {
   DaemonConfig c = sim_config(1, 1);
   EXPECT_EQ(lcm_pace_warning(c), "");  // memq://

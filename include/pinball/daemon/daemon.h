@@ -130,6 +130,10 @@ bool camera_noisier_than_calibrated(const DaemonReport& report);
 
 /// The report as one JSON object (the --json output).
 nlohmann::json report_to_json(const DaemonReport& report);
+
+/// One latency stage as JSON: count, p50_us, p99_us, max_us; a stage that
+/// measured nothing has no quantiles: null, not 0 us.
+nlohmann::json latency_to_json(const LatencySummary& summary);
 /// The report for people: score line and latency table.
 std::string report_to_text(const DaemonReport& report);
 
