@@ -128,7 +128,9 @@ std::vector<double> drop_durations(const CradleBenchOptions& o) {
 
 }  // namespace
 
-double CradleDropResult::return_share() const { return shots > 0 ? static_cast<double>(returns) / shots : 0.0; }
+double CradleDropResult::return_share() const {
+  return shots > 0 ? static_cast<double>(returns) / shots : std::numeric_limits<double>::quiet_NaN();
+}
 
 double CradleDropResult::return_share_needed() const {
   return returns > 0 ? std::pow(kShareAtTenMinutes, mean_period_s / kTenMinutes_s) : 1.0;
@@ -206,9 +208,10 @@ CradleReport run_cradle_bench(const sim::World& world, const CradleBenchOptions&
     r.mean_score = score.mean();
     r.score_ci95 = score.ci95_half_width();
     report.drops.push_back(r);
-    const CradleDropResult& best = report.drops[report.best];
-    if (r.return_share() > best.return_share() ||
-        (r.return_share() == best.return_share() && r.return_interval.low > best.return_interval.low)) {
+    if (r.shots == 0) continue;  // no shot, no share: never the best
+    const CradleDropResult* best = report.best ? &report.drops[*report.best] : nullptr;
+    if (best == nullptr || r.return_share() > best->return_share() ||
+        (r.return_share() == best->return_share() && r.return_interval.low > best->return_interval.low)) {
       report.best = d;
     }
   }
@@ -254,7 +257,7 @@ nlohmann::json to_json(const CradleReport& report) {
           {"still_speed_mps", o.still_speed_mps},
           {"left_height_m", o.left_height_m},
           {"drops", drops},
-          {"best_drop_s", report.drops.empty() ? 0.0 : report.drops[report.best].drop_s},
+          {"best_drop_s", report.best ? nlohmann::json(report.drops[*report.best].drop_s) : nlohmann::json()},
           {"wall_s", report.wall_s}};
 }
 
@@ -268,9 +271,13 @@ std::string to_text(const CradleReport& report) {
       << format_number(o.left_height_m * 1e3) << " mm above the pivots\n";
   for (std::size_t d = 0; d < report.drops.size(); ++d) {
     const CradleDropResult& r = report.drops[d];
-    out << (d == report.best ? "* " : "  ") << "drop " << format_number(r.drop_s * 1e3) << " ms: returns "
-        << r.returns << " of " << r.shots << " shots = " << format_number(r.return_share()) << " ("
-        << format_number(r.return_interval.low) << "-" << format_number(r.return_interval.high) << ")";
+    out << (report.best == d ? "* " : "  ") << "drop " << format_number(r.drop_s * 1e3) << " ms: ";
+    if (r.shots == 0) {
+      out << "no shot";
+    } else {
+      out << "returns " << r.returns << " of " << r.shots << " shots = " << format_number(r.return_share()) << " ("
+          << format_number(r.return_interval.low) << "-" << format_number(r.return_interval.high) << ")";
+    }
     if (r.returns > 0) {
       out << ", needed " << format_number(r.return_share_needed()) << "; period " << format_number(r.mean_period_s)
           << " s, " << format_number(r.points_per_cycle) << " points a cycle";
@@ -280,8 +287,11 @@ std::string to_text(const CradleReport& report) {
         << r.cut << " (" << r.cut_cycling << " cycling); mean ball " << format_number(r.mean_ball_time_s)
         << " s, " << format_mean_ci(r.mean_score, r.score_ci95) << " points\n";
   }
-  if (!report.drops.empty()) {
-    const CradleDropResult& b = report.drops[report.best];
+  if (!report.drops.empty() && !report.best) {
+    out << "no drop had a shot: no ball came to rest on a raised bat (a longer --max-ball-time or more --balls?)\n";
+  }
+  if (report.best) {
+    const CradleDropResult& b = report.drops[*report.best];
     out << "best drop " << format_number(b.drop_s * 1e3) << " ms: at " << format_number(b.return_share())
         << (b.returns > 0 ? " a return and " + format_number(b.mean_period_s) + " s a cycle, " : " a return, ");
     const double projected = b.projected_share_at_10_min();

@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -82,7 +83,7 @@ struct CradleDropResult {
   double mean_score = 0.0;
   double score_ci95 = 0.0;     ///< half-width of mean_score's 95 % interval (Student's t)
 
-  /// returns / shots (0 for none).
+  /// returns / shots (NaN, null in JSON, without a shot).
   double return_share() const;
   /// The return share a cycle of this period needs for 1 % of balls to live
   /// 10 minutes: 0.01^(period / 600 s) (1 without a period).
@@ -96,7 +97,9 @@ struct CradleReport {
   CradleBenchOptions options;
   std::string world;           ///< the world's name: "twin", "thesis", "event"
   std::vector<CradleDropResult> drops;
-  std::size_t best = 0;        ///< the drop with the highest return share (the lower end of its interval breaks ties)
+  /// The drop with the highest return share (the lower end of its interval breaks ties);
+  /// none when no drop had a shot.
+  std::optional<std::size_t> best;
   double wall_s = 0.0;
 };
 

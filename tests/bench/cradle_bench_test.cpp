@@ -89,7 +89,7 @@ TEST(CradleBench, TenMinutesAtOnePercentNeedsTheReturnShareToThePowerOfTheCycles
   EXPECT_NEAR(r.return_share_needed(), 0.97724, 1e-5);
   EXPECT_NEAR(r.projected_share_at_10_min(), std::pow(0.9, 200.0), 1e-15);
   const CradleDropResult none;
-  EXPECT_EQ(none.return_share(), 0.0);
+  EXPECT_TRUE(std::isnan(none.return_share())) << "no shot, no share";
   EXPECT_EQ(none.return_share_needed(), 1.0);
   EXPECT_EQ(none.projected_share_at_10_min(), 0.0);
 }
@@ -126,12 +126,33 @@ TEST(CradleBench, TheTextMarksTheBestDropAndLeavesOutThePeriodOfADropWithNoRetur
       << text;
 }
 
+// No shot measures no share: null, not 0, and no "best drop" chosen from nothing
+// (a short --max-ball-time left every drop without a shot).
+TEST(CradleBench, DropsWithNoShotHaveNoShareAndNoBest) {
+  CradleReport report;
+  report.world = "thesis";
+  CradleDropResult idle;
+  idle.drop_s = 0.230;
+  idle.balls = 3;
+  idle.mean_period_s = std::numeric_limits<double>::quiet_NaN();
+  idle.points_per_cycle = std::numeric_limits<double>::quiet_NaN();
+  report.drops = {idle, idle};
+  const nlohmann::json j = nlohmann::json::parse(to_json(report).dump());
+  EXPECT_TRUE(j.at("drops")[0].at("return_share").is_null());
+  EXPECT_TRUE(j.at("best_drop_s").is_null());
+  const std::string text = to_text(report);
+  EXPECT_NE(text.find("  drop 230 ms: no shot;"), std::string::npos) << text;
+  EXPECT_NE(text.find("no drop had a shot"), std::string::npos) << text;
+  EXPECT_EQ(text.find("best drop"), std::string::npos) << text;
+}
+
 // No return measures no cycle: its period is null, not 0 s, and the best
 // drop's line does not quote one.
 TEST(CradleBench, ADropWithNoReturnHasNoPeriod) {
   CradleReport report;
   report.world = "twin";
   report.drops = {drop_with_no_return()};
+  report.best = 0;
   const nlohmann::json j = nlohmann::json::parse(to_json(report).dump());
   EXPECT_TRUE(j.at("drops")[0].at("mean_period_s").is_null());
   EXPECT_TRUE(j.at("drops")[0].at("points_per_cycle").is_null());
