@@ -79,11 +79,14 @@ std::string value_text(const table::IdentifiedValue& v, const char* unit) {
   return format_number(v.value) + " ± " + format_number(v.stderr_, 2) + unit;
 }
 
+// A mean error in mm, or "none" for a class with no moment (NaN).
+std::string mm_text(double m) { return std::isnan(m) ? std::string("none") : format_number(m * 1000.0) + " mm"; }
+
 std::string prediction_text(const learn::PredictionError& e) {
   return format_mean_ci(e.mean_m * 1000.0, e.mean_ci95_m * 1000.0) + " mm mean, " + format_number(e.median_m * 1000.0) +
-         " mm median, " + format_number(e.p90_m * 1000.0) + " mm p90 (mean " + format_number(e.free_mean_m * 1000.0) +
-         " mm over " + std::to_string(e.free_moments) + " free flights, " + format_number(e.collision_mean_m * 1000.0) +
-         " mm where the ball hit something)";
+         " mm median, " + format_number(e.p90_m * 1000.0) + " mm p90 (mean " + mm_text(e.free_mean_m) + " over " +
+         std::to_string(e.free_moments) + " free flights, " + mm_text(e.collision_mean_m) +
+         " where the ball hit something)";
 }
 
 struct HeldOut {
@@ -280,10 +283,10 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
     const learn::PredictionError& nominal = held_out->nominal;
     const learn::PredictionError& fitted = held_out->identified;
     out << "  held out, by what moved the ball in the history (mean error, board -> identified): g alone "
-        << fitted.under_g_moments << " moments, " << format_number(nominal.under_g_mean_m * 1000.0) << " -> "
-        << format_number(fitted.under_g_mean_m * 1000.0) << " mm; something more (a skid, a wall or flipper it "
-        << "rolled along) " << fitted.pushed_moments << " moments, " << format_number(nominal.pushed_mean_m * 1000.0)
-        << " -> " << format_number(fitted.pushed_mean_m * 1000.0) << " mm\n";
+        << fitted.under_g_moments << " moments, " << mm_text(nominal.under_g_mean_m) << " -> "
+        << mm_text(fitted.under_g_mean_m) << "; something more (a skid, a wall or flipper it "
+        << "rolled along) " << fitted.pushed_moments << " moments, " << mm_text(nominal.pushed_mean_m) << " -> "
+        << mm_text(fitted.pushed_mean_m) << "\n";
     out << "  held out, where the ball hit something, by what the identified model hit first (mean error, board -> "
            "identified):\n";
     for (const learn::CollisionError& c : held_out->identified.collisions_by_model_hit) {

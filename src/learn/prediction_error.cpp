@@ -212,13 +212,17 @@ PredictionError prediction_error(const table::Board& belief, std::span<const bus
   out.mean_ci95_m = stats.ci95_half_width();
   out.median_m = median(errors);
   out.p90_m = quantile(errors, 0.9);
+  // A class with no moment has no mean: NaN (null in JSON, "none" in text), not 0 mm.
+  const auto mean_of = [](const RunningStats& r) {
+    return r.count() > 0 ? r.mean() : std::numeric_limits<double>::quiet_NaN();
+  };
   out.free_moments = static_cast<std::size_t>(free.count());
-  out.free_mean_m = free.mean();
-  out.collision_mean_m = collided.mean();
+  out.free_mean_m = mean_of(free);
+  out.collision_mean_m = mean_of(collided);
   out.under_g_moments = static_cast<std::size_t>(under_g.count());
-  out.under_g_mean_m = under_g.mean();
+  out.under_g_mean_m = mean_of(under_g);
   out.pushed_moments = static_cast<std::size_t>(pushed.count());
-  out.pushed_mean_m = pushed.mean();
+  out.pushed_mean_m = mean_of(pushed);
   for (std::size_t h = 0; h < by_hit.size(); ++h) {
     if (by_hit[h].count() == 0) continue;
     const std::vector<std::string>& names = h < flipper_hit ? groups[h].obstacles : std::vector<std::string>{};

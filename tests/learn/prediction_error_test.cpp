@@ -189,6 +189,11 @@ TEST(PredictionError, APushedBallStartsFromItsOwnAcceleration) {
   const PredictionError free = prediction_error(open_board(), plays, under_g, options);
   EXPECT_EQ(free.under_g_moments, under_g.size());
   EXPECT_LT(free.under_g_mean_m, 1e-4);  // the model's semi-implicit Euler steps alone
+  // A class with no moment has no mean: NaN (null in JSON), not the 0 mm it was printed as.
+  EXPECT_EQ(skid.under_g_moments, 0u);
+  EXPECT_TRUE(std::isnan(skid.under_g_mean_m));
+  EXPECT_EQ(free.pushed_moments, 0u);
+  EXPECT_TRUE(std::isnan(free.pushed_mean_m));
 }
 
 TEST(PredictionError, NoMomentNearACoilCommandOrWithoutTheBall) {

@@ -77,12 +77,12 @@ struct PredictionError {
   /// The moments whose seen window (moment to horizon) fits one parabola:
   /// the ball flew free, and only g and the start's noise matter there.
   std::size_t free_moments = 0;
-  double free_mean_m = 0.0;       ///< mean error over them (m)
-  double collision_mean_m = 0.0;  ///< mean error over the others: something was hit in the window (m)
+  double free_mean_m = 0.0;       ///< mean error over them (m); NaN with none
+  double collision_mean_m = 0.0;  ///< mean error over the others, something hit in the window (m); NaN: none
   std::size_t under_g_moments = 0;  ///< moments whose history g alone moved (PredictionStart::pushed false)
-  double under_g_mean_m = 0.0;       ///< mean error over them (m)
+  double under_g_mean_m = 0.0;       ///< mean error over them (m); NaN with none
   std::size_t pushed_moments = 0;   ///< moments whose history something more pushed (skid, a wall, a flipper)
-  double pushed_mean_m = 0.0;       ///< mean error over them (m)
+  double pushed_mean_m = 0.0;       ///< mean error over them (m); NaN with none
   /// The collision moments by what the model hit first, most moments first.
   std::vector<CollisionError> collisions_by_model_hit;
   /// Each start's error (m), in the order of the starts; NaN where the
