@@ -168,6 +168,23 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
 
 namespace {
 
+// The file --out updates, read first (a bad one is refused before any work). Its other
+// sections stay, so a file whose camera, flippers or gravity are another board's is refused:
+// written over with this board's name, it would claim them for this one.
+calibration::Calibration calibration_to_update(const std::string& out, const std::string& board) {
+  calibration::Calibration cal;
+  if (out.empty() || !std::filesystem::exists(out)) return cal;
+  cal = calibration::read_calibration(out);
+  const bool board_sections = cal.camera || !cal.flippers.empty() || cal.gravity;
+  std::error_code ec;
+  const bool same = cal.board == board || std::filesystem::equivalent(cal.board, board, ec);
+  if (board_sections && !board.empty() && !cal.board.empty() && !same) {
+    throw std::runtime_error("calibrate: --out " + out + " is a calibration of " + cal.board + ", not of " + board +
+                             ": its other sections are that board's; write this one to another file");
+  }
+  return cal;
+}
+
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
 nlohmann::json vec_json(const Vec2& v) { return nlohmann::json::array({v.x(), v.y()}); }
@@ -797,8 +814,7 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
   if (!a.print_target.empty()) return print_target(a, target, out);
   const bool simulated = !a.sim_board.empty();
   // The file to update: read first (a bad one is refused before any work).
-  calibration::Calibration cal;
-  if (!a.out.empty() && std::filesystem::exists(a.out)) cal = calibration::read_calibration(a.out);
+  calibration::Calibration cal = calibration_to_update(a.out, simulated ? a.sim_board : a.board);
   std::vector<calibration::TargetImage> images;
   std::optional<vision::CameraIntrinsics> truth;
   if (simulated) {
@@ -917,7 +933,7 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
                                       {"theta_offset_deg", a.sim_theta_offset_deg}};
   }
   // --out updates an existing file: the other sections stay.
-  if (!a.out.empty() && std::filesystem::exists(a.out)) c.cal = calibration::read_calibration(a.out);
+  c.cal = calibration_to_update(a.out, board_path);
   c.cal.board = board_path;
   c.cal.date.clear();
   if (a.kind == "flippers") c.cal.flippers.clear();

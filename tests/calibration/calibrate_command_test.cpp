@@ -98,6 +98,17 @@ TEST_F(Calibrate, BadInputsExitWithOne) {
                 " --calibration " + bad)
                 .exit_code,
             1);
+  // Updating a file of another board renamed it to this board and kept the other's sections.
+  const std::string other = (dir_ / "other.yaml").string();
+  ASSERT_EQ(run("calibrate gravity --sim boards/mit1993.board --sim-rolls 2 --out " + other).exit_code, 0);
+  const std::string kept = pinball::testing::slurp(other);
+  const Result foreign = run("calibrate gravity --sim boards/scenes/box.board --sim-rolls 2 --out " + other);
+  EXPECT_EQ(foreign.exit_code, 1);
+  EXPECT_NE(foreign.err.find("--out " + other + " is a calibration of boards/mit1993.board, not of "
+                                                 "boards/scenes/box.board"),
+            std::string::npos)
+      << foreign.err;
+  EXPECT_EQ(pinball::testing::slurp(other), kept);
   // One roll given twice counted twice and narrowed the interval to nothing.
   const std::string roll = (dir_ / "roll.csv").string();
   std::ofstream(roll) << "t,x,y\n0,0.2,0.9\n";
