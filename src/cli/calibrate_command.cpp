@@ -279,6 +279,11 @@ void run_flippers(Context& c) {
   } else {
     const std::string from = c.a.calibration.empty() ? c.a.out : c.a.calibration;
     if (from.empty()) throw std::runtime_error("calibrate flippers: give --calibration FILE with a camera section");
+    if (!std::filesystem::exists(from)) {
+      // The --out of a first run: nothing measured the camera yet.
+      throw std::runtime_error("calibrate flippers: " + from + " does not exist: the markers are placed through the "
+                               "camera's homography, so run `calibrate camera --out " + from + "` first");
+    }
     const calibration::Calibration from_file = calibration::read_calibration(from);
     h.emplace(calibration::camera_homography(from_file, from));
     lens = from_file.intrinsics;

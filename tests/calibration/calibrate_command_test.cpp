@@ -98,6 +98,13 @@ TEST_F(Calibrate, BadInputsExitWithOne) {
                 " --calibration " + bad)
                 .exit_code,
             1);
+  // Flippers before the camera: said so, not "cannot open".
+  const std::string first = (dir_ / "first.yaml").string();
+  const Result no_camera = run("calibrate flippers --board boards/mit1993.board --down " + bad + " --up " + bad +
+                               " --out " + first);
+  EXPECT_EQ(no_camera.exit_code, 1);
+  EXPECT_NE(no_camera.err.find("run `calibrate camera --out " + first + "` first"), std::string::npos)
+      << no_camera.err;
   // Updating a file of another board renamed it to this board and kept the other's sections.
   const std::string other = (dir_ / "other.yaml").string();
   ASSERT_EQ(run("calibrate gravity --sim boards/mit1993.board --sim-rolls 2 --out " + other).exit_code, 0);
