@@ -54,6 +54,7 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
     ++line_no;
     if (!text.empty() && text.back() == '\r') text.pop_back();
     if (line_no == 1) {
+      if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // a byte-order mark, as some editors write
       const auto header = split(text);
       const bool txy = header.size() >= 3 && header[0] == "t" && header[1] == "x" && header[2] == "y";
       has_contacts = txy && header.size() == 5 && header[3] == "left_contact" && header[4] == "right_contact";
@@ -96,6 +97,7 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
     rows.push_back(row);
   }
   if (line_no == 0) fail(path, 1, "empty file: expected the header 't,x,y'");
+  if (rows.empty()) fail(path, line_no, "no observation after the header");
   return rows;
 }
 

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/error_text.h"
 #include "common/temp_path.h"
@@ -66,6 +67,18 @@ TEST(ObservationIo, BadFilesAreRefusedNamingTheLine) {
   EXPECT_NE(read_error(nan).find(nan + ":2: column 'x' is not a finite number"), std::string::npos);
   const std::string empty = write_csv("empty.csv", "");
   EXPECT_NE(read_error(empty).find(empty + ":1: empty file"), std::string::npos);
+  // A header and nothing else tracked nothing and exited 0.
+  const std::string only_header = write_csv("only_header.csv", "t,x,y\n\n");
+  EXPECT_NE(read_error(only_header).find(only_header + ":2: no observation after the header"), std::string::npos)
+      << read_error(only_header);
+}
+
+// A byte-order mark before the header (an editor's) is skipped, as in board files.
+TEST(ObservationIo, AByteOrderMarkBeforeTheHeaderIsSkipped) {
+  const std::string bom = write_csv("bom.csv", "\xEF\xBB\xBFt,x,y\n0,0.1,0.2\n");
+  const std::vector<ObservationRow> rows = read_observations_csv(bom);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].observation.p_board.y(), 0.2);
 }
 
 }  // namespace
