@@ -176,8 +176,7 @@ calibration::Calibration calibration_to_update(const std::string& out, const std
   if (out.empty() || !std::filesystem::exists(out)) return cal;
   cal = calibration::read_calibration(out);
   const bool board_sections = cal.camera || !cal.flippers.empty() || cal.gravity;
-  std::error_code ec;
-  const bool same = cal.board == board || std::filesystem::equivalent(cal.board, board, ec);
+  const bool same = cal.board == board || same_file(cal.board, board);
   if (board_sections && !board.empty() && !cal.board.empty() && !same) {
     throw std::runtime_error("calibrate: --out " + out + " is a calibration of " + cal.board + ", not of " + board +
                              ": its other sections are that board's; write this one to another file");

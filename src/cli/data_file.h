@@ -72,14 +72,19 @@ inline void check_distinct_outputs(const std::vector<std::pair<const char*, std:
   }
 }
 
+/// Whether two paths name one file (the same path, a link or a hard link); false when either is missing.
+inline bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return std::filesystem::equivalent(a, b, ec) && !ec;
+}
+
 /// One file given twice to an option that takes many (the same path, a link
 /// or a hard link) would count its data twice and narrow every interval:
 /// refused, "OPTION PATH is given twice: WHY".
 inline void check_distinct_inputs(const std::vector<std::string>& paths, const char* option, const char* why) {
   for (std::size_t i = 0; i < paths.size(); ++i) {
     for (std::size_t k = i + 1; k < paths.size(); ++k) {
-      std::error_code ec;
-      if (std::filesystem::equivalent(paths[i], paths[k], ec) && !ec) {
+      if (same_file(paths[i], paths[k])) {
         throw std::runtime_error(std::string(option) + " " + paths[k] + " is given twice: " + why);
       }
     }

@@ -37,15 +37,11 @@ std::vector<bus::RecordedPlay> read_all(const std::vector<std::string>& paths) {
 // The same file twice would count its events twice (and a held-out log that
 // is fitted is no test); an --out that is an input would be replaced by the overlay.
 void check_distinct_files(const IdentifyArgs& a) {
-  const auto same = [](const std::string& x, const std::string& y) {
-    std::error_code ec;
-    return std::filesystem::equivalent(x, y, ec) && !ec;
-  };
   check_distinct_inputs(a.logs, "identify: log", "its events would count twice");
   check_distinct_inputs(a.held_out, "identify: --held-out", "its moments would count twice");
   for (std::size_t i = 0; i < a.logs.size(); ++i) {
     for (const std::string& held : a.held_out) {
-      if (same(a.logs[i], held)) {
+      if (same_file(a.logs[i], held)) {
         throw std::runtime_error("identify: --held-out " + held + " is also a fitted log: a held-out log must be one "
                                  "never fitted");
       }
@@ -56,7 +52,7 @@ void check_distinct_files(const IdentifyArgs& a) {
   inputs.insert(inputs.end(), a.held_out.begin(), a.held_out.end());
   inputs.push_back(find_data_file(a.board));
   for (const std::string& in : inputs) {
-    if (same(a.out, in)) {
+    if (same_file(a.out, in)) {
       throw std::runtime_error("identify: --out " + a.out + " is the input " + in + "; it would be replaced");
     }
   }

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "board_loader_internal.h"
+#include "pinball/core/text_file.h"
 
 namespace pinball::table {
 
@@ -38,8 +39,7 @@ void statement(loader::LoadState& state, const loader::Statement& st) {
 }  // namespace
 
 Board parse_board(std::string_view text, const std::string& source_name) {
-  // A UTF-8 byte-order mark, which some editors write first, is no keyword.
-  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  text = without_utf8_bom(text);
   if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos) {
     throw BoardError(source_name, loader::line_of(text, nul), "a NUL byte (at byte " + std::to_string(nul + 1) +
                                             "): a board file is text; is this the file you meant?");

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "pinball/core/text_file.h"
+
 namespace pinball::track {
 namespace {
 
@@ -54,7 +56,7 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
     ++line_no;
     if (!text.empty() && text.back() == '\r') text.pop_back();
     if (line_no == 1) {
-      if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);  // a byte-order mark, as some editors write
+      text = std::string(without_utf8_bom(text));
       const auto header = split(text);
       const bool txy = header.size() >= 3 && header[0] == "t" && header[1] == "x" && header[2] == "y";
       has_contacts = txy && header.size() == 5 && header[3] == "left_contact" && header[4] == "right_contact";

@@ -13,9 +13,16 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <system_error>
 
 namespace pinball {
+
+/// `text` without a UTF-8 byte-order mark at its start, which some editors
+/// write first: no reader should take it for part of a keyword or a header.
+inline std::string_view without_utf8_bom(std::string_view text) {
+  return text.starts_with("\xEF\xBB\xBF") ? text.substr(3) : text;
+}
 
 /// The whole file at `path`. Throws std::runtime_error "path: cannot open"
 /// or "path: cannot read".
