@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "pinball/core/format.h"
 #include "pinball/sim/ball_runner.h"
 
 namespace pinball::simlab {
@@ -45,6 +46,10 @@ std::vector<KeyEvent> parse_key_script(const std::string& text) {
     const double t_s = std::strtod(time_text.c_str(), &time_end);
     if (time_text.empty() || time_end != time_text.c_str() + time_text.size() || !std::isfinite(t_s) || t_s < 0.0) {
       bad_entry(index, entry, "time must be a number of seconds >= 0");
+    }
+    // A headless session steps every dt up to the last entry: a time of 1e300 s never ended.
+    if (t_s > kMaxKeyScriptTime_s) {
+      bad_entry(index, entry, "time must be at most " + format_number(kMaxKeyScriptTime_s) + " s (a day of play)");
     }
     if (t_s < last_t_s) bad_entry(index, entry, "times must not decrease");
     last_t_s = t_s;

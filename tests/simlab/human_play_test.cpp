@@ -50,6 +50,9 @@ TEST(KeyScript, BadEntriesAreNamed) {
   EXPECT_NE(message("0.5:launch,1:jump").find("entry 2 '1:jump': unknown action 'jump'"), std::string::npos);
   EXPECT_NE(message("1:launch,0.5:left").find("times must not decrease"), std::string::npos);
   EXPECT_NE(message("x:launch").find("time must be a number"), std::string::npos);
+  EXPECT_NE(message("0:launch,1e300:left").find("entry 2 '1e300:left': time must be at most 86400 s"),
+            std::string::npos);
+  EXPECT_NO_THROW(parse_key_script("86400:launch"));
   EXPECT_NE(message("launch").find("expected TIME:ACTION"), std::string::npos);
   EXPECT_NE(message(" , ").find("no entries"), std::string::npos);
 }

@@ -30,8 +30,11 @@ struct KeyEvent {
   bool down = true;  ///< true: pressed; false: released
 };
 
+/// The latest time a key script may name (s): a day of play.
+inline constexpr double kMaxKeyScriptTime_s = 86400.0;
+
 /// Parses a key script: comma- or newline-separated "T:ACTION" with T in
-/// session seconds (non-decreasing) and ACTION one of launch, left-down,
+/// session seconds (non-decreasing, at most kMaxKeyScriptTime_s) and ACTION one of launch, left-down,
 /// left-up, right-down, right-up, left (a 0.1 s tap), right (a 0.1 s tap).
 /// Throws std::invalid_argument naming the entry and what is wrong.
 std::vector<KeyEvent> parse_key_script(const std::string& text);
