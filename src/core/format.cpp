@@ -9,6 +9,9 @@ namespace pinball {
 
 namespace {
 
+// The magnitude from which format_number writes an exponent.
+constexpr double kLargestFixed = 1e15;
+
 // Decimals that give `digits` significant digits for |x|, at least 0.
 int decimals_for(double x, int digits) {
   if (x == 0.0 || !std::isfinite(x)) return 0;
@@ -29,6 +32,12 @@ std::string fixed(double x, int decimals) {
 }  // namespace
 
 std::string format_number(double x, int digits) {
+  // Past 15 integer digits a fixed number is noise to a reader (1e100 had printed 101 digits).
+  if (std::isfinite(x) && std::fabs(x) >= kLargestFixed) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.*g", std::clamp(digits, 1, 17), x);
+    return buf;
+  }
   // 9.996 at 3 digits rounds to 10.0, which has one decimal fewer than 9.996 needs.
   int d = decimals_for(x, digits);
   const double rounded = std::round(x * std::pow(10.0, d)) / std::pow(10.0, d);
@@ -45,6 +54,9 @@ std::string format_number(double x, int digits) {
 std::string format_mean_ci(double mean, double half_width, int digits) {
   if (!std::isfinite(half_width)) return format_number(mean, digits) + " ± ∞";
   if (!(half_width > 0.0)) return format_number(mean, digits) + " ± 0";
+  if (std::fabs(mean) >= kLargestFixed || half_width >= kLargestFixed) {
+    return format_number(mean, digits) + " ± " + format_number(half_width, 2);
+  }
   const int d = decimals_for(half_width, 2);
   return fixed(mean, d) + " ± " + fixed(half_width, d);
 }

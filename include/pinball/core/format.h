@@ -9,7 +9,8 @@ namespace pinball {
 
 /// `x` to `digits` significant digits in fixed notation, trailing zeros
 /// dropped; a number with more integer digits than that is rounded to an
-/// integer ("9193", "12.3", "0.0457", "0.0005").
+/// integer ("9193", "12.3", "0.0457", "0.0005"); from 1e15 on, which only
+/// a corrupt input reaches, `digits` digits with an exponent ("1e+100").
 std::string format_number(double x, int digits = 3);
 
 /// A mean and the half-width of its interval, both to the half-width's
