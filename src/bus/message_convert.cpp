@@ -160,25 +160,40 @@ ObservationLayout decode_observation(const void* data, std::size_t size, pinball
   return ObservationLayout::kBeforeDelivery;
 }
 
+const char* observation_fault(const pinball_lcm::lcmt_pinball_observation& m) {
+  if (m.utime < 0) return "utime below 0";
+  if (m.delivered_utime < 0) return "delivered_utime below 0";
+  if (m.seq < 0) return "seq below 0";
+  if (!m.found) return nullptr;
+  if (!std::isfinite(m.x_m) || !std::isfinite(m.y_m)) return "a found ball's position is not finite";
+  if (!(m.confidence >= 0.0 && m.confidence <= 1.0)) return "a found ball's confidence is outside 0..1";
+  return nullptr;
+}
+
 bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& found, track::Observation& out,
                           track::ContactSensors& contacts) {
-  if (m.utime < 0 || m.delivered_utime < 0 || m.seq < 0) return false;
+  if (observation_fault(m) != nullptr) return false;
   found = m.found;
   contacts.left = m.contact_left;
   contacts.right = m.contact_right;
   out.t_s = from_utime(m.utime);
   out.latency_s = std::max(0.0, from_utime(m.delivered_utime) - out.t_s);
   if (!found) return true;
-  if (!std::isfinite(m.x_m) || !std::isfinite(m.y_m) || !(m.confidence >= 0.0 && m.confidence <= 1.0)) return false;
   out.p_board = Vec2(m.x_m, m.y_m);
   out.confidence = m.confidence;
   return true;
 }
 
-bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m) {
+const char* flipper_command_fault(const pinball_lcm::lcmt_pinball_flipper_command& m) {
   using M = pinball_lcm::lcmt_pinball_flipper_command;
-  return m.utime >= 0 && m.flipper >= -1 && m.flipper <= 1 && m.cause >= M::CAUSE_PROJECTION &&
-         m.cause <= M::CAUSE_BUS_FAULT;
+  if (m.utime < 0) return "utime below 0";
+  if (m.flipper < -1 || m.flipper > 1) return "flipper outside -1..1 (-1 every flipper, 0 left, 1 right)";
+  if (m.cause < M::CAUSE_PROJECTION || m.cause > M::CAUSE_BUS_FAULT) return "cause outside 0..5";
+  return nullptr;
+}
+
+bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m) {
+  return flipper_command_fault(m) == nullptr;
 }
 
 track::TrajectoryProjection from_lcm_projection(const pinball_lcm::lcmt_pinball_projection& m) {

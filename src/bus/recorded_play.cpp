@@ -50,8 +50,17 @@ RecordedPlay read_recorded_play(const std::string& path) {
   play.source = path;
   std::map<std::string, std::uint64_t> channel_counts;
   std::uint64_t observation_messages = 0, command_messages = 0, sightings = 0;
+  // Messages that decode but fail the check: of our type, with a bad field (not "another type").
+  std::uint64_t observations_decoded = 0, commands_decoded = 0;
+  auto left_out = [&](const std::string& channel, std::uint64_t nth, std::size_t event, const char* why) {
+    if (play.malformed++ == 0) {
+      play.first_malformed =
+          channel + " message " + std::to_string(nth) + " (log event " + std::to_string(event + 1) + "): " + why;
+    }
+  };
   double latest_frame_s = -1e300;
-  for (const LcmLogEvent& e : events) {
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const LcmLogEvent& e = events[i];
     ++channel_counts[e.channel];
     if (e.channel == kObservationChannel) {
       ++observation_messages;
@@ -59,9 +68,13 @@ RecordedPlay read_recorded_play(const std::string& path) {
       bool found = false;
       track::Observation o;
       track::ContactSensors contacts;
-      if (decode_observation(e.data.data(), e.data.size(), m) == ObservationLayout::kMalformed ||
-          !from_lcm_observation(m, found, o, contacts)) {
-        ++play.malformed;
+      if (decode_observation(e.data.data(), e.data.size(), m) == ObservationLayout::kMalformed) {
+        left_out(e.channel, observation_messages, i, "does not decode as lcmt_pinball_observation");
+        continue;
+      }
+      ++observations_decoded;
+      if (!from_lcm_observation(m, found, o, contacts)) {
+        left_out(e.channel, observation_messages, i, observation_fault(m));
         continue;
       }
       check_one_run(path, latest_frame_s, o.t_s, m.seq);
@@ -70,8 +83,13 @@ RecordedPlay read_recorded_play(const std::string& path) {
     } else if (e.channel == kFlipperCommandChannel) {
       ++command_messages;
       pinball_lcm::lcmt_pinball_flipper_command m;
-      if (!decode(e, m) || !valid_flipper_command(m)) {
-        ++play.malformed;
+      if (!decode(e, m)) {
+        left_out(e.channel, command_messages, i, "does not decode as lcmt_pinball_flipper_command");
+        continue;
+      }
+      ++commands_decoded;
+      if (!valid_flipper_command(m)) {
+        left_out(e.channel, command_messages, i, flipper_command_fault(m));
         continue;
       }
       play.commands.push_back({from_utime(m.utime), m.flipper, m.energize != 0, m.cause});
@@ -82,12 +100,17 @@ RecordedPlay read_recorded_play(const std::string& path) {
     throw std::runtime_error(path + ": no " + kObservationChannel + " messages: the camera's sightings are missing" + has);
   if (command_messages == 0)
     throw std::runtime_error(path + ": no " + kFlipperCommandChannel + " messages: the coil commands are missing" + has);
+  // None usable: another type on the channel when none decodes, else our type with bad fields.
+  auto none_usable = [&](const std::string& channel, std::uint64_t messages, std::uint64_t decoded,
+                         const char* type) {
+    const std::string of = path + ": none of its " + std::to_string(messages) + " " + channel + " messages ";
+    if (decoded == 0) return std::runtime_error(of + "decodes as " + type + " (another type?)");
+    return std::runtime_error(of + "is well formed (first: " + play.first_malformed + ")");
+  };
   if (play.frames.empty())
-    throw std::runtime_error(path + ": none of its " + std::to_string(observation_messages) + " " +
-                             kObservationChannel + " messages decodes as lcmt_pinball_observation (another type?)");
+    throw none_usable(kObservationChannel, observation_messages, observations_decoded, "lcmt_pinball_observation");
   if (play.commands.empty())
-    throw std::runtime_error(path + ": none of its " + std::to_string(command_messages) + " " +
-                             kFlipperCommandChannel + " messages decodes as lcmt_pinball_flipper_command (another type?)");
+    throw none_usable(kFlipperCommandChannel, command_messages, commands_decoded, "lcmt_pinball_flipper_command");
   if (sightings == 0) throw std::runtime_error(path + ": no frame of its " + std::to_string(play.frames.size()) +
                                                " saw the ball");
   // A log keeps the order messages were written in; threads may interleave.

@@ -153,6 +153,7 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                    {"frames", r.frames},
                    {"sightings", r.sightings},
                    {"malformed_messages", r.malformed},
+                   {"first_malformed", r.first_malformed.empty() ? nlohmann::json() : nlohmann::json(r.first_malformed)},
                    {"commands", r.commands},
                    {"free_flights", r.flights},
                    {"board_gravity_mps2", board.gravity_mps2},
@@ -199,8 +200,8 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
       << " frames (" << format_number(seen) << " % saw the ball), " << r.commands << " commands, " << r.flights
       << " free flights\n";
   if (r.malformed > 0) {
-    out << "  " << r.malformed << " messages on PINBALL_OBSERVATION and PINBALL_FLIPPER_CMD left out: they do not "
-        << "decode, or hold numbers that are not finite\n";
+    out << "  " << r.malformed << " messages on PINBALL_OBSERVATION and PINBALL_FLIPPER_CMD left out (they do not "
+        << "decode, or have a bad field); the first: " << r.first_malformed << "\n";
   }
   const learn::FlightGravity& g = r.gravity_no_drag;
   out << "  g along the table  " << value_text(*r.overlay.gravity_mps2, " m/s²") << " (board "

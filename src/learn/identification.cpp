@@ -491,6 +491,7 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
     const bus::RecordedPlay& play = recordings[r];
     result.overlay.recordings.push_back(play.source);
     result.frames += play.frames.size();
+    if (result.malformed == 0 && play.malformed > 0) result.first_malformed = play.source + ": " + play.first_malformed;
     result.malformed += play.malformed;
     result.commands += play.commands.size();
     result.recorded_s += play.duration_s();

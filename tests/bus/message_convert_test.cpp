@@ -120,10 +120,12 @@ TEST(MessageConvert, MalformedObservationsAreRefused) {
   m.found = true;
   m.x_m = std::nan("");
   EXPECT_FALSE(from_lcm_observation(m, found, o, c));
+  EXPECT_STREQ(observation_fault(m), "a found ball's position is not finite");
   m.x_m = 0.1;
   m.y_m = 0.2;
   m.confidence = 1.5;
   EXPECT_FALSE(from_lcm_observation(m, found, o, c));
+  EXPECT_STREQ(observation_fault(m), "a found ball's confidence is outside 0..1");
   m.confidence = 1.0;
   m.utime = -5;
   EXPECT_FALSE(from_lcm_observation(m, found, o, c));
@@ -131,9 +133,25 @@ TEST(MessageConvert, MalformedObservationsAreRefused) {
   EXPECT_TRUE(from_lcm_observation(m, found, o, c));
   m.delivered_utime = -1;
   EXPECT_FALSE(from_lcm_observation(m, found, o, c));
+  EXPECT_STREQ(observation_fault(m), "delivered_utime below 0");
   m.delivered_utime = 2;  // stamped before its exposure (a miscalibrated latency): no negative lead
   ASSERT_TRUE(from_lcm_observation(m, found, o, c));
   EXPECT_EQ(o.latency_s, 0.0);
+}
+
+TEST(MessageConvert, MalformedFlipperCommandsNameTheirField) {
+  pinball_lcm::lcmt_pinball_flipper_command m{};
+  EXPECT_TRUE(valid_flipper_command(m));
+  EXPECT_EQ(flipper_command_fault(m), nullptr);
+  m.flipper = 7;
+  EXPECT_FALSE(valid_flipper_command(m));
+  EXPECT_NE(std::string(flipper_command_fault(m)).find("flipper outside -1..1"), std::string::npos);
+  m.flipper = -1;
+  m.cause = 9;
+  EXPECT_STREQ(flipper_command_fault(m), "cause outside 0..5");
+  m.cause = 0;
+  m.utime = -1;
+  EXPECT_STREQ(flipper_command_fault(m), "utime below 0");
 }
 
 TEST(MessageConvert, LogsFromBeforeTheDeliveryStampStillDecode) {

@@ -106,6 +106,28 @@ TEST(RecordedPlay, RefusesMessagesOfAnotherTypeOnItsChannels) {
   EXPECT_NE(what.find("lcmt_pinball_observation"), std::string::npos) << what;
 }
 
+TEST(RecordedPlay, CommandsOfOurTypeWithABadFieldAreNamedNotCalledAnotherType) {
+  RecordedPlay play = small_play();
+  for (RecordedCommand& c : play.commands) c.flipper = 7;
+  const std::string what = error_for("flipper7.lcm", recorded_play_log(play));
+  EXPECT_EQ(what.find("another type"), std::string::npos) << what;
+  EXPECT_NE(what.find("none of its 2 PINBALL_FLIPPER_CMD messages is well formed"), std::string::npos) << what;
+  EXPECT_NE(what.find("flipper outside -1..1"), std::string::npos) << what;
+}
+
+TEST(RecordedPlay, CountsAndNamesTheFirstBadMessageAmongGoodOnes) {
+  RecordedPlay play = small_play();
+  play.commands.push_back({0.0600, 5, true, 0});
+  const std::string path = pinball::testing::temp_path("recorded_play", "one_bad.lcm");
+  write_log(path, recorded_play_log(play));
+  const RecordedPlay back = read_recorded_play(path);
+  std::remove(path.c_str());
+  EXPECT_EQ(back.commands.size(), 2u);
+  EXPECT_EQ(back.malformed, 1u);
+  EXPECT_NE(back.first_malformed.find("PINBALL_FLIPPER_CMD message 3"), std::string::npos) << back.first_malformed;
+  EXPECT_NE(back.first_malformed.find("flipper outside"), std::string::npos) << back.first_malformed;
+}
+
 TEST(RecordedPlay, RefusesALogWhereTheBallIsNeverSeen) {
   RecordedPlay blind = small_play();
   for (RecordedFrame& f : blind.frames) f.found = false;

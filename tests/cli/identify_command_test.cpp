@@ -46,6 +46,8 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   EXPECT_EQ(j["gravity"]["bootstrap_resamples"], 5);
   EXPECT_GT(j["gravity"]["g_stderr_mps2"].get<double>(), 0.0);
   EXPECT_GT(j["free_flights"].get<int>(), 20);
+  EXPECT_EQ(j["malformed_messages"], 0);
+  EXPECT_TRUE(j["first_malformed"].is_null());
   EXPECT_EQ(j["overlay"], overlay);
   EXPECT_FALSE(j["not_identified"].empty());
   // The recording's flippers never rose: each is reported, none identified, no delay.

@@ -85,11 +85,20 @@ pinball_lcm::lcmt_pinball_daemon_stats to_lcm_daemon_stats(std::int64_t utime, s
                                                             std::span<const StageLatency> stages,
                                                             const DaemonStatsCounts& counts);
 
+/// What is wrong with a decoded observation message ("seq below 0", "a found
+/// ball's position is not finite"), or nullptr when it is well formed. A
+/// static string: the receiving threads call it and allocate nothing.
+const char* observation_fault(const pinball_lcm::lcmt_pinball_observation& m);
+
 /// The observation inside a message: t_s the exposure date, latency_s the
 /// delivery stamp less it (never below 0); false when the message is malformed
-/// (non-finite or out-of-range fields, a found ball without a position).
+/// (observation_fault names why).
 bool from_lcm_observation(const pinball_lcm::lcmt_pinball_observation& m, bool& found, track::Observation& out,
                           track::ContactSensors& contacts);
+
+/// What is wrong with a decoded flipper command ("flipper outside -1..1"), or
+/// nullptr when it is well formed. A static string, as observation_fault.
+const char* flipper_command_fault(const pinball_lcm::lcmt_pinball_flipper_command& m);
 
 /// A received flipper command is well formed (flipper -1..1, cause 0..5).
 bool valid_flipper_command(const pinball_lcm::lcmt_pinball_flipper_command& m);

@@ -36,6 +36,7 @@ struct RecordedPlay {
   std::vector<RecordedFrame> frames;      ///< PINBALL_OBSERVATION, sorted by t_s
   std::vector<RecordedCommand> commands;  ///< PINBALL_FLIPPER_CMD, sorted by t_s
   std::uint64_t malformed = 0;            ///< messages on those channels that failed to decode or check
+  std::string first_malformed;            ///< the first of them and why ("PINBALL_FLIPPER_CMD message 3 ...")
   double duration_s() const { return frames.empty() ? 0.0 : frames.back().t_s - frames.front().t_s; }
 };
 
@@ -44,7 +45,8 @@ struct RecordedPlay {
 /// unreadable, empty, not an LCM log or truncated (bus::require_lcm_log);
 /// a log with no PINBALL_OBSERVATION or no PINBALL_FLIPPER_CMD messages (the
 /// message lists the channels it has); a log whose messages on those channels
-/// are not pinball messages (none decodes); one where no frame saw the ball;
+/// are not pinball messages (none decodes) or all have a bad field (the first
+/// is named); one where no frame saw the ball;
 /// and one whose clock goes back more than a second (runs appended with
 /// lcm_url mode=a, which sorting by time would shuffle together).
 RecordedPlay read_recorded_play(const std::string& path);

@@ -164,7 +164,8 @@ struct IdentificationResult {
   std::vector<NotIdentified> not_identified;
   std::size_t frames = 0;                 ///< frames read
   std::size_t sightings = 0;              ///< frames that saw the ball
-  std::uint64_t malformed = 0;            ///< messages on the two channels left out: undecodable or not finite
+  std::uint64_t malformed = 0;            ///< messages on the two channels left out: undecodable or a bad field
+  std::string first_malformed;            ///< the first of them, its log and why (empty: none)
   std::size_t commands = 0;               ///< coil commands read
   double recorded_s = 0.0;                ///< total duration of the recordings (s)
   std::size_t flights = 0;                ///< free flights found
