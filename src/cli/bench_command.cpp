@@ -125,10 +125,12 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_option("--seeds", a.seeds, "protocol: seeds to run, from --seed on")->check(finite_range(1, 1000));
   cmd->add_option("--csv", a.csv,
                   "precision: write scene,stepper,setting,max_error_m,final_error_m,run_time_s here; transfer: one "
-                  "row per world and controller");
+                  "row per world and controller")
+      ->check(output_file());
   cmd->add_option("--png", a.png,
                   "precision: write the log-log plot of error against run time here; transfer: the score ratio to "
-                  "the spastic flipper against each perturbation");
+                  "the spastic flipper against each perturbation")
+      ->check(output_file());
   add_world_options(*cmd, a.world);
   add_camera_model_options(*cmd, a.camera);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");

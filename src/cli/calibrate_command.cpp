@@ -110,7 +110,8 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->capture_default_str()
       ->needs(sim);
   cmd->add_option("--print-target", a.print_target,
-                  "intrinsics: write the printable target (PNG, 10 px/mm: print at 254 dpi, 100 %) and stop");
+                  "intrinsics: write the printable target (PNG, 10 px/mm: print at 254 dpi, 100 %) and stop")
+      ->check(output_file());
   cmd->add_option("--roll", a.rolls, "gravity: observation CSV (t,x,y) of one roll from rest (repeat)")
       ->check(input_file())
       ->default_str("");
@@ -119,7 +120,8 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->check(finite_range(1e-6, 0.1));
   cmd->add_option("--calibration", a.calibration, "calibration file holding the camera homography (default: --out)")
       ->transform(data_file());
-  cmd->add_option("--out", a.out, "calibration file to write, or update keeping its other sections");
+  cmd->add_option("--out", a.out, "calibration file to write, or update keeping its other sections")
+      ->check(output_file());
   cmd->add_option("--png", a.png, "picture of the detected markers, fitted circles or gravity fit");
   cmd->add_option("--seed", a.seed, "--sim: seed of the simulated lab")
       ->check(unsigned_64());

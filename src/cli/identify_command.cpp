@@ -312,7 +312,7 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
       ->check(input_file());
   cmd->add_option("--board", a.board, "board file of the recorded table (its geometry; the values it guesses are fitted)")
       ->transform(data_file());
-  cmd->add_option("--out", a.out, "overlay file to write (YAML); none: report only");
+  cmd->add_option("--out", a.out, "overlay file to write (YAML); none: report only")->check(output_file());
   cmd->add_option("--sigma-m", a.sigma_m, "detector noise of one coordinate (m): the free-flight χ² test")
       ->check(finite_range(1e-5, 0.05));
   cmd->add_option("--bootstrap", a.bootstrap,

@@ -80,10 +80,10 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
       ->check(finite_range(std::uint64_t{1}, std::uint64_t{1'000'000'000}));
   cmd->add_option("--seed", a.seed, "random seed; same seed, same result, whatever --threads")
       ->check(unsigned_64());
-  cmd->add_option("--out", a.out, "controller file to write (JSON, docs/learning.md)");
+  cmd->add_option("--out", a.out, "controller file to write (JSON, docs/learning.md)")->check(output_file());
   cmd->add_option("--controller", a.controller, "evaluate: the controller file")->transform(data_file());
   cmd->add_option("--threads", a.threads, "worker threads")->check(finite_range(1, 256));
-  cmd->add_option("--curve", a.curve, "write the learning curve to this CSV");
+  cmd->add_option("--curve", a.curve, "write the learning curve to this CSV")->check(output_file());
   cmd->add_option("--plot", a.plot, "draw the learning curve to this PNG");
   cmd->add_option("--eval-balls", a.eval_balls,
                   "evaluate the result on this many fresh balls (default: 0 after a search, 1000 otherwise)")
@@ -131,7 +131,8 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   add_progress_flag(*cmd, a.progress);
   cmd->add_option("--checkpoint", a.checkpoint,
                   "record every batch of balls in this file as the run goes, so that a run cut short resumes "
-                  "(--resume) with the result of an uninterrupted one");
+                  "(--resume) with the result of an uninterrupted one")
+      ->check(output_file());
   cmd->add_flag("--resume", a.resume, "continue the run recorded in --checkpoint (the same command and seed)")
       ->needs("--checkpoint");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "data_file.h"
 #include "pinball/core/data_path.h"
 #include "pinball/core/format.h"
 #include "pinball/core/json_write_archive.h"
@@ -94,7 +95,8 @@ CLI::App* add_play_command(CLI::App& app, PlayArgs& a) {
                   "print balls and mean score per ball (95 % interval) per player of this score CSV")
       ->check(input_file());
   cmd->add_option("--player", a.player, "the player's name in the score file (default: $USER, else 'player')");
-  cmd->add_option("--csv", a.csv, "score file each ball is appended to (created with its header)");
+  cmd->add_option("--csv", a.csv, "score file each ball is appended to (created with its header)")
+      ->check(output_file());
   cmd->add_option("--balls", a.balls, "stop after this many balls (default 0: play until Esc or q)")
       ->check(finite_range(0, 1'000'000));
   cmd->add_option("--max-ball-time", a.max_ball_time_s, "simulated seconds after which a ball still in play is cut")

@@ -19,7 +19,7 @@ namespace pinball::cli {
 CLI::App* add_render_command(CLI::App& app, RenderArgs& a) {
   CLI::App* cmd = app.add_subcommand("render", "draw a board file to a PNG");
   cmd->add_option("board", a.board, "board file")->required()->transform(data_file());
-  cmd->add_option("--out", a.out, "PNG file to write")->required();
+  cmd->add_option("--out", a.out, "PNG file to write")->required()->check(output_file());
   cmd->add_option("--px-per-m", a.px_per_m, "scale in pixels per metre")->check(finite_range(50.0, 10000.0));
   cmd->add_flag("--normals", a.normals, "draw the normal of every line");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");

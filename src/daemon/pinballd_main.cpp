@@ -130,7 +130,8 @@ static int run_pinballd(int argc, char** argv) {
       ->default_str(defaults.lcm_url);
   app.add_option("--can-log", can_log,
                  "write every CAN frame to this file in candump's log format (frames it cannot write are "
-                 "dropped, counted, and make the exit status 3)");
+                 "dropped, counted, and make the exit status 3)")
+      ->check(pinball::output_file());
   app.add_flag("--realtime", realtime, "simulation paced to the wall clock (default: lockstep virtual clock)");
   app.add_flag("--json", json, "print the report as one JSON object on stdout");
   app.add_flag("--threads", threads, "print the thread table and exit");

@@ -522,6 +522,20 @@ TEST_F(Cli, BadArgumentsExitWithUsageError) {
   }
 }
 
+TEST_F(Cli, AnEmptyOutputPathIsRefusedNotTakenAsNone) {
+  // An unset shell variable ("--out $OUT") had silently written nothing.
+  for (const char* args : {"sim boards/mit1993.board --trace ''", "sim boards/mit1993.board --video ''",
+                           "identify boards/mit1993.board --board boards/mit1993.board --out ''",
+                           "learn boards/mit1993.board --out ''", "calibrate gravity --sim boards/mit1993.board --out ''",
+                           "play --headless --keys 0:launch boards/mit1993.board --csv ''",
+                           "bench precision --csv ''", "render boards/mit1993.board --out ''",
+                           "view --snapshot ''"}) {
+    const CommandResult r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_NE(r.err.find("an empty path names no file to write"), std::string::npos) << args << ": " << r.err;
+  }
+}
+
 // A flipper ten times as fast as the thesis's: 5 ms, within --dt's range, is too long for them.
 TEST_F(Cli, TimeStepThatBreaksTheFlipperConditionIsRefused) {
   const fs::path fast = variant_board(dir_, "-25 30 2000 ", "-25 30 20000 ");  // the left flipper

@@ -696,6 +696,9 @@ TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
                       overridden),
             1);
   EXPECT_EQ(overridden.rfind("pinballd: " + config + " and the command line: can.log: ", 0), 0u) << overridden;
+  std::string empty;  // an unset variable in a lab script: no log written, and nobody told
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " --can-log '' 2>&1", empty), 2);
+  EXPECT_NE(empty.find("--can-log: an empty path names no file to write"), std::string::npos) << empty;
   // With --json a script reads one object on stdout either way.
   std::string failed;
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --json --config " + config + " 2>/dev/null", failed), 1);

@@ -35,6 +35,14 @@ inline CLI::Validator input_file() {
       "FILE");
 }
 
+/// A check for an output file option: a value given must name a file. An
+/// empty one (a script's unset variable) had meant "write nothing", silently.
+inline CLI::Validator output_file() {
+  return CLI::Validator(
+      [](std::string& path) { return path.empty() ? std::string("an empty path names no file to write") : ""; },
+      "FILE");
+}
+
 /// A transform for a file option: the path through find_data_file, which must then be an input_file().
 inline CLI::Validator data_file() {
   return CLI::Validator(
