@@ -298,6 +298,7 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
   std::optional<control::ControllerSpec> controller;
   if (!a.controllers.empty()) {
     controller = control::load_controller(a.controllers.front());
+    control::check_controller_launch(*controller, board, a.controllers.front());
     options.controller = &*controller;
     options.controller_name = a.controllers.front();
     // The online planner beside the same planner on the true state: what the
@@ -438,6 +439,7 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
   specs.reserve(files.size());  // the options borrow them
   for (const std::string& f : files) {
     specs.push_back(control::load_controller(f));
+    control::check_controller_launch(specs.back(), board, f);
     options.controllers.push_back({std::filesystem::path(f).stem().string(), f, &specs.back()});
   }
   const bench::TransferReport report = bench::run_transfer_bench(

@@ -625,6 +625,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     j["out"] = a.out;
   } else if (a.method == "evaluate") {
     result_spec = control::load_controller(a.controller);
+    control::check_controller_launch(result_spec, board, a.controller);
     eval_spec = &result_spec;
     j["controller"] = a.controller;
   } else if (a.method == "imitate") {

@@ -98,6 +98,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   double pull = -1.0;
   if (policy == "controller") {
     const control::ControllerSpec spec = control::load_controller(a.controller);
+    control::check_controller_launch(spec, board, a.controller);
     learned = learn::make_controller(spec, board);
     learned_player.emplace(board, a.camera, *learned, a.seed ^ 0x5DEECE66Dull);
     pull = spec.launcher_pull;

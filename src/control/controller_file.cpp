@@ -298,4 +298,15 @@ ControllerSpec load_controller(const std::string& path) {
   return spec;
 }
 
+void check_controller_launch(const ControllerSpec& spec, const table::Board& board, const std::string& path) {
+  const bool randomised = spec.randomise_launch;
+  const double pull = randomised ? spec.launch_pull_min : spec.launcher_pull;
+  if (!randomised && pull < 0.0) return;  // the board's own pull, checked with the board
+  try {
+    table::check_launch_pull(board, pull);
+  } catch (const std::invalid_argument& e) {
+    throw ControllerFileError(path + ": " + (randomised ? "launcher.pull_min" : "launcher.pull") + ": " + e.what());
+  }
+}
+
 }  // namespace pinball::control

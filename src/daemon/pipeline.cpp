@@ -159,6 +159,7 @@ DaemonInputs load_daemon_inputs(const DaemonConfig& config) {
   DaemonInputs in;
   in.board = table::load_belief_board(sim ? config.sim.board : config.board, config.identified);
   in.spec = control::load_controller(config.controller);
+  if (sim) control::check_controller_launch(in.spec, in.board, config.controller);  // a lab launches by hand
   in.setup = tracking_setup_for(config, in.board);
   if (!sim && config.camera.source != "lcm" && !in.setup.homography) {
     throw ConfigError(config.origin + ": calibration: the lab camera needs a calibration file with a camera section "

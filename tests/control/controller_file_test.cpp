@@ -11,6 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/error_text.h"
+#include "common/thesis_board.h"
+
 namespace pinball::control {
 namespace {
 
@@ -288,6 +291,22 @@ TEST(ControllerFile, EveryShippedControllerLoads) {
   }
   EXPECT_GE(loaded, 13);
   EXPECT_TRUE(load_controller(PINBALL_SOURCE_DIR "/controllers/spastic.json").spastic);
+}
+
+TEST(ControllerFile, ALaunchTooWeakForTheBoardIsRefusedNamingTheFileAndKey) {
+  const table::Board& board = pinball::testing::thesis_board();
+  ControllerSpec s;
+  EXPECT_EQ(pinball::testing::error_text([&] { check_controller_launch(s, board, "c.json"); }), "no error")
+      << "a negative pull is the board's own";
+  s.launcher_pull = 0.0;  // within the file's range, yet no launch leaves the plunger
+  const std::string weak = pinball::testing::error_text([&] { check_controller_launch(s, board, "c.json"); });
+  EXPECT_EQ(weak.rfind("c.json: launcher.pull: launch pull 0 ", 0), 0u) << weak;
+  s.launcher_pull = 0.5;
+  EXPECT_EQ(pinball::testing::error_text([&] { check_controller_launch(s, board, "c.json"); }), "no error");
+  s.randomise_launch = true;  // then the range's low end is the pull that matters
+  s.launch_pull_min = 0.01;
+  const std::string range = pinball::testing::error_text([&] { check_controller_launch(s, board, "c.json"); });
+  EXPECT_EQ(range.rfind("c.json: launcher.pull_min: ", 0), 0u) << range;
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "pinball/control/imitation_controller.h"
 #include "pinball/control/planner_settings.h"
 #include "pinball/control/spastic_controller.h"
+#include "pinball/table/board.h"
 
 namespace pinball::control {
 
@@ -67,5 +68,11 @@ ControllerSpec controller_from_json(const std::string& text, const std::string& 
 void save_controller(const ControllerSpec& spec, const std::string& path);
 /// Reads a controller file. Throws ControllerFileError for any bad input.
 ControllerSpec load_controller(const std::string& path);
+
+/// The launches a controller sets (launcher.pull, or a randomised range's low
+/// end) leave `board`'s launcher (table::check_launch_pull). Throws
+/// ControllerFileError "path: launcher.pull: ..."; the file alone cannot tell,
+/// since a pull's launch speed depends on the board.
+void check_controller_launch(const ControllerSpec& spec, const table::Board& board, const std::string& path);
 
 }  // namespace pinball::control
