@@ -285,15 +285,25 @@ void save_controller(const ControllerSpec& spec, const std::string& path) {
 }
 
 ControllerSpec load_controller(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw ControllerFileError(path + ": cannot open");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  ControllerSpec spec = controller_from_json(ss.str(), path);
+  std::string text;
+  try {
+    text = read_text_file(path);
+  } catch (const std::runtime_error& e) {
+    throw ControllerFileError(e.what());
+  }
+  ControllerSpec spec = controller_from_json(text, path);
   // A planner's shot-value table is named relative to the controller file, so
   // that the two travel together.
-  if (spec.planner && spec.planner->shot_values && std::filesystem::path(*spec.planner->shot_values).is_relative()) {
-    spec.planner->shot_values = (std::filesystem::path(path).parent_path() / *spec.planner->shot_values).string();
+  if (spec.planner && spec.planner->shot_values) {
+    std::string& table = *spec.planner->shot_values;
+    if (table.empty()) throw ControllerFileError(path + ": planner.shot_values: names no file (leave the key out for none)");
+    if (std::filesystem::path(table).is_relative()) table = (std::filesystem::path(path).parent_path() / table).string();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(table, ec)) {
+      throw ControllerFileError(path + ": planner.shot_values: " + table +
+                                (std::filesystem::exists(table, ec) ? " is not a file" : " does not exist") +
+                                " (a relative path is from the controller file's folder)");
+    }
   }
   return spec;
 }

@@ -141,11 +141,10 @@ void write_shot_value_table(const ShotValueTable& t, const std::string& path) {
 }
 
 ShotValueTable read_shot_value_table(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read");
+  const std::string text = read_text_file(path);
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(in);
+    j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(path + ": not JSON: " + e.what());
   }

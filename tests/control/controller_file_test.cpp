@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/error_text.h"
+#include "common/temp_path.h"
 #include "common/thesis_board.h"
 
 namespace pinball::control {
@@ -291,6 +292,31 @@ TEST(ControllerFile, EveryShippedControllerLoads) {
   }
   EXPECT_GE(loaded, 13);
   EXPECT_TRUE(load_controller(PINBALL_SOURCE_DIR "/controllers/spastic.json").spastic);
+}
+
+TEST(ControllerFile, AShotValueTableThatIsNoFileIsRefusedAtLoadNamingTheKey) {
+  const std::string dir = pinball::testing::temp_path("controller_file", "shot_values");
+  std::filesystem::create_directories(dir);
+  nlohmann::json j = nlohmann::json::parse(controller_to_json([] {
+    ControllerSpec s;
+    s.planner = PlannerSettings{};
+    return s;
+  }()));
+  auto load_with = [&](const nlohmann::json& table) {
+    j["planner"]["shot_values"] = table;
+    const std::string path = dir + "/planner.json";
+    std::ofstream(path) << j.dump();
+    return pinball::testing::error_text([&] { load_controller(path); });
+  };
+  EXPECT_NE(load_with("").find("planner.json: planner.shot_values: names no file"), std::string::npos);
+  EXPECT_NE(load_with("absent.json").find("planner.shot_values: " + dir + "/absent.json does not exist"),
+            std::string::npos);
+  EXPECT_NE(load_with(dir).find("planner.shot_values: " + dir + " is not a file"), std::string::npos);
+  std::ofstream(dir + "/values.json") << "{}";
+  EXPECT_EQ(load_with("values.json"), "no error") << "relative to the controller file's folder";
+  EXPECT_NE(pinball::testing::error_text([&] { load_controller(dir); }).find("is a folder, not a file"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ControllerFile, ALaunchTooWeakForTheBoardIsRefusedNamingTheFileAndKey) {

@@ -79,7 +79,11 @@ TEST(ShotValues, RefusesAMissingFileAnotherFormatAndBinsThatDoNotAgree) {
       EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
     }
   };
-  refused(temp_path("absent.json"), "cannot read");
+  refused(temp_path("absent.json"), "cannot open");
+  const std::string folder = temp_path("a_folder");
+  std::filesystem::create_directories(folder);
+  refused(folder, "is a folder, not a file");  // it had said only "basic_filebuf::underflow error"
+  std::filesystem::remove(folder);
   const std::string other = temp_path("other.json");
   std::ofstream(other) << R"({"format": "pinball-controller"})";
   refused(other, "not a shot-value table");

@@ -24,9 +24,12 @@ inline std::string_view without_utf8_bom(std::string_view text) {
   return text.starts_with("\xEF\xBB\xBF") ? text.substr(3) : text;
 }
 
-/// The whole file at `path`. Throws std::runtime_error "path: cannot open"
-/// or "path: cannot read".
+/// The whole file at `path`. Throws std::runtime_error "path: cannot open",
+/// "path: is a folder, not a file" (a folder opens, then fails its first read
+/// with a library message that names nothing) or "path: cannot read".
 inline std::string read_text_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": is a folder, not a file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open");
   std::ostringstream s;
