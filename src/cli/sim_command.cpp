@@ -17,6 +17,7 @@
 #include "pinball/core/number_option.h"
 #include "pinball/learn/planning_controller.h"
 #include "pinball/core/json_write_archive.h"
+#include "pinball/control/spastic_controller.h"
 #include "pinball/core/format.h"
 #include "pinball/core/progress.h"
 #include "pinball/core/running_stats.h"
@@ -48,7 +49,8 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
                   "a learned controller file (docs/learning.md); implies --policy controller")
       ->transform(data_file());
   cmd->add_option("--reach", a.reach_m, "spastic: flip when the projected impact is this close (m)")
-      ->check(finite_range(0.0, 1.0));
+      ->check(finite_range(0.0, 1.0))
+      ->default_str(format_exact(control::SpasticConfig{}.reach_m));
   add_camera_model_options(*cmd, a.camera);
   cmd->add_option("--actuation", a.actuation,
                   "how commands reach the flippers: direct (the solenoid delay applied to the table), or can "
@@ -93,6 +95,10 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     policy = "controller";
   }
   if (policy == "controller" && a.controller.empty()) throw std::invalid_argument("sim: --policy controller needs --controller FILE");
+  if (a.reach_m && policy != "spastic") {
+    throw std::invalid_argument("sim: --reach is the spastic flipper's: give --policy spastic (or a controller file's "
+                                "spastic.reach_m)");
+  }
   std::unique_ptr<control::FlipperController> learned;
   std::optional<simlab::SimulatedPlayer> learned_player;
   double pull = -1.0;
@@ -106,7 +112,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   std::optional<simlab::SimulatedSpasticPlayer> spastic;
   if (policy == "spastic") {
     control::SpasticConfig spastic_config;
-    spastic_config.reach_m = a.reach_m;
+    if (a.reach_m) spastic_config.reach_m = *a.reach_m;
     spastic.emplace(board, a.camera, spastic_config, a.seed ^ 0x5DEECE66Dull);
   }
   // The recordings are opened once every input has loaded: a bad controller leaves no file behind.

@@ -21,9 +21,16 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
       ->transform(CLI::CheckedTransformer(kinds).description(""))
       ->type_name("{model,twin}")
       ->default_str("model");
+  // --world is declared first, so its value is in place when these two are checked, wherever it stands.
+  const simlab::WorldKind& kind = world.kind;
   cmd.add_option("--twin-params", world.twin_params_path,
                  "the twin's physical parameters (default: config/twin.yaml)")
-      ->transform(data_file());
+      ->transform(data_file())
+      ->check(CLI::Validator(
+          [&kind](std::string&) {
+            return kind == simlab::WorldKind::kTwin ? "" : "only the twin reads it: give --world twin too";
+          },
+          ""));
   cmd.add_option("--world-board", world.board_path,
                  "the world: the board the table really is (default: the belief, the board the tracker and "
                  "controller assume); same flippers required")
@@ -34,6 +41,11 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
                  "the model world's integrator: thesis (fixed-step Euler, Ch. 3) or event (exact between events, "
                  "docs/physics.md)")
       ->transform(CLI::CheckedTransformer(steppers).description(""))
+      ->check(CLI::Validator(
+          [&kind](std::string&) {
+            return kind == simlab::WorldKind::kModel ? "" : "the twin steps with MuJoCo's own integrator, not a stepper";
+          },
+          ""))
       ->type_name("{thesis,event}")
       ->default_str("thesis");
   cmd.add_option("--dt", world.dt_s,

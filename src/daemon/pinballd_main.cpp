@@ -184,6 +184,14 @@ static int run_pinballd(int argc, char** argv) {
     if (!lcm_url.empty()) config.lcm_url = lcm_url;
     if (realtime) config.sim.realtime = true;
     if (!can_log.empty()) config.can.log = can_log;
+    // Given on the command line and then read by no world: said, not ignored (a file lists every key).
+    const bool twin = config.sim.world == pinball::simlab::WorldKind::kTwin;
+    if (!stepper.empty() && twin) {
+      throw std::invalid_argument("--stepper: the twin steps with MuJoCo's own integrator, not a stepper");
+    }
+    if (!twin_params.empty() && !twin) {
+      throw std::invalid_argument("--twin-params: only the twin reads it: give --world twin (or sim.world: twin)");
+    }
     // A setting checked after this point is named by where it came from.
     std::size_t settings_given = 0;
     for (const CLI::Option* o : app.get_options()) settings_given += o->count();

@@ -522,6 +522,19 @@ TEST_F(Cli, BadArgumentsExitWithUsageError) {
   }
 }
 
+TEST_F(Cli, AnOptionNothingInThePlayReadsIsRefused) {
+  // Either order: --world is read first wherever it stands.
+  for (const char* args : {"sim boards/mit1993.board --world twin --stepper event",
+                           "sim boards/mit1993.board --stepper event --world twin"}) {
+    expect_refused("", {args, 2, "--stepper: the twin steps with MuJoCo's own integrator"});
+  }
+  expect_refused("", {"sim boards/mit1993.board --twin-params config/twin.yaml", 2,
+                      "--twin-params: only the twin reads it"});
+  expect_refused("", {"sim boards/mit1993.board --reach 0.05", 1, "--reach is the spastic flipper's"});
+  expect_refused("", {"sim boards/mit1993.board --controller controllers/imitation.json --reach 0.05", 1,
+                      "--reach is the spastic flipper's"});
+}
+
 TEST_F(Cli, AnEmptyOutputPathIsRefusedNotTakenAsNone) {
   // An unset shell variable ("--out $OUT") had silently written nothing.
   for (const char* args : {"sim boards/mit1993.board --trace ''", "sim boards/mit1993.board --video ''",
