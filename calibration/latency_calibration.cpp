@@ -488,7 +488,15 @@ LatencyEstimate measure_latency(const LatencyRecording& recording, const Flipper
       list += (list.empty() ? "" : ", ") + std::string("event ") + std::to_string(i + 1) + ": " +
               to_string(est.events[i].rejection);
     }
-    throw std::runtime_error(why + (list.empty() ? "" : " (" + list + ")"));
+    // The one cause a setting cures: the stroke's start is over within a frame or two.
+    const bool short_of_frames = std::any_of(est.events.begin(), est.events.end(), [](const LatencyEvent& ev) {
+      return ev.rejection == LatencyRejection::kTooFewFitFrames;
+    });
+    const std::string hint = short_of_frames ? "; too few frames in the fit window: the flipper's stroke starts within "
+                                               "fewer frames than the fit needs at this frame rate: run the camera "
+                                               "faster (--fps)"
+                                             : "";
+    throw std::runtime_error(why + (list.empty() ? "" : " (" + list + ")") + hint);
   }
   for (const LatencyEvent& ev : est.events) {
     if (ev.used()) est.motion_row_px += ev.motion_row_px / est.events_used;

@@ -494,6 +494,18 @@ void run_latency_sim(Context& c) {
   o.flipper = flipper_index(c.board, a.flipper);
   o.actuation_delay_s = a.actuation_delay_ms * 1e-3;
   if (a.sim_latency_ms >= 0.0) o.camera.realism.latency_min_s = a.sim_latency_ms * 1e-3;
+  // The simulated camera reads its rows out in a fixed time, and keeps 0.18 s of the table's motion.
+  const double readout_s = o.camera.realism.row_time_s * o.camera.height_px;
+  constexpr double kSimMinFps = 10.0;
+  if (a.fps < kSimMinFps || a.fps * readout_s > 1.0) {
+    throw std::invalid_argument("calibrate latency --sim: --fps " + format_number(a.fps) +
+                                ": the simulated camera runs at " + format_number(kSimMinFps) + " to " +
+                                format_number(std::floor(1.0 / readout_s)) + " frames/s (it reads a frame out in " +
+                                format_number(readout_s * 1e3) + " ms)");
+  }
+  o.camera.fps = a.fps;  // the rate asked of the camera, as in the lab (it had stayed 200)
+  o.camera.exposure_s = std::min(o.camera.exposure_s, 1.0 / a.fps);
+  o.lead_in_s = std::max(o.lead_in_s, calibration::latency_lead_in_s(calibration::LatencyOptions{}, 1.0 / a.fps));
   c.err << "calibrate latency: simulating " << o.events << " fires of " << c.board.flippers[o.flipper].name << "\n";
   const simlab::SimLatencyRun run = simlab::simulate_latency_run(c.board, o);
   calibration::LatencyOptions lo = run.timing;
@@ -684,7 +696,7 @@ void run_latency_lab(Context& c) {
   Rng rng(a.seed);
   std::vector<double> commands;
   const int driver = static_cast<int>(index);
-  double next = steady_now_s() + (lo.dejitter_frames + 40) * period;  // the frame clock settles first
+  double next = steady_now_s() + calibration::latency_lead_in_s(lo, period);  // the frame clock settles first
   c.err << "calibrate latency: firing " << name << " " << a.events << " times, " << spacing_s << " s apart\n";
   for (int k = 0; k < a.events && !stop.load() && !g_latency_interrupted.load(); ++k) {
     sleep_until(next + rng.uniform(0.0, period));  // a random phase against the frames

@@ -247,6 +247,22 @@ TEST_F(Calibrate, LatencyOnTheSimulatedCameraWritesTheTimingAndKeepsTheRest) {
   EXPECT_EQ(run("calibrate latency --sim boards/mit1993.board --events 5 --flipper middle").exit_code, 1);
 }
 
+// --fps is the simulated camera's rate too (it had stayed 200), within what that camera can do;
+// too slow a camera for the stroke is told how to cure it.
+TEST_F(Calibrate, LatencySimRunsTheCameraAtTheRateAskedOfIt) {
+  Result r = run("calibrate latency --sim boards/mit1993.board --events 6 --fps 120 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j["latency"]["frame_period_ms"].get<double>(), 1000.0 / 120.0, 1e-9);
+  EXPECT_NEAR(j["latency"]["latency_ms"].get<double>(), 7.0, 0.5);
+  r = run("calibrate latency --sim boards/mit1993.board --events 6 --fps 60");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("run the camera faster (--fps)"), std::string::npos) << r.err;
+  r = run("calibrate latency --sim boards/mit1993.board --fps 300");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--fps 300: the simulated camera runs at 10 to 208 frames/s"), std::string::npos) << r.err;
+}
+
 // The lab path on a machine without the camera or the CAN interface: one
 // line naming both, nothing fired, nothing written.
 TEST_F(Calibrate, LatencyInTheLabWithoutHardwareFailsClearlyAndWritesNothing) {

@@ -165,6 +165,13 @@ struct LatencyEstimate {
 /// std::invalid_argument for a period <= 0 or a window < 2.
 double estimate_frame_period_s(const LatencyRecording& recording, double nominal_period_s, int window = 100);
 
+/// How long a run records before its first command (s): the frames that date
+/// the clock (dejitter_frames) and the rest frames, with a margin, at the
+/// camera's period. The lab's run and the simulated one both wait this long.
+inline double latency_lead_in_s(const LatencyOptions& options, double frame_period_s) {
+  return (options.dejitter_frames + options.rest_frames + 34) * frame_period_s;
+}
+
 /// Measures the latency from a recording. Throws std::invalid_argument for bad
 /// options or frames, and std::runtime_error "latency: only 2 of 10 events
 /// usable (event 3: no motion seen, ...)" when fewer than 3 events survive.
