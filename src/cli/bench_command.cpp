@@ -10,6 +10,7 @@
 
 #include "camera_options.h"
 #include "data_file.h"
+#include "flag_uses.h"
 #include "pinball/core/format.h"
 #include "pinball/core/number_option.h"
 #include "pinball/core/progress.h"
@@ -136,12 +137,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   add_progress_flag(*cmd, a.progress);
   // Which flags were given, for run_bench to refuse one the chosen bench would not read.
-  cmd->parse_complete_callback([cmd, &a] {
-    a.flags_given.clear();
-    for (const CLI::Option* option : cmd->get_options()) {
-      if (option->count() > 0 && !option->get_lnames().empty()) a.flags_given.push_back("--" + option->get_lnames().front());
-    }
-  });
+  record_flags_given(cmd, a.flags_given);
   return cmd;
 }
 
@@ -512,11 +508,6 @@ int run_draw(const BenchArgs& a, const table::Board& board, std::ostream& out, s
 // Which benches read each flag that not every bench reads. A flag given to a
 // bench that would ignore it is refused, so that `bench tracker --noise-px 1`
 // does not quietly run the tracker bench's own camera grid instead.
-struct FlagUse {
-  std::vector<std::string_view> flags;
-  std::vector<std::string_view> benches;
-};
-
 const std::vector<FlagUse>& bench_flag_uses() {
   static const std::vector<FlagUse> uses = {
       {{"--board"}, {"speed", "tracker", "detector", "camera", "calibration", "precision", "ceiling", "aim", "cradle",
@@ -543,27 +534,6 @@ const std::vector<FlagUse>& bench_flag_uses() {
   return uses;
 }
 
-// "cradle", "ceiling and aim", "ceiling, aim, cradle and transfer".
-std::string list_in_words(const std::vector<std::string_view>& items) {
-  std::string text;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    text += (i == 0 ? "" : i + 1 == items.size() ? " and " : ", ") + std::string(items[i]);
-  }
-  return text;
-}
-
-void refuse_flags_the_bench_does_not_read(const BenchArgs& a) {
-  for (const std::string& flag : a.flags_given) {
-    for (const FlagUse& use : bench_flag_uses()) {
-      if (std::ranges::find(use.flags, flag) == use.flags.end()) continue;
-      if (std::ranges::find(use.benches, a.which) == use.benches.end()) {
-        throw std::invalid_argument("bench " + a.which + ": " + flag + " applies to " + list_in_words(use.benches) +
-                                    " only");
-      }
-    }
-  }
-}
-
 }  // namespace
 
 int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
@@ -572,7 +542,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   // Progress only on a terminal or with --progress: a stream without a buffer swallows it.
   std::ostream no_progress(nullptr);
   std::ostream& err = progress_wanted(a.progress) ? all_err : no_progress;
-  refuse_flags_the_bench_does_not_read(a);
+  refuse_flags_not_read(a.flags_given, bench_flag_uses(), "bench", a.which);
   if (a.which == "latency") return run_latency(a, out, err);
   if (a.which == "protocol") return run_protocol(a, out, err);
   const table::Board board = table::load_belief_board(a.board, a.identified);  // the belief of ceiling and transfer

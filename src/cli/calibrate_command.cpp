@@ -22,6 +22,7 @@
 
 #include "commands.h"
 #include "data_file.h"
+#include "flag_uses.h"
 #include "pinball/calibration/calibration_figure.h"
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/calibration/camera_calibration.h"
@@ -62,15 +63,17 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
   cmd->add_option("--board", a.board, "the machine's board file (flipper names, sides, rough places)")
       ->transform(data_file())
       ->excludes(sim);
-  cmd->add_option("--image", a.image, "camera: image of the markers")->check(input_file());
+  cmd->add_option("--image", a.image, "camera: image of the markers")->check(input_file())->excludes(sim);
   cmd->add_option("--markers", a.markers, "camera: marker positions, CSV x,y (m); default: the board's default layout")
       ->check(input_file());
   cmd->add_option("--down", a.down, "flippers: image of the pivot and tip markers, flippers down")
-      ->check(input_file());
-  cmd->add_option("--up", a.up, "flippers: the same with the flippers held up")->check(input_file());
+      ->check(input_file())
+      ->excludes(sim);
+  cmd->add_option("--up", a.up, "flippers: the same with the flippers held up")->check(input_file())->excludes(sim);
   cmd->add_option("--sweep", a.sweeps, "flippers: video of one flipper swept stop to stop (repeat, board order)")
       ->check(input_file())
-      ->default_str("");
+      ->default_str("")
+      ->excludes(sim);
   cmd->add_option("--method", a.method, "flippers: method written to the file when both ran")
       ->check(CLI::IsMember({"markers", "markerless"}));
   cmd->add_option("--target", a.target,
@@ -114,12 +117,14 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->check(output_file());
   cmd->add_option("--roll", a.rolls, "gravity: observation CSV (t,x,y) of one roll from rest (repeat)")
       ->check(input_file())
-      ->default_str("");
+      ->default_str("")
+      ->excludes(sim);
   cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")->check(finite_range(1, 1000));
   cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")
       ->check(finite_range(1e-6, 0.1));
   cmd->add_option("--calibration", a.calibration, "calibration file holding the camera homography (default: --out)")
-      ->transform(data_file());
+      ->transform(data_file())
+      ->excludes(sim);
   cmd->add_option("--out", a.out, "calibration file to write, or update keeping its other sections")
       ->check(output_file());
   cmd->add_option("--png", a.png, "picture of the detected markers, fitted circles or gravity fit");
@@ -141,8 +146,8 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
                   "intrinsics into the same --out first, docs/calibration.md)")
       ->check(CLI::IsMember({"ideal", "typical"}))
       ->needs(sim);
-  cmd->add_option("--device", a.device, "latency: the camera, /dev/videoN");
-  cmd->add_option("--can", a.can, "latency: the driver board's SocketCAN interface, e.g. can0");
+  cmd->add_option("--device", a.device, "latency: the camera, /dev/videoN")->excludes(sim);
+  cmd->add_option("--can", a.can, "latency: the driver board's SocketCAN interface, e.g. can0")->excludes(sim);
   cmd->add_option("--flipper", a.flipper, "latency: the flipper to fire, by the board's name (default: the first)");
   cmd->add_option("--events", a.events, "latency: times the flipper is fired")->check(finite_range(3, 1000));
   cmd->add_option("--sim-latency-ms", a.sim_latency_ms,
@@ -165,10 +170,30 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->default_str("");  // -1: the simulated camera's
   cmd->add_option("--fps", a.fps, "latency: the frame rate asked of the camera")->check(finite_range(1.0, 2000.0));
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
+  record_flags_given(cmd, a.flags_given);
   return cmd;
 }
 
 namespace {
+
+// Which kinds read each flag that not every kind reads: `calibrate latency
+// --sim-rolls 9` had run as if it were not there.
+const std::vector<FlagUse>& calibrate_flag_uses() {
+  static const std::vector<FlagUse> uses = {
+      {{"--target", "--images", "--sim-views", "--camera-size", "--print-target"}, {"intrinsics"}},
+      {{"--image"}, {"camera"}},
+      {{"--markers", "--sim-pivot-offset-mm", "--sim-length-offset-mm", "--sim-theta-offset-deg", "--sim-camera"},
+       {"camera", "flippers"}},
+      {{"--down", "--up", "--sweep", "--method"}, {"flippers"}},
+      {{"--roll", "--sim-rolls", "--sigma"}, {"gravity"}},
+      {{"--calibration"}, {"flippers", "latency"}},
+      {{"--png"}, {"intrinsics", "camera", "flippers", "gravity"}},
+      {{"--device", "--can", "--flipper", "--events", "--sim-latency-ms", "--actuation-delay-ms", "--row-time-us",
+        "--exposure-us", "--fps"},
+       {"latency"}},
+  };
+  return uses;
+}
 
 // The file --out updates, read first (a bad one is refused before any work). Its other
 // sections stay, so a file whose camera, flippers or gravity are another board's is refused:
@@ -931,6 +956,7 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
 int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) {
   // What is written at the end can be written: checked before any work, and
   // before `latency` fires a flipper in the lab.
+  refuse_flags_not_read(a.flags_given, calibrate_flag_uses(), "calibrate", a.kind);
   check_output_folder(a.out, "--out");
   check_png_output(a.png, "--png");
   check_png_output(a.print_target, "--print-target");

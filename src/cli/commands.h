@@ -176,6 +176,7 @@ struct CalibrateArgs {
   double exposure_us = -1.0;         ///< latency: the camera's exposure time (µs); < 0: the simulated camera's, or 0 in the lab
   double fps = 200.0;                ///< latency: the frame rate asked of the camera
   bool json = false;                 ///< one JSON object on stdout
+  std::vector<std::string> flags_given;  ///< the long flags on the command line ("--sim-rolls"), set by the parser
 };
 CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& args);
 int run_calibrate(const CalibrateArgs& args, std::ostream& out, std::ostream& err);

@@ -126,6 +126,25 @@ TEST_F(Calibrate, BadInputsExitWithOne) {
       << twice.err;
 }
 
+// A flag the kind (or the simulation) would not read is refused, not ignored.
+TEST_F(Calibrate, AFlagTheKindDoesNotReadIsRefused) {
+  const Result rolls = run("calibrate latency --sim boards/mit1993.board --sim-rolls 9");
+  EXPECT_EQ(rolls.exit_code, 1);
+  EXPECT_NE(rolls.err.find("calibrate latency: --sim-rolls applies to gravity only"), std::string::npos) << rolls.err;
+  const Result fps = run("calibrate gravity --sim boards/mit1993.board --fps 60");
+  EXPECT_EQ(fps.exit_code, 1);
+  EXPECT_NE(fps.err.find("calibrate gravity: --fps applies to latency only"), std::string::npos) << fps.err;
+  const Result png = run("calibrate latency --sim boards/mit1993.board --png " + (dir_ / "x.png").string());
+  EXPECT_NE(png.err.find("--png applies to intrinsics, camera, flippers and gravity only"), std::string::npos)
+      << png.err;
+  // The simulation makes its own images, rolls and hardware.
+  const std::string roll = (dir_ / "roll.csv").string();
+  std::ofstream(roll) << "t,x,y\n0,0.2,0.9\n";
+  const Result lab_input = run("calibrate gravity --sim boards/mit1993.board --roll " + roll);
+  EXPECT_EQ(lab_input.exit_code, 2);
+  EXPECT_NE(lab_input.err.find("--sim excludes --roll"), std::string::npos) << lab_input.err;
+}
+
 // What is written at the end is checked before any work: in the lab,
 // `latency` would otherwise fire the flipper twenty times and then fail.
 TEST_F(Calibrate, AnOutputThatCannotBeWrittenIsRefusedBeforeAnyWork) {
