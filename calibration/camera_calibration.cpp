@@ -222,7 +222,7 @@ std::vector<Vec2> default_marker_layout(const table::Board& board) {
   return out;
 }
 
-std::vector<Vec2> read_marker_layout_csv(const std::string& path) {
+std::vector<Vec2> read_marker_layout_csv(const std::string& path, const table::Board& board) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
   std::string line;
@@ -244,9 +244,20 @@ std::vector<Vec2> read_marker_layout_csv(const std::string& path) {
     if (!(s >> x >> comma >> y) || comma != ',' || !std::isfinite(x) || !std::isfinite(y)) {
       throw std::runtime_error(path + ":" + std::to_string(line_no) + ": expected two numbers x,y (m)");
     }
+    // Markers sit on the playfield or its rim; farther off is a unit or a file mistaken.
+    if (!table::near_playfield(board, Vec2(x, y))) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": marker (" + format_number(x) + ", " +
+                               format_number(y) + ") m is " + table::off_playfield_text(board) +
+                               " (positions are in metres, board frame)");
+    }
     out.emplace_back(x, y);
   }
   if (!header) throw std::runtime_error(path + ":1: header must be x,y");
+  try {
+    check_marker_layout(out);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
   return out;
 }
 

@@ -65,7 +65,8 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->excludes(sim);
   cmd->add_option("--image", a.image, "camera: image of the markers")->check(input_file())->excludes(sim);
   cmd->add_option("--markers", a.markers, "camera: marker positions, CSV x,y (m); default: the board's default layout")
-      ->check(input_file());
+      ->check(input_file())
+      ->excludes(sim);  // the simulated lab sets out the default layout
   cmd->add_option("--down", a.down, "flippers: image of the pivot and tip markers, flippers down")
       ->check(input_file())
       ->excludes(sim);
@@ -182,7 +183,8 @@ const std::vector<FlagUse>& calibrate_flag_uses() {
   static const std::vector<FlagUse> uses = {
       {{"--target", "--images", "--sim-views", "--camera-size", "--print-target"}, {"intrinsics"}},
       {{"--image"}, {"camera"}},
-      {{"--markers", "--sim-pivot-offset-mm", "--sim-length-offset-mm", "--sim-theta-offset-deg", "--sim-camera"},
+      {{"--markers"}, {"camera"}},
+      {{"--sim-pivot-offset-mm", "--sim-length-offset-mm", "--sim-theta-offset-deg", "--sim-camera"},
        {"camera", "flippers"}},
       {{"--down", "--up", "--sweep", "--method"}, {"flippers"}},
       {{"--roll", "--sim-rolls", "--sigma"}, {"gravity"}},
@@ -242,7 +244,7 @@ struct Context {
 
 calibration::HomographyFit camera(Context& c) {
   const std::vector<Vec2> layout = c.a.markers.empty() ? calibration::default_marker_layout(c.board)
-                                                       : calibration::read_marker_layout_csv(c.a.markers);
+                                                       : calibration::read_marker_layout_csv(c.a.markers, c.board);
   const cv::Mat image = c.lab ? c.lab->camera_image() : plot::read_gray_image(c.a.image);
   c.err << "calibrate camera: " << layout.size() << " markers in the layout, image " << image.cols << "x" << image.rows
         << "\n";
@@ -399,7 +401,9 @@ void run_gravity(Context& c) {
     for (const std::string& path : c.a.rolls) {
       calibration::GravityRoll r;
       r.source = path;
-      for (const track::ObservationRow& row : track::read_observations_csv(path)) r.observations.push_back(row.observation);
+      const std::vector<track::ObservationRow> rows = track::read_observations_csv(path);
+      track::check_observations_on_board(rows, c.board, path);
+      for (const track::ObservationRow& row : rows) r.observations.push_back(row.observation);
       rolls.push_back(std::move(r));
     }
   }

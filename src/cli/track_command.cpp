@@ -47,6 +47,7 @@ const char* side_name(int flipper) { return flipper == track::kLeftFlipper ? "le
 int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
   const table::Board board = table::load_board(a.board);
   const std::vector<track::ObservationRow> rows = track::read_observations_csv(a.observations);
+  track::check_observations_on_board(rows, board, a.observations);
   track::TrackerConfig config = track::default_tracker_config(board, track::CameraModelConfig{});
   track::FlipperGeometry geometry = track::flipper_geometry_from_board(board);
   if (!a.calibration.empty()) {

@@ -438,23 +438,17 @@ std::vector<table::ObstacleGroupOverlay> material_groups(const table::Board& boa
 }
 
 void check_recording_fits_board(const bus::RecordedPlay& play, const table::Board& board) {
-  constexpr double kMargin_m = 0.05;
-  constexpr double kMostOff = 0.05;
   std::size_t found = 0;
   std::size_t off = 0;
   for (const bus::RecordedFrame& f : play.frames) {
     if (!f.found) continue;
     ++found;
-    const Vec2& p = f.p_board;
-    const bool on = p.x() >= -kMargin_m && p.x() <= board.width_m + kMargin_m && p.y() >= -kMargin_m &&
-                    p.y() <= board.height_m + kMargin_m;
-    off += on ? 0 : 1;
+    off += table::near_playfield(board, f.p_board) ? 0 : 1;
   }
-  if (found > 0 && static_cast<double>(off) > kMostOff * static_cast<double>(found)) {
+  if (found > 0 && static_cast<double>(off) > table::kMostOffPlayfield * static_cast<double>(found)) {
     throw std::runtime_error(play.source + ": " + std::to_string(off) + " of its " + std::to_string(found) +
-                             " sightings lie more than " + format_number(kMargin_m * 1e2) + " cm off the " +
-                             format_number(board.width_m) + " x " + format_number(board.height_m) + " m board " +
-                             board.source + ": a log of another table, or a camera calibration in other units?");
+                             " sightings lie " + table::off_playfield_text(board) +
+                             ": a log of another table, or a camera calibration in other units?");
   }
   const int flippers = static_cast<int>(board.flippers.size());
   for (const bus::RecordedCommand& c : play.commands) {

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pinball/core/format.h"
+
 namespace pinball::table {
 
 Shape make_line_shape(const Vec2& p0, const Vec2& p1) {
@@ -138,6 +140,16 @@ double min_launch_speed_mps(const Board& board) {
 
 double slowest_launch_mps(const Board& board, double pull) {
   return pull * (1.0 - board.launcher.noise_max) * board.ball.speed_max_mps;
+}
+
+bool near_playfield(const Board& board, const Vec2& p) {
+  const double m = kOffPlayfieldMargin_m;
+  return p.x() >= -m && p.x() <= board.width_m + m && p.y() >= -m && p.y() <= board.height_m + m;
+}
+
+std::string off_playfield_text(const Board& board) {
+  return "over " + format_number(kOffPlayfieldMargin_m * 1e2) + " cm off the " + format_number(board.width_m) +
+         " x " + format_number(board.height_m) + " m playfield of " + board.source;
 }
 
 void check_launch_pull(const Board& board, double pull) {

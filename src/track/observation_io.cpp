@@ -1,5 +1,6 @@
 #include "pinball/track/observation_io.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -101,6 +102,18 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
   if (line_no == 0) fail(path, 1, "empty file: expected the header 't,x,y'");
   if (rows.empty()) fail(path, line_no, "no observation after the header");
   return rows;
+}
+
+void check_observations_on_board(const std::vector<ObservationRow>& rows, const table::Board& board,
+                                 const std::string& path) {
+  const auto off = static_cast<std::size_t>(std::count_if(rows.begin(), rows.end(), [&](const ObservationRow& r) {
+    return !table::near_playfield(board, r.observation.p_board);
+  }));
+  if (static_cast<double>(off) > table::kMostOffPlayfield * static_cast<double>(rows.size())) {
+    throw std::runtime_error(path + ": " + std::to_string(off) + " of its " + std::to_string(rows.size()) +
+                             " observations lie " + table::off_playfield_text(board) +
+                             " (positions are in metres, board frame: a file in mm, or of another table?)");
+  }
 }
 
 }  // namespace pinball::track

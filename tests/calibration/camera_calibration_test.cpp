@@ -1,11 +1,14 @@
 #include "pinball/calibration/camera_calibration.h"
 
+#include <cstdio>
+#include <fstream>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "common/error_text.h"
+#include "common/temp_path.h"
 #include "pinball/core/rng.h"
 #include "pinball/simlab/sim_camera_source.h"
 #include "pinball/table/board_loader.h"
@@ -87,6 +90,26 @@ TEST(CameraCalibration, DegenerateLayoutsAreRefused) {
 // The message must name what to fix: the layout, or the spots that are no marker.
 std::string fit_error(const std::vector<DetectedMarker>& det, const std::vector<Vec2>& layout) {
   return pinball::testing::error_text([&] { fit_homography(det, layout, cv::Size(640, 480)); });
+}
+
+TEST(CameraCalibration, ALayoutFileOffTheBoardOrDegenerateIsRefusedNamingTheFile) {
+  const std::string path = pinball::testing::temp_path("camera_calibration", "layout.csv");
+  table::Board board = table();
+  board.source = "lab.board";
+  auto read = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    return pinball::testing::error_text([&] { read_marker_layout_csv(path, board); });
+  };
+  std::string layout = "x,y\n";
+  for (const Vec2& p : default_marker_layout(board)) layout += std::to_string(p.x()) + "," + std::to_string(p.y()) + "\n";
+  EXPECT_EQ(read(layout), "no error");
+  // The same layout in millimetres: it had been fitted, and failed with no word of the file.
+  EXPECT_EQ(read("x,y\n51,100\n"),
+            path + ":2: marker (51, 100) m is over 5 cm off the 0.51 x 1.07 m playfield of lab.board "
+                   "(positions are in metres, board frame)");
+  EXPECT_EQ(read("x,y\n0.1,0.1\n0.1,0.1\n0.3,0.5\n0.2,0.9\n"),
+            path + ": marker layout: markers 0 and 1 coincide (closer than 10 mm)");
+  std::remove(path.c_str());
 }
 
 TEST(CameraCalibration, SymmetricLayoutIsNamedAsTheCause) {

@@ -74,6 +74,23 @@ TEST(ObservationIo, BadFilesAreRefusedNamingTheLine) {
 }
 
 // A byte-order mark before the header (an editor's) is skipped, as in board files.
+TEST(ObservationIo, AFileMostlyOffTheBoardIsRefusedAsOtherUnits) {
+  table::Board board;
+  board.width_m = 0.51;
+  board.height_m = 1.07;
+  board.source = "lab.board";
+  std::vector<ObservationRow> rows(20);
+  for (std::size_t i = 0; i < rows.size(); ++i) rows[i].observation.p_board = Vec2(0.25, 0.5 + 0.01 * i);
+  const auto check = [&] {
+    return pinball::testing::error_text([&] { check_observations_on_board(rows, board, "roll.csv"); });
+  };
+  rows[0].observation.p_board = Vec2(250.0, 500.0);  // one stray sighting in 20: 5 %, kept
+  EXPECT_EQ(check(), "no error");
+  rows[1].observation.p_board = Vec2(0.25, -0.2);
+  EXPECT_EQ(check(), "roll.csv: 2 of its 20 observations lie over 5 cm off the 0.51 x 1.07 m playfield of lab.board "
+                     "(positions are in metres, board frame: a file in mm, or of another table?)");
+}
+
 TEST(ObservationIo, AByteOrderMarkBeforeTheHeaderIsSkipped) {
   const std::string bom = write_csv("bom.csv", "\xEF\xBB\xBFt,x,y\n0,0.1,0.2\n");
   const std::vector<ObservationRow> rows = read_observations_csv(bom);

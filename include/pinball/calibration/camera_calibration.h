@@ -53,9 +53,11 @@ void check_marker_layout(std::span<const Vec2> board_points, double min_separati
 /// that would make the matching ambiguous (m, board frame).
 std::vector<Vec2> default_marker_layout(const table::Board& board);
 
-/// Reads marker board positions from a CSV with header x,y (m). Throws
-/// std::runtime_error "file:line: what".
-std::vector<Vec2> read_marker_layout_csv(const std::string& path);
+/// Reads marker board positions from a CSV with header x,y (m) for `board`.
+/// Throws std::runtime_error "file:line: what" for a bad row or a marker over
+/// 5 cm off the playfield (a layout in mm, or another table's), and "file:
+/// marker layout: ..." for a layout check_marker_layout refuses.
+std::vector<Vec2> read_marker_layout_csv(const std::string& path, const table::Board& board);
 
 /// Matching and fitting settings.
 struct HomographyFitConfig {

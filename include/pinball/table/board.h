@@ -251,6 +251,21 @@ double slowest_launch_mps(const Board& board, double pull);
 /// A board with a `start` never launches: any pull passes.
 void check_launch_pull(const Board& board, double pull);
 
+/// How far off the playfield a point a file gives (a sighting, a marker) may
+/// lie (m) before the file is taken for another table's or for other units:
+/// the rim, and a calibration's error, fit well within it.
+inline constexpr double kOffPlayfieldMargin_m = 0.05;
+/// The share of a recording's sightings that may lie that far off: a
+/// detector's stray sightings stay well below it.
+inline constexpr double kMostOffPlayfield = 0.05;
+
+/// True when `p` (m, board frame) lies within kOffPlayfieldMargin_m of the playfield.
+bool near_playfield(const Board& board, const Vec2& p);
+
+/// "over 5 cm off the 0.51 x 1.07 m playfield of B": what the messages that
+/// refuse such points say of them.
+std::string off_playfield_text(const Board& board);
+
 /// How far a flipper's tip region sweeps across in one step: l·sin(θ̇₀·dt/2)
 /// (m), its length once the half sweep passes π/2. It must stay below the
 /// ball's radius, or the bat can jump over the ball.

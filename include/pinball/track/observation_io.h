@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "pinball/table/board.h"
 #include "pinball/track/observation.h"
 
 namespace pinball::track {
@@ -21,5 +22,11 @@ struct ObservationRow {
 /// (bad header, missing or non-finite number, contact not 0/1, time going
 /// backwards) and returns nothing partial.
 std::vector<ObservationRow> read_observations_csv(const std::string& path);
+
+/// Throws std::runtime_error "path: 40 of its 200 observations lie over 5 cm
+/// off the ... playfield of B ..." when more than table::kMostOffPlayfield of
+/// `rows` lie that far off `board`: a file in mm, or of another table.
+void check_observations_on_board(const std::vector<ObservationRow>& rows, const table::Board& board,
+                                 const std::string& path);
 
 }  // namespace pinball::track
