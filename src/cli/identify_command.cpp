@@ -129,7 +129,10 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
                                     {"scan", scan}};
   nlohmann::json strokes = nlohmann::json::array();
   for (const learn::FlipperStrokeFit& f : r.flipper_strokes) {
+    const table::Flipper& on_board = board.flippers[static_cast<std::size_t>(&f - r.flipper_strokes.data())];
     strokes.push_back({{"name", f.name},
+                       {"board_omega_rad_s", on_board.omega_rad_s},
+                       {"board_mu", on_board.mu},
                        {"shots", f.shots},
                        {"outliers", f.outliers},
                        {"identified", f.identified},
@@ -244,10 +247,11 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
   }
   for (const learn::FlipperStrokeFit& f : r.flipper_strokes) {
     if (!f.identified) continue;
+    const table::Flipper& on_board = board.flippers[static_cast<std::size_t>(&f - r.flipper_strokes.data())];
     out << "  flipper " << f.name << ": rise delay " << format_number(f.rise_delay_s.value * 1000.0) << " ± "
         << format_number(f.rise_delay_s.stderr_ * 1000.0, 2) << " ms, stroke " << value_text(f.omega_rad_s, " rad/s")
-        << " (board " << format_number(board.flippers[&f - r.flipper_strokes.data()].omega_rad_s) << ")";
-    if (f.mu) out << ", mu " << value_text(*f.mu, "");
+        << " (board " << format_number(on_board.omega_rad_s) << ")";
+    if (f.mu) out << ", mu " << value_text(*f.mu, "") << " (board " << format_number(on_board.mu) << ")";
     out << " (" << f.shots << " shots, " << f.outliers << " outliers); contact time residual "
         << format_number(f.timing_rms_nominal_s * 1000.0) << " -> " << format_number(f.timing_rms_fitted_s * 1000.0)
         << " ms; replayed shots' velocity error (median): board " << format_number(f.velocity_error_nominal_mps)

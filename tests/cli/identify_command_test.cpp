@@ -54,6 +54,10 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   ASSERT_EQ(j["flippers"].size(), 2u);
   EXPECT_EQ(j["flippers"][0]["name"], "left_flipper");
   EXPECT_FALSE(j["flippers"][0]["identified"].get<bool>());
+  // The board's values beside the fit's, as the text gives them.
+  EXPECT_DOUBLE_EQ(j["flippers"][0]["board_omega_rad_s"].get<double>(),
+                   pinball::testing::thesis_board().flippers[0].omega_rad_s);
+  EXPECT_DOUBLE_EQ(j["flippers"][0]["board_mu"].get<double>(), pinball::testing::thesis_board().flippers[0].mu);
   EXPECT_EQ(j["flipper_shots"], 0);
   EXPECT_TRUE(j["actuation_delay_s"].is_null());
   EXPECT_TRUE(j["actuation_delay_stderr_s"].is_null());
