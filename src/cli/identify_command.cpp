@@ -28,9 +28,17 @@
 namespace pinball::cli {
 namespace {
 
-std::vector<bus::RecordedPlay> read_all(const std::vector<std::string>& paths) {
+// Reading a log of half an hour takes seconds: shown as a stage of its own.
+std::vector<bus::RecordedPlay> read_all(const std::vector<std::string>& paths, std::ostream* shown,
+                                        const std::string& label) {
   std::vector<bus::RecordedPlay> plays;
-  for (const std::string& path : paths) plays.push_back(bus::read_recorded_play(path));
+  if (paths.empty()) return plays;
+  ProgressMeter meter(shown, "identify: " + label, static_cast<double>(paths.size()), "logs");
+  meter.update(0);
+  for (const std::string& path : paths) {
+    plays.push_back(bus::read_recorded_play(path));
+    meter.update(static_cast<double>(plays.size()));
+  }
   return plays;
 }
 
@@ -335,8 +343,9 @@ int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
   check_output_folder(a.out, "--out");
   check_distinct_files(a);
   const table::Board board = table::load_board(find_data_file(a.board));  // the default too, from any folder
-  const std::vector<bus::RecordedPlay> plays = read_all(a.logs);
-  const std::vector<bus::RecordedPlay> held = read_all(a.held_out);
+  std::ostream* shown = progress_wanted(a.progress) ? &err : nullptr;
+  const std::vector<bus::RecordedPlay> plays = read_all(a.logs, shown, "reading logs");
+  const std::vector<bus::RecordedPlay> held = read_all(a.held_out, shown, "reading held-out logs");
   for (const std::vector<bus::RecordedPlay>* logs : {&plays, &held}) {
     for (const bus::RecordedPlay& play : *logs) learn::check_recording_fits_board(play, board);
   }
@@ -344,7 +353,6 @@ int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
   options.flights.sigma_m = a.sigma_m;
   options.bootstrap = a.bootstrap;
   options.seed = a.seed;
-  std::ostream* shown = progress_wanted(a.progress) ? &err : nullptr;
   std::optional<ProgressMeter> meter;
   std::string stage;
   // The held-out moments first: a log too short to test on is said before the fit, not as a ratio of 0.

@@ -295,6 +295,7 @@ FlightGravity fit_flight_gravity(std::span<const bus::RecordedPlay> recordings, 
     Rng rng(seed);
     Eigen::MatrixXd estimates(bootstrap, fit.theta.size());
     std::vector<const FlightData*> sample(kept.size());
+    if (progress) progress(0, bootstrap);
     for (int b = 0; b < bootstrap; ++b) {
       for (auto& s : sample) s = kept[static_cast<std::size_t>(rng.uniform01() * static_cast<double>(kept.size()))];
       estimates.row(b) = fit_shared(sample, fit.theta).theta.transpose();

@@ -318,6 +318,7 @@ WallThicknessFit fit_wall_thickness(const table::Board& belief, std::span<const 
   const std::vector<PredictionStart> starts = prediction_starts(recordings, options);
   std::vector<double> thickness;
   std::vector<std::vector<double>> errors;  // per thickness, per start
+  if (progress) progress(0, kSteps);
   for (int k = 0; k < kSteps; ++k) {
     table::Board b = belief;
     table::set_wall_thickness(b, k * kStep_m);
@@ -481,6 +482,8 @@ IdentificationResult identify_table(const table::Board& board, std::span<const b
                                     const std::function<void(const std::string&, int, int)>& progress) {
   IdentificationResult result;
   std::vector<FreeFlight> flights;
+  // Each stage reports 0 done as it starts, so that its meter times the whole stage.
+  if (progress) progress("free flights", 0, static_cast<int>(recordings.size()));
   for (std::size_t r = 0; r < recordings.size(); ++r) {
     const bus::RecordedPlay& play = recordings[r];
     result.overlay.recordings.push_back(play.source);

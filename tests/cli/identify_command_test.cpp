@@ -43,6 +43,8 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_NEAR(j["gravity"]["g_mps2"].get<double>(), 0.95, 0.02);
+  // Not a terminal, no --progress: stderr stays quiet for a script.
+  EXPECT_EQ(r.err.find("identify: "), std::string::npos) << r.err;
   EXPECT_EQ(j["gravity"]["bootstrap_resamples"], 5);
   EXPECT_GT(j["gravity"]["g_stderr_mps2"].get<double>(), 0.0);
   EXPECT_GT(j["free_flights"].get<int>(), 20);
@@ -112,6 +114,19 @@ TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
             std::string::npos)
       << text.out;
   EXPECT_EQ(run("identify " + held + " --bootstrap 1").exit_code, 2) << "one resample gives no spread";
+}
+
+// Each stage's meter starts with the stage: the first line of one is 0 done, so the
+// time of the first unit is counted (it had said "1/50, 0 ms elapsed, ETA 0 ms").
+TEST_F(IdentifyCommand, ProgressShowsEveryStageFromItsStart) {
+  const std::string log = record("progress.lcm", 10, 5);
+  const pinball::testing::CommandResult r = run("identify " + log + " --bootstrap 3 --progress");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* first : {"identify: reading logs: 0/1 logs (0 %)", "identify: free flights: 0/1 (0 %)",
+                            "identify: gravity bootstrap: 0/3 (0 %)", "identify: wall thickness: 0/9 (0 %)"}) {
+    EXPECT_NE(r.err.find(first), std::string::npos) << first << "\n" << r.err;
+  }
+  EXPECT_NE(r.err.find("identify: gravity bootstrap: 3/3 (100 %)"), std::string::npos) << r.err;
 }
 
 TEST_F(IdentifyCommand, BadLogsAreRefusedNamingTheFileAndNothingIsWritten) {

@@ -99,7 +99,7 @@ struct FlightGravity {
 /// holds each flight's frames. `nominal_g_mps2` starts the search and gives
 /// the "before" residual. With `fit_drag` c is free, else 0. `bootstrap`
 /// resamples of the flights (0: none) give the stderrs, drawn from `seed`;
-/// `progress(done, total)` is called after each. Throws std::runtime_error
+/// `progress(done, total)` is called with 0 before the first and after each. Throws std::runtime_error
 /// with fewer than 2 flights.
 FlightGravity fit_flight_gravity(std::span<const bus::RecordedPlay> recordings, std::span<const FreeFlight> flights,
                                  double nominal_g_mps2, double sigma_m, bool fit_drag, int bootstrap,

@@ -187,7 +187,7 @@ void check_recording_fits_board(const bus::RecordedPlay& play, const table::Boar
 
 /// Identifies what `recordings` show of the table `board` describes (the
 /// belief: its geometry must be the recorded table's). `progress(stage,
-/// done, total)` reports long stages. Throws std::runtime_error when the
+/// done, total)` reports long stages, with done 0 as each starts. Throws std::runtime_error when the
 /// recordings hold fewer than 2 free flights (nothing at all can be fitted).
 IdentificationResult identify_table(const table::Board& board, std::span<const bus::RecordedPlay> recordings,
                                     const IdentifyOptions& options = {},
