@@ -1,10 +1,13 @@
 #include "transfer_bench.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "pinball/learn/planning_controller.h"
 #include "pinball/control/spastic_controller.h"
@@ -164,21 +167,76 @@ std::vector<PlannedWorld> plan_worlds(const table::Board& belief, const Transfer
 }
 
 // Shares one count of balls over every cell for the progress line, which
-// names the world being played.
+// names the world being played. The ETA goes world kind by world kind
+// (thesis, event, twin): a twin ball costs many model balls, and one rate
+// over every ball had the ETA far too short while the twin played and far
+// too long after it.
 class ProgressCount {
  public:
-  ProgressCount(const std::function<void(const std::string&)>& progress, long total)
-      : total_(std::max(1L, total)), count_(total_, total_ / 100, [this, &progress](long d, double elapsed_s) {
-          // "transfer: 4000/116000 balls (3 %), 40 s elapsed, ETA 19 min 10 s; gravity_pct=+10"
-          if (progress) progress(format_progress("transfer", d, total_, "balls", elapsed_s, world_));
-        }) {}
-  /// Before a world's balls (no ball in flight): the name the lines carry.
-  void start_world(const std::string& world) { world_ = world; }
+  // `balls_by_kind`: this rank's balls of each world to play, with the world's kind.
+  ProgressCount(const std::function<void(const std::string&)>& progress,
+                const std::vector<std::pair<std::string, long>>& balls_by_kind)
+      : total_(std::max(1L, total_of(balls_by_kind))),
+        count_(total_, total_ / 100, [this, &progress](long d, double elapsed_s) { report(progress, d, elapsed_s); }) {
+    for (const auto& [kind, balls] : balls_by_kind) {
+      auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const auto& k) { return k.first == kind; });
+      if (it == kinds_.end()) it = kinds_.insert(kinds_.end(), {kind, KindProgress{}});
+      it->second.total += static_cast<double>(balls);
+    }
+  }
+  /// Before a world's balls (no ball in flight): the name the lines carry, and its kind's clock.
+  void start_world(const std::string& world, const std::string& kind) {
+    close_world();
+    world_ = world;
+    kind_ = kind;
+    world_start_done_ = count_.done();
+    world_start_s_ = elapsed_s();
+  }
   void ball_done() { count_.one_done(); }
 
  private:
+  static long total_of(const std::vector<std::pair<std::string, long>>& balls_by_kind) {
+    long total = 0;
+    for (const auto& entry : balls_by_kind) total += entry.second;
+    return total;
+  }
+  double elapsed_s() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  // The world just played, into its kind's figures.
+  void close_world() {
+    if (kind_.empty()) return;
+    KindProgress& k = kind(kind_);
+    k.done += static_cast<double>(count_.done() - world_start_done_);
+    k.wall_s += elapsed_s() - world_start_s_;
+  }
+  KindProgress& kind(const std::string& name) {
+    return std::find_if(kinds_.begin(), kinds_.end(), [&](const auto& k) { return k.first == name; })->second;
+  }
+  // Under the count's lock; kinds_ changes only between worlds, with no ball in flight.
+  void report(const std::function<void(const std::string&)>& progress, long done, double elapsed) {
+    if (!progress) return;
+    std::vector<KindProgress> now;
+    now.reserve(kinds_.size());
+    for (const auto& [name, k] : kinds_) {
+      KindProgress p = k;
+      if (name == kind_) {
+        p.done += static_cast<double>(done - world_start_done_);
+        p.wall_s += elapsed - world_start_s_;
+      }
+      now.push_back(p);
+    }
+    const double eta_s = eta_by_kind_s(now, done > 0 ? elapsed / static_cast<double>(done) : 0.0);
+    // "transfer: 4000/116000 balls (3 %), 40 s elapsed, ETA 19 min 10 s; gravity_pct=+10"
+    progress(format_progress("transfer", static_cast<double>(done), static_cast<double>(total_), "balls", elapsed,
+                             world_, 0.0, eta_s));
+  }
+
   long total_;
+  std::vector<std::pair<std::string, KindProgress>> kinds_;
   std::string world_;
+  std::string kind_;
+  long world_start_done_ = 0;
+  double world_start_s_ = 0.0;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   SharedProgress count_;
 };
 
@@ -187,7 +245,7 @@ void play_world(PlannedWorld& w, const table::Board& belief, const TransferBench
                 const std::vector<TransferController>& players, ProgressCount& progress) {
   const auto balls = static_cast<std::size_t>(w.row.balls);
   const auto start = std::chrono::steady_clock::now();
-  progress.start_world(w.row.name);
+  progress.start_world(w.row.name, w.row.world);
   const std::vector<learn::Blob> blobs = learn::distributed_map(players.size() * balls, o.threads, [&](std::size_t i) {
     const auto ball_start = std::chrono::steady_clock::now();
     const std::unique_ptr<sim::World> ball_world = w.world->fork();
@@ -260,10 +318,14 @@ TransferReport run_transfer_bench(const table::Board& belief, const TransferBenc
   std::vector<TransferController> players{{"spastic", "", nullptr}};
   players.insert(players.end(), options.controllers.begin(), options.controllers.end());
   std::vector<PlannedWorld> worlds = plan_worlds(belief, options);
-  long balls = 0;
-  for (const PlannedWorld& w : worlds) balls += w.row.played ? w.row.balls : 0;
   // Progress counts this rank's share of the job (learn::distributed_map deals balls to the ranks).
-  ProgressCount count(progress, balls * static_cast<long>(players.size()) / learn::team_size());
+  std::vector<std::pair<std::string, long>> balls_by_kind;
+  for (const PlannedWorld& w : worlds) {
+    if (w.row.played) {
+      balls_by_kind.emplace_back(w.row.world, w.row.balls * static_cast<long>(players.size()) / learn::team_size());
+    }
+  }
+  ProgressCount count(progress, balls_by_kind);
   TransferReport report;
   report.board = belief.source;
   report.options = options;

@@ -59,7 +59,9 @@ CLI::App* add_bench_command(CLI::App& app, BenchArgs& a) {
            "transfer", "protocol", "draw"}));
   cmd->add_option("--board", a.board, "board file (ceiling, transfer: the belief)")->transform(data_file());
   add_identified_option(*cmd, a.identified);
-  cmd->add_option("--steps", a.steps, "speed: steps per timed run (the MuJoCo twin's runs: a tenth)")
+  cmd->add_option("--steps", a.steps,
+                  "speed: steps per timed run, at least (whole balls are played; the report gives the steps run; "
+                  "the MuJoCo twin's runs: a tenth)")
       ->check(finite_range(1000, 1'000'000'000));
   cmd->add_option("--repeats", a.repeats, "timed runs per configuration (median reported)")->check(finite_range(1, 99));
   cmd->add_option("--approaches", a.approaches, "tracker: free-flight approaches to collect")

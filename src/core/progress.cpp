@@ -42,7 +42,8 @@ std::string format_count(double x) {
 }  // namespace
 
 std::string format_progress(std::string_view label, double done, double total, std::string_view unit,
-                            double elapsed_s, std::string_view note, double done_in_no_time) {
+                            double elapsed_s, std::string_view note, double done_in_no_time,
+                            std::optional<double> eta_s) {
   // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on "a" + b + "c" chains here.
   std::string line(label);
   line.append(": ").append(format_count(done)).append("/").append(format_count(total));
@@ -53,11 +54,22 @@ std::string format_progress(std::string_view label, double done, double total, s
   }
   line.append(", ").append(format_duration(elapsed_s)).append(" elapsed");
   const double done_in_time = done - done_in_no_time;
-  if (done_in_time > 0.0 && total > done) {
+  if (eta_s && total > done) {
+    line.append(", ETA ").append(format_duration(*eta_s));
+  } else if (done_in_time > 0.0 && total > done) {
     line.append(", ETA ").append(format_duration(elapsed_s / done_in_time * (total - done)));
   }
   if (!note.empty()) line.append("; ").append(note);
   return line;
+}
+
+double eta_by_kind_s(std::span<const KindProgress> kinds, double fallback_s_per_unit) {
+  double eta_s = 0.0;
+  for (const KindProgress& k : kinds) {
+    const double left = std::fmax(0.0, k.total - k.done);
+    eta_s += left * (k.done > 0.0 ? k.wall_s / k.done : fallback_s_per_unit);
+  }
+  return eta_s;
 }
 
 bool progress_wanted(bool asked) { return asked || ::isatty(STDERR_FILENO) == 1; }

@@ -39,6 +39,17 @@ TEST(FormatProgress, UnitsDoneInNoTimeAreNotInTheRate) {
   EXPECT_EQ(format_progress("cem", 3000, 6000, "balls", 0.1, "", 3000), "cem: 3000/6000 balls (50 %), 100 ms elapsed");
 }
 
+TEST(Progress, AnEtaByKindTakesEachKindsOwnRate) {
+  // 100 model balls done in 10 s, 10 twin balls done in 10 s: a twin ball costs ten.
+  const KindProgress model{300, 100, 10.0}, twin{20, 10, 10.0};
+  EXPECT_DOUBLE_EQ(eta_by_kind_s(std::vector<KindProgress>{model, twin}, 1.0), 200 * 0.1 + 10 * 1.0);
+  // A kind none of which is done yet goes at the rate so far.
+  const KindProgress sweep{50, 0, 0.0};
+  EXPECT_DOUBLE_EQ(eta_by_kind_s(std::vector<KindProgress>{model, sweep}, 0.25), 200 * 0.1 + 50 * 0.25);
+  EXPECT_EQ(format_progress("transfer", 110, 320, "balls", 20.0, "twin", 0.0, 30.0),
+            "transfer: 110/320 balls (34 %), 20 s elapsed, ETA 30 s; twin");
+}
+
 TEST(ProgressMeter, ShowsAtMostOncePerIntervalAndAlwaysTheEnd) {
   std::ostringstream out;
   ProgressMeter meter(&out, "sim", 4, "balls", false, 1.0);

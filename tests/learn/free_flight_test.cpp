@@ -2,10 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include <vector>
-
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "common/thesis_board.h"
 #include "pinball/core/rng.h"

@@ -10,6 +10,8 @@
 #include <functional>
 #include <iosfwd>
 #include <mutex>
+#include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -22,9 +24,23 @@ std::string format_duration(double s);
 /// optional note after a semicolon. The ETA is left out until something is
 /// done; the percent is rounded down, so 100 % means finished. `done_in_no_time`
 /// of the done units took none of the time (taken from a checkpoint): the ETA
-/// comes from the rate of the others.
+/// comes from the rate of the others. `eta_s`, when given, is the ETA instead.
 std::string format_progress(std::string_view label, double done, double total, std::string_view unit,
-                            double elapsed_s, std::string_view note = {}, double done_in_no_time = 0.0);
+                            double elapsed_s, std::string_view note = {}, double done_in_no_time = 0.0,
+                            std::optional<double> eta_s = std::nullopt);
+
+/// Work of one kind among several that run at different rates (a twin ball
+/// costs many model balls): its units in all, done, and the wall time spent on them (s).
+struct KindProgress {
+  double total = 0.0;
+  double done = 0.0;
+  double wall_s = 0.0;
+};
+
+/// The time left (s): each kind's units left at that kind's own rate, or at
+/// `fallback_s_per_unit` (the rate over everything so far) while none of it
+/// is done. One rate over every unit had put a bench's ETA far off.
+double eta_by_kind_s(std::span<const KindProgress> kinds, double fallback_s_per_unit);
 
 /// Whether to show progress: asked for (--progress), or stderr is a terminal.
 bool progress_wanted(bool asked);
