@@ -156,6 +156,12 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->check(finite_range(0.0, 100.0))
       ->default_str("")  // -1: the typical camera's
       ->needs(sim);
+  cmd->add_option("--sim-actuation-delay-ms", a.sim_actuation_delay_ms,
+                  "latency --sim: the simulated machine's true actuation delay (ms; default: --actuation-delay-ms), "
+                  "to see what assuming another costs")
+      ->check(finite_range(0.0, 100.0))
+      ->default_str("")  // -1: --actuation-delay-ms
+      ->needs(sim);
   cmd->add_option("--actuation-delay-ms", a.actuation_delay_ms,
                   "latency: the host's command to the flipper's first motion (ms)")
       ->check(finite_range(0.0, 100.0));
@@ -190,8 +196,8 @@ const std::vector<FlagUse>& calibrate_flag_uses() {
       {{"--roll", "--sim-rolls", "--sigma"}, {"gravity"}},
       {{"--calibration"}, {"flippers", "latency"}},
       {{"--png"}, {"intrinsics", "camera", "flippers", "gravity"}},
-      {{"--device", "--can", "--flipper", "--events", "--sim-latency-ms", "--actuation-delay-ms", "--row-time-us",
-        "--exposure-us", "--fps"},
+      {{"--device", "--can", "--flipper", "--events", "--sim-latency-ms", "--sim-actuation-delay-ms",
+        "--actuation-delay-ms", "--row-time-us", "--exposure-us", "--fps"},
        {"latency"}},
   };
   return uses;
@@ -488,6 +494,7 @@ void report_latency(Context& c, const calibration::LatencyEstimate& e, const cal
   if (truth) {
     j["truth"] = {{"latency_ms", truth->true_latency_s * 1e3},
                   {"mean_latency_ms", truth->true_mean_latency_s * 1e3},
+                  {"actuation_delay_ms", truth->timing.actuation_delay_s * 1e3},
                   {"error_ms", (e.latency_s - truth->true_latency_s) * 1e3}};
   }
   c.report["latency"] = j;
@@ -510,7 +517,8 @@ void report_latency(Context& c, const calibration::LatencyEstimate& e, const cal
     << o.row_time_s * 1e6 << " us, actuation delay " << o.actuation_delay_s * 1e3 << " ms\n";
   if (truth) {
     s << "simulated camera: true minimum latency " << truth->true_latency_s * 1e3 << " ms, error "
-      << std::showpos << (e.latency_s - truth->true_latency_s) * 1e3 << std::noshowpos << " ms\n";
+      << std::showpos << (e.latency_s - truth->true_latency_s) * 1e3 << std::noshowpos
+      << " ms; the machine's actuation delay " << truth->timing.actuation_delay_s * 1e3 << " ms\n";
   }
   c.text = s.str();
 }
@@ -521,7 +529,8 @@ void run_latency_sim(Context& c) {
   o.seed = a.seed;
   o.events = a.events;
   o.flipper = flipper_index(c.board, a.flipper);
-  o.actuation_delay_s = a.actuation_delay_ms * 1e-3;
+  // The machine's true delay; --actuation-delay-ms is what the measurement assumes (below).
+  o.actuation_delay_s = (a.sim_actuation_delay_ms >= 0.0 ? a.sim_actuation_delay_ms : a.actuation_delay_ms) * 1e-3;
   if (a.sim_latency_ms >= 0.0) o.camera.realism.latency_min_s = a.sim_latency_ms * 1e-3;
   // The simulated camera reads its rows out in a fixed time, and keeps 0.18 s of the table's motion.
   const double readout_s = o.camera.realism.row_time_s * o.camera.height_px;
@@ -538,6 +547,7 @@ void run_latency_sim(Context& c) {
   c.err << "calibrate latency: simulating " << o.events << " fires of " << c.board.flippers[o.flipper].name << "\n";
   const simlab::SimLatencyRun run = simlab::simulate_latency_run(c.board, o);
   calibration::LatencyOptions lo = run.timing;
+  lo.actuation_delay_s = a.actuation_delay_ms * 1e-3;
   if (a.row_time_us >= 0.0) lo.row_time_s = a.row_time_us * 1e-6;
   if (a.exposure_us >= 0.0) lo.exposure_s = a.exposure_us * 1e-6;
   const calibration::LatencyEstimate e = calibration::measure_latency(run.recording, run.region, lo);

@@ -172,6 +172,7 @@ struct CalibrateArgs {
   int events = 20;                   ///< latency: times the flipper is fired
   double sim_latency_ms = -1.0;      ///< latency --sim: the camera's minimum latency (ms); < 0: the typical camera's
   double actuation_delay_ms = firmware::kDefaultActuationDelay_s * 1e3;  ///< latency: command to first motion (ms)
+  double sim_actuation_delay_ms = -1.0;  ///< latency --sim: the machine's true delay (ms); < 0: actuation_delay_ms
   double row_time_us = -1.0;         ///< latency: rolling shutter row time (µs); < 0: the camera's (--sim) or the file's
   double exposure_us = -1.0;         ///< latency: the camera's exposure time (µs); < 0: the simulated camera's, or 0 in the lab
   double fps = 200.0;                ///< latency: the frame rate asked of the camera

@@ -277,6 +277,13 @@ TEST_F(Calibrate, LatencySimRunsTheCameraAtTheRateAskedOfIt) {
   r = run("calibrate latency --sim boards/mit1993.board --events 6 --fps 60");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("run the camera faster (--fps)"), std::string::npos) << r.err;
+  // The machine's true delay apart from the one assumed: the error goes one for one into the latency.
+  r = run("calibrate latency --sim boards/mit1993.board --events 6 --sim-actuation-delay-ms 6 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json late = nlohmann::json::parse(r.out)["latency"];
+  EXPECT_EQ(late["actuation_delay_ms"].get<double>(), 4.0) << "assumed: --actuation-delay-ms's default";
+  EXPECT_EQ(late["truth"]["actuation_delay_ms"].get<double>(), 6.0);
+  EXPECT_NEAR(late["truth"]["error_ms"].get<double>(), 2.0, 0.3);
   r = run("calibrate latency --sim boards/mit1993.board --fps 300");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("--fps 300: the simulated camera runs at 10 to 208 frames/s"), std::string::npos) << r.err;
