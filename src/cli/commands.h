@@ -32,7 +32,8 @@ struct SimArgs {
   double video_fps = 60.0;       ///< video frame rate (simulated time)
   bool video_camera = false;     ///< video from the simulated camera's frames instead of the board view
   track::CameraModelConfig camera;  ///< the camera the spastic player sees through
-  std::optional<double> reach_m;  ///< spastic: flip when the projected impact is this close (m); none: the spastic default
+  /// spastic: flip when the projected impact is this close (m); none: the spastic default
+  std::optional<double> reach_m;
   std::string actuation = "direct";  ///< direct | can: flipper commands through the CAN path
   double actuation_delay_s = firmware::kDefaultActuationDelay_s;  ///< solenoid rise before the flipper moves (s)
   bool json = false;             ///< one JSON object on stdout

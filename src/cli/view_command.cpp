@@ -248,7 +248,8 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
   cmd->add_option("--controller", a.controller, "controller file, for d_critical (default: the configuration's, else none)")
       ->transform(data_file());
   cmd->add_option("--snapshot", a.snapshot,
-                  "PNG to write: with --at, the picture at that time and no window; with --quit-at, the window's last frame")
+                  "PNG to write: with --at, the picture at that time and no window; with --quit-at, the window's "
+                  "last frame")
       ->check(output_file());
   cmd->add_option("--at", a.at_s, "snapshot time: seconds from the log's first event or the first live message (default: the end)")
       ->check(finite_range(0.0, 1e9))

@@ -43,7 +43,8 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
       ->transform(CLI::CheckedTransformer(steppers).description(""))
       ->check(CLI::Validator(
           [&kind](std::string&) {
-            return kind == simlab::WorldKind::kModel ? "" : "the twin steps with MuJoCo's own integrator, not a stepper";
+            return kind == simlab::WorldKind::kModel ? ""
+                                                     : "the twin steps with MuJoCo's own integrator, not a stepper";
           },
           ""))
       ->type_name("{thesis,event}")

@@ -296,8 +296,12 @@ ControllerSpec load_controller(const std::string& path) {
   // that the two travel together.
   if (spec.planner && spec.planner->shot_values) {
     std::string& table = *spec.planner->shot_values;
-    if (table.empty()) throw ControllerFileError(path + ": planner.shot_values: names no file (leave the key out for none)");
-    if (std::filesystem::path(table).is_relative()) table = (std::filesystem::path(path).parent_path() / table).string();
+    if (table.empty()) {
+      throw ControllerFileError(path + ": planner.shot_values: names no file (leave the key out for none)");
+    }
+    if (std::filesystem::path(table).is_relative()) {
+      table = (std::filesystem::path(path).parent_path() / table).string();
+    }
     std::error_code ec;
     if (!std::filesystem::is_regular_file(table, ec)) {
       throw ControllerFileError(path + ": planner.shot_values: " + table +

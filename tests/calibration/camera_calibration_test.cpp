@@ -101,7 +101,9 @@ TEST(CameraCalibration, ALayoutFileOffTheBoardOrDegenerateIsRefusedNamingTheFile
     return pinball::testing::error_text([&] { read_marker_layout_csv(path, board); });
   };
   std::string layout = "x,y\n";
-  for (const Vec2& p : default_marker_layout(board)) layout += std::to_string(p.x()) + "," + std::to_string(p.y()) + "\n";
+  for (const Vec2& p : default_marker_layout(board)) {
+    layout += std::to_string(p.x()) + "," + std::to_string(p.y()) + "\n";
+  }
   EXPECT_EQ(read(layout), "no error");
   // The same layout in millimetres: it had been fitted, and failed with no word of the file.
   EXPECT_EQ(read("x,y\n51,100\n"),

@@ -539,7 +539,8 @@ TEST_F(Cli, AnEmptyOutputPathIsRefusedNotTakenAsNone) {
   // An unset shell variable ("--out $OUT") had silently written nothing.
   for (const char* args : {"sim boards/mit1993.board --trace ''", "sim boards/mit1993.board --video ''",
                            "identify boards/mit1993.board --board boards/mit1993.board --out ''",
-                           "learn boards/mit1993.board --out ''", "calibrate gravity --sim boards/mit1993.board --out ''",
+                           "learn boards/mit1993.board --out ''",
+                           "calibrate gravity --sim boards/mit1993.board --out ''",
                            "play --headless --keys 0:launch boards/mit1993.board --csv ''",
                            "bench precision --csv ''", "render boards/mit1993.board --out ''",
                            "view --snapshot ''"}) {

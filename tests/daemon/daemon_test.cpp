@@ -699,8 +699,8 @@ TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
   std::string unread;  // a world option for the other world: refused, not ignored
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --world twin --stepper event 2>&1", unread), 1);
   EXPECT_NE(unread.find("--stepper: the twin steps with MuJoCo's own integrator"), std::string::npos) << unread;
-  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --twin-params " + kSource + "/config/twin.yaml 2>&1", unread),
-            1);
+  const std::string twin_params = std::string(kSource) + "/config/twin.yaml";
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --twin-params " + twin_params + " 2>&1", unread), 1);
   EXPECT_NE(unread.find("--twin-params: only the twin reads it"), std::string::npos) << unread;
   std::string empty;  // an unset variable in a lab script: no log written, and nobody told
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " --can-log '' 2>&1", empty), 2);

@@ -381,8 +381,9 @@ TEST(RecordingFitsBoard, SightingsOffTheBoardForeignFlippersAndAnotherClockAreRe
   };
   bus::RecordedPlay far = play;
   for (int k = 0; k < 6; ++k) far.frames[static_cast<std::size_t>(k)].p_board.x() = 1000.0;
-  EXPECT_EQ(error_of(far).rfind("game.lcm: 6 of its 100 sightings lie over 5 cm off the 0.51 x 1.07 m playfield of ", 0),
-            0u)
+  EXPECT_EQ(
+      error_of(far).rfind("game.lcm: 6 of its 100 sightings lie over 5 cm off the 0.51 x 1.07 m playfield of ", 0),
+      0u)
       << error_of(far);
   far.frames[5].p_board.x() = 0.2;  // 5 %: a few stray detections are no other table
   EXPECT_EQ(error_of(far), "");
