@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
@@ -55,6 +56,19 @@ std::optional<LcmLogTarget> lcm_log_target(const std::string& url) {
   if (mode != "w" && mode != "a") return std::nullopt;
   t.append = mode == "a";
   return t;
+}
+
+std::optional<std::string> lcm_log_source(const std::string& url) {
+  if (url.rfind("file://", 0) != 0 || lcm_log_target(url)) return std::nullopt;
+  const std::string rest = url.substr(std::string("file://").size());
+  return rest.substr(0, rest.find('?'));
+}
+
+std::string lcm_url_problem(const std::string& url) {
+  static const std::set<std::string> kProviders = {"udpm", "mpudpm", "file", "memq", "tcpq"};
+  const std::size_t scheme_end = url.find("://");
+  if (scheme_end != std::string::npos && kProviders.count(url.substr(0, scheme_end)) == 1) return "";
+  return "'" + url + "' names no LCM provider: it starts with udpm://, mpudpm://, file://, memq:// or tcpq://";
 }
 
 void subscribe_raw(lcm::LCM& lcm, const char* channel, RawHandler& handler) {

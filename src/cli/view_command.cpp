@@ -195,7 +195,7 @@ int view_live(const ViewArgs& a, const view::ViewScene& scene, bool window, std:
   // time from the first message), or when the source ends or goes quiet.
   const double until_s = window ? a.quit_at_s : a.at_s;
   while (true) {
-    const int n = ended ? 0 : listener.poll(window ? 5 : 50);
+    const int n = ended ? 0 : listener.poll(window ? 5 : 50, until_s);
     if (n < 0) ended = true;
     const double now_s = steady_s();
     if (n > 0) last_message_s = now_s;

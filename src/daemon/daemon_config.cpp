@@ -363,10 +363,7 @@ void validate_daemon_config(const DaemonConfig& c, const std::string& s) {
   check_coils(c.coils, s);
   require(!c.controller.empty(), s, "controller", "is required");
   require(!c.lcm_url.empty(), s, "lcm_url", "is required");
-  const std::size_t scheme_end = c.lcm_url.find("://");
-  static const std::set<std::string> kLcmProviders = {"udpm", "mpudpm", "file", "memq", "tcpq"};
-  require(scheme_end != std::string::npos && kLcmProviders.count(c.lcm_url.substr(0, scheme_end)) == 1, s, "lcm_url",
-          "'" + c.lcm_url + "' names no LCM provider: it starts with udpm://, mpudpm://, file://, memq:// or tcpq://");
+  require(bus::lcm_url_problem(c.lcm_url).empty(), s, "lcm_url", bus::lcm_url_problem(c.lcm_url));
   // A file:// URL without mode=w or mode=a reads a log, where liblcm refuses every publish; and
   // pinballd publishes every frame's projection and command: it would run blind to LCM and exit 3.
   require(c.lcm_url.rfind("file://", 0) != 0 || bus::lcm_log_target(c.lcm_url).has_value(), s, "lcm_url",

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "pinball/bus/channels.h"
+#include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/lcm_bus.h"
 #include "pinball/bus/message_convert.h"
 
@@ -18,6 +19,9 @@ void on_lcm_message(const lcm_recv_buf_t* rbuf, const char* channel, void* user)
 }  // namespace
 
 LcmListener::LcmListener(const std::string& url, ViewState& state) : state_(state) {
+  if (const std::string problem = bus::lcm_url_problem(url); !problem.empty()) throw std::runtime_error("lcm: " + problem);
+  // liblcm plays a damaged log by the lengths it reads (a segmentation fault): checked as every reader checks it.
+  if (const std::optional<std::string> log = bus::lcm_log_source(url)) bus::require_lcm_log(*log);
   lcm_ = lcm_create(url.c_str());
   if (lcm_ == nullptr) throw std::runtime_error("lcm: cannot open '" + url + "'");
   try {
@@ -37,7 +41,7 @@ LcmListener::LcmListener(const std::string& url, ViewState& state) : state_(stat
 
 LcmListener::~LcmListener() { lcm_destroy(lcm_); }
 
-int LcmListener::poll(int timeout_ms) {
+int LcmListener::poll(int timeout_ms, double stop_at_s) {
   // lcm_handle_timeout handles one message; drain what waits (bounded, so a
   // flood cannot starve the window) after waiting at most timeout_ms for the first.
   constexpr int kMaxPerPoll = 20000;
@@ -46,6 +50,8 @@ int LcmListener::poll(int timeout_ms) {
     const int r = bus::handle_lcm_timeout(lcm_, i == 0 ? timeout_ms : 0);
     if (r < 0) return handled_in_poll_ > 0 ? handled_in_poll_ : -1;
     if (r == 0) break;
+    // A log played at full speed arrives in one burst: stop where the caller looks.
+    if (stop_at_s >= 0.0 && received_ > 0 && state_.now_s() >= stop_at_s) break;
   }
   return handled_in_poll_;
 }

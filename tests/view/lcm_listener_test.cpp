@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <stdexcept>
 
 #include "common/temp_path.h"
@@ -28,6 +29,34 @@ TEST(LcmListener, ReceivesEveryDaemonChannelThroughLiblcm) {
   EXPECT_EQ(state.commands().size(), 2u);
   // Stamped with liblcm's receive time, which the file provider takes from the log.
   EXPECT_NEAR(state.now_s(), 1.0, 1e-6);  // the daemon's clock: the messages' utime
+}
+
+// A log played at full speed arrives in one burst: the poll stops where the view looks.
+TEST(LcmListener, APollStopsAtTheTimeAskedForEvenInABurst) {
+  const std::string path = pinball::testing::temp_path("lcm_listener", "burst.lcmlog");
+  pinball::testing::write_view_log(path);
+  ViewState state;
+  LcmListener listener("file://" + path + "?speed=0", state);
+  int polls = 0;
+  while (state.now_s() < 0.5 && listener.poll(100, 0.5) >= 0 && ++polls < 1000) {
+  }
+  EXPECT_GE(state.now_s(), 0.5);
+  EXPECT_LT(state.now_s(), 0.6) << "it had played the whole log in one poll";
+}
+
+// liblcm plays a damaged log by the lengths it reads (a length of 2^31 crashed it): refused first.
+TEST(LcmListener, ADamagedLogIsRefusedBeforeLiblcmReadsIt) {
+  const std::string path = pinball::testing::temp_path("lcm_listener", "damaged.lcmlog");
+  pinball::testing::write_view_log(path);
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 7);
+  ViewState state;
+  try {
+    LcmListener listener("file://" + path + "?speed=0", state);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": damaged LCM log"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
 }
 
 TEST(LcmListener, ABadUrlIsNamed) {

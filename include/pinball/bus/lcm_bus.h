@@ -63,6 +63,16 @@ struct LcmLogTarget {
 /// URL (other providers, file:// in read mode, which is liblcm's default).
 std::optional<LcmLogTarget> lcm_log_target(const std::string& url);
 
+/// The log a file:// URL plays (read mode, liblcm's default); std::nullopt
+/// for every other URL. liblcm trusts a log's lengths: its reader must be
+/// checked first (require_lcm_log).
+std::optional<std::string> lcm_log_source(const std::string& url);
+
+/// Why `url` names no provider liblcm has ("" when it does): empty, or a
+/// scheme other than udpm, mpudpm, file, memq and tcpq. liblcm would print a
+/// line of its own and fail; the programs say this one instead.
+std::string lcm_url_problem(const std::string& url);
+
 /// lcm_handle_timeout for a provider that may have no descriptor (a tcpq://
 /// server that is gone, a udpm:// socket that failed): liblcm would select on
 /// -1, which glibc's checks abort. Returns -1 then, as for an error.

@@ -26,8 +26,9 @@ class LcmListener {
   LcmListener& operator=(const LcmListener&) = delete;
 
   /// Handles what arrives within `timeout_ms`: >= 0 messages handled, -1 when
-  /// the provider has ended (a file:// log played out) or failed.
-  int poll(int timeout_ms);
+  /// the provider has ended (a file:// log played out) or failed. With
+  /// `stop_at_s` >= 0 it stops once the view's time reaches it.
+  int poll(int timeout_ms, double stop_at_s = -1.0);
   /// Messages received so far.
   std::uint64_t received() const { return received_; }
 
