@@ -268,9 +268,19 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
+// The CSV and the plot are two files, neither of them an input (a controller's file written over by a CSV).
+void check_bench_outputs(const BenchArgs& a) {
+  const std::vector<std::pair<const char*, std::string>> outputs{{"--csv", a.csv}, {"--png", a.png}};
+  check_distinct_outputs(outputs);
+  std::vector<std::pair<const char*, std::string>> inputs{{"--board", a.board}, {"--identified", a.identified}};
+  for (const std::string& c : a.controllers) inputs.emplace_back("--controller", c);
+  check_outputs_replace_no_input(outputs, inputs);
+}
+
 int run_precision(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   check_output_folder(a.csv, "--csv");
   check_png_output(a.png, "--png");
+  check_bench_outputs(a);
   const bench::PrecisionBenchOptions options =
       a.quick ? bench::quick_precision_bench_options() : bench::default_precision_bench_options();
   const bench::PrecisionReport report = bench::run_precision_bench(
@@ -414,6 +424,7 @@ int run_aim(const BenchArgs& a, const table::Board& board, std::ostream& out, st
 int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& out, std::ostream& err) {
   check_output_folder(a.csv, "--csv");
   check_png_output(a.png, "--png");
+  check_bench_outputs(a);
   bench::TransferBenchOptions options =
       a.quick ? bench::quick_transfer_bench_options() : bench::TransferBenchOptions{};
   if (a.balls > 0) options.balls = a.balls;

@@ -64,7 +64,8 @@ inline void check_distinct_outputs(const std::vector<std::pair<const char*, std:
       const std::string& a = outputs[i].second;
       const std::string& b = outputs[k].second;
       if (a.empty() || b.empty()) continue;
-      if (fs::weakly_canonical(a) == fs::weakly_canonical(b)) {
+      // Absolute first: weakly_canonical leaves "y.json" relative and makes "./y.json" absolute.
+      if (fs::weakly_canonical(fs::absolute(a)) == fs::weakly_canonical(fs::absolute(b))) {
         throw std::runtime_error(std::string(outputs[i].first) + " and " + outputs[k].first + " both name " + a +
                                  ": each would overwrite the other");
       }
@@ -76,6 +77,20 @@ inline void check_distinct_outputs(const std::vector<std::pair<const char*, std:
 inline bool same_file(const std::string& a, const std::string& b) {
   std::error_code ec;
   return std::filesystem::equivalent(a, b, ec) && !ec;
+}
+
+/// An output that is one of the inputs (the same path, a link or a hard link)
+/// would replace it: refused, "OUT-OPTION PATH is the input IN-OPTION PATH;
+/// it would be replaced". Empty paths are options not given.
+inline void check_outputs_replace_no_input(const std::vector<std::pair<const char*, std::string>>& outputs,
+                                           const std::vector<std::pair<const char*, std::string>>& inputs) {
+  for (const auto& [out_option, out] : outputs) {
+    for (const auto& [in_option, in] : inputs) {
+      if (out.empty() || in.empty() || !same_file(out, in)) continue;
+      throw std::runtime_error(std::string(out_option) + " " + out + " is the input " + in_option + " " + in +
+                               "; it would be replaced");
+    }
+  }
 }
 
 /// One file given twice to an option that takes many (the same path, a link

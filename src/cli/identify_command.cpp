@@ -55,15 +55,10 @@ void check_distinct_files(const IdentifyArgs& a) {
       }
     }
   }
-  if (a.out.empty()) return;
-  std::vector<std::string> inputs = a.logs;
-  inputs.insert(inputs.end(), a.held_out.begin(), a.held_out.end());
-  inputs.push_back(find_data_file(a.board));
-  for (const std::string& in : inputs) {
-    if (same_file(a.out, in)) {
-      throw std::runtime_error("identify: --out " + a.out + " is the input " + in + "; it would be replaced");
-    }
-  }
+  std::vector<std::pair<const char*, std::string>> inputs{{"--board", find_data_file(a.board)}};
+  for (const std::string& log : a.logs) inputs.emplace_back("log", log);
+  for (const std::string& log : a.held_out) inputs.emplace_back("--held-out", log);
+  check_outputs_replace_no_input({{"identify: --out", a.out}}, inputs);
 }
 
 // The standard uncertainty of the flippers' mean rise delay (the actuation

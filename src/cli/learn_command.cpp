@@ -454,6 +454,19 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
                           {"--plot", args.plot},
                           {"--checkpoint", args.checkpoint},
                           {"--out's cycle file", cycle_path}});
+  // A learned controller written over its board, or a curve over the controller: found too late, after the run.
+  check_outputs_replace_no_input({{"--out", args.out},
+                                  {"--curve", args.curve},
+                                  {"--plot", args.plot},
+                                  {"--checkpoint", args.checkpoint},
+                                  {"--out's cycle file", cycle_path}},
+                                 {{"board", args.board},
+                                  {"--identified", args.identified},
+                                  {"--randomize", args.randomize},
+                                  {"--shot-values", args.shot_values},
+                                  {"--controller", args.controller},
+                                  {"--world-board", args.world.board_path},
+                                  {"--twin-params", args.world.twin_params_path}});
   LearnArgs a = args;
   a.actuation_delay_s = world_actuation_delay_s(
       args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,

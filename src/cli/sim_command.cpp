@@ -83,6 +83,13 @@ CLI::App* add_sim_command(CLI::App& app, SimArgs& a) {
 int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
   check_output_folder(a.trace, "--trace", /*streamed=*/true);
   check_named_output(a.video, "--video", sim::check_avi_name);
+  check_distinct_outputs({{"--trace", a.trace}, {"--video", a.video}});
+  check_outputs_replace_no_input({{"--trace", a.trace}, {"--video", a.video}},
+                                 {{"board", a.board},
+                                  {"--identified", a.identified},
+                                  {"--controller", a.controller},
+                                  {"--world-board", a.world.board_path},
+                                  {"--twin-params", a.world.twin_params_path}});
   const table::Board board = table::load_belief_board(a.board, a.identified);
   const simlab::WorldSpec world_spec = simlab::world_for_belief(a.world, a.board, a.identified);
   const simlab::OwnedWorld world = simlab::make_world(world_spec, board);

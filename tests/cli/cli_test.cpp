@@ -535,6 +535,27 @@ TEST_F(Cli, AnOptionNothingInThePlayReadsIsRefused) {
                       "--reach is the spastic flipper's"});
 }
 
+// An output that is an input, or another output spelled otherwise, is refused before any work:
+// learn had written its controller over the board and exited 0.
+TEST_F(Cli, AnOutputOverAnInputOrAnotherOutputIsRefused) {
+  const std::string board = (dir_ / "b.board").string();
+  std::filesystem::copy_file(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board", board);
+  const std::string kept = pinball::testing::slurp(board);
+  expect_refused("", {"learn " + board + " --method tournament --budget-balls 60 --out " + board, 1,
+                      "--out " + board + " is the input board " + board + "; it would be replaced"});
+  expect_refused("", {"sim " + board + " --balls 1 --trace " + board, 1, "--trace " + board + " is the input board"});
+  expect_refused("", {"learn " + board + " --method evaluate --controller controllers/spastic.json --out "
+                      "controllers/spastic.json", 1, "is the input --controller controllers/spastic.json"});
+  EXPECT_EQ(pinball::testing::slurp(board), kept);
+  // The same file spelled two ways: the curve had replaced the controller.
+  const CommandResult twice =
+      run_shell("cd " + dir_.string() + " && " PINBALL_EXE " learn " PINBALL_SOURCE_DIR
+                "/boards/mit1993.board --method tournament --budget-balls 60 --out y.json --curve ./y.json");
+  EXPECT_EQ(twice.exit_code, 1);
+  EXPECT_NE(twice.err.find("--out and --curve both name y.json"), std::string::npos) << twice.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "y.json"));
+}
+
 TEST_F(Cli, AnEmptyOutputPathIsRefusedNotTakenAsNone) {
   // An unset shell variable ("--out $OUT") had silently written nothing.
   for (const char* args : {"sim boards/mit1993.board --trace ''", "sim boards/mit1993.board --video ''",
