@@ -133,6 +133,7 @@ struct LearnArgs {
   bool progress = false;                ///< percent and ETA on stderr even when it is not a terminal
   std::string checkpoint;               ///< record every batch here (resumable); empty: none
   bool resume = false;                  ///< continue the run recorded in `checkpoint`
+  std::vector<std::string> flags_given;  ///< the long flags on the command line ("--rounds"), set by the parser
 };
 CLI::App* add_learn_command(CLI::App& app, LearnArgs& args);
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err);

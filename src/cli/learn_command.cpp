@@ -20,6 +20,7 @@
 
 #include "camera_options.h"
 #include "data_file.h"
+#include "flag_uses.h"
 #include "commands.h"
 #include "progress_option.h"
 #include "world_options.h"
@@ -136,6 +137,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_flag("--resume", a.resume, "continue the run recorded in --checkpoint (the same command and seed)")
       ->needs("--checkpoint");
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
+  record_flags_given(cmd, a.flags_given);
   return cmd;
 }
 
@@ -441,6 +443,32 @@ int run_shot_values(const LearnArgs& a, std::ostream& out, std::ostream& err) {
   return 0;
 }
 
+namespace {
+
+// Which methods read each flag that not every method reads: an option a method
+// would drop is refused, not ignored (`--method evaluate --curve c.csv` wrote
+// nothing and said nothing; `--method launcher --randomize R` searched the board).
+const std::vector<FlagUse>& learn_flag_uses() {
+  static const std::vector<FlagUse> uses = {
+      {{"--balls-per-controller"}, {"tournament"}},
+      {{"--population"}, {"relay", "cem"}},
+      {{"--rounds"}, {"imitate"}},
+      {{"--controller"}, {"evaluate"}},
+      {{"--shot-values"}, {"imitate"}},
+      {{"--drain-penalty"}, {"imitate", "shot-values"}},
+      {{"--curve", "--plot", "--randomize", "--lead", "--partitions", "--partition-h", "--rolling",
+        "--randomise-launch"},
+       {"tournament", "relay", "cem", "imitate"}},
+      {{"--budget-balls"}, {"tournament", "relay", "cem", "imitate", "shot-values"}},
+      {{"--eval-balls"}, {"tournament", "relay", "cem", "imitate", "none", "spastic", "evaluate"}},
+      {{"--threads", "--max-ball-time", "--actuation-delay", "--pull"},
+       {"tournament", "relay", "cem", "imitate", "none", "spastic", "evaluate", "shot-values"}},
+  };
+  return uses;
+}
+
+}  // namespace
+
 int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   const auto start = std::chrono::steady_clock::now();
   // What is written at the end can be written: a typo must not cost an hour's search.
@@ -471,9 +499,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   a.actuation_delay_s = world_actuation_delay_s(
       args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,
       args.identified);
-  if (a.drain_penalty >= 0.0 && a.method != "imitate" && a.method != "shot-values")
-    throw std::invalid_argument("learn: --drain-penalty is for imitate (its teacher) or shot-values, not --method " +
-                                a.method);
+
   // Options a method does not read are refused, not ignored: launcher prints its pulls and
   // writes nothing; shot-values writes its table, with no curve and no checkpoint.
   if (a.method == "launcher" || a.method == "shot-values") {
@@ -489,6 +515,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
       if (!value.empty()) throw std::invalid_argument("learn: --method " + a.method + " does not read " + option);
     }
   }
+  refuse_flags_not_read(a.flags_given, learn_flag_uses(), "learn", a.method);
   if (a.method == "launcher") return run_launcher_search(a, out, err);
   if (a.method == "shot-values") return run_shot_values(a, out, err);
   const bool search = a.method == "tournament" || a.method == "relay" || a.method == "cem";
@@ -529,15 +556,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     if (world_spec.kind != simlab::WorldKind::kModel || !world_spec.board_path.empty())
       throw std::invalid_argument("learn: --randomize draws its worlds around the belief's model; it cannot be "
                                   "combined with --world twin or --world-board");
-    if (!search && a.method != "imitate")
-      throw std::invalid_argument("learn: --randomize is for a search (tournament, relay, cem) or imitate, not --method " +
-                                  a.method);
   }
-  if (!a.shot_values.empty() && a.method != "imitate")
-    throw std::invalid_argument("learn: --shot-values is for imitate (its teacher), not --method " + a.method);
-  if (a.lead && !search && a.method != "imitate")
-    throw std::invalid_argument("learn: --lead is for a search (tournament, relay, cem) or imitate, not --method " +
-                                a.method);
   // With --randomize the search plays the drawn worlds; the final evaluation
   // (objective.ev) plays the belief's own world, the home world.
   struct Objective final : learn::BallObjective {

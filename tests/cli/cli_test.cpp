@@ -126,7 +126,7 @@ TEST_F(Cli, LearnRandomizeSearchesAcrossDrawnWorldsAndJudgesInTheHomeWorld) {
   EXPECT_EQ(led_table.at("lead_actuation_delay_s"), 0.006);
   const CommandResult spastic_led = run("learn boards/mit1993.board --method spastic --eval-balls 2 --lead");
   EXPECT_EQ(spastic_led.exit_code, 1);
-  EXPECT_NE(spastic_led.err.find("--lead is for a search (tournament, relay, cem) or imitate"), std::string::npos)
+  EXPECT_NE(spastic_led.err.find("learn spastic: --lead applies to tournament, relay, cem and imitate only"), std::string::npos)
       << spastic_led.err;
 
   const CommandResult spastic = run("learn boards/mit1993.board --method spastic --eval-balls 2 --randomize " +
@@ -359,7 +359,7 @@ TEST_F(Cli, LearnShotValuesWritesATableThatImitateAndThePlannerUse) {
   const CommandResult outside = run("learn boards/mit1993.board --method cem --budget-balls 2 --out " + learned +
                                     " --shot-values " + table);
   EXPECT_NE(outside.exit_code, 0);
-  EXPECT_NE(outside.err.find("--shot-values is for imitate"), std::string::npos) << outside.err;
+  EXPECT_NE(outside.err.find("learn cem: --shot-values applies to imitate only"), std::string::npos) << outside.err;
   const CommandResult wrong = run("learn boards/mit1993.board --method imitate --budget-balls 2 --rounds 1 --out " + learned +
                                   " --shot-values " + planner_file);
   EXPECT_NE(wrong.exit_code, 0);
@@ -405,7 +405,7 @@ TEST_F(Cli, LearnDrainPenaltyPricesTheShotTableAndTheTeacher) {
   for (const std::string& method : {"cem --budget-balls 2 --out " + learned, std::string("launcher")}) {
     const CommandResult refused = run("learn boards/mit1993.board --method " + method + " --drain-penalty 5000");
     EXPECT_EQ(refused.exit_code, 1) << method;
-    EXPECT_NE(refused.err.find("--drain-penalty is for imitate"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("--drain-penalty applies to imitate and shot-values only"), std::string::npos) << refused.err;
   }
   EXPECT_EQ(run(imitate + learned + " --drain-penalty -1").exit_code, 2) << "below the range";
 }
@@ -865,6 +865,16 @@ TEST_F(Cli, LearnMethodsRefuseOptionsTheyDoNotRead) {
            {"--method shot-values --out sv.yaml --curve sv.csv", "--method shot-values does not read --curve"},
            {"--method shot-values --out sv.yaml --checkpoint sv.ckpt",
             "--method shot-values does not read --checkpoint"},
+           // Had exited 0: nothing written, the option's world or setting not played.
+           {"--method evaluate --controller controllers/spastic.json --curve c.csv",
+            "learn evaluate: --curve applies to tournament, relay, cem and imitate only"},
+           {"--method launcher --randomize config/randomize.yaml",
+            "learn launcher: --randomize applies to tournament, relay, cem and imitate only"},
+           {"--method launcher --threads 2", "learn launcher: --threads applies to"},
+           {"--method tournament --population 40 --out t.json",
+            "learn tournament: --population applies to relay and cem only"},
+           {"--method shot-values --out sv.yaml --eval-balls 5", "learn shot-values: --eval-balls applies to"},
+           {"--method none --rounds 3", "learn none: --rounds applies to imitate only"},
        }) {
     const CommandResult r = run("learn boards/mit1993.board " + args);
     EXPECT_EQ(r.exit_code, 1) << args;
@@ -938,7 +948,7 @@ TEST_F(Cli, FindsTheShippedBoardsAndControllersFromAnyFolder) {
   // (found: the refusal is the method's, after the parse)
   const CommandResult drawn =
       run_in(dir_, "learn boards/mit1993.board --method spastic --randomize config/randomize.yaml");
-  EXPECT_NE(drawn.err.find("--randomize is for a search"), std::string::npos) << drawn.err;
+  EXPECT_NE(drawn.err.find("--randomize applies to tournament, relay, cem and imitate only"), std::string::npos) << drawn.err;
   // A board found nowhere is still refused, naming what was typed.
   const CommandResult missing = run_in(dir_, "sim boards/no_such.board");
   EXPECT_EQ(missing.exit_code, 2);
