@@ -44,6 +44,16 @@ void check_one_run(const std::string& path, double& latest_s, double t_s, std::i
   latest_s = std::max(latest_s, t_s);
 }
 
+void check_log_holds_one_run(const std::string& path, const std::vector<LcmLogEvent>& events) {
+  double latest_s = -1e300;
+  for (const LcmLogEvent& e : events) {
+    if (e.channel != kObservationChannel) continue;
+    pinball_lcm::lcmt_pinball_observation m;
+    if (decode_observation(e.data.data(), e.data.size(), m) == ObservationLayout::kMalformed || m.utime < 0) continue;
+    check_one_run(path, latest_s, from_utime(m.utime), m.seq);
+  }
+}
+
 RecordedPlay read_recorded_play(const std::string& path) {
   const std::vector<LcmLogEvent> events = read_lcm_log(path);  // refuses empty, non-LCM and damaged logs
   RecordedPlay play;

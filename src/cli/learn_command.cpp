@@ -474,6 +474,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   // What is written at the end can be written: a typo must not cost an hour's search.
   check_output_folder(args.out, "--out");
   check_output_folder(args.curve, "--curve");
+  check_output_folder(args.checkpoint, "--checkpoint");  // a missing folder had said only "cannot create it"
   check_png_output(args.plot, "--plot");
   const std::string cycle_path = args.out.empty() ? std::string() : args.out + ".cycle.json";
   check_output_folder(cycle_path, "--out's cycle file");
@@ -611,6 +612,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
       err << "learn: cycle controller saved to " << cycle_path << "\n";
     };
     learn::SearchResult r;
+    const std::uint64_t replayed_before = learn::checkpoint_status().replayed_items;
     if (a.method == "tournament") {
       learn::TournamentConfig t;
       t.balls_per_controller = a.balls_per_controller;
@@ -651,7 +653,10 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     j["best_estimated_mean"] = r.best_mean;
     j["best_estimated_balls"] = r.best_balls;
     j["search_wall_s"] = r.wall_s;
-    j["search_balls_per_s"] = r.wall_s > 0 ? static_cast<double>(r.balls_used) / r.wall_s : 0.0;
+    // Balls taken from a checkpoint took no time: the rate is of the balls played (it had said 88 balls/s for 62).
+    const double played = static_cast<double>(r.balls_used) -
+                          static_cast<double>(learn::checkpoint_status().replayed_items - replayed_before);
+    j["search_balls_per_s"] = played > 0.0 && r.wall_s > 0 ? nlohmann::json(played / r.wall_s) : nlohmann::json();
     j["cycle_found"] = r.cycle_found;
     j["counters"] = counters;
     j["out"] = a.out;
@@ -752,7 +757,10 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
     auto num = [](const nlohmann::json& x, int digits = 3) { return format_number(x.get<double>(), digits); };
     if (search) {
       out << "balls used       " << j["balls_used"] << " of " << a.budget_balls << " in " << j["generations"]
-          << " generations, " << num(j["search_balls_per_s"]) << " balls/s\n"
+          << " generations, "
+          << (j["search_balls_per_s"].is_null() ? std::string("every ball from the checkpoint")
+                                                 : num(j["search_balls_per_s"]) + " balls/s")
+          << "\n"
           << "best estimate    " << num(j["best_estimated_mean"], 4) << " over " << j["best_estimated_balls"]
           << " balls\n"
           << "cycle found      " << (j["cycle_found"].get<bool>() ? "yes" : "no") << "\n"

@@ -21,8 +21,11 @@ CLI::App* add_replay_command(CLI::App& app, ReplayArgs& a) {
   cmd->add_option("log", a.log, "LCM log file")->required()->check(input_file());
   cmd->add_option("--config", a.config, "the pinballd configuration the log was recorded with (default: none)")
       ->transform(data_file());
-  cmd->add_option("--board", a.board, "board file (default: the configuration's)")->transform(data_file());
-  cmd->add_option("--controller", a.controller, "controller file (default: the configuration's)")
+  const daemon::DaemonConfig defaults;
+  cmd->add_option("--board", a.board, "board file (default: the configuration's, else " + defaults.sim.board + ")")
+      ->transform(data_file());
+  cmd->add_option("--controller", a.controller,
+                  "controller file (default: the configuration's, else " + defaults.controller + ")")
       ->transform(data_file());
   cmd->add_flag("--json", a.json, "print one JSON object");
   add_progress_flag(*cmd, a.progress);
@@ -53,12 +56,17 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
     config.board = a.board;
   }
   if (!a.controller.empty()) config.controller = a.controller;
+  // What the decisions were replayed with: a log recorded with another controller is "NOT reproduced".
+  const std::string board = config.mode == "sim" ? config.sim.board : config.board;
+  const bool defaults_only = a.config.empty() && a.controller.empty();
   const daemon::ReplayReport r =
       daemon::replay_log(a.log, config, [&](const std::string& line) {
         if (progress_wanted(a.progress)) err << "replay: " << line << "\n";  // stderr stays quiet for a script
       });
   if (a.json) {
-    out << nlohmann::json{{"events", r.events},
+    out << nlohmann::json{{"board", board},
+                          {"controller", config.controller},
+                          {"events", r.events},
                           {"observations", r.observations},
                           {"observations_without_latency", r.observations_without_latency},
                           {"malformed", r.malformed},
@@ -73,6 +81,8 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
                .dump(2)
         << "\n";
   } else {
+    out << "replayed with    controller " << config.controller << ", board " << board
+        << (defaults_only ? " (the defaults: give --controller or --config as recorded)" : "") << "\n";
     out << "observations " << r.observations << "  recorded decisions " << r.recorded_commands << "  replayed "
         << r.replayed_commands << "  matched " << r.matched << "  malformed " << r.malformed << "\n";
     out << verdict(r) << "\n";

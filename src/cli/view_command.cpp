@@ -10,12 +10,16 @@
 #include <optional>
 #include <ostream>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/highgui.hpp>
 
 #include "commands.h"
 #include "data_file.h"
+#include "pinball/bus/lcm_log_format.h"
+#include "pinball/bus/recorded_play.h"
 #include "pinball/core/format.h"
 #include "pinball/core/number_option.h"
 #include "pinball/daemon/daemon_config.h"
@@ -121,8 +125,9 @@ constexpr const char* kKeys = "space pause | . , frame +/- | l j 1 s +/- | L J 1
 int view_log_snapshot(const ViewArgs& a, const view::ViewScene& scene, view::LogPlayer& player, std::ostream& out) {
   const double t_s = a.at_s < 0.0 ? player.duration_s() : a.at_s;
   if (t_s > player.duration_s() + 1e-9) {
-    throw std::runtime_error("--at " + format_number(t_s) + ": the log " + a.log + " ends at " +
-                             format_number(player.duration_s()) + " s");
+    // Exact: rounded, "--at 35.9000001" was refused as "--at 35.9 ... ends at 35.9 s".
+    throw std::runtime_error("--at " + format_exact(t_s) + ": the log " + a.log + " ends at " +
+                             format_exact(player.duration_s()) + " s");
   }
   player.seek(t_s);
   const cv::Mat picture = view::render_view(scene, player.state(), {a.log, "log " + format_number(t_s) + " s"});
@@ -277,7 +282,9 @@ int run_view(const ViewArgs& a, std::ostream& out, std::ostream& err) {
   }
   const view::ViewScene scene = scene_for(a);
   if (!a.log.empty()) {
-    view::LogPlayer player(bus::read_lcm_log(a.log));
+    std::vector<bus::LcmLogEvent> events = bus::read_lcm_log(a.log);
+    bus::check_log_holds_one_run(a.log, events);  // two runs appended would play interleaved
+    view::LogPlayer player(std::move(events));
     return window ? view_log_window(a, scene, player, out) : view_log_snapshot(a, scene, player, out);
   }
   return view_live(a, scene, window, out, err);

@@ -71,6 +71,10 @@ std::string open_on_root(const CheckpointOptions& o, Tape& tape) {
   std::error_code ec;
   const bool exists = fs::exists(o.path, ec);
   if (!o.resume) {
+    if (fs::is_directory(o.path, ec)) return "checkpoint " + o.path + " is a folder, not a file";
+    if (exists && !fs::is_regular_file(o.path, ec)) {
+      return "checkpoint " + o.path + " is not a regular file (a device, a pipe): it cannot hold a run";
+    }
     if (exists) {
       return "checkpoint " + o.path + " already exists: pass --resume to continue that run, or remove the file to start again";
     }

@@ -350,7 +350,8 @@ ImitationResult learn_by_imitation(const table::Board& board, const ImitationLea
   if (config.table.lead_actuation_delay_s != config.demonstration.lead_actuation_delay_s)
     throw std::invalid_argument("imitation: the table's lead must be the one its demonstrations are keyed with");
   if (budget_balls < static_cast<std::uint64_t>(config.rounds)) {
-    throw std::invalid_argument("imitation: the budget must give every round a ball");
+    throw std::invalid_argument("imitation: a budget of " + std::to_string(budget_balls) + " balls (--budget-balls) "
+                                "cannot give each of " + std::to_string(config.rounds) + " rounds (--rounds) a ball");
   }
   ImitationResult result;
   std::vector<control::ShotExample> shots;

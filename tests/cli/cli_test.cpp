@@ -314,7 +314,7 @@ TEST_F(Cli, LearnImitateWritesAShotTableThatEvaluateAndSimPlay) {
   // Fewer balls than rounds, and no --out, are refused in one line.
   const CommandResult few = run("learn boards/mit1993.board --method imitate --budget-balls 1 --rounds 2 --out " + out);
   EXPECT_NE(few.exit_code, 0);
-  EXPECT_NE(few.err.find("every round a ball"), std::string::npos) << few.err;
+  EXPECT_NE(few.err.find("cannot give each of 2 rounds (--rounds) a ball"), std::string::npos) << few.err;
   EXPECT_NE(run("learn boards/mit1993.board --method imitate --budget-balls 2").exit_code, 0);
 }
 
@@ -854,6 +854,26 @@ TEST_F(Cli, ADeviceIsNoInputFile) {
   const CommandResult csv = run("play boards/mit1993.board --headless --keys 0.1:launch --balls 1 --csv /dev/full");
   EXPECT_EQ(csv.exit_code, 1);
   EXPECT_NE(csv.err.find("/dev/full: is not a regular file"), std::string::npos) << csv.err;
+}
+
+// A search resumed from a checkpoint that holds it whole played no ball: no rate made up from
+// the balls it read (it had said 88 balls/s for a search that ran at 62). A checkpoint that is
+// a folder is named as one.
+TEST_F(Cli, AResumedSearchRatesOnlyTheBallsItPlayed) {
+  const std::string ckpt = (dir_ / "t.ckpt").string();
+  const std::string learn = "learn boards/mit1993.board --method tournament --budget-balls 60 --eval-balls 0 --out " +
+                            (dir_ / "t.json").string() + " --checkpoint " + ckpt + " --json";
+  const CommandResult first = run(learn);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  EXPECT_GT(nlohmann::json::parse(first.out).at("search_balls_per_s").get<double>(), 0.0);
+  const CommandResult again = run(learn + " --resume");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_TRUE(nlohmann::json::parse(again.out).at("search_balls_per_s").is_null()) << again.out;
+  const CommandResult folder = run("learn boards/mit1993.board --method tournament --budget-balls 60 --out " +
+                                   (dir_ / "f.json").string() + " --checkpoint " + dir_.string());
+  EXPECT_EQ(folder.exit_code, 1);
+  EXPECT_NE(folder.err.find("--checkpoint " + dir_.string() + ": is a folder, not a file"), std::string::npos)
+      << folder.err;
 }
 
 // A method refuses the options it would not read: launcher wrote none of its --out, --curve

@@ -300,6 +300,11 @@ TEST(Replay, ALogOfAnotherTypeOnTheChannelIsSaidToBeMalformed) {
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("NOT reproduced: no PINBALL_OBSERVATION message decoded (5 malformed"), std::string::npos)
       << text;
+  // What it replayed with: nothing given, the defaults, said so (another controller's log is "NOT reproduced").
+  EXPECT_NE(text.find("replayed with    controller controllers/imitation.json, board boards/mit1993.board (the "
+                      "defaults: give --controller or --config as recorded)"),
+            std::string::npos)
+      << text;
   // A script reads the same sentence under "verdict".
   const int json_status =
       std::system((std::string(PINBALL_EXE) + " replay " + log + " --json > " + text_out + " 2>/dev/null").c_str());
@@ -308,6 +313,8 @@ TEST(Replay, ALogOfAnotherTypeOnTheChannelIsSaidToBeMalformed) {
   const nlohmann::json j = nlohmann::json::parse(json_in);
   const std::string said = j.at("verdict").get<std::string>();
   EXPECT_EQ(said.rfind("NOT reproduced: no PINBALL_OBSERVATION message decoded (5", 0), 0u) << said;
+  EXPECT_EQ(j.at("controller"), "controllers/imitation.json");
+  EXPECT_EQ(j.at("board"), "boards/mit1993.board");
   std::remove(log.c_str());
   std::remove(text_out.c_str());
 }

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/command_test.h"
+#include "pinball/bus/recorded_play.h"
 #include "pinball/view/view_render.h"
 #include "view/view_log.h"
 
@@ -45,6 +46,22 @@ TEST_F(ViewCommand, SnapshotOfALogShowsTheBallWhereTheLogSaysItWas) {
   const cv::Point2d c = ball_in(png);
   EXPECT_NEAR(c.x, j["ball"]["u_px"].get<double>(), 1.0);
   EXPECT_NEAR(c.y, j["ball"]["v_px"].get<double>(), 1.0);
+}
+
+// Two runs appended to one log (lcm_url mode=a) had played interleaved on one timeline.
+TEST_F(ViewCommand, ALogOfTwoRunsAppendedIsRefusedAsReplayRefusesIt) {
+  bus::RecordedPlay run;  // 5 s of frames: the second run's clock starts again 5 s back
+  for (int i = 0; i < 500; ++i) run.frames.push_back({0.01 * i, i, true, Vec2(0.25, 0.5), false, false});
+  run.commands.push_back({1.0, 0, true, 0});
+  const std::string twice = (dir_ / "twice.lcmlog").string();
+  {
+    std::ofstream out(twice, std::ios::binary);
+    out << bus::recorded_play_log(run) << bus::recorded_play_log(run);
+  }
+  const CommandResult r = view(twice + " --snapshot " + (dir_ / "t.png").string() + " --at 0.5");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(twice + ": its clock goes back"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("several runs appended to one log (mode=a)?"), std::string::npos) << r.err;
 }
 
 // A configuration that keeps pinballd's default controller names the shipped

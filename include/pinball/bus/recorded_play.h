@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "pinball/bus/lcm_log_format.h"
 #include "pinball/core/geometry.h"
 
 namespace pinball::bus {
@@ -56,6 +57,11 @@ RecordedPlay read_recorded_play(const std::string& path);
 /// clock that started again, a second run appended (lcm_url mode=a). Throws
 /// std::runtime_error "path: its clock goes back ..." naming the frame.
 void check_one_run(const std::string& path, double& latest_s, double t_s, std::int64_t seq);
+
+/// check_one_run over every PINBALL_OBSERVATION of `events` (the log at
+/// `path`) that decodes; for a reader that plays the whole log on one
+/// timeline (`pinball view`), where two runs would play interleaved.
+void check_log_holds_one_run(const std::string& path, const std::vector<LcmLogEvent>& events);
 
 /// `play` as the bytes of an LCM log (frames and commands interleaved in time
 /// order, stamped with their own times), which read_recorded_play reads back:
