@@ -2,6 +2,7 @@
 // recorded LCM log (pause, seek, frame by frame), or one picture of either
 // with --snapshot, without a display.
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -18,6 +19,7 @@
 
 #include "commands.h"
 #include "data_file.h"
+#include "pinball/bus/channels.h"
 #include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/recorded_play.h"
 #include "pinball/core/format.h"
@@ -284,6 +286,15 @@ int run_view(const ViewArgs& a, std::ostream& out, std::ostream& err) {
   if (!a.log.empty()) {
     std::vector<bus::LcmLogEvent> events = bus::read_lcm_log(a.log);
     bus::check_log_holds_one_run(a.log, events);  // two runs appended would play interleaved
+    // A log of another program had drawn an empty table and exited 0.
+    const bool any = std::any_of(events.begin(), events.end(), [](const bus::LcmLogEvent& e) {
+      return std::ranges::find_if(bus::kDaemonChannels, [&](const char* c) { return e.channel == c; }) !=
+             bus::kDaemonChannels.end();
+    });
+    if (!any) {
+      throw std::runtime_error(a.log + ": none of its " + std::to_string(events.size()) +
+                               " messages is on the daemon's channels (PINBALL_*): a log of another program?");
+    }
     view::LogPlayer player(std::move(events));
     return window ? view_log_window(a, scene, player, out) : view_log_snapshot(a, scene, player, out);
   }

@@ -30,8 +30,7 @@ LcmListener::LcmListener(const std::string& url, ViewState& state) : state_(stat
     lcm_destroy(lcm_);
     throw;
   }
-  for (const char* channel : {bus::kObservationChannel, bus::kProjectionChannel, bus::kFlipperCommandChannel,
-                              bus::kDriverStatusChannel, bus::kGameChannel, bus::kStatsChannel}) {
+  for (const char* channel : bus::kDaemonChannels) {
     if (lcm_subscribe(lcm_, channel, &on_lcm_message, this) == nullptr) {
       lcm_destroy(lcm_);
       throw std::runtime_error("lcm: cannot subscribe to " + std::string(channel) + " on '" + url + "'");

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/command_test.h"
+#include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/recorded_play.h"
 #include "pinball/view/view_render.h"
 #include "view/view_log.h"
@@ -62,6 +63,18 @@ TEST_F(ViewCommand, ALogOfTwoRunsAppendedIsRefusedAsReplayRefusesIt) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find(twice + ": its clock goes back"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("several runs appended to one log (mode=a)?"), std::string::npos) << r.err;
+}
+
+// A log of another program had drawn an empty table and exited 0.
+TEST_F(ViewCommand, ALogWithNoDaemonMessageIsRefused) {
+  std::string bytes;
+  const std::uint8_t pose[4] = {1, 2, 3, 4};
+  bus::append_lcm_event(bytes, 0, 1000, "POSE", pose, sizeof pose);
+  const std::string other = (dir_ / "other.lcmlog").string();
+  std::ofstream(other, std::ios::binary) << bytes;
+  const CommandResult r = view(other + " --snapshot " + (dir_ / "o.png").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(other + ": none of its 1 messages is on the daemon's channels"), std::string::npos) << r.err;
 }
 
 // A configuration that keeps pinballd's default controller names the shipped
