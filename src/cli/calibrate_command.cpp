@@ -532,7 +532,7 @@ void run_latency_sim(Context& c) {
   // The machine's true delay; --actuation-delay-ms is what the measurement assumes (below).
   o.actuation_delay_s = (a.sim_actuation_delay_ms >= 0.0 ? a.sim_actuation_delay_ms : a.actuation_delay_ms) * 1e-3;
   if (a.sim_latency_ms >= 0.0) o.camera.realism.latency_min_s = a.sim_latency_ms * 1e-3;
-  // The simulated camera reads its rows out in a fixed time, and keeps 0.18 s of the table's motion.
+  // The simulated camera reads its rows out in a fixed time; far below 100 frames/s no event can be fitted.
   const double readout_s = o.camera.realism.row_time_s * o.camera.height_px;
   constexpr double kSimMinFps = 10.0;
   if (a.fps < kSimMinFps || a.fps * readout_s > 1.0) {
@@ -544,6 +544,8 @@ void run_latency_sim(Context& c) {
   o.camera.fps = a.fps;  // the rate asked of the camera, as in the lab (it had stayed 200)
   o.camera.exposure_s = std::min(o.camera.exposure_s, 1.0 / a.fps);
   o.lead_in_s = std::max(o.lead_in_s, calibration::latency_lead_in_s(calibration::LatencyOptions{}, 1.0 / a.fps));
+  // A slow camera with a long latency (10 fps, 100 ms) needs a longer step: it had failed with the step's own message.
+  o.step_s = std::max(o.step_s, simlab::min_latency_step_s(o.camera));
   c.err << "calibrate latency: simulating " << o.events << " fires of " << c.board.flippers[o.flipper].name << "\n";
   const simlab::SimLatencyRun run = simlab::simulate_latency_run(c.board, o);
   calibration::LatencyOptions lo = run.timing;

@@ -243,9 +243,12 @@ int view_live(const ViewArgs& a, const view::ViewScene& scene, bool window, std:
 CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
   CLI::App* cmd = app.add_subcommand(
       "view", "watch pinballd: live over LCM, or a recorded LCM log with pause, seek and frame stepping");
-  cmd->add_option("log", a.log, "LCM log to play (pinballd --lcm-url file://...?mode=w, lcm-logger); none: live")
-      ->check(input_file());
-  cmd->add_option("--lcm-url", a.lcm_url, "live: the LCM URL pinballd publishes on (default: --config's, else udpm)");
+  // Options one mode reads and the other would drop are refused together (CLI11's excludes and needs).
+  CLI::Option* log =
+      cmd->add_option("log", a.log, "LCM log to play (pinballd --lcm-url file://...?mode=w, lcm-logger); none: live")
+          ->check(input_file());
+  cmd->add_option("--lcm-url", a.lcm_url, "live: the LCM URL pinballd publishes on (default: --config's, else udpm)")
+      ->excludes(log);
   cmd->add_option("--config", a.config, "the pinballd configuration: board, calibration, controller, LCM URL")
       ->transform(data_file());
   cmd->add_option("--board", a.board, "board file (default: the configuration's, boards/mit1993.board)")
@@ -258,18 +261,24 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
                   "PNG to write: with --at, the picture at that time and no window; with --quit-at, the window's "
                   "last frame")
       ->check(output_file());
-  cmd->add_option("--at", a.at_s, "snapshot time: seconds from the log's first event or the first live message (default: the end)")
-      ->check(finite_range(0.0, 1e9))
-      ->default_str("");  // -1: the end
+  CLI::Option* at = cmd->add_option("--at", a.at_s,
+                                    "snapshot time: seconds from the log's first event or the first live message "
+                                    "(default: the end)")
+                        ->check(finite_range(0.0, 1e9))
+                        ->default_str("");  // -1: the end
   cmd->add_option("--quit-at", a.quit_at_s, "window: play until this time (s), write --snapshot, quit")
       ->check(finite_range(0.0, 1e9))
-      ->default_str("");  // -1: play until q
-  cmd->add_option("--speed", a.speed, "log playback speed (keys + and - change it)")
-      ->check(finite_range(1.0 / 64.0, 64.0));
+      ->default_str("")  // -1: play until q
+      ->excludes(at);
+  cmd->add_option("--speed", a.speed, "log playback speed in the window (keys + and - change it)")
+      ->check(finite_range(1.0 / 64.0, 64.0))
+      ->needs(log)
+      ->excludes(at);
   cmd->add_option("--px-per-m", a.px_per_m, "scale of the table in pixels per metre")
       ->check(finite_range(100.0, 4000.0));
   cmd->add_option("--wait-s", a.wait_s, "live without a window: stop when nothing arrives for this long (s)")
-      ->check(finite_range(0.1, 3600.0));
+      ->check(finite_range(0.1, 3600.0))
+      ->excludes(log);
   cmd->add_flag("--json", a.json, "print one JSON object (what the view showed last)");
   return cmd;
 }

@@ -47,6 +47,13 @@ SimCameraConfig SimLatencyOptions::typical_camera() {
   return c;
 }
 
+double min_latency_step_s(const SimCameraConfig& camera) {
+  const SimCameraRealism& r = camera.realism;
+  // The camera keeps 2048 samples: 1800 steps must span a frame's exposure, readout and delivery.
+  const double needed_s = 1.0 / camera.fps + r.latency_min_s + 20.0 * r.latency_jitter_mean_s + 0.01;
+  return needed_s / 1800.0;
+}
+
 SimLatencyRun simulate_latency_run(const table::Board& board, const SimLatencyOptions& o) {
   const char* ctx = "simulated latency run";
   check_input(o.flipper < board.flippers.size(), ctx, "the board has no flipper " + std::to_string(o.flipper));
@@ -63,9 +70,7 @@ SimLatencyRun simulate_latency_run(const table::Board& board, const SimLatencyOp
   SimCameraConfig cc = o.camera;
   cc.seed = o.seed;
   const SimCameraRealism& r = cc.realism;
-  // The camera keeps 2048 samples: they must span a frame's exposure, readout and delivery.
-  const double needed_s = 1.0 / cc.fps + r.latency_min_s + 20.0 * r.latency_jitter_mean_s + 0.01;
-  check_input(std::isfinite(o.step_s) && o.step_s > 0.0 && o.step_s * 1800.0 >= needed_s && o.step_s <= 0.001, ctx,
+  check_input(std::isfinite(o.step_s) && o.step_s >= min_latency_step_s(cc) && o.step_s <= 0.001, ctx,
               "step_s must be <= 1 ms and cover the camera's latency in 1800 steps");
 
   const table::Flipper& flipper = board.flippers[o.flipper];

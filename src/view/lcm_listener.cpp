@@ -19,7 +19,9 @@ void on_lcm_message(const lcm_recv_buf_t* rbuf, const char* channel, void* user)
 }  // namespace
 
 LcmListener::LcmListener(const std::string& url, ViewState& state) : state_(state) {
-  if (const std::string problem = bus::lcm_url_problem(url); !problem.empty()) throw std::runtime_error("lcm: " + problem);
+  if (const std::string problem = bus::lcm_url_problem(url); !problem.empty()) {
+    throw std::runtime_error("lcm: " + problem);
+  }
   // liblcm plays a damaged log by the lengths it reads (a segmentation fault): checked as every reader checks it.
   if (const std::optional<std::string> log = bus::lcm_log_source(url)) bus::require_lcm_log(*log);
   lcm_ = lcm_create(url.c_str());

@@ -284,6 +284,11 @@ TEST_F(Calibrate, LatencySimRunsTheCameraAtTheRateAskedOfIt) {
   EXPECT_EQ(late["actuation_delay_ms"].get<double>(), 4.0) << "assumed: --actuation-delay-ms's default";
   EXPECT_EQ(late["truth"]["actuation_delay_ms"].get<double>(), 6.0);
   EXPECT_NEAR(late["truth"]["error_ms"].get<double>(), 2.0, 0.3);
+  // A slow camera with a long latency is simulated (its step lengthens), and fails as a real one would.
+  r = run("calibrate latency --sim boards/mit1993.board --events 3 --fps 10 --sim-latency-ms 100");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err.find("step_s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("events usable"), std::string::npos) << r.err;
   r = run("calibrate latency --sim boards/mit1993.board --fps 300");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("--fps 300: the simulated camera runs at 10 to 208 frames/s"), std::string::npos) << r.err;

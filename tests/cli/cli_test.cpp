@@ -126,7 +126,8 @@ TEST_F(Cli, LearnRandomizeSearchesAcrossDrawnWorldsAndJudgesInTheHomeWorld) {
   EXPECT_EQ(led_table.at("lead_actuation_delay_s"), 0.006);
   const CommandResult spastic_led = run("learn boards/mit1993.board --method spastic --eval-balls 2 --lead");
   EXPECT_EQ(spastic_led.exit_code, 1);
-  EXPECT_NE(spastic_led.err.find("learn spastic: --lead applies to tournament, relay, cem and imitate only"), std::string::npos)
+  EXPECT_NE(spastic_led.err.find("learn spastic: --lead applies to tournament, relay, cem and imitate only"),
+            std::string::npos)
       << spastic_led.err;
 
   const CommandResult spastic = run("learn boards/mit1993.board --method spastic --eval-balls 2 --randomize " +
@@ -405,7 +406,8 @@ TEST_F(Cli, LearnDrainPenaltyPricesTheShotTableAndTheTeacher) {
   for (const std::string& method : {"cem --budget-balls 2 --out " + learned, std::string("launcher")}) {
     const CommandResult refused = run("learn boards/mit1993.board --method " + method + " --drain-penalty 5000");
     EXPECT_EQ(refused.exit_code, 1) << method;
-    EXPECT_NE(refused.err.find("--drain-penalty applies to imitate and shot-values only"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("--drain-penalty applies to imitate and shot-values only"), std::string::npos)
+        << refused.err;
   }
   EXPECT_EQ(run(imitate + learned + " --drain-penalty -1").exit_code, 2) << "below the range";
 }
@@ -968,7 +970,8 @@ TEST_F(Cli, FindsTheShippedBoardsAndControllersFromAnyFolder) {
   // (found: the refusal is the method's, after the parse)
   const CommandResult drawn =
       run_in(dir_, "learn boards/mit1993.board --method spastic --randomize config/randomize.yaml");
-  EXPECT_NE(drawn.err.find("--randomize applies to tournament, relay, cem and imitate only"), std::string::npos) << drawn.err;
+  EXPECT_NE(drawn.err.find("--randomize applies to tournament, relay, cem and imitate only"), std::string::npos)
+      << drawn.err;
   // A board found nowhere is still refused, naming what was typed.
   const CommandResult missing = run_in(dir_, "sim boards/no_such.board");
   EXPECT_EQ(missing.exit_code, 2);

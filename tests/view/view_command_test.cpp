@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -63,6 +66,23 @@ TEST_F(ViewCommand, ALogOfTwoRunsAppendedIsRefusedAsReplayRefusesIt) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find(twice + ": its clock goes back"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("several runs appended to one log (mode=a)?"), std::string::npos) << r.err;
+}
+
+// An option the mode would drop is refused: a log's view read no --lcm-url or --wait-s, a snapshot at
+// --at no --speed, and --at beside --quit-at had turned into a window that dropped --at.
+TEST_F(ViewCommand, AnOptionTheModeWouldDropIsRefused) {
+  const std::string png = (dir_ / "x.png").string();
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {log_ + " --snapshot " + png + " --at 0.5 --lcm-url memq://", "--lcm-url excludes log"},
+           {log_ + " --snapshot " + png + " --at 0.5 --wait-s 2", "--wait-s excludes log"},
+           {log_ + " --snapshot " + png + " --at 0.5 --speed 2", "--speed excludes --at"},
+           {log_ + " --snapshot " + png + " --at 0.5 --quit-at 1", "--quit-at excludes --at"},
+           {"--lcm-url memq:// --snapshot " + png + " --speed 2", "--speed requires log"},
+       }) {
+    const CommandResult r = view(args);
+    EXPECT_EQ(r.exit_code, 2) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << "\n" << r.err;
+  }
 }
 
 // A log of another program had drawn an empty table and exited 0.

@@ -48,6 +48,11 @@ struct SimLatencyRun {
   std::uint64_t frames_dropped = 0;         ///< frames the camera lost
 };
 
+/// The shortest step (s) at which the camera's history spans its frame
+/// period, exposure and latency: a slow camera or a long latency needs a
+/// longer one than SimLatencyOptions' default (at most 1 ms works).
+double min_latency_step_s(const SimCameraConfig& camera);
+
 /// Plays the procedure. Throws std::invalid_argument for a bad option (no
 /// such flipper, a step that the camera's history cannot hold, ...).
 SimLatencyRun simulate_latency_run(const table::Board& board, const SimLatencyOptions& options);
