@@ -178,10 +178,11 @@ class ProgressCount {
                 const std::vector<std::pair<std::string, long>>& balls_by_kind)
       : total_(std::max(1L, total_of(balls_by_kind))),
         count_(total_, total_ / 100, [this, &progress](long d, double elapsed_s) { report(progress, d, elapsed_s); }) {
-    for (const auto& [kind, balls] : balls_by_kind) {
-      auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const auto& k) { return k.first == kind; });
-      if (it == kinds_.end()) it = kinds_.insert(kinds_.end(), {kind, KindProgress{}});
-      it->second.total += static_cast<double>(balls);
+    for (const auto& world : balls_by_kind) {
+      const std::string& name = world.first;  // a named reference: clang 14 captures no structured binding
+      auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const auto& k) { return k.first == name; });
+      if (it == kinds_.end()) it = kinds_.insert(kinds_.end(), {name, KindProgress{}});
+      it->second.total += static_cast<double>(world.second);
     }
   }
   /// Before a world's balls (no ball in flight): the name the lines carry, and its kind's clock.
