@@ -85,7 +85,7 @@ CLI::App* add_learn_command(CLI::App& app, LearnArgs& a) {
   cmd->add_option("--controller", a.controller, "evaluate: the controller file")->transform(data_file());
   cmd->add_option("--threads", a.threads, "worker threads")->check(finite_range(1, 256));
   cmd->add_option("--curve", a.curve, "write the learning curve to this CSV")->check(output_file());
-  cmd->add_option("--plot", a.plot, "draw the learning curve to this PNG");
+  cmd->add_option("--plot", a.plot, "draw the learning curve to this PNG")->check(output_file());
   cmd->add_option("--eval-balls", a.eval_balls,
                   "evaluate the result on this many fresh balls (default: 0 after a search, 1000 otherwise)")
       ->check(finite_range(0, 10'000'000))
@@ -500,7 +500,6 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   a.actuation_delay_s = world_actuation_delay_s(
       args.actuation_delay_given ? std::optional<double>(args.actuation_delay_s) : std::nullopt, args.world,
       args.identified);
-
   // Options a method does not read are refused, not ignored: launcher prints its pulls and
   // writes nothing; shot-values writes its table, with no curve and no checkpoint.
   if (a.method == "launcher" || a.method == "shot-values") {
