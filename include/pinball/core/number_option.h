@@ -27,14 +27,17 @@ inline std::string bound_text(double v) {
 }
 
 /// A check that `text` is a finite number for which `ok` holds; `rule` ends
-/// the message ("nan is not a finite number > 0") and is the help's text.
+/// the message ("-1 is not > 0", "nan is not a finite number > 0") and is
+/// the help's text.
 template <class Ok>
 CLI::Validator finite_number(Ok ok, const std::string& rule) {
   return CLI::Validator(
       [ok, rule](std::string& text) -> std::string {
         double v = 0.0;
         if (!CLI::detail::lexical_cast(text, v)) return "'" + text + "' is not a number";
-        if (!std::isfinite(v) || !ok(v)) return text + " is not a finite number " + rule;
+        if (!std::isfinite(v)) return text + " is not a finite number " + rule;
+        // "-1 is not a finite number in [0, 1]" had read as if -1 were not finite.
+        if (!ok(v)) return text + " is not " + rule;
         return "";
       },
       rule);
@@ -42,7 +45,7 @@ CLI::Validator finite_number(Ok ok, const std::string& rule) {
 
 }  // namespace number_option_detail
 
-/// A finite number in [min, max]: "nan is not a finite number in [1, 1000]".
+/// A finite number in [min, max]: "0 is not in [1, 1000]".
 inline CLI::Validator finite_range(double min, double max) {
   return number_option_detail::finite_number([min, max](double v) { return v >= min && v <= max; },
                                              "in [" + number_option_detail::bound_text(min) + ", " +
