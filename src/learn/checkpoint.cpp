@@ -5,6 +5,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
 #include "pinball/learn/team.h"
 
 namespace pinball::learn {
@@ -64,6 +66,29 @@ std::streamoff read_records(std::ifstream& in, std::streamoff start, std::vector
   return start + static_cast<std::streamoff>(good);
 }
 
+// The keys of two fingerprints that are one label and a JSON object ("pinball learn {...}", as
+// learn's are) whose values differ, "seed (1 recorded, 2 now), ...": two lines of thirty keys
+// each had hidden the one that mattered. Empty when the labels differ or either is no object.
+std::string differing_keys(const std::string& recorded, const std::string& now) {
+  const std::size_t ra = recorded.find('{');
+  const std::size_t nb = now.find('{');
+  if (ra == std::string::npos || nb == std::string::npos || recorded.substr(0, ra) != now.substr(0, nb)) return "";
+  const nlohmann::json a = nlohmann::json::parse(recorded.substr(ra), nullptr, false);
+  const nlohmann::json b = nlohmann::json::parse(now.substr(nb), nullptr, false);
+  if (!a.is_object() || !b.is_object()) return "";
+  nlohmann::json keys = a;
+  keys.update(b);
+  std::string out;
+  for (const auto& item : keys.items()) {
+    const std::string& key = item.key();
+    const std::string was = a.contains(key) ? a.at(key).dump() : "none";
+    const std::string is = b.contains(key) ? b.at(key).dump() : "none";
+    if (was == is) continue;
+    out += (out.empty() ? "" : ", ") + key + " (" + was + " recorded, " + is + " now)";
+  }
+  return out;
+}
+
 // Rank 0: reads or creates the file; returns "" or what is wrong.
 std::string open_on_root(const CheckpointOptions& o, Tape& tape) {
   namespace fs = std::filesystem;
@@ -99,8 +124,12 @@ std::string open_on_root(const CheckpointOptions& o, Tape& tape) {
   }
   if (!std::getline(in, fingerprint)) return "checkpoint " + o.path + ": cut off in its header";
   if (fingerprint != o.fingerprint) {
-    return "checkpoint " + o.path + " was written by another run: it recorded\n  " + fingerprint +
-           "\nand this run is\n  " + o.fingerprint + "\n(the same command, seed and board files are needed; --threads may differ)";
+    const std::string keys = differing_keys(fingerprint, o.fingerprint);
+    const std::string what =
+        keys.empty() ? ": it recorded\n  " + fingerprint + "\nand this run is\n  " + o.fingerprint + "\n"
+                     : " (they differ in " + keys + ") ";
+    return "checkpoint " + o.path + " was written by another run" + what +
+           "(the same command, seed and board files are needed; --threads may differ)";
   }
   const std::streamoff start = static_cast<std::streamoff>(expected.size());
   const std::streamoff good = read_records(in, start, tape.batches);
