@@ -178,12 +178,7 @@ class ProgressCount {
                 const std::vector<std::pair<std::string, long>>& balls_by_kind)
       : total_(std::max(1L, total_of(balls_by_kind))),
         count_(total_, total_ / 100, [this, &progress](long d, double elapsed_s) { report(progress, d, elapsed_s); }) {
-    for (const auto& world : balls_by_kind) {
-      const std::string& name = world.first;  // a named reference: clang 14 captures no structured binding
-      auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const auto& k) { return k.first == name; });
-      if (it == kinds_.end()) it = kinds_.insert(kinds_.end(), {name, KindProgress{}});
-      it->second.total += static_cast<double>(world.second);
-    }
+    for (const auto& world : balls_by_kind) kind(world.first).total += static_cast<double>(world.second);
   }
   /// Before a world's balls (no ball in flight): the name the lines carry, and its kind's clock.
   void start_world(const std::string& world, const std::string& kind) {
@@ -209,8 +204,11 @@ class ProgressCount {
     k.done += static_cast<double>(count_.done() - world_start_done_);
     k.wall_s += elapsed_s() - world_start_s_;
   }
+  // The kind's figures, made on first use (the constructor's) in the order the worlds come.
   KindProgress& kind(const std::string& name) {
-    return std::find_if(kinds_.begin(), kinds_.end(), [&](const auto& k) { return k.first == name; })->second;
+    auto it = std::find_if(kinds_.begin(), kinds_.end(), [&](const auto& k) { return k.first == name; });
+    if (it == kinds_.end()) it = kinds_.insert(kinds_.end(), {name, KindProgress{}});
+    return it->second;
   }
   // Under the count's lock; kinds_ changes only between worlds, with no ball in flight.
   void report(const std::function<void(const std::string&)>& progress, long done, double elapsed) {
