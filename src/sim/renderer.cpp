@@ -46,6 +46,7 @@ constexpr double kDashOff_px = 6.0;  // gap between dashes (round caps eat about
 constexpr double kFlipperWidth_m = 0.010;  // drawn width; the model's flipper is a segment
 constexpr double kNormalTick_m = 0.015;    // length of a normal tick
 constexpr int kScaleBarStrip_px = 44;      // the strip below the playfield that holds the scale bar
+constexpr int kScaleBarMinWidth_px = 96;  // narrow boards (a low --px-per-m) still show the bar's label
 
 // Pixel (u, v) as an OpenCV fixed-point point for `shift = kShift`.
 cv::Point to_fixed(const cv::Point2d& uv_px) {
@@ -253,7 +254,8 @@ std::vector<plot::LegendEntry> legend_entries() {
 }  // namespace
 
 cv::Size render_size(const table::Board& board, const RenderOptions& options) {
-  const int w_px = static_cast<int>(std::lround(board.width_m * options.px_per_m)) + 2 * options.margin_px;
+  const int playfield_w_px = static_cast<int>(std::lround(board.width_m * options.px_per_m)) + 2 * options.margin_px;
+  const int w_px = options.draw_scale_bar ? std::max(playfield_w_px, kScaleBarMinWidth_px) : playfield_w_px;
   const int h_px = static_cast<int>(std::lround(board.height_m * options.px_per_m)) + 2 * options.margin_px +
                    (options.draw_scale_bar ? kScaleBarStrip_px : 0);
   return {w_px, h_px};

@@ -454,6 +454,24 @@ TEST(RendererTest, ScaleBarAddsAStripBelowThePlayfield) {
   EXPECT_GT(pinball::testing::count_colour(strip, cv::Scalar(0, 0, 0), 10), 60);
 }
 
+// At 50 px/m the thesis board is 26 px wide: the image widens so the bar's label ("20 cm") is not cut.
+TEST(RendererTest, ANarrowBoardWidensItsImageForTheScaleBarsLabel) {
+  table::Board thesis;  // 0.51 x 1.07 m
+  RenderOptions o;
+  o.px_per_m = 50.0;
+  o.margin_px = 0;
+  o.draw_scale_bar = true;
+  const cv::Mat image = render_board(thesis, nullptr, o);
+  EXPECT_GT(image.cols, static_cast<int>(std::lround(0.51 * 50.0)));
+  EXPECT_EQ(image.size(), render_size(thesis, o));
+  // The label's white box lies wholly inside: none of it in the image's last column.
+  const cv::Mat strip = image(cv::Rect(0, image.rows - 44, image.cols, 44));
+  EXPECT_GT(pinball::testing::count_colour(strip, cv::Scalar(255, 255, 255), 5), 200);
+  EXPECT_EQ(pinball::testing::count_colour(strip.col(strip.cols - 1), cv::Scalar(255, 255, 255), 5), 0);
+  o.draw_scale_bar = false;
+  EXPECT_EQ(render_size(thesis, o).width, static_cast<int>(std::lround(0.51 * 50.0)));
+}
+
 TEST_F(RendererFileTest, BoardFigureIsWrittenWithLegendAndNotTrivial) {
   // What `pinball render` writes: the board with its scale bar, the legend beside it, a title above.
   const table::Board b = line_board();
