@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -54,13 +55,31 @@ std::string key_script_text(const std::string& keys) {
   return s.str();
 }
 
+// Balls per value of one column (world, board): the means pool them, so the report says what they pool.
+std::map<std::string, std::int64_t> balls_by(const std::vector<simlab::PlayRow>& rows,
+                                             std::string simlab::PlayRow::*column) {
+  std::map<std::string, std::int64_t> n;
+  for (const simlab::PlayRow& r : rows) ++n[r.*column];
+  return n;
+}
+
+std::string counts_in_words(const std::map<std::string, std::int64_t>& counts) {
+  std::string text;
+  for (const auto& [name, n] : counts) text += (text.empty() ? "" : ", ") + name + " " + std::to_string(n);
+  return text;
+}
+
 int run_stats(const PlayArgs& a, std::ostream& out) {
   const std::vector<simlab::PlayRow> rows = simlab::read_play_csv(a.stats);
   const std::vector<simlab::PlayerStats> stats = simlab::play_stats(rows);
+  const std::map<std::string, std::int64_t> worlds = balls_by(rows, &simlab::PlayRow::world);
+  const std::map<std::string, std::int64_t> boards = balls_by(rows, &simlab::PlayRow::board);
   if (a.json) {
     nlohmann::json players = nlohmann::json::array();
     for (std::size_t i = 0; i + 1 < stats.size(); ++i) players.push_back(to_json_value(stats[i]));
     out << nlohmann::json{{"file", a.stats},
+                          {"balls_by_world", worlds},
+                          {"balls_by_board", boards},
                           {"players", players},
                           {"pooled", stats.empty() ? nlohmann::json(nullptr) : to_json_value(stats.back())},
                           {"thesis_human_mean_per_ball", kThesisHumanMeanPerBall}}
@@ -68,11 +87,14 @@ int run_stats(const PlayArgs& a, std::ostream& out) {
         << "\n";
     return 0;
   }
-  out << a.stats << ": " << rows.size() << " balls\n\n";
+  out << a.stats << ": " << rows.size() << " balls\n";
   if (stats.empty()) {
-    out << "no balls played yet\n";
+    out << "\nno balls played yet\n";
     return 0;
   }
+  out << "worlds: " << counts_in_words(worlds) << "; boards: " << counts_in_words(boards) << "\n";
+  if (worlds.size() > 1 || boards.size() > 1) out << "the means below pool these games\n";
+  out << "\n";
   out << std::left << std::setw(20) << "Subject" << std::right << std::setw(14) << "Number balls"
       << "   Mean per ball (95 % interval)\n";
   for (const simlab::PlayerStats& s : stats) {

@@ -17,6 +17,7 @@
 
 #include "pinball/core/format.h"
 #include "pinball/core/running_stats.h"
+#include "pinball/core/utc_date.h"
 
 namespace pinball::simlab {
 namespace {
@@ -160,9 +161,15 @@ std::vector<PlayRow> read_play_csv(const std::string& path) {
     r.player = f[0];
     if (r.player.empty()) fail_at(path, line, "column 'player' is empty");
     r.date = f[1];
-    if (r.date.empty()) fail_at(path, line, "column 'date' is empty");
+    if (!is_utc_iso8601(r.date)) {
+      fail_at(path, line, "column 'date' must be a UTC date like 2026-12-02T13:45:21Z, got '" + r.date + "'");
+    }
     r.board = f[2];
+    if (r.board.empty()) fail_at(path, line, "column 'board' is empty");
     r.world = f[3];
+    if (r.world != "thesis" && r.world != "event" && r.world != "twin") {
+      fail_at(path, line, "column 'world' must be thesis, event or twin, got '" + r.world + "'");
+    }
     const auto [end, ec] = std::from_chars(f[4].data(), f[4].data() + f[4].size(), r.ball);
     if (f[4].empty() || ec != std::errc() || end != f[4].data() + f[4].size() || r.ball < 1) {
       fail_at(path, line, "column 'ball' must be a whole number >= 1, got '" + f[4] + "'");

@@ -55,6 +55,8 @@ TEST_F(Play, AHeadlessScriptPlaysBallsAndEachGetsItsRow) {
   EXPECT_EQ(s.at("players")[0].at("balls"), 1);
   EXPECT_TRUE(s.at("players")[0].at("score_ci95_half_width").is_null());  // one ball: no interval
   EXPECT_EQ(s.at("pooled").at("balls"), 2);
+  EXPECT_EQ(s.at("balls_by_world"), (nlohmann::json{{"event", 1}, {"thesis", 1}}));
+  EXPECT_EQ(s.at("balls_by_board"), (nlohmann::json{{"boards/mit1993.board", 2}}));
   EXPECT_DOUBLE_EQ(s.at("players")[0].at("mean_score_per_ball").get<double>(),
                    j.at("ball_scores")[0].at("score").get<double>());
   EXPECT_DOUBLE_EQ(s.at("pooled").at("mean_score_per_ball").get<double>(),
@@ -64,6 +66,9 @@ TEST_F(Play, AHeadlessScriptPlaysBallsAndEachGetsItsRow) {
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find("Number balls"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("all players"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("worlds: event 1, thesis 1; boards: boards/mit1993.board 2\nthe means below pool these games"),
+            std::string::npos)
+      << table.out;
   EXPECT_NE(table.out.find(" ± ∞\n"), std::string::npos) << "one ball bounds nothing:\n" << table.out;
   EXPECT_EQ(table.out.find(" ± 0\n"), std::string::npos) << table.out;
 }

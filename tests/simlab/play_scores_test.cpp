@@ -137,8 +137,15 @@ TEST(PlayScores, ABadRowIsNamedByFileAndLine) {
   EXPECT_EQ(error_of(path), path + ":3: column 'score' must be a number >= 0, got 'lots'");
   std::ofstream(path) << kPlayCsvHeader << "\nada,2026,b,thesis,1,100\n";
   EXPECT_EQ(error_of(path), path + ":2: expected 8 columns, got 6");
-  std::ofstream(path) << kPlayCsvHeader << "\nada,2026,b,thesis,1,100,3,yes\n";
+  std::ofstream(path) << kPlayCsvHeader << "\nada,2026-12-02T13:45:21Z,b,thesis,1,100,3,yes\n";
   EXPECT_EQ(error_of(path), path + ":2: column 'cut' must be 0 or 1, got 'yes'");
+  // Another file's columns in the right number: a date that is not one, a world no command plays.
+  std::ofstream(path) << kPlayCsvHeader << "\nada,2026,b,thesis,1,100,3,0\n";
+  EXPECT_EQ(error_of(path), path + ":2: column 'date' must be a UTC date like 2026-12-02T13:45:21Z, got '2026'");
+  std::ofstream(path) << kPlayCsvHeader << "\nada,2026-12-02T13:45:21Z,b,mujoco,1,100,3,0\n";
+  EXPECT_EQ(error_of(path), path + ":2: column 'world' must be thesis, event or twin, got 'mujoco'");
+  std::ofstream(path) << kPlayCsvHeader << "\nada,2026-12-02T13:45:21Z,,thesis,1,100,3,0\n";
+  EXPECT_EQ(error_of(path), path + ":2: column 'board' is empty");
   std::ofstream(path) << "t,x,y\n";
   EXPECT_NE(error_of(path).find(path + ":1: the header must be"), std::string::npos);
   EXPECT_THROW(check_play_csv_appendable(path), std::runtime_error);  // not a score file: never appended to
