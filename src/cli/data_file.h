@@ -48,8 +48,10 @@ inline void check_output_folder(const std::string& path, const char* option, boo
   const fs::path probe = (folder.empty() ? fs::path(".") : folder) / (".pinball-probe-" + std::to_string(::getpid()));
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) {
+    // ENOENT in a folder that exists: a file system that makes no files (/proc), not a missing folder.
+    const std::string why = errno == ENOENT ? "its file system takes no new files" : std::strerror(errno);
     throw std::runtime_error(said + ": cannot write in " + (folder.empty() ? std::string(".") : folder.string()) +
-                             " (" + std::strerror(errno) + ")");
+                             " (" + why + ")");
   }
   ::close(fd);
   fs::remove(probe, ec);

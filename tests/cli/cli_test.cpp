@@ -828,7 +828,7 @@ TEST_F(Cli, OutputsThatCannotBeWrittenWholeAreRefusedFirst) {
     std::string says;
   } cases[] = {
       {"--out /dev/null", "--out /dev/null: is not a regular file"},
-      {"--out /proc/c.json", "--out /proc/c.json: cannot write in /proc"},
+      {"--out /proc/c.json", "--out /proc/c.json: cannot write in /proc (its file system takes no new files)"},
       {"--out " + out + " --curve " + out, "--out and --curve both name " + out},
       {"--out " + out + " --checkpoint " + out, "--out and --checkpoint both name " + out},
       {"--out " + out + " --curve " + out + ".cycle.json", "--curve and --out's cycle file both name"},
