@@ -62,6 +62,17 @@ FlipperCalibration calibrate_flipper_markers(const table::Flipper& f, std::span<
   const Vec2 pivot_up = nearest(up, f.pivot, tolerance_m, "the pivot of " + name + " (flippers up)");
   const Vec2 tip_up =
       nearest(up, table::flipper_tip(f, f.theta_max_rad), tolerance_m, "the tip of " + name + " (flippers up)");
+  // One rigid blade on one pivot: its two sightings must agree, or the camera or a marker moved
+  // between the pictures (averaging them would place the pivot between two places it never was).
+  const auto check_agree = [&](double down_m, double up_m, const char* what) {
+    if (std::abs(down_m - up_m) <= kMarkerAgreement_m) return;
+    throw std::runtime_error("flipper calibration: " + name + ": " + what + " differs by " +
+                             format_number(std::abs(down_m - up_m) * 1e3, 3) + " mm between the down and up pictures " +
+                             "(at most " + format_number(kMarkerAgreement_m * 1e3) +
+                             " mm): the camera or a marker moved; take both pictures again");
+  };
+  check_agree(0.0, (pivot_up - pivot_down).norm(), "the pivot marker's place");
+  check_agree((tip_down - pivot_down).norm(), (tip_up - pivot_up).norm(), "the blade's length (pivot to tip marker)");
   FlipperCalibration c;
   c.name = f.name;
   c.side = f.side;

@@ -295,6 +295,8 @@ void run_camera(Context& c) {
   c.report["camera"] = j;
 }
 
+std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
 void run_flippers(Context& c) {
   const bool markers = c.lab || (!c.a.down.empty() && !c.a.up.empty());
   const bool sweeps = c.lab || !c.a.sweeps.empty();
@@ -308,6 +310,8 @@ void run_flippers(Context& c) {
   cv::Mat background;
   std::optional<vision::CameraHomography> h;
   std::optional<calibration::IntrinsicsCalibration> lens = c.cal.intrinsics;  // the lens the homography was fitted after
+  cv::Size camera_size;     // the image size the homography was measured at (lab files)
+  std::string camera_file;  // the file holding it
   if (c.lab) {
     h.emplace(camera(c).calibration.image_from_board);
   } else {
@@ -321,11 +325,24 @@ void run_flippers(Context& c) {
     const calibration::Calibration from_file = calibration::read_calibration(from);
     h.emplace(calibration::camera_homography(from_file, from));
     lens = from_file.intrinsics;
+    camera_size = cv::Size(from_file.camera->image_width_px, from_file.camera->image_height_px);
+    camera_file = from;
   }
+  // The homography maps pixels of the camera's image size: a picture of another size (resized, another
+  // camera mode) would place every marker mm off without a word.
+  const auto check_image_size = [&](const cv::Size& size, const std::string& what) {
+    if (c.lab || size == camera_size) return;
+    throw std::runtime_error("calibrate flippers: " + what + " is " + size_text(size.width, size.height) + ", but " +
+                             camera_file + "'s camera section was measured on " +
+                             size_text(camera_size.width, camera_size.height) +
+                             " images; take the flipper pictures at the camera's size; nothing written");
+  };
   std::vector<Vec2> down, up;
   if (markers) {
     const cv::Mat di = c.lab ? c.lab->flipper_markers_image(false) : plot::read_gray_image(c.a.down);
     const cv::Mat ui = c.lab ? c.lab->flipper_markers_image(true) : plot::read_gray_image(c.a.up);
+    check_image_size(di.size(), "--down " + c.a.down);
+    check_image_size(ui.size(), "--up " + c.a.up);
     std::vector<calibration::DetectedMarker> seen_down = calibration::detect_markers(di);
     std::vector<calibration::DetectedMarker> seen_up = calibration::detect_markers(ui);
     if (lens) {  // the homography is the ideal image's
@@ -357,6 +374,10 @@ void run_flippers(Context& c) {
         open = [cc] { return std::make_unique<vision::CaptureSource>(cc); };
       }
       c.err << "calibrate flippers: sweep of " << f.name << "\n";
+      if (!c.lab) {
+        vision::Frame first;
+        if (open()->read(first)) check_image_size(first.gray.size(), "--sweep " + c.a.sweeps[i]);
+      }
       markerless.push_back(calibration::calibrate_flipper_sweep(open, *h, f, {}, &tracks[i]));
       j["markerless"] = flipper_json(markerless.back());
       if (background.empty()) {
@@ -774,7 +795,6 @@ cv::Size parse_size(const std::string& text) {
   return {w, h};
 }
 
-std::string size_text(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 bool is_image_name(const std::filesystem::path& p) {
   const std::string ext = lowercase_extension(p);

@@ -6,9 +6,12 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -95,14 +98,30 @@ inline void check_outputs_replace_no_input(const std::vector<std::pair<const cha
   }
 }
 
+/// Whether two files hold the same bytes (a copy); false when either cannot be read.
+inline bool same_contents(const std::string& a, const std::string& b) {
+  std::error_code ec_a, ec_b;
+  const auto size_a = std::filesystem::file_size(a, ec_a);
+  const auto size_b = std::filesystem::file_size(b, ec_b);
+  if (ec_a || ec_b || size_a != size_b) return false;
+  std::ifstream in_a(a, std::ios::binary), in_b(b, std::ios::binary);
+  if (!in_a || !in_b) return false;
+  return std::equal(std::istreambuf_iterator<char>(in_a), std::istreambuf_iterator<char>(),
+                    std::istreambuf_iterator<char>(in_b), std::istreambuf_iterator<char>());
+}
+
 /// One file given twice to an option that takes many (the same path, a link
-/// or a hard link) would count its data twice and narrow every interval:
-/// refused, "OPTION PATH is given twice: WHY".
+/// or a hard link, or a copy of its bytes) would count its data twice and
+/// narrow every interval: refused, "OPTION PATH is given twice: WHY" or
+/// "OPTION PATH is a copy of OTHER: WHY".
 inline void check_distinct_inputs(const std::vector<std::string>& paths, const char* option, const char* why) {
   for (std::size_t i = 0; i < paths.size(); ++i) {
     for (std::size_t k = i + 1; k < paths.size(); ++k) {
       if (same_file(paths[i], paths[k])) {
         throw std::runtime_error(std::string(option) + " " + paths[k] + " is given twice: " + why);
+      }
+      if (same_contents(paths[i], paths[k])) {
+        throw std::runtime_error(std::string(option) + " " + paths[k] + " is a copy of " + paths[i] + ": " + why);
       }
     }
   }

@@ -89,6 +89,22 @@ TEST_F(Calibrate, SimulatedLabEndToEnd) {
   EXPECT_EQ(j.at("gravity_mps2").get<double>(), c.gravity->g_mps2);
 }
 
+// Flipper pictures resized to 660x495 placed the pivots 10-15 mm off, and the file still said 640x480.
+TEST_F(Calibrate, FlipperPicturesOfAnotherSizeThanTheCamerasAreRefused) {
+  const std::string file = (dir_ / "lab.yaml").string();
+  ASSERT_EQ(run("calibrate camera --sim boards/mit1993.board --out " + file).exit_code, 0);
+  const std::string kept = pinball::testing::slurp(file);
+  const std::string other_size = (dir_ / "board.png").string();  // any picture that is not 640x480
+  ASSERT_EQ(run("render boards/mit1993.board --out " + other_size).exit_code, 0);
+  const Result r = run("calibrate flippers --board boards/mit1993.board --down " + other_size + " --up " + other_size +
+                       " --out " + file);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("calibrate flippers: --down " + other_size + " is "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(", but " + file + "'s camera section was measured on 640x480 images"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(pinball::testing::slurp(file), kept);
+}
+
 TEST_F(Calibrate, BadInputsExitWithOne) {
   EXPECT_EQ(run("calibrate camera --board boards/mit1993.board").exit_code, 1);  // no image
   EXPECT_EQ(run("calibrate wobble --sim boards/mit1993.board").exit_code, 2);
@@ -124,6 +140,15 @@ TEST_F(Calibrate, BadInputsExitWithOne) {
   EXPECT_NE(twice.err.find("calibrate gravity: --roll " + roll + " is given twice: one roll would count twice"),
             std::string::npos)
       << twice.err;
+  // So did a copy of it under another name (g "1.11322 [1.11322, 1.11322]" from one roll copied five times).
+  const std::string copy = (dir_ / "roll_copy.csv").string();
+  fs::copy_file(roll, copy);
+  const Result copied = run("calibrate gravity --board boards/mit1993.board --roll " + roll + " --roll " + copy);
+  EXPECT_EQ(copied.exit_code, 1);
+  EXPECT_NE(copied.err.find("calibrate gravity: --roll " + copy + " is a copy of " + roll +
+                            ": one roll would count twice"),
+            std::string::npos)
+      << copied.err;
 }
 
 // A flag the kind (or the simulation) would not read is refused, not ignored.

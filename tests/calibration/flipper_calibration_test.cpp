@@ -78,6 +78,38 @@ TEST(FlipperCalibration, MarkersGivePivotTipAndStops) {
   }
 }
 
+// A pivot marker 20 mm to the side in the up picture was averaged in: the pivot 10 mm off, the
+// blade 9 mm short. The two sightings of one rigid blade must agree.
+TEST(FlipperCalibration, APivotThatMovedBetweenThePicturesIsRefused) {
+  const table::Flipper f = flipper(table::Side::kLeft, {0.165, 0.16});
+  const std::vector<Vec2> down{f.pivot, table::flipper_tip(f, f.theta_min_rad)};
+  const Vec2 moved = f.pivot + Vec2{0.020, 0.0};
+  const std::vector<Vec2> up{moved, table::flipper_tip(f, f.theta_max_rad)};
+  try {
+    calibrate_flipper_markers(f, down, up);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("the pivot marker's place differs by 20 mm between the down and up pictures "
+                                         "(at most 3 mm): the camera or a marker moved"),
+              std::string::npos)
+        << e.what();
+  }
+  // Within a marker's placement error both sightings are kept (and averaged).
+  const std::vector<Vec2> up_close{f.pivot + Vec2{0.001, 0.0}, table::flipper_tip(f, f.theta_max_rad)};
+  EXPECT_NO_THROW(calibrate_flipper_markers(f, down, up_close));
+  // A tip marker 10 mm further out in one picture: the blade's length differs.
+  const Vec2 along = (table::flipper_tip(f, f.theta_max_rad) - f.pivot).normalized();
+  const std::vector<Vec2> long_up{f.pivot, table::flipper_tip(f, f.theta_max_rad) + 0.010 * along};
+  try {
+    calibrate_flipper_markers(f, down, long_up);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("the blade's length (pivot to tip marker) differs by 10 mm"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(FlipperCalibration, SweepTrackGivesPivotLengthAndStops) {
   // Tips of a right flipper resting on both stops and moving between them, 0.2 mm noise.
   const table::Flipper f = flipper(table::Side::kRight, {0.345, 0.16});

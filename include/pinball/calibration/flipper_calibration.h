@@ -36,10 +36,16 @@ namespace pinball::calibration {
 /// Elevation θ (rad) of a flipper of `side` whose tip is at `tip` (the board's convention).
 double flipper_angle(table::Side side, const Vec2& pivot, const Vec2& tip);
 
+/// How far the two sightings of one pivot marker (down, up), or the blade's
+/// two lengths, may differ: a few times a marker's placement error.
+inline constexpr double kMarkerAgreement_m = 0.003;
+
 /// Marker method: `down` and `up` are the markers seen (board frame, m) with
 /// the flippers down and held up. The markers of `nominal` are those nearest
 /// to its nominal pivot and tips, within tolerance_m. Throws
-/// std::runtime_error naming the flipper and the marker that is missing.
+/// std::runtime_error naming the flipper and the marker that is missing, or
+/// the pivot or length that moved by more than kMarkerAgreement_m between
+/// the pictures.
 FlipperCalibration calibrate_flipper_markers(const table::Flipper& nominal, std::span<const Vec2> down,
                                              std::span<const Vec2> up, double tolerance_m = 0.03);
 
