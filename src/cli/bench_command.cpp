@@ -12,6 +12,7 @@
 #include "data_file.h"
 #include "flag_uses.h"
 #include "pinball/core/format.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/number_option.h"
 #include "pinball/core/progress.h"
 #include "pinball/core/text_file.h"
@@ -157,7 +158,7 @@ int run_tracker(const BenchArgs& a, const table::Board& board, std::ostream& out
   const bench::TrackerReport report = bench::run_tracker_bench(
       board, options, [&](const std::string& line) { err << "bench tracker: " << line << "\n"; });
   if (a.json) {
-    out << bench::to_json(report).dump(2) << "\n";
+    out << json_text(bench::to_json(report), 2) << "\n";
   } else {
     out << bench::to_text(report);
   }
@@ -170,7 +171,7 @@ int run_detector(const BenchArgs& a, const table::Board& board, std::ostream& ou
   const bench::DetectorReport report = bench::run_detector_bench(
       board, options, [&](const std::string& line) { err << "bench detector: " << line << "\n"; });
   if (a.json) {
-    out << bench::to_json(report).dump(2) << "\n";
+    out << json_text(bench::to_json(report), 2) << "\n";
   } else {
     out << bench::to_text(report);
   }
@@ -193,7 +194,7 @@ int run_camera(const BenchArgs& a, const table::Board& board, std::ostream& out,
   const bench::CameraReport report =
       bench::run_camera_bench(board, options, [&](const std::string& line) { err << "bench camera: " << line << "\n"; });
   if (a.json) {
-    out << bench::to_json(report).dump(2) << "\n";
+    out << json_text(bench::to_json(report), 2) << "\n";
   } else {
     out << bench::to_text(report);
   }
@@ -210,7 +211,7 @@ int run_calibration(const BenchArgs& a, const table::Board& board, std::ostream&
   const bench::CalibrationReport report = bench::run_calibration_bench(
       board, options, [&](const std::string& line) { err << "bench calibration: " << line << "\n"; });
   if (a.json) {
-    out << bench::to_json(report).dump(2) << "\n";
+    out << json_text(bench::to_json(report), 2) << "\n";
   } else {
     out << bench::to_text(report);
   }
@@ -236,7 +237,7 @@ int run_latency(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   if (a.json) {
     nlohmann::json j = bench::to_json(r);
     j["daemon"] = bench::to_json(d);
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
     return 0;
   }
   out << "fire() to coil output over the stream transport, " << r.samples << " samples\n"
@@ -288,7 +289,7 @@ int run_precision(const BenchArgs& a, const table::Board& board, std::ostream& o
   if (!a.png.empty()) bench::plot_precision_png(report, a.png);
   if (!a.csv.empty()) write_text_file(a.csv, bench::to_csv(report));
   if (a.json) {
-    out << bench::to_json(report).dump(2) << "\n";
+    out << json_text(bench::to_json(report), 2) << "\n";
   } else {
     out << bench::to_markdown(report);
   }
@@ -327,7 +328,7 @@ int run_ceiling(const BenchArgs& a, const table::Board& board, std::ostream& out
     nlohmann::json j = bench::to_json(report);
     j.update(identified_report(a.identified));
     j.update(world_json);
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
   } else {
     out << bench::to_text(report) << identified_text_line(a.identified);
     if (a.world.kind == simlab::WorldKind::kTwin) out << world_text_line(world_json);
@@ -384,7 +385,7 @@ int run_cradle(const BenchArgs& a, const table::Board& board, std::ostream& out,
     j.update(world_report(world_spec, a.board, *world.world));
     j.update(identified_report(a.identified));
     j["perturbations"] = perturbations;
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
   } else {
     out << bench::to_text(report) << identified_text_line(a.identified);
     if (!a.perturb.empty()) {
@@ -414,7 +415,7 @@ int run_aim(const BenchArgs& a, const table::Board& board, std::ostream& out, st
   if (a.json) {
     nlohmann::json j = bench::to_json(report);
     j.update(identified_report(a.identified));
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
   } else {
     out << bench::to_text(report) << identified_text_line(a.identified);
   }
@@ -457,7 +458,7 @@ int run_transfer(const BenchArgs& a, const table::Board& board, std::ostream& ou
   if (!a.png.empty()) bench::plot_transfer_png(report, a.png);
   if (!a.csv.empty()) write_text_file(a.csv, bench::to_csv(report));
   if (a.json) {
-    out << bench::to_json(report).dump(2) << "\n";
+    out << json_text(bench::to_json(report), 2) << "\n";
   } else {
     out << bench::to_text(report);
   }
@@ -473,7 +474,7 @@ int run_protocol(const BenchArgs& a, std::ostream& out, std::ostream& err) {
   const bench::ProtocolBenchReport r =
       bench::run_protocol_bench(o, [&](const std::string& line) { err << "bench protocol: " << line << "\n"; });
   if (a.json) {
-    out << bench::to_json(r).dump(2) << "\n";
+    out << json_text(bench::to_json(r), 2) << "\n";
   } else {
     out << r.frames << " frames (" << r.mutated << " with bits flipped, " << r.noise << " random) over "
         << format_number(r.simulated_s) << " s of board time; " << r.valid_frames << " decoded for the board, " << r.bad_frames
@@ -504,7 +505,7 @@ int run_draw(const BenchArgs& a, const table::Board& board, std::ostream& out, s
   const bench::DrawBenchReport r =
       bench::run_draw_bench(board, o, [&](const std::string& line) { err << "bench draw: " << line << "\n"; });
   if (a.json) {
-    out << bench::to_json(r).dump(2) << "\n";
+    out << json_text(bench::to_json(r), 2) << "\n";
     return 0;
   }
   auto row = [&](const char* what, const bench::DrawCost& c) {
@@ -576,7 +577,7 @@ int run_bench(const BenchArgs& args, std::ostream& out, std::ostream& all_err) {
   const bench::SpeedReport report =
       bench::run_speed_bench(board, options, [&](const std::string& line) { err << "bench speed: " << line << "\n"; });
   if (a.json) {
-    out << bench::to_json(report).dump(2) << "\n";
+    out << json_text(bench::to_json(report), 2) << "\n";
     return 0;
   }
   out << "thesis stepper on " << report.board << ", dt " << report.dt_s << " s\n";

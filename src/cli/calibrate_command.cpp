@@ -31,7 +31,9 @@
 #include "pinball/calibration/intrinsics_calibration.h"
 #include "pinball/calibration/latency_calibration.h"
 #include "pinball/core/clock.h"
+#include "pinball/core/file_name.h"
 #include "pinball/core/format.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/number_option.h"
 #include "pinball/core/rng.h"
@@ -40,7 +42,6 @@
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/socketcan_transport.h"
 #include "pinball/plot/draw.h"
-#include "pinball/core/file_name.h"
 #include "pinball/plot/png_file.h"
 #include "pinball/simlab/sim_lab.h"
 #include "pinball/simlab/sim_latency_lab.h"
@@ -866,10 +867,16 @@ int print_target(const CalibrateArgs& a, const calibration::TargetSpec& target, 
   files.commit();
   const double w_mm = img.cols / kPrintPxPerM * 1e3, h_mm = img.rows / kPrintPxPerM * 1e3;
   if (a.json) {
-    out << nlohmann::json{{"kind", "intrinsics"},      {"target", target.describe()}, {"print_target", a.print_target},
-                          {"width_px", img.cols},      {"height_px", img.rows},       {"px_per_mm", kPrintPxPerM * 1e-3},
-                          {"sheet_width_mm", w_mm},    {"sheet_height_mm", h_mm},     {"square_mm", target.square_m * 1e3}}
-                  .dump(2)
+    out << json_text(nlohmann::json{{"kind", "intrinsics"},
+                                    {"target", target.describe()},
+                                    {"print_target", a.print_target},
+                                    {"width_px", img.cols},
+                                    {"height_px", img.rows},
+                                    {"px_per_mm", kPrintPxPerM * 1e-3},
+                                    {"sheet_width_mm", w_mm},
+                                    {"sheet_height_mm", h_mm},
+                                    {"square_mm", target.square_m * 1e3}},
+                     2)
         << "\n";
   } else {
     out << "wrote " << a.print_target << ": " << target.describe() << ", " << img.cols << "x" << img.rows
@@ -956,7 +963,7 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
   if (!a.out.empty()) err << "calibrate: wrote " << a.out << "\n";
 
   if (a.json) {
-    out << report.dump(2) << "\n";
+    out << json_text(report, 2) << "\n";
     return 0;
   }
   out << "intrinsics: " << in.target << "; " << fit.images.size() << " images, " << in.images_used << " used, "
@@ -1036,7 +1043,7 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
   c.report["simulated"] = !a.sim_board.empty();
   c.report["out"] = a.out;
   if (a.json) {
-    out << c.report.dump(2) << "\n";
+    out << json_text(c.report, 2) << "\n";
   } else if (!c.text.empty()) {
     out << c.text;
   } else {

@@ -16,6 +16,7 @@
 #include "commands.h"
 #include "data_file.h"
 #include "pinball/core/format.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/number_option.h"
 #include "pinball/core/progress.h"
@@ -379,7 +380,7 @@ int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
   if (a.json) {
     nlohmann::json j = result_json(a, board, r, held_out);
     j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
   } else {
     print_text(a, board, r, held_out, out);
   }

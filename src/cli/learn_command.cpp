@@ -26,10 +26,11 @@
 #include "world_options.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/control/imitation_controller.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/number_option.h"
+#include "pinball/learn/demonstrations.h"
 #include "pinball/learn/shot_value_collection.h"
 #include "pinball/learn/shot_values.h"
-#include "pinball/learn/demonstrations.h"
 #include <functional>
 #include <optional>
 #include "pinball/control/spastic_controller.h"
@@ -40,10 +41,10 @@
 #include "pinball/learn/checkpoint.h"
 #include "pinball/learn/cross_entropy.h"
 #include "pinball/learn/evaluator.h"
-#include "pinball/learn/randomized_evaluator.h"
 #include "pinball/learn/launcher_search.h"
 #include "pinball/learn/learning_curve.h"
 #include "pinball/learn/parallel_runner.h"
+#include "pinball/learn/randomized_evaluator.h"
 #include "pinball/learn/relay_race.h"
 #include "pinball/learn/team.h"
 #include "pinball/learn/tournament.h"
@@ -279,7 +280,7 @@ std::string run_fingerprint(const LearnArgs& a) {
     j["identified"] = a.identified;
     j["identified_fnv1a"] = file_digest(a.identified);
   }
-  return "pinball learn " + j.dump();
+  return "pinball learn " + json_text(j);
 }
 
 // The job's figures for the report: ranks, and what gathering cost.
@@ -388,7 +389,7 @@ int run_launcher_search(const LearnArgs& a, std::ostream& out, std::ostream& err
                         {"best_hittable", r.best_successes},
                         {"pulls", tried}};
     j.update(identified_report(a.identified));
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
     return 0;
   }
   out << "launcher search on " << a.board << " (seed " << a.seed << "): pull -> launches reaching a hittable state\n"
@@ -433,7 +434,7 @@ int run_shot_values(const LearnArgs& a, std::ostream& out, std::ostream& err) {
                         {"actuation_delay_s", config.actuation_delay_s},
                         {"max_ball_time_s", config.max_ball_time_s}, {"wall_s", wall_s}};
     j.update(identified_report(a.identified));
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
     return 0;
   }
   out << "shot values on " << a.board << " (seed " << a.seed << ", " << a.budget_balls << " balls of the looking-ahead "
@@ -747,7 +748,7 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
   j.update(world_report(world_spec, a.board, *world.world));
   j["wall_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (a.json) {
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
   } else {
     out << "learn " << a.method << " on " << a.board << " (seed " << a.seed << ", " << a.threads << " threads";
     if (learn::team_size() > 1) out << " on each of " << learn::team_size() << " MPI ranks";

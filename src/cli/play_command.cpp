@@ -19,6 +19,7 @@
 #include "data_file.h"
 #include "pinball/core/data_path.h"
 #include "pinball/core/format.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/number_option.h"
 #include "pinball/core/running_stats.h"
@@ -77,13 +78,13 @@ int run_stats(const PlayArgs& a, std::ostream& out) {
   if (a.json) {
     nlohmann::json players = nlohmann::json::array();
     for (std::size_t i = 0; i + 1 < stats.size(); ++i) players.push_back(to_json_value(stats[i]));
-    out << nlohmann::json{{"file", a.stats},
-                          {"balls_by_world", worlds},
-                          {"balls_by_board", boards},
-                          {"players", players},
-                          {"pooled", stats.empty() ? nlohmann::json(nullptr) : to_json_value(stats.back())},
-                          {"thesis_human_mean_per_ball", kThesisHumanMeanPerBall}}
-               .dump(2)
+    out << json_text(nlohmann::json{{"file", a.stats},
+                                    {"balls_by_world", worlds},
+                                    {"balls_by_board", boards},
+                                    {"players", players},
+                                    {"pooled", stats.empty() ? nlohmann::json(nullptr) : to_json_value(stats.back())},
+                                    {"thesis_human_mean_per_ball", kThesisHumanMeanPerBall}},
+                     2)
         << "\n";
     return 0;
   }
@@ -239,7 +240,7 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
     }
     j["wall_s"] = wall_s;
     j.update(world_report(a.world, a.board, *world.world));
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
     return 0;
   }
   out << world_text_line(world_report(a.world, a.board, *world.world));

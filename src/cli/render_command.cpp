@@ -7,12 +7,13 @@
 
 #include "commands.h"
 #include "data_file.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/number_option.h"
 #include "pinball/plot/draw.h"
 #include "pinball/plot/png_file.h"
-#include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/renderer.h"
+#include "pinball/table/board_loader.h"
 
 namespace pinball::cli {
 
@@ -42,11 +43,11 @@ int run_render(const RenderArgs& a, std::ostream& out, std::ostream&) {
       plot::annotated_picture(sim::render_board(board, &state, options), sim::board_legend(), title, notes);
   plot::write_png(image, a.out);
   if (a.json) {
-    out << nlohmann::json{{"board", a.board},          {"out", a.out},
-                          {"width_px", image.cols},     {"height_px", image.rows},
-                          {"obstacles", board.obstacles.size()}, {"sensors", board.sensors.size()},
-                          {"flippers", board.flippers.size()}}
-               .dump(2)
+    out << json_text(nlohmann::json{{"board", a.board},          {"out", a.out},
+                                    {"width_px", image.cols},     {"height_px", image.rows},
+                                    {"obstacles", board.obstacles.size()}, {"sensors", board.sensors.size()},
+                                    {"flippers", board.flippers.size()}},
+                     2)
         << "\n";
   } else {
     out << "wrote " << a.out << " (" << image.cols << "x" << image.rows << " px, " << board.obstacles.size()

@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "data_file.h"
 #include "progress_option.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/progress.h"
 #include "pinball/daemon/replay.h"
 
@@ -64,21 +65,21 @@ int run_replay(const ReplayArgs& a, std::ostream& out, std::ostream& err) {
         if (progress_wanted(a.progress)) err << "replay: " << line << "\n";  // stderr stays quiet for a script
       });
   if (a.json) {
-    out << nlohmann::json{{"board", board},
-                          {"controller", config.controller},
-                          {"events", r.events},
-                          {"observations", r.observations},
-                          {"observations_without_latency", r.observations_without_latency},
-                          {"malformed", r.malformed},
-                          {"recorded_commands", r.recorded_commands},
-                          {"replayed_commands", r.replayed_commands},
-                          {"matched", r.matched},
-                          {"first_mismatch", r.first_mismatch},
-                          {"mismatch", r.mismatch},
-                          {"skipped_timing", r.skipped_timing},
-                          {"reproduced", r.reproduced},
-                          {"verdict", verdict(r)}}
-               .dump(2)
+    out << json_text(nlohmann::json{{"board", board},
+                                    {"controller", config.controller},
+                                    {"events", r.events},
+                                    {"observations", r.observations},
+                                    {"observations_without_latency", r.observations_without_latency},
+                                    {"malformed", r.malformed},
+                                    {"recorded_commands", r.recorded_commands},
+                                    {"replayed_commands", r.replayed_commands},
+                                    {"matched", r.matched},
+                                    {"first_mismatch", r.first_mismatch},
+                                    {"mismatch", r.mismatch},
+                                    {"skipped_timing", r.skipped_timing},
+                                    {"reproduced", r.reproduced},
+                                    {"verdict", verdict(r)}},
+                     2)
         << "\n";
   } else {
     out << "replayed with    controller " << config.controller << ", board " << board

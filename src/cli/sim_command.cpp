@@ -14,24 +14,25 @@
 #include "camera_options.h"
 #include "data_file.h"
 #include "commands.h"
-#include "pinball/core/number_option.h"
-#include "pinball/learn/planning_controller.h"
-#include "pinball/core/json_write_archive.h"
 #include "pinball/control/spastic_controller.h"
 #include "pinball/core/format.h"
+#include "pinball/core/json_text.h"
+#include "pinball/core/json_write_archive.h"
+#include "pinball/core/number_option.h"
 #include "pinball/core/progress.h"
 #include "pinball/core/running_stats.h"
+#include "pinball/learn/planning_controller.h"
 #include "progress_option.h"
-#include "pinball/sim/ball_runner.h"
-#include "pinball/table/board_overlay.h"
-#include "pinball/simlab/can_flipper_drive.h"
-#include "pinball/simlab/delay_line.h"
 #include "pinball/control/controller_file.h"
-#include "pinball/simlab/simulated_player.h"
+#include "pinball/sim/ball_runner.h"
 #include "pinball/sim/renderer.h"
 #include "pinball/sim/state_hash.h"
 #include "pinball/sim/video_recorder.h"
+#include "pinball/simlab/can_flipper_drive.h"
+#include "pinball/simlab/delay_line.h"
 #include "pinball/simlab/sim_camera_source.h"
+#include "pinball/simlab/simulated_player.h"
+#include "pinball/table/board_overlay.h"
 #include "trace_writer.h"
 #include "world_options.h"
 
@@ -240,7 +241,7 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     };
     j.update(identified_report(a.identified));
     j.update(world_report(world_spec, a.board, *world.world));
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
   } else {
     out << identified_text_line(a.identified);
     out << world_text_line(world_report(world_spec, a.board, *world.world));

@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "data_file.h"
 #include "pinball/calibration/calibration_file.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/number_option.h"
 #include "pinball/table/board_loader.h"
 #include "pinball/track/observation_io.h"
@@ -96,19 +97,19 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
       << losses << " losses, " << tracker.flushes() << " collision flushes, " << tracker.pushes()
       << " pushed fits\n";
   if (a.json) {
-    out << nlohmann::json{{"board", a.board},
-                          {"observations_file", a.observations},
-                          {"calibration", a.calibration},
-                          {"gravity_mps2", config.g_mps2},
-                          {"sigma_m", config.sigma_m},
-                          {"observations", rows.size()},
-                          {"valid_projections", valid},
-                          {"launches", launches},
-                          {"losses", losses},
-                          {"collision_flushes", tracker.flushes()},
-                          {"pushed_fits", tracker.pushes()},
-                          {"projections", projections}}
-               .dump(2)
+    out << json_text(nlohmann::json{{"board", a.board},
+                                    {"observations_file", a.observations},
+                                    {"calibration", a.calibration},
+                                    {"gravity_mps2", config.g_mps2},
+                                    {"sigma_m", config.sigma_m},
+                                    {"observations", rows.size()},
+                                    {"valid_projections", valid},
+                                    {"launches", launches},
+                                    {"losses", losses},
+                                    {"collision_flushes", tracker.flushes()},
+                                    {"pushed_fits", tracker.pushes()},
+                                    {"projections", projections}},
+                     2)
         << "\n";
   }
   return 0;

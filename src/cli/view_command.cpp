@@ -23,6 +23,7 @@
 #include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/recorded_play.h"
 #include "pinball/core/format.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/number_option.h"
 #include "pinball/daemon/daemon_config.h"
 #include "pinball/plot/draw.h"
@@ -102,7 +103,7 @@ void report(const ViewArgs& a, const std::string& source, double t_s, const view
                      {"frames_drawn", s.frames_drawn},
                      {"draw_fps", draw_fps}};
     j["snapshot"] = a.snapshot.empty() ? nlohmann::json(nullptr) : nlohmann::json(a.snapshot);
-    out << j.dump(2) << "\n";
+    out << json_text(j, 2) << "\n";
     return;
   }
   out << source << " at " << format_number(t_s) << " s: " << state.messages() << " messages (" << state.malformed()

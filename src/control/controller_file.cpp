@@ -1,4 +1,5 @@
 #include "pinball/control/controller_file.h"
+#include "pinball/core/json_text.h"
 
 #include <cmath>
 #include <cstdint>
@@ -92,7 +93,7 @@ ShotTable shot_table_from_json(const json& j, JsonReadArchive& r) {
   // The rows' order is this build's (kShotFields); a file that names another was read as if it
   // named this one. It is for a reader: when given, it must be this order.
   if (j.is_object() && j.contains("shot_fields") && j["shot_fields"] != json(kShotFields)) {
-    r.fail("imitation.shot_fields", "must be " + json(kShotFields).dump() + ", the order of each shot's numbers");
+    r.fail("imitation.shot_fields", "must be " + json_text(json(kShotFields)) + ", the order of each shot's numbers");
   }
   ImitationConfig c;
   json settings = j;  // the table's settings; its shots are rows, read below
@@ -248,17 +249,17 @@ std::string controller_to_json(const ControllerSpec& s) {
   };
   if (s.planner) j["planner"] = to_json_value(*s.planner);
   if (s.spastic) j["spastic"] = to_json_value(*s.spastic);
-  if (!s.shot_table) return j.dump(2) + "\n";
+  if (!s.shot_table) return json_text(j, 2) + "\n";
   // One line per shot: the table stays readable (and diffable) at thousands of shots.
   json table = shot_table_json(*s.shot_table);
   std::string shots = "[";
   for (std::size_t i = 0; i < table["shots"].size(); ++i) {
-    shots += (i == 0 ? "\n      " : ",\n      ") + table["shots"][i].dump();
+    shots += (i == 0 ? "\n      " : ",\n      ") + json_text(table["shots"][i]);
   }
   shots += table["shots"].empty() ? "]" : "\n    ]";
   table["shots"] = "@SHOTS@";
   j["imitation"] = table;
-  std::string text = j.dump(2);
+  std::string text = json_text(j, 2);
   text.replace(text.find("\"@SHOTS@\""), 9, shots);
   return text + "\n";
 }

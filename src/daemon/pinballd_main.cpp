@@ -15,6 +15,7 @@
 
 #include "pinball/core/data_file_option.h"
 #include "pinball/core/file_sink.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/number_option.h"
 #include "pinball/daemon/config_check.h"
 #include "pinball/daemon/daemon.h"
@@ -151,13 +152,13 @@ static int run_pinballd(int argc, char** argv) {
     // One line, as `pinball` says it; and --check --json still answers with one object.
     std::fprintf(stderr, "pinballd: %s (try --help)\n", e.what());
     if (given(argc, argv, "--check") && given(argc, argv, "--json")) {
-      std::cout << config_check_failure_to_json(e.what()).dump(2) << std::endl;
+      std::cout << pinball::json_text(config_check_failure_to_json(e.what()), 2) << std::endl;
     }
     return 2;
   }
   if (threads) {
     if (json) {
-      std::cout << thread_table_json().dump(2) << std::endl;
+      std::cout << pinball::json_text(thread_table_json(), 2) << std::endl;
     } else {
       std::fputs(thread_table_markdown().c_str(), stdout);
     }
@@ -200,7 +201,7 @@ static int run_pinballd(int argc, char** argv) {
     if (check) {
       const ConfigCheck result = check_daemon_config(config);
       if (json) {
-        std::cout << config_check_to_json(result).dump(2) << std::endl;
+        std::cout << pinball::json_text(config_check_to_json(result), 2) << std::endl;
       } else {
         std::cout << config_check_to_text(result);
       }
@@ -222,7 +223,7 @@ static int run_pinballd(int argc, char** argv) {
     const DaemonReport report = daemon.run();
     g_daemon = nullptr;
     if (json) {
-      std::cout << report_to_json(report).dump(2) << std::endl;
+      std::cout << pinball::json_text(report_to_json(report), 2) << std::endl;
     } else {
       std::cout << report_to_text(report);
     }
@@ -237,7 +238,7 @@ static int run_pinballd(int argc, char** argv) {
   } catch (const std::exception& e) {
     // --check --json: a script reads one object whatever the verdict (the configuration file
     // itself included); a person reads stderr.
-    if (check && json) std::cout << config_check_failure_to_json(e.what()).dump(2) << std::endl;
+    if (check && json) std::cout << pinball::json_text(config_check_failure_to_json(e.what()), 2) << std::endl;
     std::fprintf(stderr, "pinballd: %s\n", e.what());
     return 1;
   }

@@ -1,3 +1,4 @@
+#include "pinball/core/json_text.h"
 #include "pinball/learn/checkpoint.h"
 
 #include <filesystem>
@@ -81,8 +82,8 @@ std::string differing_keys(const std::string& recorded, const std::string& now) 
   std::string out;
   for (const auto& item : keys.items()) {
     const std::string& key = item.key();
-    const std::string was = a.contains(key) ? a.at(key).dump() : "none";
-    const std::string is = b.contains(key) ? b.at(key).dump() : "none";
+    const std::string was = a.contains(key) ? json_text(a.at(key)) : "none";
+    const std::string is = b.contains(key) ? json_text(b.at(key)) : "none";
     if (was == is) continue;
     out += (out.empty() ? "" : ", ") + key + " (" + was + " recorded, " + is + " now)";
   }

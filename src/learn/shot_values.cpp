@@ -1,3 +1,4 @@
+#include "pinball/core/json_text.h"
 #include "pinball/learn/shot_values.h"
 
 #include <cmath>
@@ -137,7 +138,7 @@ void write_shot_value_table(const ShotValueTable& t, const std::string& path) {
   j["min_weight"] = t.min_weight;
   j["sum"] = t.sum;
   j["count"] = t.count;
-  write_text_file(path, j.dump() + "\n");
+  write_text_file(path, json_text(j) + "\n");
 }
 
 ShotValueTable read_shot_value_table(const std::string& path) {

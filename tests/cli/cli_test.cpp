@@ -818,6 +818,20 @@ TEST_F(Cli, OutputsAreCheckedFirstAndARefusedRunWritesNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "v.avi"));
 }
 
+// A board named in Latin-1 (caf\xe9.board) ended every --json report with nlohmann's type_error.316 and exit
+// 1, after the run and its files: the report now carries U+FFFD for the bad byte.
+TEST_F(Cli, AFileNameThatIsNotUtf8StillGivesTheJsonReport) {
+  const fs::path board = dir_ / "caf\xe9.board";
+  fs::copy_file(fs::path(PINBALL_SOURCE_DIR) / "boards/mit1993.board", board);
+  const std::string png = (dir_ / "r.png").string();
+  const CommandResult render = run("render '" + board.string() + "' --out " + png + " --json");
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  EXPECT_EQ(nlohmann::json::parse(render.out).at("board"), (dir_ / "caf\xef\xbf\xbd.board").string());
+  const CommandResult sim = run("sim '" + board.string() + "' --balls 1 --max-ball-time 2 --json");
+  ASSERT_EQ(sim.exit_code, 0) << sim.err;
+  EXPECT_EQ(nlohmann::json::parse(sim.out).at("balls"), 1);
+}
+
 // What a whole-file output cannot become is found before the work too: a device (the rename
 // would replace it), a folder that takes no file, two outputs on one file.
 TEST_F(Cli, OutputsThatCannotBeWrittenWholeAreRefusedFirst) {
