@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -15,6 +14,7 @@
 #include "pinball/bus/lcm_bus.h"
 #include "pinball/core/data_path.h"
 #include "pinball/core/format.h"
+#include "pinball/core/text_file.h"
 #include "pinball/core/yaml_read_archive.h"
 #include "pinball/daemon/thread_table.h"
 #include "pinball/firmware/codec.h"
@@ -245,7 +245,8 @@ void resolve_one(const std::string& source, const std::string& key, std::string*
   std::error_code ec;
   if (use == PathUse::kRead) {
     require(fs::exists(resolved, ec), source, key, said + ", which does not exist");
-    require(!fs::is_directory(resolved, ec), source, key, said + ", which is a folder, not a file");
+    const std::string problem = input_file_problem(resolved.string());  // a folder, a device (/dev/zero)
+    require(problem.empty(), source, key, said + ", which " + problem);
   } else if (use == PathUse::kWrite) {
     const std::string problem = unwritable_path_problem(resolved);
     require(problem.empty(), source, key, said + problem);
@@ -329,14 +330,16 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
 }
 
 DaemonConfig load_daemon_config(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError(path + ": cannot open");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  std::string text;
+  try {
+    text = read_text_file(path);
+  } catch (const std::runtime_error& e) {
+    throw ConfigError(e.what());
+  }
   // The folder of the file as an absolute path: its relative paths mean the
   // same whatever the working directory.
   const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
-  DaemonConfig c = daemon_config_from_yaml(ss.str(), path, folder.string());
+  DaemonConfig c = daemon_config_from_yaml(text, path, folder.string());
   c.origin = path;
   return c;
 }

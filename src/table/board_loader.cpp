@@ -51,6 +51,7 @@ Board parse_board(std::string_view text, const std::string& source_name) {
 }
 
 Board load_board(const std::string& path) {
+  if (const std::string problem = input_file_problem(path); !problem.empty()) throw BoardError(path, 0, problem);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw BoardError(path, 0, std::string("cannot open board file: ") + std::strerror(errno));
   std::ostringstream text;

@@ -85,5 +85,18 @@ TEST(TextFile, ReadingAMissingFileNamesIt) {
   }
 }
 
+// pinballd's `controller: /dev/zero` was read until memory ran out (std::bad_alloc after 1 GB).
+TEST(TextFile, ADeviceOrAFolderIsNamedNotRead) {
+  try {
+    read_text_file("/dev/zero");
+    ADD_FAILURE() << "a device was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "/dev/zero: is a device, not a file");
+  }
+  EXPECT_EQ(input_file_problem("/dev/null"), "is a device, not a file");
+  EXPECT_EQ(input_file_problem("/tmp"), "is a folder, not a file");
+  EXPECT_EQ(input_file_problem("/nonexistent/pinball.yaml"), "");  // opening it says so
+}
+
 }  // namespace
 }  // namespace pinball

@@ -111,6 +111,25 @@ TEST(YamlReadArchive, AFileHoldsOneDocument) {
   EXPECT_EQ(read("---\ncount: 5\n...\n").count, 5);  // one document, marked out, is fine
 }
 
+// A file cut short after a section's name ("sim" on the last line) read as "sim:", an empty section:
+// all defaults, and pinballd ran another game than its file's.
+TEST(YamlReadArchive, ABareWordWhereAKeyNeedsItsColonIsRefused) {
+  try {
+    load_yaml("count: 1\ninner", "t.yaml");
+    FAIL() << "a bare word was read as a key";
+  } catch (const YamlSyntaxError& e) {
+    EXPECT_EQ(e.key(), "2");
+    EXPECT_EQ(e.message(), "not valid YAML: 'inner' has no ':' after it (a key is 'key: value'; is the file cut short?)");
+  }
+  EXPECT_THROW(load_yaml("outer:\n  count: 1\n  inner\n", "t.yaml"), YamlSyntaxError);
+  // An empty section written as one, or a null value, stays what it was.
+  EXPECT_EQ(read("inner:\ncount: 3\n").count, 3);
+  EXPECT_EQ(read("count: 3\ninner: ~\n").count, 3);
+  EXPECT_EQ(read("count: 3\ninner:   # nothing yet\n").count, 3);
+  EXPECT_NO_THROW(load_yaml("list:\n  - a\n  - b:\n", "t.yaml"));
+  EXPECT_NO_THROW(load_yaml("{a: , b: 1}\n", "t.yaml"));
+}
+
 TEST(YamlReadArchive, WrongTypesSayWhatWasExpected) {
   EXPECT_EQ(error_of("count: many"), "t.yaml:count: expected an integer (int32), got 'many' (line 1)");
   EXPECT_EQ(error_of("count: 2.5"), "t.yaml:count: expected an integer (int32), got '2.5' (line 1)");

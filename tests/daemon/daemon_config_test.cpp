@@ -49,7 +49,7 @@ TEST(DaemonConfig, AnEmptyFileIsRefusedNotTheSimulation) {
     load_daemon_config("/dev/null");
     FAIL() << "/dev/null was accepted";
   } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("/dev/null: (file): is empty", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()), "/dev/null: is a device, not a file");  // /dev/zero was read without end
   }
 }
 

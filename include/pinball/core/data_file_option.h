@@ -12,17 +12,15 @@
 #include <CLI/CLI.hpp>
 
 #include "pinball/core/data_path.h"
+#include "pinball/core/text_file.h"
 
 namespace pinball {
 
 /// Why `path`, an input, is not one to read: "" for a file or a pipe; a
 /// device (/dev/zero, /dev/full) would be read for ever, or fail as no file.
 inline std::string device_input_problem(const std::string& path) {
-  std::error_code ec;
-  const std::filesystem::file_status st = std::filesystem::status(path, ec);
-  if (!ec && (std::filesystem::is_character_file(st) || std::filesystem::is_block_file(st)))
-    return path + " is a device, not a file";
-  return "";
+  const std::string problem = input_file_problem(path);
+  return problem.empty() ? "" : path + " " + problem;
 }
 
 /// A check for an input file option: it must exist, and be no folder and no device.

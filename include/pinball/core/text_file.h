@@ -24,12 +24,25 @@ inline std::string_view without_utf8_bom(std::string_view text) {
   return text.starts_with("\xEF\xBB\xBF") ? text.substr(3) : text;
 }
 
-/// The whole file at `path`. Throws std::runtime_error "path: cannot open",
-/// "path: is a folder, not a file" (a folder opens, then fails its first read
-/// with a library message that names nothing) or "path: cannot read".
-inline std::string read_text_file(const std::string& path) {
+/// Why `path` is no file to read whole, or "" when it may be tried: "is a
+/// folder, not a file" (a folder opens, then fails its first read with a
+/// library message that names nothing) or "is a device, not a file"
+/// (/dev/zero would be read until memory runs out).
+inline std::string input_file_problem(const std::string& path) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": is a folder, not a file");
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (ec) return "";
+  if (std::filesystem::is_directory(st)) return "is a folder, not a file";
+  if (std::filesystem::is_character_file(st) || std::filesystem::is_block_file(st)) return "is a device, not a file";
+  return "";
+}
+
+/// The whole file at `path`. Throws std::runtime_error "path: cannot open",
+/// "path: " + input_file_problem(path), or "path: cannot read".
+inline std::string read_text_file(const std::string& path) {
+  if (const std::string problem = input_file_problem(path); !problem.empty()) {
+    throw std::runtime_error(path + ": " + problem);
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open");
   std::ostringstream s;

@@ -3,8 +3,10 @@
 // Header-only so that pinball_core links Eigen alone; a target that includes
 // it links yaml-cpp.
 
+#include <algorithm>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
@@ -67,10 +69,39 @@ class YamlSyntaxError : public KeyError {
   using KeyError::KeyError;
 };
 
+namespace yaml_detail {
+// yaml-cpp reads a bare word on its own line after a mapping's keys ("sim", the
+// last line of a file cut short) as the key of an empty value, which a section
+// takes for "all defaults"; YAML has no such line. A key without a value must
+// have its ':' on the key's line.
+inline void refuse_keys_without_colon(const YAML::Node& n, const std::vector<std::string_view>& lines,
+                                      const std::string& file) {
+  if (n.IsSequence()) {
+    for (const YAML::Node& item : n) refuse_keys_without_colon(item, lines, file);
+    return;
+  }
+  if (!n.IsMap()) return;
+  for (const auto& entry : n) {
+    const YAML::Node& value = entry.second;
+    if (value.IsNull()) {
+      const YAML::Mark at = entry.first.Mark();
+      const bool known = at.line >= 0 && static_cast<std::size_t>(at.line) < lines.size();
+      if (known && lines[static_cast<std::size_t>(at.line)].find(':', static_cast<std::size_t>(std::max(at.column, 0))) ==
+                       std::string_view::npos) {
+        throw YamlSyntaxError(file, std::to_string(at.line + 1),
+                              "not valid YAML: '" + entry.first.Scalar() +
+                                  "' has no ':' after it (a key is 'key: value'; is the file cut short?)");
+      }
+    }
+    refuse_keys_without_colon(value, lines, file);
+  }
+}
+}  // namespace yaml_detail
+
 /// Parses YAML text holding at most one document (none: a null node).
 /// Throws YamlSyntaxError "file:line: not valid YAML: ...", also for a second
 /// document after `---`: yaml-cpp's Load would keep the first and silently
-/// drop the rest.
+/// drop the rest, and for a bare word where a key needs its ':'.
 inline YAML::Node load_yaml(const std::string& text, const std::string& file) {
   std::vector<YAML::Node> documents;
   try {
@@ -82,7 +113,15 @@ inline YAML::Node load_yaml(const std::string& text, const std::string& file) {
     throw YamlSyntaxError(file, std::to_string(documents[1].Mark().line + 1),
                           "not valid YAML: a second YAML document (after ---): a file holds one");
   }
-  return documents.empty() ? YAML::Node() : documents.front();
+  if (documents.empty()) return YAML::Node();
+  std::vector<std::string_view> lines;
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    lines.push_back(std::string_view(text).substr(start, end - start));
+    start = end + 1;
+  }
+  yaml_detail::refuse_keys_without_colon(documents.front(), lines, file);
+  return documents.front();
 }
 
 /// A versioned file's version, read first whatever else the file holds, so

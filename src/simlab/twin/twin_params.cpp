@@ -1,11 +1,10 @@
 #include "pinball/simlab/twin_params.h"
 
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include "pinball/core/check.h"
 #include "pinball/core/format.h"
+#include "pinball/core/text_file.h"
 #include "pinball/core/yaml_read_archive.h"
 
 namespace pinball::simlab {
@@ -91,12 +90,9 @@ RangeViolation find_violation(const TwinParams& p) {
 void check_twin_params(const TwinParams& params) { check_input(find_violation(params), "twin parameters"); }
 
 TwinParams load_twin_params(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot read the twin's parameter file");
-  std::stringstream text;
-  text << in.rdbuf();
+  const std::string text = read_text_file(path);  // "path: cannot open", a folder, a device
   TwinParams p;
-  const YAML::Node root = load_yaml(text.str(), path);  // "path:line: not valid YAML: ..."
+  const YAML::Node root = load_yaml(text, path);  // "path:line: not valid YAML: ..."
   YamlReadArchive(path, {.refuse_unknown_keys = true, .require_every_key = true}).read(root, "", &p);
   if (const RangeViolation bad = find_violation(p)) throw KeyError(path, bad.key, bad.rule);
   p.source = path;
