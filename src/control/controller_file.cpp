@@ -108,6 +108,8 @@ ShotTable shot_table_from_json(const json& j, JsonReadArchive& r) {
   }
   std::vector<std::vector<double>> rows;
   r.read(&shots, "imitation.shots", &rows);
+  // No shot to imitate: the controller would never flip, and play as if nothing were wrong.
+  if (rows.empty()) r.fail("imitation.shots", "is empty: a table of no shots never flips");
   std::vector<ShotExample> examples;
   examples.reserve(rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -180,6 +182,8 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
   }
   if (j.contains("imitation")) s.shot_table = std::make_shared<const ShotTable>(shot_table_from_json(j["imitation"], r));
   if (j.contains("planner")) {
+    // The planner would play and the shot table be read for nothing: which did the file mean?
+    if (s.shot_table) r.fail("planner", "a controller file holds an imitation or a planner object, not both");
     PlannerSettings p;
     r.read(&j["planner"], "planner", &p);
     refuse(r, "planner", check_planner_settings(p));

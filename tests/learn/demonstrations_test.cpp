@@ -255,6 +255,22 @@ TEST(Demonstrations, LearningByImitationSharesTheBudgetOverRounds) {
   EXPECT_THROW(learn_by_imitation(thesis_board(), c, 5, 9, 2, {}), std::invalid_argument);
 }
 
+// Balls cut at 0.05 s never reach a flipper: learn wrote a table of no shots, which never flips
+// (and which no controller file may hold).
+TEST(Demonstrations, ATeacherThatFiredNoShotGivesNoTable) {
+  ImitationLearningConfig c;
+  c.demonstration = short_config();
+  c.demonstration.max_ball_time_s = 0.05;
+  c.rounds = 1;
+  try {
+    learn_by_imitation(thesis_board(), c, 2, 9, 1, {});
+    FAIL() << "a table of no shots was learned";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("imitation: the teacher fired no shot in 2 balls"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Demonstrations, TheLearnedTableOutscoresNoFlippingOnFreshBalls) {
   ImitationLearningConfig c;
   c.demonstration = short_config();
