@@ -170,7 +170,10 @@ void identify_launcher(const table::Board& board, std::span<const bus::RecordedP
   const double end_stderr = spread / (n + 1);
   table::LauncherOverlay launcher;
   launcher.pull = {std::min(1.0, top / clamp), end_stderr / clamp, n};
-  launcher.noise_max = {std::clamp(1.0 - bottom / top, 0.0, 0.999), std::sqrt(2.0) * end_stderr / top, n};
+  // At most the board format's noise (a wider spread is slow launches of another cause: a weak pull,
+  // a ball that rolled back): an overlay gives no world a board file could not.
+  launcher.noise_max = {std::clamp(1.0 - bottom / top, 0.0, table::kMaxLaunchNoise), std::sqrt(2.0) * end_stderr / top,
+                        n};
   result.overlay.launcher = launcher;
 }
 

@@ -1,5 +1,6 @@
 #include "pinball/table/board_overlay.h"
 
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -54,6 +55,7 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
   // g and ρ in the board format's ranges: an overlay gives no world a board file could not.
   if (o.gravity_mps2) check_value(*o.gravity_mps2, kAboveZero, {kMaxGravity_mps2, false}, " m/s^2", "gravity_mps2", r);
   if (o.wall_thickness_m) check_value(*o.wall_thickness_m, kZero, {0.05, false}, " m", "wall_thickness_m", r);
+  std::map<std::string, std::string> obstacle_at;  // each obstacle's one place: a second would be dropped
   for (std::size_t i = 0; i < o.obstacle_groups.size(); ++i) {
     const ObstacleGroupOverlay& g = o.obstacle_groups[i];
     const std::string key = "obstacle_groups[" + std::to_string(i) + "]";
@@ -62,11 +64,27 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
     if (g.obstacles.empty()) r.fail(key + ".obstacles", "names no obstacle");
     check_value(g.rho, kZero, {kMaxRho, false}, "", key + ".rho", r);
     if (g.kick_mps) check_value(*g.kick_mps, kZero, {kMaxOverlayKick_mps, false}, " m/s", key + ".kick_mps", r);
+    // A kick identified for a group the board gives none would turn its walls into kickers.
+    if (g.kick_mps && g.board_kick_mps == 0.0) {
+      r.fail(key + ".kick_mps", "is only for a group the board gives a kick (its board_kick_mps is 0)");
+    }
+    for (std::size_t j = 0; j < g.obstacles.size(); ++j) {
+      const std::string at = key + ".obstacles[" + std::to_string(j) + "]";
+      if (const auto [first, fresh] = obstacle_at.emplace(g.obstacles[j], at); !fresh) {
+        r.fail(at, "'" + g.obstacles[j] + "' is given twice (also " + first->second + "): which value counts?");
+      }
+    }
     if (g.friction) check_value(*g.friction, kZero, {kMaxWallFriction, false}, "", key + ".friction", r);
   }
   for (std::size_t i = 0; i < o.flippers.size(); ++i) {
     const std::string key = "flippers[" + std::to_string(i) + "]";
     if (o.flippers[i].name.empty()) r.fail(key + ".name", "is empty");
+    for (std::size_t k = 0; k < i; ++k) {
+      if (o.flippers[k].name == o.flippers[i].name) {
+        r.fail(key + ".name", "'" + o.flippers[i].name + "' is given twice (also flippers[" + std::to_string(k) +
+                                  "]): which value counts?");
+      }
+    }
     if (o.flippers[i].mu) check_value(*o.flippers[i].mu, kZero, {kMaxFlipperMu, false}, "", key + ".mu", r);
     if (o.flippers[i].omega_rad_s)
       check_value(*o.flippers[i].omega_rad_s, kAboveZero, {200.0, false}, " rad/s", key + ".omega_rad_s", r);
@@ -75,7 +93,7 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
   }
   if (o.launcher) {
     check_value(o.launcher->pull, kAboveZero, {1.0, false}, "", "launcher.pull", r);
-    check_value(o.launcher->noise_max, kZero, {1.0, true}, "", "launcher.noise_max", r);
+    check_value(o.launcher->noise_max, kZero, {kMaxLaunchNoise, false}, "", "launcher.noise_max", r);
   }
 }
 

@@ -126,7 +126,7 @@ void launcher(LoadState& state, const Reader& r) {
   l.pull = r.attribute("pull", 1.0);
   r.require(l.pull > 0 && l.pull <= 1, "attribute pull", "in (0, 1]", l.pull);
   l.noise_max = r.attribute("noise", 0.03);
-  r.require(l.noise_max >= 0 && l.noise_max <= 0.5, "attribute noise", "in [0, 0.5]", l.noise_max);
+  r.require(l.noise_max >= 0 && l.noise_max <= kMaxLaunchNoise, "attribute noise", "in [0, 0.5]", l.noise_max);
 }
 
 void start(LoadState& state, const Reader& r) {

@@ -186,10 +186,10 @@ TEST(BoardOverlay, EveryRangeIsChecked) {
   o.launcher->pull.value = 1.01;
   expect_key_error(board_overlay_to_yaml(o), "launcher.pull.value", "must be in (0, 1]");
   o = full();
-  o.launcher->noise_max.value = 1.0;
-  expect_key_error(board_overlay_to_yaml(o), "launcher.noise_max.value", "must be in [0, 1)");
+  o.launcher->noise_max.value = 0.51;  // the board format's noise= is at most 0.5
+  expect_key_error(board_overlay_to_yaml(o), "launcher.noise_max.value", "must be in [0, 0.5]");
   o.launcher->noise_max.value = -0.01;
-  expect_key_error(board_overlay_to_yaml(o), "launcher.noise_max.value", "must be in [0, 1)");
+  expect_key_error(board_overlay_to_yaml(o), "launcher.noise_max.value", "must be in [0, 0.5]");
   o = full();
   o.obstacle_groups[0].rho.stderr_ = -0.01;
   expect_key_error(board_overlay_to_yaml(o), "obstacle_groups[0].rho.stderr", "must be >= 0");
@@ -213,6 +213,26 @@ TEST(BoardOverlay, EveryRangeIsChecked) {
   o = full();
   o.obstacle_groups[0].obstacles.clear();
   expect_key_error(board_overlay_to_yaml(o), "obstacle_groups[0].obstacles", "names no obstacle");
+}
+
+// A flipper listed twice played the last of its values; an obstacle in two groups, the last group's
+// rho; a kick for walls the board gives none made them kickers (mean speed 0.9 -> 4.9 m/s).
+TEST(BoardOverlay, ANameGivenTwiceAndAKickForAGroupWithoutOneAreRefused) {
+  BoardOverlay o = full();
+  o.flippers.push_back(o.flippers[0]);
+  expect_key_error(board_overlay_to_yaml(o), "flippers[2].name",
+                   "'left_flipper' is given twice (also flippers[0]): which value counts?");
+  o = full();
+  o.obstacle_groups[1].obstacles.push_back("top_left_arc");
+  expect_key_error(board_overlay_to_yaml(o), "obstacle_groups[1].obstacles[3]",
+                   "'top_left_arc' is given twice (also obstacle_groups[0].obstacles[1]): which value counts?");
+  o = full();
+  o.obstacle_groups[0].obstacles.push_back("top_right_arc");
+  expect_key_error(board_overlay_to_yaml(o), "obstacle_groups[0].obstacles[2]", "is given twice");
+  o = full();
+  o.obstacle_groups[0].kick_mps = value(3.0, 0.1, 20);  // the arcs' board_kick_mps is 0
+  expect_key_error(board_overlay_to_yaml(o), "obstacle_groups[0].kick_mps",
+                   "is only for a group the board gives a kick (its board_kick_mps is 0)");
 }
 
 TEST(BoardOverlay, AnotherVersionIsRefusedAsSuch) {

@@ -51,6 +51,10 @@ inline constexpr double kMaxRho = 2.0;
 /// most g itself (9.81), with rounding.
 inline constexpr double kMaxGravity_mps2 = 10.0;
 
+/// The largest launch noise R_max a board or an overlay may give: a launch
+/// is P · (1 − R) · the clamp, R ~ U[0, R_max], so 0.5 already halves it.
+inline constexpr double kMaxLaunchNoise = 0.5;
+
 /// The largest flipper friction coefficient a board or an overlay may give
 /// (rubber on a ball is about 1; 1e154 overflowed the clamp to a stopped ball).
 inline constexpr double kMaxFlipperMu = 10.0;

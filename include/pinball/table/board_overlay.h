@@ -129,11 +129,13 @@ std::string board_overlay_to_yaml(const BoardOverlay& overlay);
 void write_board_overlay(const BoardOverlay& overlay, const std::string& path);
 
 /// Reads an overlay file. Throws KeyError "path:key: what is wrong" for a
-/// missing, unknown, repeated, mistyped or out-of-range key (ρ in [0, 3],
-/// kick in [0, 10] m/s, wall friction in [0, 2], wall thickness in [0, 0.05] m, g in (0, 20] m/s², μ in [0, 10], ω in (0, 200] rad/s,
-/// rise delay in [0, 0.1] s, pull in (0, 1],
-/// noise_max in [0, 1), stderr ≥ 0, events ≥ 0) or a wrong version;
-/// std::runtime_error naming the file when it cannot be read or parsed.
+/// missing, unknown, repeated, mistyped or out-of-range key (ρ in [0, 2],
+/// kick in [0, 10] m/s, wall friction in [0, 2], wall thickness in [0, 0.05]
+/// m, g in (0, 10] m/s², μ in [0, 10], ω in (0, 200] rad/s, rise delay in
+/// [0, 0.1] s, pull in (0, 1], noise_max in [0, 0.5], stderr ≥ 0, events ≥
+/// 0), an obstacle or flipper given twice, a kick for a group the board gives
+/// none, or a wrong version; std::runtime_error naming the file when it
+/// cannot be read or parsed.
 BoardOverlay read_board_overlay(const std::string& path);
 
 /// Parses YAML text; `name` stands for the file in messages.
