@@ -32,10 +32,23 @@ std::string ball_placement_problem(const LoadState& state, const Vec2& p) {
   return "";
 }
 
+// The hole whose centre lies within its radius of `p` (a ball placed at `p` falls in at once), or none.
+const Sensor* hole_at(const Board& board, const Vec2& p) {
+  for (const Sensor& sensor : board.sensors) {
+    if (sensor.kind == SensorKind::kHole && (p - sensor.shape.p0).norm() <= sensor.shape.radius_m) return &sensor;
+  }
+  return nullptr;
+}
+
 void check_launcher_clear(const LoadState& state) {
   const std::string problem = ball_placement_problem(state, state.board.launcher.position);
   if (!problem.empty()) {
     throw BoardError(state.file, state.seen.at("launcher"), "launcher: ball at the launch position " + problem);
+  }
+  // In a hole every ball falls in at its first step (an eater: each lost at once, scoring 0).
+  if (const Sensor* hole = hole_at(state.board, state.board.launcher.position)) {
+    throw BoardError(state.file, state.seen.at("launcher"),
+                     "launcher: ball at the launch position starts inside hole '" + hole->name + "'");
   }
 }
 
@@ -88,11 +101,7 @@ void check_start(const LoadState& state) {
     fail("ball at fields X Y (" + fmt(p.x() / state.length_scale) + ", " + fmt(p.y() / state.length_scale) + ") " +
          unit_name(state) + " " + problem);
   }
-  for (const Sensor& sensor : board.sensors) {
-    if (sensor.kind == SensorKind::kHole && (p - sensor.shape.p0).norm() <= sensor.shape.radius_m) {
-      fail("ball at fields X Y starts inside hole '" + sensor.name + "'");
-    }
-  }
+  if (const Sensor* hole = hole_at(board, p)) fail("ball at fields X Y starts inside hole '" + hole->name + "'");
   if ((p - board.launcher.position).norm() < r && v.norm() < min_launch_speed_mps(board)) {
     fail("a ball at fields X Y this slow (" + in_file_unit(state, v.norm(), "/s") +
          ") counts as resting in the launcher and "
