@@ -32,12 +32,19 @@ std::string ball_placement_problem(const LoadState& state, const Vec2& p) {
   return "";
 }
 
-// The hole whose centre lies within its radius of `p` (a ball placed at `p` falls in at once), or none.
-const Sensor* hole_at(const Board& board, const Vec2& p) {
+// What takes a ball placed at `p` at once: a hole its centre lies in ("hole 'name'"), or an eating
+// sensor it touches ("eating sensor 'name'"); "" for none.
+std::string sensor_taking_ball_at(const Board& board, const Vec2& p) {
   for (const Sensor& sensor : board.sensors) {
-    if (sensor.kind == SensorKind::kHole && (p - sensor.shape.p0).norm() <= sensor.shape.radius_m) return &sensor;
+    if (sensor.kind == SensorKind::kHole && (p - sensor.shape.p0).norm() <= sensor.shape.radius_m) {
+      return "hole '" + sensor.name + "'";
+    }
+    if (sensor.kind == SensorKind::kProximity && sensor.action.eats_ball &&
+        distance_to_shape(sensor.shape, p) <= board.ball.radius_m) {
+      return "eating sensor '" + sensor.name + "'";
+    }
   }
-  return nullptr;
+  return "";
 }
 
 void check_launcher_clear(const LoadState& state) {
@@ -45,10 +52,10 @@ void check_launcher_clear(const LoadState& state) {
   if (!problem.empty()) {
     throw BoardError(state.file, state.seen.at("launcher"), "launcher: ball at the launch position " + problem);
   }
-  // In a hole every ball falls in at its first step (an eater: each lost at once, scoring 0).
-  if (const Sensor* hole = hole_at(state.board, state.board.launcher.position)) {
+  // Every ball would be taken at its first step (by an eater: each lost at once, scoring 0).
+  if (const std::string taker = sensor_taking_ball_at(state.board, state.board.launcher.position); !taker.empty()) {
     throw BoardError(state.file, state.seen.at("launcher"),
-                     "launcher: ball at the launch position starts inside hole '" + hole->name + "'");
+                     "launcher: ball at the launch position starts inside " + taker);
   }
 }
 
@@ -101,7 +108,9 @@ void check_start(const LoadState& state) {
     fail("ball at fields X Y (" + fmt(p.x() / state.length_scale) + ", " + fmt(p.y() / state.length_scale) + ") " +
          unit_name(state) + " " + problem);
   }
-  if (const Sensor* hole = hole_at(board, p)) fail("ball at fields X Y starts inside hole '" + hole->name + "'");
+  if (const std::string taker = sensor_taking_ball_at(board, p); !taker.empty()) {
+    fail("ball at fields X Y starts inside " + taker);
+  }
   if ((p - board.launcher.position).norm() < r && v.norm() < min_launch_speed_mps(board)) {
     fail("a ball at fields X Y this slow (" + in_file_unit(state, v.norm(), "/s") +
          ") counts as resting in the launcher and "

@@ -593,8 +593,12 @@ TEST(BoardLoaderErrors, BallAtTheLauncherOverlaps) {
   expect_body_error("line 0.5 0.06 0.4 0.06\n", 7, "overlaps 'line@8'");
   // Flipper in its down position: pivot left of the launcher, tip lowered onto it.
   expect_body_error("flipper left 0.38 0.09 0.076 -0.5 0.5 35 name=lf\n", 7, "overlaps flipper 'lf'");
-  // Just clear of an obstacle is fine; sensors never block.
-  EXPECT_NO_THROW(parse("circle 0.45 0.0837 0.02\nhole 0.45 0.05 0.01 eat\n"));
+  // Just clear of an obstacle is fine; a sensor that only counts never blocks.
+  EXPECT_NO_THROW(parse("circle 0.45 0.0837 0.02\nsensor circle 0.45 0.05 0.01 score=5\n"));
+  // One that takes the ball at once is refused: every ball was lost at its first step, scoring 0.
+  expect_body_error("hole 0.45 0.05 0.01 eat name=h\n", 7,
+                    "launcher: ball at the launch position starts inside hole 'h'");
+  expect_body_error("sensor line 0.4 0.06 0.5 0.06 eat name=s\n", 7, "starts inside eating sensor 's'");
   EXPECT_NO_THROW(parse("flipper left 0.38 0.09 0.076 0.1 0.5 35\n"));  // raised rest clears the ball
 }
 
