@@ -175,6 +175,11 @@ void bank(LoadState& state, const Reader& r) {
 std::string statement_name(LoadState& state, const Reader& r) {
   std::string name =
       r.flag("name") ? std::string(r.text("name")) : std::string(r.keyword()) + "@" + std::to_string(r.line());
+  // A trace writes names into CSV cells and joins a step's events with '|' ("hit:NAME|lost").
+  if (name.find_first_of(",|\"") != std::string::npos) {
+    r.fail("attribute name '" + name +
+           "' may not contain ',', '|' or '\"': a trace's columns and events are split on them");
+  }
   const auto [it, fresh] = state.names.emplace(name, r.line());
   if (!fresh) {
     r.fail("attribute name '" + name + "' is already line " + std::to_string(it->second) +

@@ -451,6 +451,15 @@ TEST(BoardLoaderErrors, TwoStatementsOfOneNameAreRefusedAtTheSecond) {
   EXPECT_EQ(parse("circle 0.1 0.5 0.01 name=a\ncircle 0.2 0.5 0.01 name=b\n").obstacles.size(), 2u);
 }
 
+// name=bot,tom gave a trace row of 7 columns; name=a|lost an event "hit:a|lost" that reads as a lost ball.
+TEST(BoardLoaderErrors, ANameThatATraceWouldSplitIsRefused) {
+  for (const std::string bad : {"bot,tom", "a|lost", "say\"hi\""}) {
+    expect_body_error("circle 0.1 0.5 0.01 name=" + bad + "\n", 8,
+                      "attribute name '" + bad + "' may not contain ',', '|' or '\"'");
+  }
+  EXPECT_EQ(parse("circle 0.1 0.5 0.01 name=bumper_1.left-top\n").obstacles.size(), 1u);
+}
+
 TEST(BoardLoaderErrors, AttributeMisuse) {
   expect_body_error("circle 0.1 0.5 0.01 rho=1 rho=2\n", 8, "attribute 'rho' given twice");
   expect_body_error("circle 0.1 0.5 0.01 eat=1\n", 8, "attribute 'eat' is a flag and takes no value");
