@@ -3,6 +3,8 @@
 #include <stdexcept>
 
 #include "pinball/core/data_path.h"
+#include "pinball/core/format.h"
+#include "pinball/table/board.h"
 #include "pinball/table/board_loader.h"
 #ifdef PINBALL_HAVE_TWIN
 #include "pinball/simlab/twin_world.h"
@@ -56,6 +58,15 @@ OwnedWorld make_world(const WorldSpec& spec, const table::Board& belief) {
   sim::ModelWorldOptions options;
   options.stepper = spec.stepper;
   options.dt_s = spec.dt_s;
+  if (spec.dt_s > 0.0) {
+    // The step asked for (--dt, sim.dt) against the board's flippers: said as that choice, not the board's.
+    try {
+      table::check_flipper_time_step(*out.board, spec.dt_s);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("the time step asked for (--dt " + format_number(spec.dt_s) +
+                                  " s) is too long for this board's flippers: " + e.what());
+    }
+  }
   out.world = sim::make_model_world(*out.board, options);
   return out;
 }

@@ -171,7 +171,18 @@ void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, B
                          " (its flippers: " + names_of(board.flippers) + ")");
     }
     if (f.mu) target->mu = f.mu->value;
-    if (f.omega_rad_s) target->omega_rad_s = f.omega_rad_s->value;
+    if (f.omega_rad_s) {
+      target->omega_rad_s = f.omega_rad_s->value;
+      // A faster stroke sweeps further in one of the board's steps: the loader's rule must still hold.
+      try {
+        Board one = b;
+        one.flippers = {*target};
+        check_flipper_time_step(one, b.dt_s);
+      } catch (const std::invalid_argument& e) {
+        throw KeyError(name, "flippers[" + std::to_string(i) + "].omega_rad_s",
+                       std::string(e.what()) + " on the board " + board.source);
+      }
+    }
   }
   if (overlay.launcher) {
     b.launcher.pull = overlay.launcher->pull.value;

@@ -595,6 +595,22 @@ TEST_F(Cli, TimeStepOutsideTheBoardsRangeIsABadArgument) {
   }
 }
 
+// In range, but too long for the board's flippers: the message named the board's rule, not --dt.
+TEST_F(Cli, ATimeStepTooLongForTheFlippersNamesTheOption) {
+  std::string text = slurp(fs::path(PINBALL_SOURCE_DIR) / "boards/mit1993.board");
+  for (std::size_t at = text.find(" 76 -25 30 2000"); at != std::string::npos; at = text.find(" 76 -25 30 2000")) {
+    text.replace(at, 15, " 76 -25 30 3000");  // strokes of 3000 deg/s sweep 20 mm in 10 ms
+  }
+  const fs::path board = dir_ / "fast_flippers.board";
+  std::ofstream(board) << text;
+  ASSERT_EQ(run("sim " + board.string() + " --balls 1 --max-ball-time 1").exit_code, 0);  // at the board's dt
+  const CommandResult r = run("sim " + board.string() + " --dt 0.01");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("the time step asked for (--dt 0.01 s) is too long for this board's flippers: flipper "),
+            std::string::npos)
+      << r.err;
+}
+
 TEST_F(Cli, RenderWritesAPng) {
   const fs::path png = dir_ / "board.png";
   const CommandResult r = run("render boards/mit1993.board --out " + png.string() + " --json");

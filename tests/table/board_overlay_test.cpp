@@ -436,6 +436,27 @@ std::string refusal(const BoardOverlay& o) {
   return "";
 }
 
+// A stroke of 200 rad/s on a board stepped at 5 ms sweeps 36 mm a step: the stepper's message named
+// no overlay and no key.
+TEST(BoardOverlay, AStrokeTooFastForTheBoardsStepIsRefusedAtItsKey) {
+  Board b = load_board(kBoard);
+  b.dt_s = 0.005;
+  const Board file = b;
+  BoardOverlay o;
+  o.flippers = {{"left_flipper", std::nullopt, value(200.0, 1.0, 10), std::nullopt}};
+  try {
+    apply_board_overlay(o, "over.yaml", b);
+    FAIL() << "no error";
+  } catch (const KeyError& e) {
+    EXPECT_EQ(e.key(), "flippers[0].omega_rad_s");
+    EXPECT_NE(e.message().find("flipper 'left_flipper': l*sin(omega*dt/2) = "), std::string::npos) << e.what();
+    EXPECT_NE(e.message().find("at dt = 0.005 s"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(b.flippers[0].omega_rad_s, file.flippers[0].omega_rad_s);  // all or nothing
+  o.flippers[0].omega_rad_s->value = 20.0;
+  EXPECT_NO_THROW(apply_board_overlay(o, "over.yaml", b));
+}
+
 TEST(BoardOverlay, ALaunchThatCannotLeaveTheLauncherIsRefused) {
   BoardOverlay o;
   o.launcher = LauncherOverlay{value(0.03, 0.01, 30), value(0.03, 0.01, 30)};
