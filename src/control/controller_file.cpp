@@ -1,5 +1,4 @@
 #include "pinball/control/controller_file.h"
-#include "pinball/core/json_text.h"
 
 #include <cmath>
 #include <cstdint>
@@ -12,6 +11,7 @@
 
 #include "pinball/core/check.h"
 #include "pinball/core/json_read_archive.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/text_file.h"
 

@@ -1,4 +1,3 @@
-#include "pinball/core/json_text.h"
 #include "pinball/learn/checkpoint.h"
 
 #include <filesystem>
@@ -8,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pinball/core/json_text.h"
 #include "pinball/learn/team.h"
 
 namespace pinball::learn {

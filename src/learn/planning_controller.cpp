@@ -19,7 +19,13 @@ LookaheadConfig lookahead_config(const control::PlannerSettings& s, double dt_s)
   c.horizon_s = s.horizon_s;
   c.drain_penalty = s.drain_penalty;
   c.step_budget = s.step_budget;
-  if (s.shot_values) c.shot_values = std::make_shared<const ShotValueTable>(read_shot_value_table(*s.shot_values));
+  if (s.shot_values) {
+    try {
+      c.shot_values = std::make_shared<const ShotValueTable>(read_shot_value_table(*s.shot_values));
+    } catch (const std::runtime_error& e) {  // said as the controller's key, not as if the board were at fault
+      throw std::runtime_error(std::string("the planner's shot_values table: ") + e.what());
+    }
+  }
   return c;
 }
 

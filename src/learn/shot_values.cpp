@@ -1,4 +1,3 @@
-#include "pinball/core/json_text.h"
 #include "pinball/learn/shot_values.h"
 
 #include <cmath>
@@ -10,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pinball/core/json_read_archive.h"
+#include "pinball/core/json_text.h"
 #include "pinball/core/text_file.h"
 
 namespace pinball::learn {
@@ -143,12 +144,7 @@ void write_shot_value_table(const ShotValueTable& t, const std::string& path) {
 
 ShotValueTable read_shot_value_table(const std::string& path) {
   const std::string text = read_text_file(path);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(path + ": not JSON: " + e.what());
-  }
+  const nlohmann::json j = parse_json(text, path);  // "path: (file): not valid JSON: ...", a key given twice
   if (!j.is_object() || j.value("format", "") != "pinball-shot-values") {
     throw std::runtime_error(path + ": not a shot-value table (format must be \"pinball-shot-values\")");
   }

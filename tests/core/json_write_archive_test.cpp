@@ -87,6 +87,10 @@ TEST(JsonReadArchive, ParseJsonRefusesWhatNlohmannWouldResolveSilently) {
   // A number past a double's range is nlohmann's out_of_range, not a parse error.
   EXPECT_EQ(error_of(R"({"g_mps2": 1e400})").rfind("t.json:(file): not valid JSON: ", 0), 0u);
   EXPECT_NE(error_of("{\"count\": 1,\n \"x\": }").find("line 2"), std::string::npos);
+  // Where and what, without nlohmann's "[json.exception.parse_error.101]" tag.
+  EXPECT_EQ(error_of(""), "t.json:(file): not valid JSON: parse error at line 1, column 1: syntax error while parsing "
+                          "value - unexpected end of input; expected '[', '{', or a literal");
+  EXPECT_EQ(error_of(R"({"g_mps2": 1e400})"), "t.json:(file): not valid JSON: number overflow parsing '1e400'");
 }
 
 }  // namespace

@@ -98,7 +98,7 @@ TEST(ShotValues, RefusesAMissingFileAnotherFormatAndBinsThatDoNotAgree) {
   refused(broken, "bins");
   const std::string truncated = temp_path("truncated.json");
   std::ofstream(truncated) << R"({"format": "pinball-shot-values", "flippers": 2)";
-  refused(truncated, "not JSON");
+  refused(truncated, "not valid JSON");
   for (const std::string& p : {other, broken, truncated}) std::filesystem::remove(p);
 }
 

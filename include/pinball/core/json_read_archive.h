@@ -136,7 +136,11 @@ inline nlohmann::json parse_json(const std::string& text, const std::string& fil
   try {
     return json::parse(text, watch);
   } catch (const json::exception& e) {  // parse_error, and out_of_range for 1e400
-    throw KeyError(file, "(file)", std::string("not valid JSON: ") + e.what());
+    // Without nlohmann's "[json.exception.parse_error.101] " tag: a reader wants where and what.
+    std::string what = e.what();
+    const std::size_t tag_end = what.find("] ");
+    if (what.starts_with("[json.exception.") && tag_end != std::string::npos) what.erase(0, tag_end + 2);
+    throw KeyError(file, "(file)", "not valid JSON: " + what);
   }
 }
 
