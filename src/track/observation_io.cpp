@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "pinball/core/format.h"
+#include "pinball/core/statistics.h"
 #include "pinball/core/text_file.h"
 
 namespace pinball::track {
@@ -113,6 +115,20 @@ void check_observations_on_board(const std::vector<ObservationRow>& rows, const 
     throw std::runtime_error(path + ": " + std::to_string(off) + " of its " + std::to_string(rows.size()) +
                              " observations lie " + table::off_playfield_text(board) +
                              " (positions are in metres, board frame: a file in mm, or of another table?)");
+  }
+  // Times in ms or ns pass every other check (they increase) and give a tracker fits of nonsense,
+  // or a gravity a million times too small: a camera gives its frames a few ms apart.
+  if (rows.size() < 2) return;
+  std::vector<double> spacing_s;
+  spacing_s.reserve(rows.size() - 1);
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    spacing_s.push_back(rows[i].observation.t_s - rows[i - 1].observation.t_s);
+  }
+  const double typical_s = median(std::move(spacing_s));
+  if (typical_s > kMostFramePeriod_s) {
+    throw std::runtime_error(path + ": its observations are " + format_number(typical_s, 3) +
+                             " s apart (the median): a camera's frames are a few ms apart, at most " +
+                             format_number(kMostFramePeriod_s) + " s (times are in seconds: a file in ms or ns?)");
   }
 }
 

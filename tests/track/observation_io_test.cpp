@@ -73,7 +73,7 @@ TEST(ObservationIo, BadFilesAreRefusedNamingTheLine) {
       << read_error(only_header);
 }
 
-// A byte-order mark before the header (an editor's) is skipped, as in board files.
+// Positions in mm, or another table's: refused as a whole, a stray sighting kept.
 TEST(ObservationIo, AFileMostlyOffTheBoardIsRefusedAsOtherUnits) {
   table::Board board;
   board.width_m = 0.51;
@@ -91,6 +91,26 @@ TEST(ObservationIo, AFileMostlyOffTheBoardIsRefusedAsOtherUnits) {
                      "(positions are in metres, board frame: a file in mm, or of another table?)");
 }
 
+// Times in ms passed (they increase): track gave 176 'valid' projections where the seconds gave 73,
+// and calibrate gravity wrote g = 1.1e-6 m/s^2.
+TEST(ObservationIo, TimesInMillisecondsAreRefused) {
+  table::Board board;
+  board.source = "lab.board";
+  std::vector<ObservationRow> rows(20);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    rows[i].observation.p_board = Vec2(0.25, 0.5 + 0.001 * i);
+    rows[i].observation.t_s = 5.0 * i;  // 200 fps, in ms
+  }
+  EXPECT_EQ(pinball::testing::error_text([&] { check_observations_on_board(rows, board, "obs.csv"); }),
+            "obs.csv: its observations are 5 s apart (the median): a camera's frames are a few ms apart, at most 1 s "
+            "(times are in seconds: a file in ms or ns?)");
+  for (std::size_t i = 0; i < rows.size(); ++i) rows[i].observation.t_s = 1.7e9 + 0.005 * i;  // Unix time, seconds
+  rows[10].observation.t_s += 30.0;  // one long gap (the ball out of sight) is no unit
+  for (std::size_t i = 11; i < rows.size(); ++i) rows[i].observation.t_s += 30.0;
+  EXPECT_EQ(pinball::testing::error_text([&] { check_observations_on_board(rows, board, "obs.csv"); }), "no error");
+}
+
+// A byte-order mark before the header (an editor's) is skipped, as in board files.
 TEST(ObservationIo, AByteOrderMarkBeforeTheHeaderIsSkipped) {
   const std::string bom = write_csv("bom.csv", "\xEF\xBB\xBFt,x,y\n0,0.1,0.2\n");
   const std::vector<ObservationRow> rows = read_observations_csv(bom);

@@ -23,9 +23,14 @@ struct ObservationRow {
 /// backwards) and returns nothing partial.
 std::vector<ObservationRow> read_observations_csv(const std::string& path);
 
+/// The longest median time between observations a camera gives (s): 1 fps.
+inline constexpr double kMostFramePeriod_s = 1.0;
+
 /// Throws std::runtime_error "path: 40 of its 200 observations lie over 5 cm
 /// off the ... playfield of B ..." when more than table::kMostOffPlayfield of
-/// `rows` lie that far off `board`: a file in mm, or of another table.
+/// `rows` lie that far off `board` (a file in mm, or of another table), and
+/// "path: its observations are 5 s apart ..." when their median spacing is
+/// over kMostFramePeriod_s (times in ms or ns).
 void check_observations_on_board(const std::vector<ObservationRow>& rows, const table::Board& board,
                                  const std::string& path);
 
