@@ -1,15 +1,16 @@
 #include "pinball/calibration/calibration_file.h"
 
-#include "pinball/core/format.h"
-
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
 
+#include "pinball/core/data_path.h"
+#include "pinball/core/format.h"
 #include "pinball/core/text_file.h"
 #include "pinball/core/utc_date.h"
 #include "pinball/core/yaml_read_archive.h"
@@ -240,6 +241,17 @@ vision::CameraHomography camera_homography(const Calibration& c, const std::stri
 }
 
 void check_calibration_matches_board(const Calibration& c, const std::string& name, const table::Board& board) {
+  // The table it was measured on: another board's file (not this one, nor a copy of it) means another
+  // table's camera, flippers and gravity. A recorded board no longer found cannot be compared.
+  const std::string recorded = c.board.empty() ? "" : find_data_file(c.board);
+  std::error_code ec;
+  if (!recorded.empty() && !board.source.empty() && std::filesystem::is_regular_file(recorded, ec) &&
+      std::filesystem::is_regular_file(board.source, ec) && !same_file(recorded, board.source) &&
+      !same_contents(recorded, board.source)) {
+    throw KeyError(name, "board", "is " + c.board + ", not the board " + board.source +
+                                      ": a calibration of another table (its camera, flippers and gravity are that "
+                                      "table's)");
+  }
   for (std::size_t i = 0; i < c.flippers.size(); ++i) {
     const FlipperCalibration& f = c.flippers[i];
     const std::string key = "flippers[" + std::to_string(i) + "]";

@@ -6,18 +6,16 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "pinball/core/data_file_option.h"
+#include "pinball/core/text_file.h"
 #include "pinball/plot/png_file.h"
 
 namespace pinball::cli {
@@ -78,12 +76,6 @@ inline void check_distinct_outputs(const std::vector<std::pair<const char*, std:
   }
 }
 
-/// Whether two paths name one file (the same path, a link or a hard link); false when either is missing.
-inline bool same_file(const std::string& a, const std::string& b) {
-  std::error_code ec;
-  return std::filesystem::equivalent(a, b, ec) && !ec;
-}
-
 /// An output that is one of the inputs (the same path, a link or a hard link)
 /// would replace it: refused, "OUT-OPTION PATH is the input IN-OPTION PATH;
 /// it would be replaced". Empty paths are options not given.
@@ -96,18 +88,6 @@ inline void check_outputs_replace_no_input(const std::vector<std::pair<const cha
                                "; it would be replaced");
     }
   }
-}
-
-/// Whether two files hold the same bytes (a copy); false when either cannot be read.
-inline bool same_contents(const std::string& a, const std::string& b) {
-  std::error_code ec_a, ec_b;
-  const auto size_a = std::filesystem::file_size(a, ec_a);
-  const auto size_b = std::filesystem::file_size(b, ec_b);
-  if (ec_a || ec_b || size_a != size_b) return false;
-  std::ifstream in_a(a, std::ios::binary), in_b(b, std::ios::binary);
-  if (!in_a || !in_b) return false;
-  return std::equal(std::istreambuf_iterator<char>(in_a), std::istreambuf_iterator<char>(),
-                    std::istreambuf_iterator<char>(in_b), std::istreambuf_iterator<char>());
 }
 
 /// One file given twice to an option that takes many (the same path, a link

@@ -105,6 +105,29 @@ TEST_F(Calibrate, FlipperPicturesOfAnotherSizeThanTheCamerasAreRefused) {
   EXPECT_EQ(pinball::testing::slurp(file), kept);
 }
 
+// A gravity measured on another table was applied without a word (track: g 2.5 from another board's file).
+TEST_F(Calibrate, ACalibrationOfAnotherBoardIsRefusedWhereItIsRead) {
+  const std::string table = (dir_ / "other_table.board").string();  // the thesis table with one post moved
+  std::string text = pinball::testing::slurp(std::string(PINBALL_SOURCE_DIR) + "/boards/mit1993.board");
+  text += "\ncircle 255 600 5 name=extra_post\n";
+  std::ofstream(table) << text;
+  const std::string other = (dir_ / "other.yaml").string();
+  ASSERT_EQ(run("calibrate gravity --sim " + table + " --sim-rolls 2 --out " + other).exit_code, 0);
+  const std::string csv = (dir_ / "obs.csv").string();
+  std::ofstream(csv) << "t,x,y\n0,0.2,0.6\n0.005,0.2,0.599\n0.01,0.2,0.598\n";
+  const Result r = run("track --board boards/mit1993.board --observations " + csv + " --calibration " + other);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(other + ":board: is " + table + ", not the board boards/mit1993.board: a calibration of "
+                                                        "another table"),
+            std::string::npos)
+      << r.err;
+  // Its own board, or a copy of that board's file, reads it.
+  EXPECT_EQ(run("track --board " + table + " --observations " + csv + " --calibration " + other).exit_code, 0);
+  const std::string copy = (dir_ / "other_table_copy.board").string();
+  fs::copy_file(table, copy);
+  EXPECT_EQ(run("track --board " + copy + " --observations " + csv + " --calibration " + other).exit_code, 0);
+}
+
 TEST_F(Calibrate, BadInputsExitWithOne) {
   EXPECT_EQ(run("calibrate camera --board boards/mit1993.board").exit_code, 1);  // no image
   EXPECT_EQ(run("calibrate wobble --sim boards/mit1993.board").exit_code, 2);

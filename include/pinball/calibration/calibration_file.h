@@ -229,10 +229,12 @@ void apply_calibration(const Calibration& calibration, const std::string& name, 
 /// std::runtime_error "name:camera: missing" without one.
 vision::CameraHomography camera_homography(const Calibration& calibration, const std::string& name);
 
-/// Checks that every calibrated flipper is one of the board's, on its side,
+/// Checks that the file's `board` is `board`'s file (or a copy of it; a
+/// recorded board that is no longer found is not compared), and that every
+/// calibrated flipper is one of the board's, on its side,
 /// and calibrated once: a typo in a name must not leave a flipper on the
 /// board's geometry unnoticed. Throws std::runtime_error (a KeyError)
-/// "name:flippers[i].name: ..." or "...side: ...".
+/// "name:board: ...", "name:flippers[i].name: ..." or "...side: ...".
 void check_calibration_matches_board(const Calibration& calibration, const std::string& name,
                                      const table::Board& board);
 

@@ -6,10 +6,12 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -35,6 +37,24 @@ inline std::string input_file_problem(const std::string& path) {
   if (std::filesystem::is_directory(st)) return "is a folder, not a file";
   if (std::filesystem::is_character_file(st) || std::filesystem::is_block_file(st)) return "is a device, not a file";
   return "";
+}
+
+/// Whether two paths name one file (the same path, a link or a hard link); false when either is missing.
+inline bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return std::filesystem::equivalent(a, b, ec) && !ec;
+}
+
+/// Whether two files hold the same bytes (a copy); false when either cannot be read.
+inline bool same_contents(const std::string& a, const std::string& b) {
+  std::error_code ec_a, ec_b;
+  const auto size_a = std::filesystem::file_size(a, ec_a);
+  const auto size_b = std::filesystem::file_size(b, ec_b);
+  if (ec_a || ec_b || size_a != size_b) return false;
+  std::ifstream in_a(a, std::ios::binary), in_b(b, std::ios::binary);
+  if (!in_a || !in_b) return false;
+  return std::equal(std::istreambuf_iterator<char>(in_a), std::istreambuf_iterator<char>(),
+                    std::istreambuf_iterator<char>(in_b), std::istreambuf_iterator<char>());
 }
 
 /// The whole file at `path`. Throws std::runtime_error "path: cannot open",
