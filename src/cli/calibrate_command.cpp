@@ -114,14 +114,18 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
           "WxH"))
       ->capture_default_str()
       ->needs(sim);
-  cmd->add_option("--print-target", a.print_target,
-                  "intrinsics: write the printable target (PNG, 10 px/mm: print at 254 dpi, 100 %) and stop")
-      ->check(output_file());
+  auto* print_target =
+      cmd->add_option("--print-target", a.print_target,
+                      "intrinsics: write the printable target (PNG, 10 px/mm: print at 254 dpi, 100 %) and stop")
+          ->check(output_file())
+          ->excludes(sim);
   cmd->add_option("--roll", a.rolls, "gravity: observation CSV (t,x,y) of one roll from rest (repeat)")
       ->check(input_file())
       ->default_str("")
       ->excludes(sim);
-  cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")->check(finite_range(1, 1000));
+  cmd->add_option("--sim-rolls", a.sim_rolls, "gravity with --sim: rolls to simulate")
+      ->check(finite_range(1, 1000))
+      ->needs(sim);
   cmd->add_option("--sigma", a.sigma_m, "gravity: observation noise per coordinate (m)")
       ->check(finite_range(1e-6, 0.1));
   cmd->add_option("--calibration", a.calibration, "calibration file holding the camera homography (default: --out)")
@@ -131,7 +135,8 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->check(output_file());
   cmd->add_option("--png", a.png, "picture of the detected markers, fitted circles or gravity fit");
   cmd->add_option("--seed", a.seed, "--sim: seed of the simulated lab")
-      ->check(unsigned_64());
+      ->check(unsigned_64())
+      ->needs(sim);
   cmd->add_option("--sim-pivot-offset-mm", a.sim_pivot_offset_mm,
                   "--sim: the machine's pivots sit X Y mm off the board file (default 0 0: the board file's machine)")
       ->expected(2)
@@ -178,6 +183,8 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->default_str("");  // -1: the simulated camera's
   cmd->add_option("--fps", a.fps, "latency: the frame rate asked of the camera")->check(finite_range(1.0, 2000.0));
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
+  // Printing the target is all a run with --print-target does: images to fit, or a file to write, would be ignored.
+  for (const char* measured : {"--images", "--out", "--png"}) print_target->excludes(cmd->get_option(measured));
   record_flags_given(cmd, a.flags_given);
   return cmd;
 }
@@ -303,6 +310,14 @@ void run_flippers(Context& c) {
   const bool sweeps = c.lab || !c.a.sweeps.empty();
   if (!markers && !sweeps) throw std::runtime_error("calibrate flippers: give --down and --up, or --sweep (or --sim)");
   check_distinct_inputs(c.a.sweeps, "calibrate flippers: --sweep", "one video sweeps one flipper");
+  // --method picks what is written when both ran: naming one that does not run would write the other.
+  const bool markers_asked = c.a.method == "markers";
+  const bool method_given =
+      std::find(c.a.flags_given.begin(), c.a.flags_given.end(), "--method") != c.a.flags_given.end();
+  if (method_given && !(markers_asked ? markers : sweeps)) {
+    throw std::runtime_error(std::string("calibrate flippers: --method ") + c.a.method + " needs " +
+                             (markers_asked ? "--down and --up" : "--sweep videos") + ", which were not given");
+  }
   if (!c.lab && !c.a.sweeps.empty() && c.a.sweeps.size() != c.board.flippers.size()) {
     throw std::runtime_error("calibrate flippers: " + std::to_string(c.a.sweeps.size()) + " sweep videos for " +
                              std::to_string(c.board.flippers.size()) + " flippers");
@@ -1003,6 +1018,7 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
   check_output_folder(a.out, "--out");
   check_png_output(a.png, "--png");
   check_png_output(a.print_target, "--print-target");
+  check_distinct_outputs({{"--out", a.out}, {"--png", a.png}, {"--print-target", a.print_target}});
   if (a.kind == "intrinsics") return run_intrinsics(a, out, err);
   const std::string board_path = a.sim_board.empty() ? a.board : a.sim_board;
   if (board_path.empty()) throw std::runtime_error("calibrate: give --board BOARD (or --sim BOARD)");

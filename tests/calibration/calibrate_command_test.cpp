@@ -191,6 +191,37 @@ TEST_F(Calibrate, AFlagTheKindDoesNotReadIsRefused) {
   const Result lab_input = run("calibrate gravity --sim boards/mit1993.board --roll " + roll);
   EXPECT_EQ(lab_input.exit_code, 2);
   EXPECT_NE(lab_input.err.find("--sim excludes --roll"), std::string::npos) << lab_input.err;
+  // ... and only the simulation reads a seed or a number of rolls: in the lab they ran as if not given.
+  for (const char* sim_only : {"--seed 5", "--sim-rolls 3"}) {
+    const Result lab = run("calibrate gravity --board boards/mit1993.board --roll " + roll + " " + sim_only);
+    EXPECT_EQ(lab.exit_code, 2) << sim_only;
+    EXPECT_NE(lab.err.find("requires --sim"), std::string::npos) << lab.err;
+  }
+  // --method chooses what is written when both methods ran: one that did not run wrote the other.
+  const Result method = run("calibrate flippers --board boards/mit1993.board --down " + roll + " --up " + roll +
+                            " --method markerless --calibration " + roll);
+  EXPECT_EQ(method.exit_code, 1);
+  EXPECT_NE(method.err.find("calibrate flippers: --method markerless needs --sweep videos, which were not given"),
+            std::string::npos)
+      << method.err;
+  // Printing the target is all such a run does: images, a file or a picture beside it were ignored.
+  const std::string target = (dir_ / "target.png").string();
+  for (const std::string& beside : {"--out " + (dir_ / "c.yaml").string(), "--images " + dir_.string(),
+                                    std::string("--sim boards/mit1993.board")}) {
+    const Result both = run("calibrate intrinsics --print-target " + target + " " + beside);
+    EXPECT_EQ(both.exit_code, 2) << beside;
+    EXPECT_NE(both.err.find("--print-target"), std::string::npos) << both.err;
+  }
+  EXPECT_FALSE(fs::exists(target));
+}
+
+// Two outputs on one file: the figure was lost under the YAML, exit 0.
+TEST_F(Calibrate, TwoOutputsOnOneFileAreRefused) {
+  const std::string same = (dir_ / "same.png").string();
+  const Result r = run("calibrate gravity --sim boards/mit1993.board --out " + same + " --png " + same);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--out and --png both name " + same), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(same));
 }
 
 // What is written at the end is checked before any work: in the lab,
