@@ -171,18 +171,23 @@ std::vector<DetectedMarker> detect_markers(const cv::Mat& gray, const MarkerDete
   return out;
 }
 
-void check_marker_layout(std::span<const Vec2> p, double min_separation_m) {
+void check_marker_layout(std::span<const Vec2> p, double min_separation_m, std::span<const int> source_lines) {
   const std::size_t n = p.size();
   if (n < 4) {
     throw std::invalid_argument("marker layout: " + std::to_string(n) + " markers; a homography needs at least 4");
   }
+  // "markers 1 and 4" (from 1), or "the markers of lines 2 and 5" of a file.
+  const bool by_line = source_lines.size() == n;
+  const auto number = [&](std::size_t i) { return std::to_string(by_line ? source_lines[i] : static_cast<int>(i + 1)); };
+  const std::string some = by_line ? "the markers of lines " : "markers ";
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(p[i].x()) || !std::isfinite(p[i].y())) {
-      throw std::invalid_argument("marker layout: marker " + std::to_string(i) + " is not finite");
+      throw std::invalid_argument("marker layout: " + std::string(by_line ? "the marker of line " : "marker ") +
+                                  number(i) + " is not finite");
     }
     for (std::size_t j = i + 1; j < n; ++j) {
       if ((p[i] - p[j]).norm() < min_separation_m) {
-        throw std::invalid_argument("marker layout: markers " + std::to_string(i) + " and " + std::to_string(j) +
+        throw std::invalid_argument("marker layout: " + some + number(i) + " and " + number(j) +
                                     " coincide (closer than " + format_number(min_separation_m * 1e3) + " mm)");
       }
     }
@@ -208,7 +213,8 @@ void check_marker_layout(std::span<const Vec2> p, double min_separation_m) {
   std::ostringstream msg;
   msg << "marker layout: no four markers without three (nearly) collinear";
   if (n == 4 || worst_shape < kCollinear) {
-    msg << " (markers " << worst[0] << ", " << worst[1] << ", " << worst[2] << " are collinear)";
+    msg << " (" << some << number(worst[0]) << ", " << number(worst[1]) << ", " << number(worst[2])
+        << " are collinear)";
   }
   throw std::invalid_argument(msg.str());
 }
@@ -228,6 +234,7 @@ std::vector<Vec2> read_marker_layout_csv(const std::string& path, const table::B
   std::string line;
   int line_no = 0;
   std::vector<Vec2> out;
+  std::vector<int> lines;  // each marker's line, for the layout check's messages
   bool header = false;
   while (std::getline(in, line)) {
     ++line_no;
@@ -241,8 +248,10 @@ std::vector<Vec2> read_marker_layout_csv(const std::string& path, const table::B
     std::istringstream s(line);
     double x = 0.0, y = 0.0;
     char comma = 0;
-    if (!(s >> x >> comma >> y) || comma != ',' || !std::isfinite(x) || !std::isfinite(y)) {
-      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": expected two numbers x,y (m)");
+    // Nothing after y: '0.0535abc' or a third column is no marker position.
+    if (!(s >> x >> comma >> y) || comma != ',' || !std::isfinite(x) || !std::isfinite(y) || !(s >> std::ws).eof()) {
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": expected two numbers x,y (m), got '" + line +
+                               "'");
     }
     // Markers sit on the playfield or its rim; farther off is a unit or a file mistaken.
     if (!table::near_playfield(board, Vec2(x, y))) {
@@ -251,10 +260,11 @@ std::vector<Vec2> read_marker_layout_csv(const std::string& path, const table::B
                                " (positions are in metres, board frame)");
     }
     out.emplace_back(x, y);
+    lines.push_back(line_no);
   }
   if (!header) throw std::runtime_error(path + ":1: header must be x,y");
   try {
-    check_marker_layout(out);
+    check_marker_layout(out, 0.01, lines);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(path + ": " + e.what());
   }

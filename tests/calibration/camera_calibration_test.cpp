@@ -110,7 +110,13 @@ TEST(CameraCalibration, ALayoutFileOffTheBoardOrDegenerateIsRefusedNamingTheFile
             path + ":2: marker (51, 100) m is over 5 cm off the 0.51 x 1.07 m playfield of lab.board "
                    "(positions are in metres, board frame)");
   EXPECT_EQ(read("x,y\n0.1,0.1\n0.1,0.1\n0.3,0.5\n0.2,0.9\n"),
-            path + ": marker layout: markers 0 and 1 coincide (closer than 10 mm)");
+            path + ": marker layout: the markers of lines 2 and 3 coincide (closer than 10 mm)");
+  // A third column or a number with a tail was read as x,y and the rest dropped.
+  EXPECT_EQ(read("x,y\n0.0408,0.0535abc\n"), path + ":2: expected two numbers x,y (m), got '0.0408,0.0535abc'");
+  EXPECT_EQ(read("x,y\n0.0408,0.0535,5\n"), path + ":2: expected two numbers x,y (m), got '0.0408,0.0535,5'");
+  EXPECT_EQ(read("x,y\n# comment\n0.1,0.1\n0.4,0.1 \n0.1,0.9\n0.1,0.5\n"),
+            path + ": marker layout: no four markers without three (nearly) collinear (the markers of lines 3, 5, 6 "
+                   "are collinear)");
   std::remove(path.c_str());
 }
 

@@ -46,8 +46,11 @@ std::vector<DetectedMarker> detect_markers(const cv::Mat& gray, const MarkerDete
 /// Checks that markers at these board points can define a homography: at
 /// least 4, no two within min_separation_m, and four of them with no three
 /// (nearly) collinear. Throws std::invalid_argument naming the problem
-/// ("markers 2, 3, 5 are collinear", "markers 0 and 4 coincide").
-void check_marker_layout(std::span<const Vec2> board_points, double min_separation_m = 0.01);
+/// ("markers 2, 3, 5 are collinear", "markers 1 and 4 coincide": counted
+/// from 1, or by `source_lines`, the file line of each point, when given:
+/// "the markers of lines 2 and 5 coincide").
+void check_marker_layout(std::span<const Vec2> board_points, double min_separation_m = 0.01,
+                         std::span<const int> source_lines = {});
 
 /// A layout for `board`: seven markers spread over the table, no symmetry
 /// that would make the matching ambiguous (m, board frame).
