@@ -178,7 +178,9 @@ void check_marker_layout(std::span<const Vec2> p, double min_separation_m, std::
   }
   // "markers 1 and 4" (from 1), or "the markers of lines 2 and 5" of a file.
   const bool by_line = source_lines.size() == n;
-  const auto number = [&](std::size_t i) { return std::to_string(by_line ? source_lines[i] : static_cast<int>(i + 1)); };
+  const auto number = [&](std::size_t i) {
+    return std::to_string(by_line ? source_lines[i] : static_cast<int>(i + 1));
+  };
   const std::string some = by_line ? "the markers of lines " : "markers ";
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(p[i].x()) || !std::isfinite(p[i].y())) {
