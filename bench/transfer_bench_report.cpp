@@ -1,6 +1,7 @@
 // The transfer bench's report: JSON, text and CSV (the measurement:
 // transfer_bench.cpp; the figure: transfer_bench_plot.cpp).
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "pinball/core/json_write_archive.h"
@@ -57,6 +58,16 @@ std::string score_text(const TransferCell& c, bool with_ratio) {
   if (with_ratio) s += ", " + format_number(c.ratio_to_spastic, 3) + "x" + interval_text(c.ratio_interval);
   if (c.cut > 0) s += ", " + std::to_string(c.cut) + " cut";
   return s;
+}
+
+// A number's CSV cell: empty where it is undefined (the interval of one ball, a ratio to a
+// spastic score of 0), as JSON writes null; a reader's float() takes no 'inf'.
+std::string csv_number(double x) {
+  if (!std::isfinite(x)) return "";
+  std::ostringstream out;
+  out.precision(10);
+  out << x;
+  return out.str();
 }
 
 std::string csv_text(const std::string& s) {
@@ -265,7 +276,8 @@ std::string to_csv(const TransferReport& r) {
     }
     for (const TransferCell& c : w.cells) {
       out << head << c.controller << ",played," << c.score.count() << ',' << c.score.mean() << ','
-          << c.score.ci95_half_width() << ',' << c.ratio_to_spastic << ',' << c.cut << ',' << r.options.max_ball_time_s
+          << csv_number(c.score.ci95_half_width()) << ',' << csv_number(c.ratio_to_spastic) << ',' << c.cut << ','
+          << r.options.max_ball_time_s
           << ',' << c.duration_s.mean() << ',' << c.flips.mean() << ',' << c.drains.left_outlane << ','
           << c.drains.right_outlane << ',' << c.drains.centre << ',' << c.drains.other << ',' << c.drains.left_table
           << ',' << c.wall_s << ',';

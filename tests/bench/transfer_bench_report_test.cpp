@@ -79,6 +79,17 @@ TEST(TransferReport, SummaryHasEachControllersMedianAndLowestWorldAgainstTheTarg
   EXPECT_NE(text.find(", gravity_pct=+5 | 0 | 7 |"), std::string::npos) << text;
 }
 
+// One ball a cell (--balls 1) has no interval: 'inf' was written in every row, where JSON has null.
+TEST(TransferReport, CsvLeavesAnUndefinedIntervalEmpty) {
+  bench::TransferReport r = made_report();
+  r.worlds[0].cells = {pinball::testing::made_cell("spastic", 1000.0, 1),
+                       pinball::testing::made_cell("learned", 2000.0, 1)};
+  bench::set_ratios_to_spastic(r.worlds[0].cells);
+  const std::string csv = to_csv(r);
+  EXPECT_EQ(csv.find("inf"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("model,nominal,0,thesis,learned,played,1,1900,,2.111111111,"), std::string::npos) << csv;
+}
+
 TEST(TransferReport, CsvHasAHeaderAndOneRowPerWorldAndController) {
   const std::string csv = to_csv(made_report());
   std::istringstream in(csv);
@@ -100,6 +111,7 @@ TEST(TransferReport, CsvHasAHeaderAndOneRowPerWorldAndController) {
     return n;
   };
   for (std::string line; std::getline(in, line);) EXPECT_EQ(columns(line), columns(header)) << line;
+
   EXPECT_NE(csv.find("twin,nominal,0,twin,spastic,\"skipped: this build has no MuJoCo twin, so no \"\"twin\"\" row is played\""),
             std::string::npos)
       << csv;
