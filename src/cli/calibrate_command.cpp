@@ -560,6 +560,18 @@ void report_latency(Context& c, const calibration::LatencyEstimate& e, const cal
   c.text = s.str();
 }
 
+// A rolling shutter reads its rows out within one frame: a line time that makes the read-out longer
+// (1000 us x 480 rows = 480 ms at 200 frames/s) is a unit or a digit wrong, and skews every event.
+void check_row_time(double row_time_s, int rows, double fps) {
+  const double readout_s = row_time_s * rows;
+  if (readout_s * fps <= 1.0) return;
+  throw std::invalid_argument("calibrate latency: --row-time-us " + format_number(row_time_s * 1e6) + ": " +
+                              std::to_string(rows) + " rows take " + format_number(readout_s * 1e3, 3) +
+                              " ms to read out, longer than a frame at --fps " + format_number(fps) + " (" +
+                              format_number(1e3 / fps, 3) + " ms): the line time is at most " +
+                              format_number(1e6 / (fps * rows), 3) + " us");
+}
+
 void run_latency_sim(Context& c) {
   const CalibrateArgs& a = c.a;
   simlab::SimLatencyOptions o;
@@ -578,6 +590,7 @@ void run_latency_sim(Context& c) {
                                 format_number(std::floor(1.0 / readout_s)) + " frames/s (it reads a frame out in " +
                                 format_number(readout_s * 1e3) + " ms)");
   }
+  if (a.row_time_us >= 0.0) check_row_time(a.row_time_us * 1e-6, o.camera.height_px, a.fps);  // before any work
   o.camera.fps = a.fps;  // the rate asked of the camera, as in the lab (it had stayed 200)
   o.camera.exposure_s = std::min(o.camera.exposure_s, 1.0 / a.fps);
   o.lead_in_s = std::max(o.lead_in_s, calibration::latency_lead_in_s(calibration::LatencyOptions{}, 1.0 / a.fps));
@@ -679,6 +692,7 @@ void run_latency_lab(Context& c) {
                              from + " has no camera_timing section to take it from");
   }
   const cv::Size size(file.camera->image_width_px, file.camera->image_height_px);
+  check_row_time(lo.row_time_s, size.height, a.fps);
   const std::optional<vision::CameraIntrinsics> lens =
       file.intrinsics ? std::optional<vision::CameraIntrinsics>(file.intrinsics->lens) : std::nullopt;
   const calibration::FlipperRegion region = calibration::flipper_region(

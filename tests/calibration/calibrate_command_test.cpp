@@ -215,6 +215,17 @@ TEST_F(Calibrate, AFlagTheKindDoesNotReadIsRefused) {
   EXPECT_FALSE(fs::exists(target));
 }
 
+// 1000 us a row: 480 ms to read out a frame of a camera at 200 frames/s, which wrote latency_s 0.214, exit 0.
+TEST_F(Calibrate, ALineTimeLongerThanAFrameIsRefusedBeforeAnyWork) {
+  const Result r = run("calibrate latency --sim boards/mit1993.board --events 3 --row-time-us 1000");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--row-time-us 1000: 480 rows take 480 ms to read out, longer than a frame at --fps 200 (5 ms): "
+                       "the line time is at most 10.4 us"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("simulating"), std::string::npos) << r.err;
+}
+
 // Two outputs on one file: the figure was lost under the YAML, exit 0.
 TEST_F(Calibrate, TwoOutputsOnOneFileAreRefused) {
   const std::string same = (dir_ / "same.png").string();
