@@ -5,6 +5,8 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "pinball/core/format.h"
+
 namespace pinball::vision {
 
 CameraIntrinsics typical_wide_lens(int width_px, int height_px) {
@@ -39,6 +41,10 @@ RangeViolation check_intrinsics(const CameraIntrinsics& c) {
   if (c.height_px < 32 || c.height_px > 8192) return {"height_px", "must be in [32, 8192] px"};
   if (!std::isfinite(c.fx_px) || !(c.fx_px > 0.0)) return {"fx_px", "must be > 0 px"};
   if (!std::isfinite(c.fy_px) || !(c.fy_px > 0.0)) return {"fy_px", "must be > 0 px"};
+  // Pixels are square to a few per cent: fx 1800 px with fy 750 px is views of no one camera.
+  if (!(c.fy_px <= kMostPixelAspect * c.fx_px && c.fx_px <= kMostPixelAspect * c.fy_px)) {
+    return {"fy_px", "must be within a factor " + format_number(kMostPixelAspect) + " of fx_px (pixels are square)"};
+  }
   if (!std::isfinite(c.cx_px) || c.cx_px < 0.0 || c.cx_px > c.width_px) return {"cx_px", "must be inside the image"};
   if (!std::isfinite(c.cy_px) || c.cy_px < 0.0 || c.cy_px > c.height_px) return {"cy_px", "must be inside the image"};
   const std::array<std::pair<const char*, double>, 5> coefficients{

@@ -109,6 +109,14 @@ TEST(LensModel, OutOfRangeIntrinsicsAreNamed) {
   lens.k2 = std::nan("");
   EXPECT_EQ(check_intrinsics(lens).key, "k2");
   EXPECT_THROW(PointUndistorter{lens}, std::invalid_argument);
+  // Fifteen views of no one camera fitted fx 1802 px, fy 748 px, and were written as a lens.
+  lens = typical_wide_lens();
+  lens.fx_px = 1802.0;
+  lens.fy_px = 748.0;
+  EXPECT_EQ(check_intrinsics(lens).key, "fy_px");
+  EXPECT_EQ(check_intrinsics(lens).rule, "must be within a factor 1.25 of fx_px (pixels are square)");
+  lens.fy_px = 1802.0 * 1.02;  // a real sensor's few per cent
+  EXPECT_FALSE(check_intrinsics(lens));
 }
 
 TEST(LensModel, ABlobsCentroidIsUndistortedToSecondOrder) {

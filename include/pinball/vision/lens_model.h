@@ -62,8 +62,12 @@ CameraIntrinsics without_distortion(CameraIntrinsics intrinsics);
 /// Whether any distortion coefficient is non-zero.
 bool has_distortion(const CameraIntrinsics& intrinsics);
 
+/// The most fx and fy may differ by, as a factor: a camera's pixels are square to a few per cent.
+inline constexpr double kMostPixelAspect = 1.25;
+
 /// The first setting out of range (sizes in [32, 8192], focal lengths > 0 and
-/// finite, principal point inside the image, coefficients finite and |k| < 10).
+/// finite and within kMostPixelAspect of each other, principal point inside
+/// the image, coefficients finite and |k| < 10).
 RangeViolation check_intrinsics(const CameraIntrinsics& intrinsics);
 
 /// The camera matrix K.
