@@ -850,17 +850,6 @@ std::vector<std::string> image_paths(const std::vector<std::string>& given) {
   return out;
 }
 
-// The camera section and the lens must describe images of one size.
-void check_camera_size(const calibration::Calibration& existing, const std::string& file, const cv::Size& size) {
-  if (!existing.camera) return;
-  const calibration::CameraCalibration& k = *existing.camera;
-  if (k.image_width_px == size.width && k.image_height_px == size.height) return;
-  throw std::runtime_error(file + ": its camera section was measured on " +
-                           size_text(k.image_width_px, k.image_height_px) + " images, but the intrinsics images are " +
-                           size_text(size.width, size.height) +
-                           "; calibrate both at one size (or write the intrinsics to another file); nothing written");
-}
-
 // Files written all or not at all: each to a temporary beside it, renamed when every one is written.
 class Outputs {
  public:
@@ -930,12 +919,19 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
   const bool simulated = !a.sim_board.empty();
   // The file to update: read first (a bad one is refused before any work).
   calibration::Calibration cal = calibration_to_update(a.out, simulated ? a.sim_board : a.board);
+  // The camera's homography (and the flippers placed through it) were fitted on pixels undistorted by
+  // the file's lens, or by none: a new lens beside them makes the file disagree with itself.
+  if (cal.camera) {
+    throw std::runtime_error("calibrate intrinsics: --out " + a.out + " holds a camera section fitted " +
+                             (cal.intrinsics ? "through its present lens" : "without a lens model") +
+                             ": the lens comes first, then camera and flippers; write the lens to a new file and "
+                             "calibrate camera and flippers into it (or remove the camera and flippers sections)");
+  }
   std::vector<calibration::TargetImage> images;
   std::optional<vision::CameraIntrinsics> truth;
   if (simulated) {
     (void)table::load_board(a.sim_board);  // the practice machine's board, named in the file
     const cv::Size size = parse_size(a.camera_size);
-    if (!a.out.empty()) check_camera_size(cal, a.out, size);
     truth = vision::typical_wide_lens(size.width, size.height);
     images = simlab::simulated_target_images(*truth, target, a.sim_views, a.seed);
     err << "calibrate intrinsics: rendered " << images.size() << " views of the target through the simulated "
@@ -943,9 +939,14 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
   } else {
     if (a.images.empty()) throw std::runtime_error("calibrate intrinsics: give --images FILES or DIR (or --sim BOARD)");
     const std::vector<std::string> paths = image_paths(a.images);
+    const int needed = calibration::IntrinsicsFitConfig{}.min_images;
+    if (static_cast<int>(paths.size()) < needed) {  // before reading and searching every image
+      throw std::runtime_error("calibrate intrinsics: " + std::to_string(paths.size()) +
+                               " images; the fit needs at least " + std::to_string(needed) +
+                               " views of the target (15-25 recommended)");
+    }
     check_distinct_inputs(paths, "calibrate intrinsics: image", "one view would count twice");
     for (const std::string& path : paths) images.push_back({path, plot::read_gray_image(path)});
-    if (!a.out.empty()) check_camera_size(cal, a.out, images.front().gray.size());
   }
   err << "calibrate intrinsics: " << images.size() << " images of the " << target.describe() << "\n";
   const calibration::IntrinsicsFit fit = calibration::calibrate_intrinsics(images, target);
