@@ -176,6 +176,11 @@ void check_marker_layout(std::span<const Vec2> p, double min_separation_m, std::
   if (n < 4) {
     throw std::invalid_argument("marker layout: " + std::to_string(n) + " markers; a homography needs at least 4");
   }
+  if (n > static_cast<std::size_t>(kMaxLayoutMarkers)) {
+    throw std::invalid_argument("marker layout: " + std::to_string(n) + " markers; at most " +
+                                std::to_string(kMaxLayoutMarkers) +
+                                " (the detector keeps as many, and matching tries every four of them)");
+  }
   // "markers 1 and 4" (from 1), or "the markers of lines 2 and 5" of a file.
   const bool by_line = source_lines.size() == n;
   const auto number = [&](std::size_t i) {

@@ -111,6 +111,11 @@ TEST(CameraCalibration, ALayoutFileOffTheBoardOrDegenerateIsRefusedNamingTheFile
                    "(positions are in metres, board frame)");
   EXPECT_EQ(read("x,y\n0.1,0.1\n0.1,0.1\n0.3,0.5\n0.2,0.9\n"),
             path + ": marker layout: the markers of lines 2 and 3 coincide (closer than 10 mm)");
+  // 250 markers: every four of them were built and sorted (3 GB, then std::bad_alloc).
+  std::string many = "x,y\n";
+  for (int i = 0; i < 25; ++i) many += std::to_string(0.02 + 0.019 * i) + "," + std::to_string(0.1 + 0.035 * i) + "\n";
+  EXPECT_EQ(read(many), path + ": marker layout: 25 markers; at most 24 (the detector keeps as many, and matching "
+                               "tries every four of them)");
   // A third column or a number with a tail was read as x,y and the rest dropped.
   EXPECT_EQ(read("x,y\n0.0408,0.0535abc\n"), path + ":2: expected two numbers x,y (m), got '0.0408,0.0535abc'");
   EXPECT_EQ(read("x,y\n0.0408,0.0535,5\n"), path + ":2: expected two numbers x,y (m), got '0.0408,0.0535,5'");

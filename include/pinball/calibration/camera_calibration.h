@@ -21,6 +21,10 @@
 
 namespace pinball::calibration {
 
+/// The most markers a layout may have: the detector keeps as many candidates,
+/// and matching tries every four of them (250 markers took 3 GB, then failed).
+inline constexpr int kMaxLayoutMarkers = 24;
+
 /// Marker detector settings.
 struct MarkerDetectorConfig {
   int threshold = 200;             ///< pixels brighter than this (gray levels) may belong to a marker
@@ -29,7 +33,7 @@ struct MarkerDetectorConfig {
   double max_elongation = 2.5;     ///< largest major/minor axis ratio (a disc seen at a slant is an ellipse)
   double min_fill = 0.8;           ///< smallest area / area of the ellipse with the same second moments
   double min_ring_contrast = 60.0; ///< marker mean minus the mean of the ring around it (gray levels)
-  int max_markers = 24;            ///< keep at most this many candidates (highest contrast first)
+  int max_markers = kMaxLayoutMarkers;  ///< keep at most this many candidates (highest contrast first)
 };
 
 /// One marker found in an image.
@@ -45,7 +49,8 @@ std::vector<DetectedMarker> detect_markers(const cv::Mat& gray, const MarkerDete
 
 /// Checks that markers at these board points can define a homography: at
 /// least 4, no two within min_separation_m, and four of them with no three
-/// (nearly) collinear. Throws std::invalid_argument naming the problem
+/// (nearly) collinear, and at most kMaxLayoutMarkers. Throws
+/// std::invalid_argument naming the problem
 /// ("markers 2, 3, 5 are collinear", "markers 1 and 4 coincide": counted
 /// from 1, or by `source_lines`, the file line of each point, when given:
 /// "the markers of lines 2 and 5 coincide").
