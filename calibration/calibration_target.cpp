@@ -154,7 +154,8 @@ cv::Mat target_image(const TargetSpec& t, double px_per_m, int margin_px) {
   const double w_px = t.squares_x * t.square_m * px_per_m, h_px = t.squares_y * t.square_m * px_per_m;
   check_input(w_px >= 2.0 * t.squares_x && h_px >= 2.0 * t.squares_y && w_px * h_px < 4e8, "target image",
               "the pattern would be " + std::to_string(std::lround(std::min(w_px, 1e9))) + "x" +
-                  std::to_string(std::lround(std::min(h_px, 1e9))) + " px: choose another px_per_m");
+                  std::to_string(std::lround(std::min(h_px, 1e9))) +
+                  " px (at most 4e8 px in all, at least 2 px a square)");
   const int w = static_cast<int>(std::lround(w_px)), h = static_cast<int>(std::lround(h_px));
   cv::Mat img;
   if (t.kind == TargetKind::kCharuco) {

@@ -591,6 +591,8 @@ void run_latency_sim(Context& c) {
                                 format_number(readout_s * 1e3) + " ms)");
   }
   if (a.row_time_us >= 0.0) check_row_time(a.row_time_us * 1e-6, o.camera.height_px, a.fps);  // before any work
+  // A long actuation delay needs longer between fires: the flipper at rest 0.2 s before the next command.
+  o.spacing_s = std::max(o.spacing_s, o.actuation_delay_s + o.hold_s + o.return_s + 0.2);
   o.camera.fps = a.fps;  // the rate asked of the camera, as in the lab (it had stayed 200)
   o.camera.exposure_s = std::min(o.camera.exposure_s, 1.0 / a.fps);
   o.lead_in_s = std::max(o.lead_in_s, calibration::latency_lead_in_s(calibration::LatencyOptions{}, 1.0 / a.fps));
@@ -879,7 +881,14 @@ std::string png_bytes(const cv::Mat& image, const std::string& path) {
 
 int print_target(const CalibrateArgs& a, const calibration::TargetSpec& target, std::ostream& out) {
   const int margin_px = static_cast<int>(std::lround(target.square_m * kPrintPxPerM));
-  const cv::Mat img = calibration::target_image(target, kPrintPxPerM, margin_px);
+  cv::Mat img;
+  try {
+    img = calibration::target_image(target, kPrintPxPerM, margin_px);
+  } catch (const std::invalid_argument& e) {  // said as the options the user gave
+    throw std::invalid_argument("calibrate intrinsics: --target " + a.target + " printed at " +
+                                format_number(kPrintPxPerM * 1e-3) + " px/mm: " + e.what() +
+                                "; print a target of fewer or smaller squares");
+  }
   Outputs files;
   files.add(a.print_target, png_bytes(img, a.print_target));
   files.commit();

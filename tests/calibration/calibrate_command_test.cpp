@@ -226,6 +226,19 @@ TEST_F(Calibrate, ALineTimeLongerThanAFrameIsRefusedBeforeAnyWork) {
   EXPECT_EQ(r.err.find("simulating"), std::string::npos) << r.err;
 }
 
+// Messages in the simulation's and the target image's own words ("spacing_s must leave ...",
+// "choose another px_per_m"), of settings no option sets.
+TEST_F(Calibrate, ALongDelayRunsAndAHugeTargetIsSaidInTheOptionsGiven) {
+  const Result slow = run("calibrate latency --sim boards/mit1993.board --events 3 --actuation-delay-ms 100");
+  EXPECT_EQ(slow.exit_code, 0) << slow.err;
+  const Result huge = run("calibrate intrinsics --print-target " + (dir_ / "t.png").string() +
+                          " --target chessboard:100x100:1");
+  EXPECT_EQ(huge.exit_code, 1);
+  EXPECT_NE(huge.err.find("--target chessboard:100x100:1 printed at 10 px/mm: "), std::string::npos) << huge.err;
+  EXPECT_NE(huge.err.find("print a target of fewer or smaller squares"), std::string::npos) << huge.err;
+  EXPECT_EQ(huge.err.find("px_per_m"), std::string::npos) << huge.err;
+}
+
 // Two outputs on one file: the figure was lost under the YAML, exit 0.
 TEST_F(Calibrate, TwoOutputsOnOneFileAreRefused) {
   const std::string same = (dir_ / "same.png").string();
