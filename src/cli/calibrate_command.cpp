@@ -394,7 +394,12 @@ void run_flippers(Context& c) {
         vision::Frame first;
         if (open()->read(first)) check_image_size(first.gray.size(), "--sweep " + c.a.sweeps[i]);
       }
-      markerless.push_back(calibration::calibrate_flipper_sweep(open, *h, f, {}, &tracks[i]));
+      try {
+        markerless.push_back(calibration::calibrate_flipper_sweep(open, *h, f, {}, &tracks[i]));
+      } catch (const std::runtime_error& e) {  // which of the videos
+        if (c.lab) throw;
+        throw std::runtime_error("calibrate flippers: --sweep " + c.a.sweeps[i] + " (" + f.name + "): " + e.what());
+      }
       j["markerless"] = flipper_json(markerless.back());
       if (background.empty()) {
         vision::Frame frame;

@@ -103,6 +103,15 @@ TEST_F(Calibrate, FlipperPicturesOfAnotherSizeThanTheCamerasAreRefused) {
   EXPECT_NE(r.err.find(", but " + file + "'s camera section was measured on 640x480 images"), std::string::npos)
       << r.err;
   EXPECT_EQ(pinball::testing::slurp(file), kept);
+  // A sweep video is the camera's too: named, by option and path.
+  const std::string v1 = (dir_ / "a.avi").string(), v2 = (dir_ / "b.avi").string();
+  ASSERT_EQ(run("sim boards/mit1993.board --balls 1 --max-ball-time 0.2 --seed 1 --video " + v1).exit_code, 0);
+  ASSERT_EQ(run("sim boards/mit1993.board --balls 1 --max-ball-time 0.2 --seed 2 --video " + v2).exit_code, 0);
+  const Result sweep =
+      run("calibrate flippers --board boards/mit1993.board --sweep " + v1 + " --sweep " + v2 + " --calibration " + file);
+  EXPECT_EQ(sweep.exit_code, 1);
+  EXPECT_NE(sweep.err.find("calibrate flippers: --sweep " + v1 + " is "), std::string::npos) << sweep.err;
+  EXPECT_NE(sweep.err.find("camera section was measured on 640x480 images"), std::string::npos) << sweep.err;
 }
 
 // A gravity measured on another table was applied without a word (track: g 2.5 from another board's file).
