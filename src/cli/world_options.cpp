@@ -19,6 +19,7 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
                  "which world plays the table: model (the thesis model on --stepper) or twin (the MuJoCo lab twin, "
                  "docs/worlds.md)")
       ->transform(CLI::CheckedTransformer(kinds).description(""))
+      ->transform(CLI::IsMember({"model", "twin"}).description(""))  // runs first: CLI11's own message garbles the map
       ->type_name("{model,twin}")
       ->default_str("model");
   // --world is declared first, so its value is in place when these two are checked, wherever it stands.
@@ -41,6 +42,7 @@ void add_world_options(CLI::App& cmd, simlab::WorldSpec& world) {
                  "the model world's integrator: thesis (fixed-step Euler, Ch. 3) or event (exact between events, "
                  "docs/physics.md)")
       ->transform(CLI::CheckedTransformer(steppers).description(""))
+      ->transform(CLI::IsMember({"thesis", "event"}).description(""))  // first, as --world's
       ->check(CLI::Validator(
           [&kind](std::string&) {
             return kind == simlab::WorldKind::kModel ? ""

@@ -595,6 +595,16 @@ TEST_F(Cli, TimeStepOutsideTheBoardsRangeIsABadArgument) {
   }
 }
 
+// CLI11's own message for a value not in the map read "Check bogus value in {event->,thesis->".
+TEST_F(Cli, AnUnknownWorldOrStepperNamesTheChoices) {
+  const CommandResult stepper = run("sim boards/mit1993.board --stepper bogus");
+  EXPECT_EQ(stepper.exit_code, 2);
+  EXPECT_NE(stepper.err.find("--stepper: bogus not in {thesis,event}"), std::string::npos) << stepper.err;
+  const CommandResult world = run("bench speed --world bogus");
+  EXPECT_EQ(world.exit_code, 2);
+  EXPECT_NE(world.err.find("--world: bogus not in {model,twin}"), std::string::npos) << world.err;
+}
+
 // In range, but too long for the board's flippers: the message named the board's rule, not --dt.
 TEST_F(Cli, ATimeStepTooLongForTheFlippersNamesTheOption) {
   std::string text = slurp(fs::path(PINBALL_SOURCE_DIR) / "boards/mit1993.board");
