@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pinball/core/format.h"
+#include "pinball/core/read_archive.h"
 
 namespace pinball::calibration {
 namespace {
@@ -257,8 +258,8 @@ std::vector<Vec2> read_marker_layout_csv(const std::string& path, const table::B
     char comma = 0;
     // Nothing after y: '0.0535abc' or a third column is no marker position.
     if (!(s >> x >> comma >> y) || comma != ',' || !std::isfinite(x) || !std::isfinite(y) || !(s >> std::ws).eof()) {
-      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": expected two numbers x,y (m), got '" + line +
-                               "'");
+      throw std::runtime_error(path + ":" + std::to_string(line_no) + ": expected two numbers x,y (m), got " +
+                               quote_value(line));
     }
     // Markers sit on the playfield or its rim; farther off is a unit or a file mistaken.
     if (!table::near_playfield(board, Vec2(x, y))) {

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "pinball/core/format.h"
+#include "pinball/core/read_archive.h"
 #include "pinball/core/running_stats.h"
 #include "pinball/core/utc_date.h"
 
@@ -46,7 +47,7 @@ double finite_number(const std::string& path, int line, const std::string& text,
   double v = 0.0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
   if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v) || v < 0.0) {
-    fail_at(path, line, std::string("column '") + column + "' must be a number >= 0, got '" + text + "'");
+    fail_at(path, line, std::string("column '") + column + "' must be a number >= 0, got " + quote_value(text));
   }
   return v;
 }
@@ -93,7 +94,7 @@ void check_play_csv_appendable(const std::string& path) {
     const std::string header = first_line(path);
     if (!header.empty() && header != kPlayCsvHeader) {
       throw std::runtime_error(path + ":1: not a play score file: the header must be '" + std::string(kPlayCsvHeader) +
-                               "', got '" + header + "'");
+                               "', got " + quote_value(header));
     }
     return;
   }
@@ -148,7 +149,7 @@ std::vector<PlayRow> read_play_csv(const std::string& path) {
     if (!text.empty() && text.back() == '\r') text.pop_back();
     if (line == 1) {
       if (text != kPlayCsvHeader) {
-        fail_at(path, line, "the header must be '" + std::string(kPlayCsvHeader) + "', got '" + text + "'");
+        fail_at(path, line, "the header must be '" + std::string(kPlayCsvHeader) + "', got " + quote_value(text));
       }
       continue;
     }
@@ -162,21 +163,21 @@ std::vector<PlayRow> read_play_csv(const std::string& path) {
     if (r.player.empty()) fail_at(path, line, "column 'player' is empty");
     r.date = f[1];
     if (!is_utc_iso8601(r.date)) {
-      fail_at(path, line, "column 'date' must be a UTC date like 2026-12-02T13:45:21Z, got '" + r.date + "'");
+      fail_at(path, line, "column 'date' must be a UTC date like 2026-12-02T13:45:21Z, got " + quote_value(r.date));
     }
     r.board = f[2];
     if (r.board.empty()) fail_at(path, line, "column 'board' is empty");
     r.world = f[3];
     if (r.world != "thesis" && r.world != "event" && r.world != "twin") {
-      fail_at(path, line, "column 'world' must be thesis, event or twin, got '" + r.world + "'");
+      fail_at(path, line, "column 'world' must be thesis, event or twin, got " + quote_value(r.world));
     }
     const auto [end, ec] = std::from_chars(f[4].data(), f[4].data() + f[4].size(), r.ball);
     if (f[4].empty() || ec != std::errc() || end != f[4].data() + f[4].size() || r.ball < 1) {
-      fail_at(path, line, "column 'ball' must be a whole number >= 1, got '" + f[4] + "'");
+      fail_at(path, line, "column 'ball' must be a whole number >= 1, got " + quote_value(f[4]));
     }
     r.score = finite_number(path, line, f[5], "score");
     r.duration_s = finite_number(path, line, f[6], "duration_s");
-    if (f[7] != "0" && f[7] != "1") fail_at(path, line, "column 'cut' must be 0 or 1, got '" + f[7] + "'");
+    if (f[7] != "0" && f[7] != "1") fail_at(path, line, "column 'cut' must be 0 or 1, got " + quote_value(f[7]));
     r.cut = f[7] == "1";
     rows.push_back(std::move(r));
   }

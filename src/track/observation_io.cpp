@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "pinball/core/format.h"
+#include "pinball/core/read_archive.h"
 #include "pinball/core/statistics.h"
 #include "pinball/core/text_file.h"
 
@@ -69,7 +70,7 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
       if (!(txy && header.size() == 3) && !has_contacts && !sim_trace) {
         fail(path, line_no,
              "header must be 't,x,y', 't,x,y,left_contact,right_contact' or sim --trace's 't,x,y,vx,vy,event', "
-             "got '" + text + "'");
+             "got " + quote_value(text));
       }
       columns = header.size();
       continue;
@@ -86,7 +87,7 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
       for (int k = 0; k < 2; ++k) {
         if (f[3 + k] != "0" && f[3 + k] != "1") {
           fail(path, line_no, std::string("column '") + (k == 0 ? "left_contact" : "right_contact") +
-                                  "' must be 0 or 1, got '" + std::string(f[3 + k]) + "'");
+                                  "' must be 0 or 1, got " + quote_value(std::string(f[3 + k])));
         }
       }
       row.contacts = {f[3] == "1", f[4] == "1"};

@@ -91,6 +91,14 @@ TEST(ObservationIo, AFileMostlyOffTheBoardIsRefusedAsOtherUnits) {
                      "(positions are in metres, board frame: a file in mm, or of another table?)");
 }
 
+// A binary file's first bytes were echoed into the message and garbled the terminal.
+TEST(ObservationIo, ABinaryFilesHeaderIsQuotedPrintably) {
+  const std::string path = write_csv("binary.csv", std::string("\x7f" "ELF\x02\x01\x01\0\0\0\n", 12));
+  const std::string e = read_error(path);
+  EXPECT_NE(e.find("got '?ELF??????'"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\x7f'), std::string::npos);
+}
+
 // Times in ms passed (they increase): track gave 176 'valid' projections where the seconds gave 73,
 // and calibrate gravity wrote g = 1.1e-6 m/s^2.
 TEST(ObservationIo, TimesInMillisecondsAreRefused) {
