@@ -256,9 +256,10 @@ struct Context {
   std::string text;  // the text report, when a kind has its own (else the file's YAML)
 };
 
-calibration::HomographyFit camera(Context& c) {
+calibration::HomographyFit camera(Context& c, std::size_t* layout_markers = nullptr) {
   const std::vector<Vec2> layout = c.a.markers.empty() ? calibration::default_marker_layout(c.board)
                                                        : calibration::read_marker_layout_csv(c.a.markers, c.board);
+  if (layout_markers) *layout_markers = layout.size();
   const cv::Mat image = c.lab ? c.lab->camera_image() : plot::read_gray_image(c.a.image);
   c.err << "calibrate camera: " << layout.size() << " markers in the layout, image " << image.cols << "x" << image.rows
         << "\n";
@@ -284,10 +285,12 @@ calibration::HomographyFit camera(Context& c) {
 
 void run_camera(Context& c) {
   if (!c.lab && c.a.image.empty()) throw std::runtime_error("calibrate camera: give --image (or --sim BOARD)");
-  const calibration::HomographyFit fit = camera(c);
+  std::size_t layout_markers = 0;
+  const calibration::HomographyFit fit = camera(c, &layout_markers);
   c.cal.camera = fit.calibration;
   // The section as the file writes it (homography, image size, markers, residuals), and the detections.
   nlohmann::json j = to_json_value(fit.calibration);
+  j["markers_in_layout"] = layout_markers;
   j["markers_detected"] = fit.detections;
   if (c.lab) {
     const vision::CameraHomography h(fit.calibration.image_from_board);
@@ -429,6 +432,7 @@ void run_flippers(Context& c) {
     c.cal.flippers.push_back(chosen);
   }
   c.report["flippers"] = list;
+  if (markers) c.report["markers_seen"] = {{"down", down.size()}, {"up", up.size()}};
   if (!c.a.png.empty()) {
     std::vector<calibration::FlipperFigureItem> items;
     for (std::size_t i = 0; i < c.board.flippers.size(); ++i) {

@@ -38,6 +38,7 @@ TEST_F(Calibrate, SimulatedLabEndToEnd) {
   EXPECT_EQ(j.at("camera").at("image_width_px"), 640);
   EXPECT_EQ(j.at("camera").at("image_from_board").size(), 3u);
   EXPECT_EQ(j.at("camera").at("markers_detected"), 7);
+  EXPECT_EQ(j.at("camera").at("markers_in_layout"), 7);  // as the text says on stderr
   EXPECT_LT(j.at("camera").at("truth").at("homography_max_error_mm").get<double>(), 1.0);
   EXPECT_TRUE(fs::exists(png));
 
@@ -45,6 +46,8 @@ TEST_F(Calibrate, SimulatedLabEndToEnd) {
   ASSERT_EQ(r.exit_code, 0);
   j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("flippers").size(), 2u);
+  EXPECT_EQ(j.at("markers_seen").at("down"), 4);  // each flipper's pivot and tip
+  EXPECT_EQ(j.at("markers_seen").at("up"), 4);
   for (const auto& f : j.at("flippers")) {
     EXPECT_LT(f.at("markers").at("truth").at("pivot_error_mm").get<double>(), 1.0);
     EXPECT_TRUE(f.contains("markerless"));
