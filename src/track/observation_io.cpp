@@ -56,11 +56,15 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
   std::size_t columns = 3;
   bool sim_trace = false;
   std::vector<ObservationRow> rows;
+  bool header_read = false;
   while (std::getline(in, text)) {
     ++line_no;
     if (!text.empty() && text.back() == '\r') text.pop_back();
-    if (line_no == 1) {
-      text = std::string(without_utf8_bom(text));
+    if (line_no == 1) text = std::string(without_utf8_bom(text));
+    // A comment ('# camera 2, 200 fps', '# ball lost here'), anywhere: as in a marker layout.
+    if (text.starts_with("#")) continue;
+    if (!header_read) {
+      header_read = true;
       const auto header = split(text);
       const bool txy = header.size() >= 3 && header[0] == "t" && header[1] == "x" && header[2] == "y";
       has_contacts = txy && header.size() == 5 && header[3] == "left_contact" && header[4] == "right_contact";
@@ -102,7 +106,7 @@ std::vector<ObservationRow> read_observations_csv(const std::string& path) {
     }
     rows.push_back(row);
   }
-  if (line_no == 0) fail(path, 1, "empty file: expected the header 't,x,y'");
+  if (!header_read) fail(path, std::max(line_no, 1), "empty file: expected the header 't,x,y'");
   if (rows.empty()) fail(path, line_no, "no observation after the header");
   return rows;
 }

@@ -91,6 +91,19 @@ TEST(ObservationIo, AFileMostlyOffTheBoardIsRefusedAsOtherUnits) {
                      "(positions are in metres, board frame: a file in mm, or of another table?)");
 }
 
+// '#' lines were accepted in a marker layout but not here: a comment before the header, or a note
+// between rows, was 'header must be ...' or 'expected 3 columns, got 1'.
+TEST(ObservationIo, CommentLinesAreSkippedAnywhere) {
+  const std::string path =
+      write_csv("comments.csv", "# camera 2, 200 fps\nt,x,y\n0,0.1,0.2\n# a pause\n0.005,0.1,0.21\n");
+  const std::vector<ObservationRow> rows = read_observations_csv(path);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[1].observation.p_board.y(), 0.21);
+  const std::string only = write_csv("only_comments.csv", "# nothing yet\n");
+  EXPECT_NE(read_error(only).find(only + ":1: empty file: expected the header 't,x,y'"), std::string::npos)
+      << read_error(only);
+}
+
 // A binary file's first bytes were echoed into the message and garbled the terminal.
 TEST(ObservationIo, ABinaryFilesHeaderIsQuotedPrintably) {
   const std::string path = write_csv("binary.csv", std::string("\x7f" "ELF\x02\x01\x01\0\0\0\n", 12));

@@ -2,7 +2,8 @@
 // Observation files: CSV with header t,x,y (s, m, board frame), optionally
 // followed by left_contact,right_contact (0/1 flipper contact sensors), or
 // `pinball sim --trace`'s t,x,y,vx,vy,event (the true state each step: its
-// position is read, its velocity and events are not observations).
+// position is read, its velocity and events are not observations). A line
+// starting with '#' is a comment, before the header or between rows.
 
 #include <string>
 #include <vector>
