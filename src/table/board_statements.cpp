@@ -321,6 +321,12 @@ void flipper(LoadState& state, const Reader& r) {
   r.require(v[2] > 0, "field LENGTH", "> 0", v[2]);
   require_at_most(state, r, v[2], "field LENGTH", kMaxLength_m);
   if (!(v[3] < v[4])) r.fail("field THETA_MIN (" + fmt(v[3]) + ") must be less than THETA_MAX (" + fmt(v[4]) + ")");
+  // An elevation above the horizontal: past a quarter turn either way the blade points back over its pivot
+  // (-1e9 .. 1e9, or a 360-degree stroke, had been accepted).
+  const double quarter_turn = std::numbers::pi / 2.0 / state.angle_scale;  // in the file's unit
+  const std::string quarter_text = fmt(quarter_turn) + (state.angle_scale == 1.0 ? " rad" : " deg");
+  r.require(std::abs(v[3]) <= quarter_turn, "field THETA_MIN", "within +-" + quarter_text, v[3]);
+  r.require(std::abs(v[4]) <= quarter_turn, "field THETA_MAX", "within +-" + quarter_text, v[4]);
   r.require(v[5] > 0, "field OMEGA", "> 0", v[5]);
   f.pivot = position(state, r, v[0], v[1], "fields PX PY");
   f.length_m = v[2] * state.length_scale;

@@ -336,10 +336,21 @@ TEST(BoardLoaderErrors, StartIsOnTheTableClearAndFinite) {
                     "start: ball at fields X Y (0.2, 0.5) m lies inside polygon 'block'");
 }
 
+// THETA -1e9 .. 1e9, and a stroke of 360 degrees, had been accepted (sim played them).
+TEST(BoardLoaderErrors, FlipperAnglesAreElevationsWithinAQuarterTurn) {
+  expect_body_error("flipper left 0.15 0.16 0.076 -0.5 6.0 35\n", 8,
+                    "flipper: field THETA_MAX must be within +-1.5708 rad, got 6");
+  expect_body_error("flipper right 0.35 0.16 0.076 -1e9 0.5 35\n", 8, "field THETA_MIN must be within +-1.5708 rad");
+  expect_error("pinball-board 1\nangles deg\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\n"
+               "launcher 0.45 0.05\ndt 0.0005\nflipper left 0.15 0.16 0.076 -25 335 2000\n",
+               9, "field THETA_MAX must be within +-90 deg, got 335");
+  EXPECT_NO_THROW(parse("flipper left 0.15 0.16 0.076 -1.5 1.5 35\n"));
+}
+
 // Found by a helper: mu=1e300 overflowed the speed clamp to a stopped ball, and score=1e308
 // a game's sum to inf (the report's mean: nan).
 TEST(BoardLoaderErrors, FrictionAndPointsHaveUpperBounds) {
-  expect_body_error("flipper left 0.15 0.16 0.076 -25 30 35 mu=1e300\n", 8, "attribute mu must be at most 10");
+  expect_body_error("flipper left 0.15 0.16 0.076 -0.4 0.5 35 mu=1e300\n", 8, "attribute mu must be at most 10");
   expect_body_error("circle 0.2 0.5 0.01 score=1e308\n", 8, "attribute score must be at most 1e+06");
   expect_body_error("circle 0.2 0.5 0.01 score=-5\n", 8, "attribute score must be >= 0");
   expect_body_error("circle 0.2 0.5 0.01 contact=-1\n", 8, "attribute contact must be >= 0");
