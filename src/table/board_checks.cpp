@@ -120,6 +120,30 @@ void check_start(const LoadState& state) {
 
 }  // namespace
 
+// Every piece within a few cm of the playfield: a coordinate typed in the wrong unit or with a
+// digit too many (x = 5000 mm on a 510 mm table) had been accepted up to 100 m from the origin.
+void check_pieces_on_playfield(const LoadState& state) {
+  const Board& board = state.board;
+  const auto require_near = [&](const Vec2& p, int line, const std::string& what) {
+    if (near_playfield(board, p)) return;
+    throw BoardError(state.file, line,
+                     what + " at (" + fmt(p.x() / state.length_scale) + ", " + fmt(p.y() / state.length_scale) +
+                         ") " + unit_name(state) + " lies " + off_playfield_text(board));
+  };
+  for (std::size_t i = 0; i < board.shapes.size(); ++i) {
+    const Shape& shape = board.shapes[i];
+    const std::string what = "obstacle '" + board.obstacles[i].name + "'";
+    require_near(shape.p0, board.obstacles[i].source_line, what);
+    if (shape.kind == ShapeKind::kLine) require_near(shape.p1, board.obstacles[i].source_line, what);
+  }
+  for (const Sensor& sensor : board.sensors) {
+    const std::string what = "sensor '" + sensor.name + "'";
+    require_near(sensor.shape.p0, sensor.source_line, what);
+    if (sensor.shape.kind == ShapeKind::kLine) require_near(sensor.shape.p1, sensor.source_line, what);
+  }
+  for (const Flipper& f : board.flippers) require_near(f.pivot, f.source_line, "the pivot of flipper '" + f.name + "'");
+}
+
 void check_whole_file(const LoadState& state) {
   const Board& board = state.board;
   for (const std::string_view required : kRequired) {
@@ -148,6 +172,7 @@ void check_whole_file(const LoadState& state) {
                            fmt(max_stable_dt_s(one)) + " s)");
     }
   }
+  check_pieces_on_playfield(state);
   check_launcher_clear(state);
   check_launch_speed(state);
   check_start(state);

@@ -336,6 +336,16 @@ TEST(BoardLoaderErrors, StartIsOnTheTableClearAndFinite) {
                     "start: ball at fields X Y (0.2, 0.5) m lies inside polygon 'block'");
 }
 
+// A coordinate with a digit too many (x = 5 m on a 0.51 m table) loaded: only 100 m from the origin was refused.
+TEST(BoardLoaderErrors, APieceOffThePlayfieldIsRefusedAtItsLine) {
+  expect_body_error("circle 5.0 0.5 0.01 name=far\n", 8,
+                    "obstacle 'far' at (5, 0.5) m lies over 5 cm off the 0.51 x 1.07 m playfield of x.board");
+  expect_body_error("wall 0.1 0.5 0.1 2.0\n", 8, "obstacle 'wall@8' at (0.1, 2) m lies over 5 cm off");
+  expect_body_error("sensor circle 0.25 -0.2 0.01 name=s\n", 8, "sensor 's' at (0.25, -0.2) m lies");
+  expect_body_error("flipper left 0.15 1.5 0.076 -0.5 0.5 35 name=lf\n", 8, "the pivot of flipper 'lf' at (0.15, 1.5)");
+  EXPECT_NO_THROW(parse("circle 0.54 0.5 0.01\n"));  // on the rim: within 5 cm
+}
+
 // THETA -1e9 .. 1e9, and a stroke of 360 degrees, had been accepted (sim played them).
 TEST(BoardLoaderErrors, FlipperAnglesAreElevationsWithinAQuarterTurn) {
   expect_body_error("flipper left 0.15 0.16 0.076 -0.5 6.0 35\n", 8,
@@ -550,7 +560,7 @@ TEST(BoardLoaderErrors, SizesSpeedsAndGravityAreBounded) {
   expect_body_error("circle 0.1 0.5 20\n", 8, "circle: field R (radius) must be at most 10 m, got 20");
   expect_body_error("hole 0.1 0.5 11 eat\n", 8, "hole: field R (radius) must be at most 10 m, got 11");
   expect_body_error("flipper left 0.1 0.2 50 -0.5 0.5 1\n", 8, "flipper: field LENGTH must be at most 10 m, got 50");
-  EXPECT_NO_THROW(parse("circle 0.9 0.9 0.01 rho=2 kick=100\n"));
+  EXPECT_NO_THROW(parse("circle 0.3 0.9 0.01 rho=2 kick=100\n"));
 }
 
 TEST(BoardLoaderErrors, RestitutionAndKicksAreBounded) {
@@ -589,9 +599,9 @@ TEST(BoardLoaderErrors, FlipperThetaMinNotBelowThetaMax) {
 
 TEST(BoardLoaderErrors, FlipperTooFastForTheTimeStep) {
   // 0.076 m * sin(200 rad/s * 0.0005 s / 2) = 3.8 mm: fine; at 800 rad/s 0.076 * sin(0.2) = 15.1 mm > 13.5 mm.
-  EXPECT_NO_THROW(parse("point 0.9 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 200\n"));
-  expect_body_error("point 0.9 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 800 name=lf\n", 9, "l*sin(omega*dt/2)");
-  expect_body_error("point 0.9 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 800 name=lf\n", 9, "flipper: flipper 'lf'");
+  EXPECT_NO_THROW(parse("point 0.3 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 200\n"));
+  expect_body_error("point 0.3 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 800 name=lf\n", 9, "l*sin(omega*dt/2)");
+  expect_body_error("point 0.3 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 800 name=lf\n", 9, "flipper: flipper 'lf'");
   // dt after the flipper still counts: the check runs on the whole file.
   expect_error(
       "pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\nlauncher 0.45 0.05\n"
@@ -605,7 +615,7 @@ TEST(BoardLoaderErrors, FlipperTooFastForTheTimeStep) {
 }
 
 TEST(BoardLoaderErrors, BallAtTheLauncherOverlaps) {
-  expect_body_error("point 0.9 0.9\nwall 0.44 0.0 0.44 0.2\n", 7,
+  expect_body_error("point 0.3 0.9\nwall 0.44 0.0 0.44 0.2\n", 7,
                     "launcher: ball at the launch position overlaps 'wall@9'");
   expect_body_error("circle 0.45 0.1 0.04 name=post\n", 7, "overlaps 'post'");
   // A one-sided line counts from either side.
@@ -641,7 +651,7 @@ TEST(BoardLoaderErrors, HeaderMustComeFirst) {
 }
 
 TEST(BoardLoaderErrors, DuplicateSingleton) {
-  expect_body_error("point 0.9 0.9\nball 0.01 4\n", 9, "duplicate 'ball' statement (first at line 3)");
+  expect_body_error("point 0.3 0.9\nball 0.01 4\n", 9, "duplicate 'ball' statement (first at line 3)");
   expect_body_error("launcher 0.3 0.05\n", 8, "duplicate 'launcher' statement (first at line 7)");
   expect_error("pinball-board 1\nunits mm\nunits mm\n", 3, "duplicate 'units' statement (first at line 2)");
 }
@@ -665,7 +675,7 @@ TEST(BoardLoaderErrors, Banks) {
   expect_body_error("circle 0.1 0.5 0.01 bank=drops\nbank drops bonus=5\n", 8, "undeclared bank 'drops'");
   expect_body_error("bank drops bonus=5\nbank drops bonus=6\n", 9, "bank: bank 'drops' is declared twice");
   expect_body_error("bank drops\n", 8, "bank: needs bonus=POINTS");
-  expect_body_error("point 0.9 0.9\nbank drops bonus=5\n", 9, "bank: bank 'drops' has no members");
+  expect_body_error("point 0.3 0.9\nbank drops bonus=5\n", 9, "bank: bank 'drops' has no members");
 }
 
 TEST(BoardLoaderErrors, HoleNeedsEatOrKickout) {
