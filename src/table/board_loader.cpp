@@ -4,6 +4,7 @@
 // checks. The stages are in board_reader.cpp, board_statements.cpp and
 // board_checks.cpp (board_loader_internal.h).
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <utility>
 
 #include "board_loader_internal.h"
+#include "pinball/core/read_archive.h"
 #include "pinball/core/text_file.h"
 
 namespace pinball::table {
@@ -20,7 +22,17 @@ namespace {
 void statement(loader::LoadState& state, const loader::Statement& st) {
   const std::string keyword(st.tokens[0]);
   const loader::StatementKind* kind = loader::find_kind(keyword);
-  if (kind == nullptr) throw BoardError(state.file, st.line, "unknown keyword '" + keyword + "'");
+  if (kind == nullptr) {
+    // A no-break space or a second byte-order mark glues itself to the keyword and is invisible when printed.
+    const bool odd_bytes = std::any_of(keyword.begin(), keyword.end(), [](char c) {
+      return static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f;
+    });
+    throw BoardError(state.file, st.line,
+                     "unknown keyword " + quote_value(keyword) +
+                         (odd_bytes ? " (holding bytes that are not printable ASCII, shown as '?': a no-break space "
+                                      "or a byte-order mark where a space or nothing belongs?)"
+                                    : ""));
+  }
   if (state.seen.empty() && keyword != "pinball-board") {
     throw BoardError(state.file, st.line, "expected 'pinball-board 1' as the first statement, got '" + keyword + "'");
   }

@@ -336,6 +336,13 @@ TEST(BoardLoaderErrors, StartIsOnTheTableClearAndFinite) {
                     "start: ball at fields X Y (0.2, 0.5) m lies inside polygon 'block'");
 }
 
+// A no-break space in 'balls 1' read "unknown keyword 'balls 1'", which looks like a good line.
+TEST(BoardLoaderErrors, AnInvisibleCharacterInAKeywordIsShown) {
+  expect_body_error("circle\xc2\xa0" "0.3 0.5 0.01\n", 8,
+                    "unknown keyword 'circle??0.3' (holding bytes that are not printable ASCII, shown as '?': a "
+                    "no-break space");
+}
+
 // A coordinate with a digit too many (x = 5 m on a 0.51 m table) loaded: only 100 m from the origin was refused.
 TEST(BoardLoaderErrors, APieceOffThePlayfieldIsRefusedAtItsLine) {
   expect_body_error("circle 5.0 0.5 0.01 name=far\n", 8,
