@@ -64,7 +64,11 @@ TEST(TwinParams, RefusesAWrongUnit) {
 
 TEST(TwinParams, RefusesAValueOutOfRangeSayingTheRange) {
   const std::string e = load_error(with_line("timestep_s", "timestep_s: {value: 0.01, unit: s, source: x}"));
-  EXPECT_NE(e.find("timestep_s: is 0.01 s, must be in [0.00001, 0.002]"), std::string::npos) << e;
+  EXPECT_NE(e.find("timestep_s: is 0.01 s, must be in [0.00001, 0.002] s"), std::string::npos) << e;
+  // A ratio's unit "1" is not written after the number ("is 1.5 1").
+  const std::string ratio =
+      load_error(with_line("rubber_restitution", "rubber_restitution: {value: 1.5, unit: \"1\", source: x}"));
+  EXPECT_NE(ratio.find("rubber_restitution: is 1.5, must be in [0, 0.95]"), std::string::npos) << ratio;
 }
 
 TEST(TwinParams, RefusesANumberWithoutASource) {

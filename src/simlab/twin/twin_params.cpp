@@ -66,8 +66,9 @@ RangeViolation find_violation(const TwinParams& p) {
     if (q.unit != s.unit) return {s.key, "must be given in " + std::string(s.unit) + ", not '" + q.unit + "'"};
     if (q.source.empty()) return {s.key, "needs a source (a measurement, a datasheet or a reason)"};
     if (!(q.value >= s.min && q.value <= s.max)) {
-      return {s.key, "is " + format_number(q.value) + " " + s.unit + ", must be in [" + format_number(s.min) + ", " +
-                         format_number(s.max) + "]"};
+      const std::string unit = std::string_view(s.unit) == "1" ? "" : " " + std::string(s.unit);  // "1": a ratio
+      return {s.key, "is " + format_number(q.value) + unit + ", must be in [" + format_number(s.min) + ", " +
+                         format_number(s.max) + "]" + unit};
     }
   }
   // Settings that contradict each other.
