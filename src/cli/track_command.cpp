@@ -60,7 +60,10 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
   if (a.sigma_m > 0.0) config.sigma_m = a.sigma_m;
   track::Tracker tracker(geometry, config);
 
-  nlohmann::json projections = nlohmann::json::array();
+  // --json streams its projections, one line each, and closes with the counts: a whole array built
+  // first took 2.5 GB for 10^6 observations.
+  if (a.json) out << "{\n  \"projections\": [";
+  bool first_projection = true;
   int valid = 0;
   int launches = 0;
   int losses = 0;
@@ -81,7 +84,8 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
                   {"h", p.h}, {"d_m", p.d_m}, {"t_impact_s", p.t_impact_s}, {"hittable", p.hittable},
                   {"rolling", p.rolling}});
       }
-      projections.push_back(std::move(j));
+      out << (first_projection ? "\n    " : ",\n    ") << json_text(j);
+      first_projection = false;
     } else {
       char line[256];
       if (p.valid) {
@@ -97,20 +101,19 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
       << losses << " losses, " << tracker.flushes() << " collision flushes, " << tracker.pushes()
       << " pushed fits\n";
   if (a.json) {
-    out << json_text(nlohmann::json{{"board", a.board},
-                                    {"observations_file", a.observations},
-                                    {"calibration", a.calibration},
-                                    {"gravity_mps2", config.g_mps2},
-                                    {"sigma_m", config.sigma_m},
-                                    {"observations", rows.size()},
-                                    {"valid_projections", valid},
-                                    {"launches", launches},
-                                    {"losses", losses},
-                                    {"collision_flushes", tracker.flushes()},
-                                    {"pushed_fits", tracker.pushes()},
-                                    {"projections", projections}},
-                     2)
-        << "\n";
+    const nlohmann::json summary{{"board", a.board},
+                                 {"observations_file", a.observations},
+                                 {"calibration", a.calibration},
+                                 {"gravity_mps2", config.g_mps2},
+                                 {"sigma_m", config.sigma_m},
+                                 {"observations", rows.size()},
+                                 {"valid_projections", valid},
+                                 {"launches", launches},
+                                 {"losses", losses},
+                                 {"collision_flushes", tracker.flushes()},
+                                 {"pushed_fits", tracker.pushes()}};
+    const std::string counts = json_text(summary, 2);
+    out << "\n  ],\n" << counts.substr(2) << "\n";  // the counts' keys after the array, in the one object
   }
   return 0;
 }
