@@ -143,7 +143,11 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
   if (!format.is_string() || format.get<std::string>() != kFormat) r.fail("format", "must be \"pinball-controller\"");
   // Compared as a 64-bit integer: get<int>() would truncate 4294967297 to 1.
   const json& version = need(r, j, "", "version");
-  if (!version.is_number_integer() || version.get<std::int64_t>() != kControllerFileVersion) {
+  if (!version.is_number_integer()) {  // "1" (a string) is no version number, not an unsupported one
+    r.fail("version", "must be a whole number (" + std::to_string(kControllerFileVersion) + "), got " +
+                          json_text(version));
+  }
+  if (version.get<std::int64_t>() != kControllerFileVersion) {
     r.fail("version", "unsupported (this build reads version " + std::to_string(kControllerFileVersion) + ")");
   }
   ControllerSpec s;
@@ -176,7 +180,8 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
     refuse_unknown_keys(r, m, where, {"partition", "name", "a", "flipper"});  // partition, name: for a reader
     // The list's order places each minicontroller; a partition number that says otherwise misleads.
     if (m.contains("partition") && m["partition"] != json(i)) {
-      r.fail(where + ".partition", "must be " + std::to_string(i) + ": its place in the list decides its partition");
+      r.fail(where + ".partition", "must be " + std::to_string(i) + ", got " + json_text(m["partition"]) +
+                                       ": its place in the list decides its partition");
     }
     refuse(r, where, check_minicontroller(mc));
   }

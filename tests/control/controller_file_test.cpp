@@ -97,7 +97,12 @@ TEST(ControllerFile, BadFilesGiveClearErrors) {
   // minicontrollers[i].partition is for a reader; one that contradicts the order misled it.
   nlohmann::json reordered = nlohmann::json::parse(good);
   reordered["minicontrollers"][0]["partition"] = 5;
-  expect_error(reordered.dump(), "minicontrollers[0].partition: must be 0: its place in the list decides");
+  expect_error(reordered.dump(), "minicontrollers[0].partition: must be 0, got 5: its place in the list decides");
+  reordered["minicontrollers"][0]["partition"] = "0";  // "must be 0" of a "0" read as nonsense
+  expect_error(reordered.dump(), "minicontrollers[0].partition: must be 0, got \"0\"");
+  std::string quoted_version = good;
+  quoted_version.replace(quoted_version.find("\"version\": 1"), 12, "\"version\": \"1\"");
+  expect_error(quoted_version, "version: must be a whole number (1), got \"1\"");
   std::string extra = good;
   extra.replace(extra.find("\"note\""), 6, "\"bogus\": 1, \"note\"");
   expect_error(extra, "bad.json: bogus: unknown key");
