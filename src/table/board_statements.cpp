@@ -23,6 +23,7 @@ constexpr std::string_view kObstacleAttributes = "rho friction score kick contac
 constexpr double kMaxLength_m = 10.0;        // size W and H, every radius and flipper length
 constexpr double kMaxCoordinate_m = 100.0;   // every position, either axis
 constexpr double kMaxBallRadius_m = 0.1;     // a pinball is 13.5 mm
+constexpr double kMinBallRadius_m = 0.001;   // below a millimetre the contact tolerances are the ball's size
 constexpr double kMaxSpeed_mps = 100.0;      // SPEED_MAX, kick, kickout: twenty times a hard shot
 
 /// Requires `v`, read in the file's length unit (per second with per = "/s",
@@ -92,6 +93,8 @@ void ball(LoadState& state, const Reader& r) {
   r.require(v[0] > 0, "field R (radius)", "> 0", v[0]);
   r.require(v[1] > 0, "field SPEED_MAX", "> 0", v[1]);
   require_at_most(state, r, v[0], "field R (radius)", kMaxBallRadius_m);
+  r.require(v[0] * state.length_scale >= kMinBallRadius_m, "field R (radius)",
+            "at least " + fmt(kMinBallRadius_m / state.length_scale) + " " + unit_name(state), v[0]);
   require_at_most(state, r, v[1], "field SPEED_MAX", kMaxSpeed_mps, "/s");
   state.board.ball.radius_m = v[0] * state.length_scale;
   state.board.ball.speed_max_mps = v[1] * state.length_scale;

@@ -561,6 +561,9 @@ TEST(BoardLoaderErrors, SizesSpeedsAndGravityAreBounded) {
   expect_error("pinball-board 1\nunits mm\nsize 510 1070000\n", 3,
                "size: field H (height) must be at most 10000 mm, got 1070000");
   expect_error("pinball-board 1\nball 0.5 5\n", 2, "ball: field R (radius) must be at most 0.1 m, got 0.5");
+  // 1e-300 m was accepted (a board without flippers played it): below 1 mm the contact tolerance is the ball.
+  expect_error("pinball-board 1\nball 1e-300 5\n", 2, "ball: field R (radius) must be at least 0.001 m, got 1e-300");
+  expect_error("pinball-board 1\nunits mm\nball 0.5 5000\n", 3, "field R (radius) must be at least 1 mm, got 0.5");
   expect_error("pinball-board 1\nball 0.0135 500\n", 2, "ball: field SPEED_MAX must be at most 100 m/s, got 500");
   expect_error("pinball-board 1\ngravity 11\n", 2, "gravity: field G must be at most 10 m/s^2, got 11");
   expect_error("pinball-board 1\nunits mm\ngravity 98100\n", 3, "gravity: field G must be at most 10000 mm/s^2");
