@@ -341,6 +341,7 @@ DaemonConfig load_daemon_config(const std::string& path) {
   const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
   DaemonConfig c = daemon_config_from_yaml(text, path, folder.string());
   c.origin = path;
+  c.file = path;
   return c;
 }
 
@@ -398,6 +399,9 @@ void check_written_paths(const DaemonConfig& c, const std::string& source_name) 
   const std::vector<std::pair<const char*, std::string>> written = {
       {"can.log", c.can.log}, {"lcm_url", lcm_log ? lcm_log->path : std::string()}};
   for (const auto& [key, path] : written) {
+    // The configuration file itself (found: --lcm-url file://CONFIG?mode=w made it an LCM log, exit 0).
+    require(!same_file(path, c.file), source_name, key,
+            "'" + path + "' is this configuration file: it would be replaced by the recording");
     for (const PathField& f : path_fields(inputs)) {
       if (f.use == PathUse::kRead) {
         require(!same_file(path, *f.value), source_name, key,

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "pinball/core/text_file.h"
+
 namespace pinball::daemon {
 namespace {
 
@@ -372,6 +374,26 @@ TEST(DaemonConfig, ARecordingReplacesNoInputAndNotTheOtherRecording) {
   EXPECT_THROW(check_written_paths(c, "x.yaml"), ConfigError) << "two recordings into one file";
   c.lcm_url = "file://" + c.controller + "?mode=w";
   EXPECT_THROW(check_written_paths(c, "x.yaml"), ConfigError) << "an LCM log over the controller";
+}
+
+// --lcm-url file://CONFIG?mode=w made the configuration file an LCM log, exit 0 (--check said ok).
+TEST(DaemonConfig, ARecordingReplacesNotItsOwnConfigurationFile) {
+  const std::string file = ::testing::TempDir() + "/config_self.yaml";
+  write_file(file, "version: 1\nmode: sim\n");
+  DaemonConfig c = load_daemon_config(file);
+  c.origin = file + " and the command line";  // as pinballd says it once an option overrides the file
+  c.lcm_url = "file://" + file + "?mode=w";
+  try {
+    check_written_paths(c, c.origin);
+    ADD_FAILURE() << "an LCM log over the configuration file was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), file + " and the command line: lcm_url: '" + file +
+                                         "' is this configuration file: it would be replaced by the recording");
+  }
+  c.lcm_url = "memq://";
+  c.can.log = file;
+  EXPECT_THROW(check_written_paths(c, c.origin), ConfigError);
+  EXPECT_EQ(read_text_file(file), "version: 1\nmode: sim\n");
 }
 
 TEST(DaemonConfig, TheSimulatedCameraRendersAtLeast32Pixels) {

@@ -184,6 +184,8 @@ struct DaemonConfig {
   /// Where these settings came from, for the messages of checks made after
   /// loading: the file, "the command line", or both. Not a key.
   std::string origin = "the command line";
+  /// The configuration file it was loaded from ("" for none): no recording may replace it. Not a key.
+  std::string file;
 
   template <class Archive>
   void Serialize(Archive* a) {
