@@ -23,6 +23,7 @@
 #include "pinball/core/running_stats.h"
 #include "pinball/core/clock.h"
 #include "pinball/core/file_sink.h"
+#include "pinball/core/writer_lock.h"
 #include "pinball/daemon/doorbell.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/daemon/thread_table.h"
@@ -85,6 +86,7 @@ firmware::DriverBusOptions bus_options(const DaemonConfig& c, int drivers) {
 
 struct Daemon::Impl {
   DaemonConfig config;
+  std::vector<WriterLock> recording_locks;  // the LCM and CAN logs: no second pinballd writes into them
   CpuPlan cpus;  // threads.chain_cpu
   bool fifo_allowed = true;  // false once the probe was refused: warned once, not once per thread
   bool sim_mode = true;
@@ -302,6 +304,15 @@ void Daemon::Impl::build() {
   // its name: a camera that is missing or busy fails the start before that.
   if (config.camera.source == "file" || config.camera.source == "v4l2") {
     capture = open_lab_camera(config.camera);
+  }
+  // One writer per recording, for the whole run: taken here, after every input loaded (a start that
+  // fails before leaves no empty log behind), and before liblcm opens its log.
+  const std::optional<bus::LcmLogTarget> lcm_log = bus::lcm_log_target(config.lcm_url);
+  try {
+    if (lcm_log) recording_locks.emplace_back(lcm_log->path);
+    recording_locks.emplace_back(config.can.log);
+  } catch (const std::runtime_error& e) {
+    throw ConfigError(config.origin + ": " + e.what());
   }
   lcm = std::make_unique<bus::LcmBus>(config.lcm_url);
   if (config.camera.source == "lcm") lcm->subscribe_observations(lcm_observations);
