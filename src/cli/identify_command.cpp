@@ -50,9 +50,10 @@ void check_distinct_files(const IdentifyArgs& a) {
   check_distinct_inputs(a.held_out, "identify: --held-out", "its moments would count twice");
   for (std::size_t i = 0; i < a.logs.size(); ++i) {
     for (const std::string& held : a.held_out) {
-      if (same_file(a.logs[i], held)) {
-        throw std::runtime_error("identify: --held-out " + held + " is also a fitted log: a held-out log must be one "
-                                 "never fitted");
+      if (same_file(a.logs[i], held) || same_contents(a.logs[i], held)) {
+        throw std::runtime_error("identify: --held-out " + held + " is also a fitted log" +
+                                 (same_file(a.logs[i], held) ? "" : " (a copy of " + a.logs[i] + ")") +
+                                 ": a held-out log must be one never fitted");
       }
     }
   }

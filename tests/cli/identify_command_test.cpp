@@ -179,6 +179,14 @@ TEST_F(IdentifyCommand, RefusesRepeatedInputsAndAnOutThatIsNoNewFile) {
   const pinball::testing::CommandResult held = run("identify " + log + " --held-out " + log);
   EXPECT_EQ(held.exit_code, 1);
   EXPECT_NE(held.err.find("is also a fitted log"), std::string::npos) << held.err;
+  // A copy of a fitted log held out measured the fit on its own data, exit 0.
+  const std::string copy = log + ".copy.lcm";
+  std::filesystem::copy_file(log, copy);
+  const pinball::testing::CommandResult held_copy = run("identify " + log + " --held-out " + copy);
+  EXPECT_EQ(held_copy.exit_code, 1);
+  EXPECT_NE(held_copy.err.find("identify: --held-out " + copy + " is also a fitted log (a copy of " + log + ")"),
+            std::string::npos)
+      << held_copy.err;
   const pinball::testing::CommandResult over = run("identify " + log + " --out " + log);
   EXPECT_EQ(over.exit_code, 1);
   EXPECT_NE(over.err.find("--out " + log + " is the input"), std::string::npos) << over.err;
