@@ -462,8 +462,11 @@ const std::vector<FlagUse>& learn_flag_uses() {
        {"tournament", "relay", "cem", "imitate"}},
       {{"--budget-balls"}, {"tournament", "relay", "cem", "imitate", "shot-values"}},
       {{"--eval-balls"}, {"tournament", "relay", "cem", "imitate", "none", "spastic", "evaluate"}},
-      {{"--threads", "--max-ball-time", "--actuation-delay", "--pull"},
+      {{"--threads", "--max-ball-time", "--actuation-delay"},
        {"tournament", "relay", "cem", "imitate", "none", "spastic", "evaluate", "shot-values"}},
+      // evaluate plays the controller file's own launch; only the relay credits an opportunity that lost the ball
+      {{"--pull"}, {"tournament", "relay", "cem", "imitate", "none", "spastic", "shot-values"}},
+      {{"--loss-penalty"}, {"relay"}},
   };
   return uses;
 }

@@ -942,6 +942,10 @@ TEST_F(Cli, LearnMethodsRefuseOptionsTheyDoNotRead) {
             "learn tournament: --population applies to relay and cem only"},
            {"--method shot-values --out sv.yaml --eval-balls 5", "learn shot-values: --eval-balls applies to"},
            {"--method none --rounds 3", "learn none: --rounds applies to imitate only"},
+           // Ran as if not given: evaluate plays the file's own launch, and only the relay credits a lost ball.
+           {"--method evaluate --controller controllers/best.json --pull 0.5",
+            "learn evaluate: --pull applies to tournament, relay, cem, imitate, none, spastic and shot-values only"},
+           {"--method cem --loss-penalty 5 --out c.json", "learn cem: --loss-penalty applies to relay only"},
        }) {
     const CommandResult r = run("learn boards/mit1993.board " + args);
     EXPECT_EQ(r.exit_code, 1) << args;
