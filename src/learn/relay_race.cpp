@@ -11,6 +11,18 @@ SearchResult run_relay_race(const BallObjective& objective, const SearchConfig& 
   if (r.population < 2 || r.eval_balls < 1 || r.eval_every < 1 || !(r.confidence > 0.0 && r.confidence < 1.0)) {
     throw std::invalid_argument("relay race: population >= 2, eval balls >= 1, eval every >= 1, 0 < c < 1");
   }
+  // Each of the population's seeds costs a batch at least, then a generation n + eval balls: a budget
+  // below that played every ball of it before saying so (2000 balls for --population 1000).
+  const std::uint64_t least_balls = static_cast<std::uint64_t>(r.population) * (kSeedBatch + 1) +
+                                    static_cast<std::uint64_t>(r.eval_balls);
+  if (config.budget_balls < least_balls) {
+    throw std::invalid_argument("relay race: --budget-balls " + std::to_string(config.budget_balls) +
+                                " pays for no generation: the seed search plays at least " +
+                                std::to_string(kSeedBatch) + " balls for each of " + std::to_string(r.population) +
+                                " controllers (--population), and a generation " + std::to_string(r.population) +
+                                " + " + std::to_string(r.eval_balls) + " more: at least " +
+                                std::to_string(least_balls) + "; nothing played");
+  }
   SearchRun run(objective, config, "relay");
   const control::ControllerSpec prototype = objective.prototype();
   const int k = prototype.action_function.partitions();

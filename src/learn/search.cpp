@@ -98,13 +98,12 @@ RunningStats score_stats(const std::vector<BallOutcome>& outcomes, std::size_t b
 }
 
 control::ControllerSpec seed_controller(SearchRun& run, const control::ControllerSpec& prototype) {
-  constexpr int kBatch = 8;
   control::ControllerSpec best = prototype;
   best.action_function.randomise(run.rng());
   double best_score = -1e300;
   int tried = 0;
   while (tried < run.config().seed_max_tries && run.balls_left() > 0) {
-    const int n = static_cast<int>(std::min<std::uint64_t>(kBatch, run.balls_left()));
+    const int n = static_cast<int>(std::min<std::uint64_t>(kSeedBatch, run.balls_left()));
     std::vector<control::ControllerSpec> candidates(static_cast<std::size_t>(n), prototype);
     std::vector<BallTask> tasks;
     for (auto& c : candidates) {

@@ -33,6 +33,24 @@ TEST(RelayRace, ImprovesAToyObjective) {
   EXPECT_GT(hoeffding, 0.0) << "the race eliminated someone by its intervals";
 }
 
+// --budget-balls 2000 with --population 1000 played every ball before saying no generation fitted.
+TEST(RelayRace, ABudgetBelowOneGenerationIsRefusedBeforeAnyBall) {
+  const ToyObjective toy(2);
+  SearchConfig c;
+  c.budget_balls = 9 * 10 + 9;  // seeds (8 a controller) and one generation of 10 + 10 need 100
+  try {
+    run_relay_race(toy, c, relay_config(10, 10));
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("relay race: --budget-balls 99 pays for no generation"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("at least 100; nothing played"), std::string::npos) << e.what();
+  }
+  c.budget_balls = 100;
+  c.seed_min_score = -1e9;
+  EXPECT_EQ(run_relay_race(toy, c, relay_config(10, 10)).generations, 1);
+}
+
 // Minicontroller 0 never earns anything: the zero rule replaces it after 3 opportunities.
 struct ZeroToy final : BallObjective {
   BallOutcome play(const control::ControllerSpec&, std::uint64_t) const override {

@@ -105,10 +105,13 @@ class SearchRun {
   std::chrono::steady_clock::time_point start_;
 };
 
+/// The balls the quick random search plays at a time: the least one seed costs.
+inline constexpr int kSeedBatch = 8;
+
 /// The quick random search of 6.2.1: random controllers of the prototype's
 /// shape, one ball each, until one scores at least config.seed_min_score
-/// (tried in batches of 8 whatever the thread count; the first in order wins),
-/// or the best of seed_max_tries.
+/// (tried in batches of kSeedBatch whatever the thread count; the first in
+/// order wins), or the best of seed_max_tries.
 control::ControllerSpec seed_controller(SearchRun& run, const control::ControllerSpec& prototype);
 
 /// Mean score per ball of a set of outcomes.
