@@ -198,6 +198,8 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
   if (r.sliding.skidding == 0) {  // no flight skidded: no friction was measured, not a friction of 0
     j["sliding_friction"]["decel_mps2"] = nullptr;
     j["sliding_friction"]["decel_stderr_mps2"] = nullptr;
+  } else if (r.sliding.skidding == 1) {  // one flight has no spread: its uncertainty is unknown, not 0
+    j["sliding_friction"]["decel_stderr_mps2"] = nullptr;
   }
   return j;
 }
@@ -228,7 +230,8 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
         << " (diagnostic: the model has no drag; its speed clamp stands in)\n";
   out << "  sliding friction   ";
   if (r.sliding.skidding > 0)
-    out << format_number(r.sliding.decel_mps2) << " ± " << format_number(r.sliding.decel_stderr_mps2, 2)
+    out << format_number(r.sliding.decel_mps2) << " ± "
+        << (r.sliding.skidding > 1 ? format_number(r.sliding.decel_stderr_mps2, 2) : std::string("?"))
         << " m/s² (mu times g normal to the table)";
   else
     out << "none seen";

@@ -153,9 +153,13 @@ void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, B
         ++shapes;
       }
       if (shapes == 0) {
+        // keyword@LINE is the name of an obstacle without name=: it moves with the board's lines.
+        const bool by_line = g.obstacles[j].find('@') != std::string::npos;
         throw KeyError(name, "obstacle_groups[" + std::to_string(i) + "].obstacles[" + std::to_string(j) + "]",
                        "'" + g.obstacles[j] + "' is not an obstacle of the board " + board.source +
-                           " (an obstacle's name is its name= in the board file)");
+                           (by_line ? " (an obstacle without name= is named by its keyword and line: the board's "
+                                      "lines moved since the overlay was written? give its obstacles a name=)"
+                                    : " (an obstacle's name is its name= in the board file)"));
       }
     }
   }

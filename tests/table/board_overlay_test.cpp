@@ -425,6 +425,25 @@ TEST(BoardOverlay, AnUnknownNameThrowsAndLeavesTheBoardUntouched) {
   expect_refused(o, "flippers[1].name", "middle_flipper");
 }
 
+// An overlay naming 'point@61' of a board one comment line longer said "an obstacle's name is its
+// name=", though that point has none: the line-number name moved with the lines.
+TEST(BoardOverlay, AnUnnamedObstacleThatMovedLinesIsSaidSo) {
+  Board b = load_board(kBoard);
+  BoardOverlay o;
+  ObstacleGroupOverlay g;
+  g.obstacles = {"point@9999"};
+  g.rho = value(0.5, 0.01, 10);
+  o.obstacle_groups = {g};
+  try {
+    apply_board_overlay(o, "over.yaml", b);
+    FAIL() << "no error";
+  } catch (const KeyError& e) {
+    EXPECT_NE(e.message().find("an obstacle without name= is named by its keyword and line: the board's lines moved"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // "key: message" of the KeyError applying `o` to the thesis board throws; "" when it applies.
 std::string refusal(const BoardOverlay& o) {
   Board b = load_board(kBoard);
