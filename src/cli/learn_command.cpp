@@ -797,6 +797,11 @@ int run_learn(const LearnArgs& args, std::ostream& out, std::ostream& err) {
           << (e["balls_per_s"].is_number() && std::isfinite(e["balls_per_s"].get<double>())
                   ? num(e["balls_per_s"]) + " balls/s\n"
                   : std::string("every ball from the checkpoint\n"));
+      // A score of balls cut at the limit is a score of the limit (0 for --max-ball-time 0.001): said.
+      if (e["balls_cut_at_time_limit"].get<int>() > 0) {
+        out << "                 " << e["balls_cut_at_time_limit"] << " of " << e["balls"]
+            << " balls cut at --max-ball-time " << format_number(a.max_ball_time_s) << " s\n";
+      }
     }
   }
   return 0;

@@ -953,6 +953,14 @@ TEST_F(Cli, LearnMethodsRefuseOptionsTheyDoNotRead) {
   }
 }
 
+// Every ball cut at a limit of 1 ms scored 0, and the text said nothing of it (the JSON did).
+TEST_F(Cli, LearnSaysWhenTheBallsItEvaluatedWereCut) {
+  const CommandResult r = run("learn boards/mit1993.board --method evaluate --controller controllers/best.json "
+                              "--eval-balls 3 --max-ball-time 0.001");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("3 of 3 balls cut at --max-ball-time 0.001 s"), std::string::npos) << r.out;
+}
+
 // A budget the seed search spends whole leaves no generation: refused, not an
 // untrained controller written as if learned.
 TEST_F(Cli, LearnWithABudgetTooSmallForOneGenerationWritesNothing) {
