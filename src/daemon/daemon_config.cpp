@@ -379,6 +379,13 @@ void validate_daemon_config(const DaemonConfig& c, const std::string& s) {
   check_mode(c, s);
 }
 
+void check_observation_source(const DaemonConfig& c, const std::string& s) {
+  if (c.camera.source != "lcm") return;
+  require(c.lcm_url.rfind("memq://", 0) != 0 && !bus::lcm_log_target(c.lcm_url).has_value(), s, "lcm_url",
+          "'" + c.lcm_url + "' carries no observation from another process, and camera.source lcm reads them "
+          "there: use a bus other processes publish on (udpm://239.255.76.67:7667?ttl=0)");
+}
+
 void check_written_paths(const DaemonConfig& c, const std::string& source_name) {
   const auto check = [&](const char* key, const std::string& path) {
     if (path.empty()) return;

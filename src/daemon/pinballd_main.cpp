@@ -198,6 +198,7 @@ static int run_pinballd(int argc, char** argv) {
     for (const CLI::Option* o : app.get_options()) settings_given += o->count();
     settings_given -= app.count("--config") + app.count("--json") + app.count("--check");
     if (!config_path.empty() && settings_given > 0) config.origin = config_path + " and the command line";
+    check_observation_source(config, config.origin);
     if (check) {
       const ConfigCheck result = check_daemon_config(config);
       if (json) {

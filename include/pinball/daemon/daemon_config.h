@@ -219,6 +219,13 @@ DaemonConfig daemon_config_from_yaml(const std::string& text, const std::string&
 /// Reads a configuration file; its relative paths are relative to its folder.
 DaemonConfig load_daemon_config(const std::string& path);
 
+/// For the pinballd program: with camera.source lcm the observations come
+/// from another process, which this process's own bus (memq://) or a log it
+/// writes (file://...?mode=w) cannot carry (the run had waited for them until
+/// SIGINT, exit 0). Throws ConfigError "source: lcm_url: ...". A program that
+/// publishes into the daemon's memq:// bus itself (a test) does not call it.
+void check_observation_source(const DaemonConfig& config, const std::string& source_name);
+
 /// Every key the loader accepts, dotted ("can.log", "threads.priorities.lcm"),
 /// in file order: config/lab.example.yaml must show each (a test checks).
 std::vector<std::string> daemon_config_keys();
