@@ -331,7 +331,7 @@ CLI::App* add_identify_command(CLI::App& app, IdentifyArgs& a) {
   cmd->add_option("--bootstrap", a.bootstrap,
                   "resamples behind g's and the wall thickness's uncertainties, 2..10000 (0: g's from the fit's "
                   "covariance, the thickness not identified)")
-      ->check(CLI::IsMember({0}) | finite_range(2, 10000));
+      ->check(zero_or_range(2, 10000));
   cmd->add_option("--seed", a.seed, "seed of the bootstrap")
       ->check(unsigned_64());
   cmd->add_flag("--json", a.json, "print one JSON object");

@@ -54,6 +54,16 @@ TEST(NumberOption, PositiveAndNonNegativeRefuseNanAndInfinity) {
   EXPECT_EQ(parse(finite_non_negative(), "-0.1", v), "--x: -0.1 is not >= 0");
 }
 
+// --bootstrap: 0 (none) or 2..10000. CLI11's IsMember | Range said "(1 not in {0}) OR (1 is not in [2, 10000])".
+TEST(NumberOption, ZeroOrARangeSaysBothInOnePhrase) {
+  int v = -1;
+  EXPECT_EQ(parse(zero_or_range(2, 10000), "0", v), "");
+  EXPECT_EQ(v, 0);
+  EXPECT_EQ(parse(zero_or_range(2, 10000), "50", v), "");
+  EXPECT_EQ(parse(zero_or_range(2, 10000), "1", v), "--x: 1 is not 0 or in [2, 10000]");
+  EXPECT_EQ(parse(zero_or_range(2, 10000), "abc", v), "--x: 'abc' is not a number");
+}
+
 TEST(NumberOption, ASeedIsAWholeNumberThatFitsIn64Bits) {
   std::uint64_t seed = 0;
   EXPECT_EQ(parse(unsigned_64(), "18446744073709551615", seed), "");

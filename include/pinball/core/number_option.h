@@ -52,6 +52,14 @@ inline CLI::Validator finite_range(double min, double max) {
                                                  number_option_detail::bound_text(max) + "]");
 }
 
+/// 0, or a finite number in [min, max] ("0: none"): "1 is not 0 or in [2, 10000]"
+/// (CLI11's IsMember | Range had said "(1 not in {0}) OR (1 is not in [2, 10000])").
+inline CLI::Validator zero_or_range(double min, double max) {
+  return number_option_detail::finite_number([min, max](double v) { return v == 0.0 || (v >= min && v <= max); },
+                                             "0 or in [" + number_option_detail::bound_text(min) + ", " +
+                                                 number_option_detail::bound_text(max) + "]");
+}
+
 /// A finite number > 0 (for CLI::PositiveNumber).
 inline CLI::Validator finite_positive() {
   return number_option_detail::finite_number([](double v) { return v > 0.0; }, "> 0");
