@@ -381,7 +381,8 @@ ImitationResult learn_by_imitation(const table::Board& board, const ImitationLea
   // A table of no shots never flips, and no controller file holds one (controller_file.cpp).
   if (shots.empty()) {
     throw std::runtime_error("imitation: the teacher fired no shot in " + std::to_string(budget_balls) +
-                             (budget_balls == 1 ? " ball" : " balls") + " (did every ball end before it reached a flipper? see --max-ball-time); "
+                             (budget_balls == 1 ? " ball" : " balls") +
+                             " (did every ball end before it reached a flipper? see --max-ball-time); "
                              "no controller written");
   }
   return result;

@@ -110,8 +110,8 @@ TEST_F(Calibrate, FlipperPicturesOfAnotherSizeThanTheCamerasAreRefused) {
   const std::string v1 = (dir_ / "a.avi").string(), v2 = (dir_ / "b.avi").string();
   ASSERT_EQ(run("sim boards/mit1993.board --balls 1 --max-ball-time 0.2 --seed 1 --video " + v1).exit_code, 0);
   ASSERT_EQ(run("sim boards/mit1993.board --balls 1 --max-ball-time 0.2 --seed 2 --video " + v2).exit_code, 0);
-  const Result sweep =
-      run("calibrate flippers --board boards/mit1993.board --sweep " + v1 + " --sweep " + v2 + " --calibration " + file);
+  const Result sweep = run("calibrate flippers --board boards/mit1993.board --sweep " + v1 + " --sweep " + v2 +
+                           " --calibration " + file);
   EXPECT_EQ(sweep.exit_code, 1);
   EXPECT_NE(sweep.err.find("calibrate flippers: --sweep " + v1 + " is "), std::string::npos) << sweep.err;
   EXPECT_NE(sweep.err.find("camera section was measured on 640x480 images"), std::string::npos) << sweep.err;

@@ -66,7 +66,8 @@ TEST_F(Play, AHeadlessScriptPlaysBallsAndEachGetsItsRow) {
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find("Number balls"), std::string::npos) << table.out;
   EXPECT_NE(table.out.find("all players"), std::string::npos) << table.out;
-  EXPECT_NE(table.out.find("worlds: event 1, thesis 1; boards: boards/mit1993.board 2\nthe means below pool these games"),
+  EXPECT_NE(table.out.find("worlds: event 1, thesis 1; boards: boards/mit1993.board 2\n"
+                           "the means below pool these games"),
             std::string::npos)
       << table.out;
   EXPECT_NE(table.out.find(" ± ∞\n"), std::string::npos) << "one ball bounds nothing:\n" << table.out;

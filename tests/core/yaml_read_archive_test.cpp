@@ -119,7 +119,8 @@ TEST(YamlReadArchive, ABareWordWhereAKeyNeedsItsColonIsRefused) {
     FAIL() << "a bare word was read as a key";
   } catch (const YamlSyntaxError& e) {
     EXPECT_EQ(e.key(), "2");
-    EXPECT_EQ(e.message(), "not valid YAML: 'inner' has no ':' after it (a key is 'key: value'; is the file cut short?)");
+    EXPECT_EQ(e.message(),
+              "not valid YAML: 'inner' has no ':' after it (a key is 'key: value'; is the file cut short?)");
   }
   EXPECT_THROW(load_yaml("outer:\n  count: 1\n  inner\n", "t.yaml"), YamlSyntaxError);
   // An empty section written as one, or a null value, stays what it was.

@@ -86,8 +86,8 @@ inline void refuse_keys_without_colon(const YAML::Node& n, const std::vector<std
     if (value.IsNull()) {
       const YAML::Mark at = entry.first.Mark();
       const bool known = at.line >= 0 && static_cast<std::size_t>(at.line) < lines.size();
-      if (known && lines[static_cast<std::size_t>(at.line)].find(':', static_cast<std::size_t>(std::max(at.column, 0))) ==
-                       std::string_view::npos) {
+      const std::size_t from = static_cast<std::size_t>(std::max(at.column, 0));
+      if (known && lines[static_cast<std::size_t>(at.line)].find(':', from) == std::string_view::npos) {
         throw YamlSyntaxError(file, std::to_string(at.line + 1),
                               "not valid YAML: '" + entry.first.Scalar() +
                                   "' has no ':' after it (a key is 'key: value'; is the file cut short?)");
