@@ -98,6 +98,21 @@ struct HeldOut {
 // A figure of a fit that did not run is null, not 0 (which reads as a perfect fit).
 nlohmann::json when(bool measured, double value) { return measured ? nlohmann::json(value) : nlohmann::json(); }
 
+
+// The board's own model misses a log of its table by a few mm 100 ms ahead (1-5 mm; a twin's, up to
+// 15 mm). Far beyond, the log is of another table, or its camera calibration is another's: the fit
+// runs and writes an overlay all the same (a log shifted 60 mm gave an overlay that lost every ball).
+constexpr double kForeignLogError_m = 0.025;
+
+std::vector<std::string> identify_warnings(const learn::IdentificationResult& r, const table::Board& board) {
+  std::vector<std::string> out;
+  if (r.wall_thickness.moments > 0 && r.wall_thickness.error_at_zero_m > kForeignLogError_m) {
+    out.push_back("the board's own model misses the ball by " +
+                  format_number(r.wall_thickness.error_at_zero_m * 1e3, 3) + " mm on average 100 ms ahead (a few mm on a log of its table): is the log of " + board.source +
+                  ", and its calibration this table's?");
+  }
+  return out;
+}
 nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, const learn::IdentificationResult& r,
                            const std::optional<HeldOut>& held_out) {
   nlohmann::json groups = nlohmann::json::array();
@@ -155,7 +170,8 @@ nlohmann::json result_json(const IdentifyArgs& a, const table::Board& board, con
   nlohmann::json not_identified = nlohmann::json::array();
   for (const learn::NotIdentified& n : r.not_identified)
     not_identified.push_back({{"parameter", n.parameter}, {"why", n.why}});
-  nlohmann::json j{{"board", board.source},
+  nlohmann::json j{{"warnings", identify_warnings(r, board)},
+                   {"board", board.source},
                    {"recordings", a.logs},
                    {"recorded_s", r.recorded_s},
                    {"frames", r.frames},
@@ -283,6 +299,7 @@ void print_text(const IdentifyArgs& a, const table::Board& board, const learn::I
         << ")\n";
   for (const learn::NotIdentified& n : r.not_identified)
     out << "  not identified: " << n.parameter << ": " << n.why << "\n";
+  for (const std::string& w : identify_warnings(r, board)) out << "  warning: " << w << "\n";
   if (held_out) {
     out << "  held out, ball " << format_number(learn::PredictionOptions{}.horizon_s * 1000.0) << " ms ahead ("
         << held_out->nominal.moments << " moments): board " << prediction_text(held_out->nominal) << "; identified "

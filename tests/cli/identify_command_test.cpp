@@ -27,12 +27,34 @@ class IdentifyCommand : public pinball::testing::CommandTest {
     std::ofstream(path, std::ios::binary) << bus::recorded_play_log(play);
     return path.string();
   }
+  // The same play seen 60 mm to the right: a log of another table (or another camera calibration).
+  std::string record_shifted(const std::string& name, int balls, std::uint64_t seed) {
+    bus::RecordedPlay play = pinball::testing::record_model_play(pinball::testing::thesis_board(), balls, 0.0005, seed);
+    for (bus::RecordedFrame& f : play.frames) f.p_board.x() += 0.06;
+    const std::filesystem::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << bus::recorded_play_log(play);
+    return path.string();
+  }
   std::string write(const std::string& name, const std::string& bytes) {
     const std::filesystem::path path = dir_ / name;
     std::ofstream(path, std::ios::binary) << bytes;
     return path.string();
   }
 };
+
+// A log shifted 60 mm was fitted and gave an overlay that lost every ball, with no word of doubt.
+TEST_F(IdentifyCommand, ALogTheBoardMissesByCentimetresIsWarnedOf) {
+  const std::string log = record_shifted("shifted.lcm", 6, 4);
+  const pinball::testing::CommandResult r = run("identify " + log + " --bootstrap 2 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("warnings").size(), 1u) << r.out;
+  EXPECT_NE(j.at("warnings")[0].get<std::string>().find("the board's own model misses the ball by "),
+            std::string::npos);
+  const pinball::testing::CommandResult good = run("identify " + record("good.lcm", 6, 4) + " --bootstrap 2 --json");
+  ASSERT_EQ(good.exit_code, 0) << good.err;
+  EXPECT_TRUE(nlohmann::json::parse(good.out).at("warnings").empty());
+}
 
 TEST_F(IdentifyCommand, FitsWritesTheOverlayAndJudgesItOnHeldOutPlay) {
   const std::string train = record("train.lcm", 30, 3);
