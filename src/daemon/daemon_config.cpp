@@ -398,7 +398,8 @@ void check_written_paths(const DaemonConfig& c, const std::string& source_name) 
   // A recording must not replace what the run reads, nor the other recording (found: --can-log
   // naming the controller file replaced it with the log, exit 0).
   namespace fs = std::filesystem;
-  const auto same_file = [](const std::string& a, const std::string& b) {
+  // By path, not core's same_file: a recording is often a file not made yet, which equivalent() cannot compare.
+  const auto same_path = [](const std::string& a, const std::string& b) {
     std::error_code ec;
     return !a.empty() && !b.empty() && fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
   };
@@ -407,16 +408,16 @@ void check_written_paths(const DaemonConfig& c, const std::string& source_name) 
       {"can.log", c.can.log}, {"lcm_url", lcm_log ? lcm_log->path : std::string()}};
   for (const auto& [key, path] : written) {
     // The configuration file itself (found: --lcm-url file://CONFIG?mode=w made it an LCM log, exit 0).
-    require(!same_file(path, c.file), source_name, key,
+    require(!same_path(path, c.file), source_name, key,
             "'" + path + "' is this configuration file: it would be replaced by the recording");
     for (const PathField& f : path_fields(inputs)) {
       if (f.use == PathUse::kRead) {
-        require(!same_file(path, *f.value), source_name, key,
+        require(!same_path(path, *f.value), source_name, key,
                 "'" + path + "' is the file " + f.key + " names: it would be replaced by the recording");
       }
     }
   }
-  require(!same_file(c.can.log, written[1].second), source_name, "can.log",
+  require(!same_path(c.can.log, written[1].second), source_name, "can.log",
           "'" + c.can.log + "' is the lcm_url's log too: the two recordings would write into one file");
 }
 
