@@ -70,8 +70,10 @@ std::string camera_text(const CameraSettings& c) {
   return s.str();
 }
 
-// Mode lab: what the daemon opens must be there, all of it named at once.
-void check_lab_hardware(const DaemonConfig& config, ConfigCheck& out) {
+}  // namespace
+
+std::vector<std::string> check_lab_hardware(const DaemonConfig& config) {
+  std::vector<std::string> warnings;
   std::string missing;
   if (config.camera.source == "v4l2") {
     if (const std::string m = vision::missing_camera_device(config.camera.device); !m.empty()) {
@@ -87,14 +89,13 @@ void check_lab_hardware(const DaemonConfig& config, ConfigCheck& out) {
     }
   }
   try {
-    if (std::string note = check_can_link(config.can); !note.empty()) out.warnings.push_back(note);
+    if (std::string note = check_can_link(config.can); !note.empty()) warnings.push_back(note);
   } catch (const ConfigError& e) {
     missing += (missing.empty() ? "" : "; ") + std::string(e.what());
   }
   if (!missing.empty()) throw ConfigError(config.origin + ": " + missing);
+  return warnings;
 }
-
-}  // namespace
 
 ConfigCheck check_daemon_config(DaemonConfig config) {
   validate_daemon_config(config, config.origin);
@@ -144,7 +145,9 @@ ConfigCheck check_daemon_config(DaemonConfig config) {
   } catch (const std::runtime_error& e) {
     throw ConfigError(config.origin + ": lcm_url: " + e.what());
   }
-  if (!sim) check_lab_hardware(config, out);
+  if (!sim) {
+    for (std::string& note : check_lab_hardware(config)) out.warnings.push_back(std::move(note));
+  }
   return out;
 }
 

@@ -17,6 +17,7 @@
 #include "pinball/bus/channels.h"
 #include "pinball/bus/message_convert.h"
 #include "pinball/daemon/can_link_check.h"
+#include "pinball/daemon/config_check.h"
 #include "pinball/control/actuator_controller.h"
 #include "pinball/control/controller_file.h"
 #include "pinball/core/format.h"
@@ -219,7 +220,8 @@ void Daemon::Impl::build() {
     host_link = std::move(host);
     board_link = std::move(far);
   } else {
-    if (std::string note = check_can_link(config.can); !note.empty()) warnings.push_back(note);
+    // In the lab the camera is looked for too, so that a start names all that is missing at once.
+    for (std::string& note : check_lab_hardware(config)) warnings.push_back(std::move(note));
     firmware::SocketCanOptions o;
     o.interface = config.can.interface;
     host_link = std::make_unique<firmware::SocketCanTransport>(o);

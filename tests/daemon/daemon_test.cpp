@@ -691,6 +691,10 @@ TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
   EXPECT_EQ(lab.rfind("pinballd: " + config + ": camera.device: ", 0), 0u) << "names the file it checked: " << lab;
   EXPECT_NE(lab.find("no such camera device"), std::string::npos) << lab;
   EXPECT_NE(lab.find("no interface pbnosuch0"), std::string::npos) << lab;
+  std::string started;  // the start names all that is missing too, not only the CAN interface it opens first
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --config " + config + " 2>&1", started), 1) << started;
+  EXPECT_EQ(started.rfind("pinballd: " + config + ": camera.device: ", 0), 0u) << started;
+  EXPECT_NE(started.find("no interface pbnosuch0"), std::string::npos) << started;
   std::string overridden;
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " --can-log /nonexistent-dir/x 2>&1",
                       overridden),

@@ -39,6 +39,12 @@ struct ConfigCheck {
 /// file and key of the first problem.
 ConfigCheck check_daemon_config(DaemonConfig config);
 
+/// Mode lab: the camera device exists (a file source decodes as a video) and
+/// the CAN interface is fit to run (check_can_link), every missing piece
+/// named at once in one ConfigError; returns the notes worth a warning.
+/// pinballd's start runs it before it opens anything.
+std::vector<std::string> check_lab_hardware(const DaemonConfig& config);
+
 /// The check as text (one line per item) and as one JSON object.
 std::string config_check_to_text(const ConfigCheck& check);
 nlohmann::json config_check_to_json(const ConfigCheck& check);
