@@ -249,6 +249,7 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
       cmd->add_option("log", a.log, "LCM log to play (pinballd --lcm-url file://...?mode=w, lcm-logger); none: live")
           ->check(input_file());
   cmd->add_option("--lcm-url", a.lcm_url, "live: the LCM URL pinballd publishes on (default: --config's, else udpm)")
+      ->check(lcm_url_given())
       ->excludes(log);
   cmd->add_option("--config", a.config, "the pinballd configuration: board, calibration, controller, LCM URL")
       ->transform(data_file());

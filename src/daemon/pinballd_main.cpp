@@ -128,6 +128,7 @@ static int run_pinballd(int argc, char** argv) {
   app.add_option("--seed", seed, "launch noise seed in simulation")->check(pinball::unsigned_64())
       ->default_str(std::to_string(defaults.sim.seed));
   app.add_option("--lcm-url", lcm_url, "LCM provider, e.g. memq:// or udpm://239.255.76.67:7667?ttl=0")
+      ->check(pinball::lcm_url_given())
       ->default_str(defaults.lcm_url);
   app.add_option("--can-log", can_log,
                  "write every CAN frame to this file in candump's log format (frames it cannot write are "

@@ -709,6 +709,8 @@ TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
   std::string empty;  // an unset variable in a lab script: no log written, and nobody told
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " --can-log '' 2>&1", empty), 2);
   EXPECT_NE(empty.find("--can-log: an empty path names no file to write"), std::string::npos) << empty;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --lcm-url '' 2>&1", empty), 2);  // had meant memq://
+  EXPECT_NE(empty.find("--lcm-url: an empty URL names no LCM provider"), std::string::npos) << empty;
   // With --json a script reads one object on stdout either way.
   std::string failed;
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --json --config " + config + " 2>/dev/null", failed), 1);

@@ -78,6 +78,7 @@ TEST_F(ViewCommand, AnOptionTheModeWouldDropIsRefused) {
            {log_ + " --snapshot " + png + " --at 0.5 --speed 2", "--at excludes --speed"},
            {log_ + " --snapshot " + png + " --at 0.5 --quit-at 1", "--at excludes --quit-at"},
            {"--lcm-url memq:// --snapshot " + png + " --speed 2", "--speed requires log"},
+           {"--lcm-url '' --snapshot " + png, "--lcm-url: an empty URL names no LCM provider"},  // had meant udpm
        }) {
     const CommandResult r = view(args);
     EXPECT_EQ(r.exit_code, 2) << args;

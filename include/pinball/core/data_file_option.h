@@ -41,6 +41,16 @@ inline CLI::Validator output_file() {
       "FILE");
 }
 
+/// A check for an LCM URL option: a value given must name a provider. An empty
+/// one (a script's unset variable) had quietly meant the default's.
+inline CLI::Validator lcm_url_given() {
+  return CLI::Validator(
+      [](std::string& url) {
+        return url.empty() ? std::string("an empty URL names no LCM provider (memq:// is the in-process one)") : "";
+      },
+      "URL");
+}
+
 /// A transform for a file option: the path through find_data_file, which must then be an input_file().
 inline CLI::Validator data_file() {
   return CLI::Validator(
