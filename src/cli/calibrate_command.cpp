@@ -426,9 +426,20 @@ void run_flippers(Context& c) {
       chosen.disagreement =
           calibration::compare_flippers(chosen, use_markers ? markerless[i] : by_markers[i]);
     }
-    c.err << "calibrate flippers: " << f.name << " (" << calibration::to_string(chosen.method) << "): pivot ("
-          << chosen.pivot_m.x() << ", " << chosen.pivot_m.y() << ") m, length " << chosen.length_m << " m, theta "
-          << chosen.theta_min_rad * kDeg << " .. " << chosen.theta_max_rad * kDeg << " deg\n";
+    // Both methods when both ran, the one written first, then how far apart they are.
+    auto print = [&](const calibration::FlipperCalibration& m, const char* role) {
+      c.err << "calibrate flippers: " << f.name << " (" << calibration::to_string(m.method) << role << "): pivot ("
+            << m.pivot_m.x() << ", " << m.pivot_m.y() << ") m, length " << m.length_m << " m, theta "
+            << m.theta_min_rad * kDeg << " .. " << m.theta_max_rad * kDeg << " deg\n";
+    };
+    print(chosen, markers && sweeps ? ", written" : "");
+    if (markers && sweeps) {
+      print(use_markers ? markerless[i] : by_markers[i], ", not written");
+      const calibration::FlipperDisagreement& d = *chosen.disagreement;
+      c.err << "calibrate flippers: " << f.name << " methods disagree by: pivot " << d.pivot_m * 1e3 << " mm, tip "
+            << d.tip_m * 1e3 << " mm, length " << d.length_m * 1e3 << " mm, theta " << d.theta_min_rad * kDeg
+            << " / " << d.theta_max_rad * kDeg << " deg\n";
+    }
     c.cal.flippers.push_back(chosen);
   }
   c.report["flippers"] = list;

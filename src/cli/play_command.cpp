@@ -113,7 +113,8 @@ int run_stats(const PlayArgs& a, std::ostream& out) {
 CLI::App* add_play_command(CLI::App& app, PlayArgs& a) {
   CLI::App* cmd = app.add_subcommand(
       "play", "play the simulated table at the keyboard in real time; --stats FILE: the players' means (docs/play.md)");
-  cmd->add_option("board", a.board, "board file (docs/board-format.md); not with --stats");
+  // Checked, not transformed: the score file keeps the name as the player gave it.
+  cmd->add_option("board", a.board, "board file (docs/board-format.md); not with --stats")->check(data_file());
   cmd->add_option("--stats", a.stats,
                   "print balls and mean score per ball (95 % interval) per player of this score CSV")
       ->check(input_file());

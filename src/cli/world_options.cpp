@@ -86,7 +86,9 @@ nlohmann::json world_report(const simlab::WorldSpec& spec, const std::string& be
   const sim::WorldWarnings w = world.warnings();
   nlohmann::json j = {{"world", std::string(world.name())},
                       {"world_board", spec.board_path.empty() ? belief_board : spec.board_path},
-                      {"stepper", std::string(sim::stepper_kind_name(spec.stepper))},
+                      {"stepper", spec.kind == simlab::WorldKind::kTwin  // MuJoCo integrates the twin: no stepper
+                                      ? nlohmann::json()
+                                      : nlohmann::json(sim::stepper_kind_name(spec.stepper))},
                       {"world_warnings", to_json_value(w)}};
   if (spec.kind == simlab::WorldKind::kTwin) {
     j["twin_params"] = spec.twin_params_path.empty() ? std::string("config/twin.yaml") : spec.twin_params_path;

@@ -53,6 +53,10 @@ TEST_F(Calibrate, SimulatedLabEndToEnd) {
     EXPECT_TRUE(f.contains("markerless"));
     EXPECT_TRUE(f.contains("disagreement"));
   }
+  // The text gives both methods too, as calibration.md says: it had printed the written one alone.
+  EXPECT_NE(r.err.find("left_flipper (markers, written): pivot"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("left_flipper (markerless, not written): pivot"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("left_flipper methods disagree by: pivot"), std::string::npos) << r.err;
 
   r = run("calibrate gravity --sim boards/mit1993.board --sim-rolls 3 --out " + file + " --json");
   ASSERT_EQ(r.exit_code, 0);

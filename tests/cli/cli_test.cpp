@@ -168,6 +168,7 @@ TEST_F(Cli, SimLearnAndBenchCeilingPlayTheTwin) {
   const auto s = nlohmann::json::parse(sim.out);
   EXPECT_EQ(s.at("world"), "twin");
   EXPECT_EQ(s.at("twin_params"), "config/twin.yaml");
+  EXPECT_TRUE(s.at("stepper").is_null()) << "MuJoCo integrates the twin; it had said thesis";
   EXPECT_EQ(s.at("world_warnings").at("instability"), 0);
   EXPECT_EQ(s.at("balls_left_table"), 0);
   const CommandResult again = run("sim boards/mit1993.board --world twin --policy spastic --balls 2 --seed 3 --json");

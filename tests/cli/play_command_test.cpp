@@ -97,7 +97,6 @@ TEST_F(Play, BadInputIsRefusedBeforeTheGameAndWritesNothing) {
     std::string args;  // after `play`
     std::string says;  // in the one-line error
   } cases[] = {
-      {"boards/no-such.board --headless --keys 0.1:launch" + to_csv, "no-such.board"},
       {"boards/mit1993.board --headless --keys '0.1:launch,0.5:jump'" + to_csv, "entry 2 '0.5:jump': unknown action 'jump'"},
       {"boards/mit1993.board --headless --keys 0.1:launch --csv /no-such-dir/s.csv", "/no-such-dir/s.csv"},
       {"boards/mit1993.board --player 'a,b' --headless --keys 0.1:launch" + to_csv, "player name"},
@@ -110,6 +109,10 @@ TEST_F(Play, BadInputIsRefusedBeforeTheGameAndWritesNothing) {
     EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << ": " << r.err;
     EXPECT_EQ(count_lines(r.err), 1) << r.err;
   }
+  // A board path that names no file is a bad argument, as for every command (it had exited 1).
+  const CommandResult missing = run("play boards/no-such.board --headless --keys 0.1:launch" + to_csv);
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("board: File does not exist: boards/no-such.board"), std::string::npos) << missing.err;
   EXPECT_FALSE(fs::exists(csv()));
 }
 
