@@ -20,6 +20,7 @@
 #include "commands.h"
 #include "data_file.h"
 #include "pinball/bus/channels.h"
+#include "pinball/bus/lcm_bus.h"
 #include "pinball/bus/lcm_log_format.h"
 #include "pinball/bus/recorded_play.h"
 #include "pinball/core/format.h"
@@ -63,9 +64,17 @@ view::ViewScene scene_for(const ViewArgs& a) {
   return view::load_view_scene(board, calibration, controller, a.px_per_m);
 }
 
+// The URL to listen on. One that writes a log is refused: liblcm opens it for writing and so emptied
+// the recording a pinballd configuration names (`view --config rec.yaml`), or damaged one being made.
 std::string live_url(const ViewArgs& a) {
-  if (!a.config.empty() && a.lcm_url == ViewArgs{}.lcm_url) return daemon::load_daemon_config(a.config).lcm_url;
-  return a.lcm_url;
+  const bool from_config = !a.config.empty() && a.lcm_url == ViewArgs{}.lcm_url;
+  const std::string url = from_config ? daemon::load_daemon_config(a.config).lcm_url : a.lcm_url;
+  if (const std::optional<bus::LcmLogTarget> log = bus::lcm_log_target(url)) {
+    throw std::invalid_argument("view: " + (from_config ? a.config + "'s lcm_url '" : "--lcm-url '") + url +
+                                "' writes a log, and listening there would replace " + log->path +
+                                "; to watch that recording give its file: pinball view " + log->path);
+  }
+  return url;
 }
 
 // What the window shows and the summary reports.

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <utility>
@@ -66,6 +67,24 @@ TEST_F(ViewCommand, ALogOfTwoRunsAppendedIsRefusedAsReplayRefusesIt) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find(twice + ": its clock goes back"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("several runs appended to one log (mode=a)?"), std::string::npos) << r.err;
+}
+
+// A live URL that writes a log had emptied the recording it named (liblcm opens it for writing), so
+// `view --config rec.yaml` lost the run that configuration recorded.
+TEST_F(ViewCommand, ALiveUrlThatWritesALogIsRefusedAndTheLogKept) {
+  const std::uintmax_t bytes = std::filesystem::file_size(log_);
+  const std::string png = (dir_ / "w.png").string();
+  const CommandResult r = view("--lcm-url 'file://" + log_ + "?mode=w' --snapshot " + png + " --wait-s 0.2");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("writes a log, and listening there would replace " + log_), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pinball view " + log_), std::string::npos) << r.err;
+  const std::string config = (dir_ / "rec.yaml").string();
+  std::ofstream(config) << "version: 1\nlcm_url: file://" << log_ << "?mode=a\n";
+  const CommandResult c = view("--config " + config + " --snapshot " + png + " --wait-s 0.2");
+  EXPECT_EQ(c.exit_code, 1);
+  EXPECT_NE(c.err.find(config + "'s lcm_url"), std::string::npos) << c.err;
+  EXPECT_EQ(std::filesystem::file_size(log_), bytes);
+  EXPECT_FALSE(std::filesystem::exists(png));
 }
 
 // An option the mode would drop is refused: a log's view read no --lcm-url or --wait-s, a snapshot at
