@@ -201,10 +201,14 @@ int run_sim(const SimArgs& a, std::ostream& out, std::ostream& err) {
     left_table += r.left_table ? 1 : 0;
     run_hash = sim::hash_combine_ball_end(sim::hash_combine_state(run_hash, state), r);
     progress.update(ball + 1, "mean score " + format_number(score.mean(), 4));
+    if (trace && trace->failed()) trace->finish();  // throws now: --trace /dev/full had played the whole run first
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (trace) trace->close();
-  if (video) video->close();
+  // Both checked before either replaces its old file: a run that fails leaves what was there.
+  if (video) video->finish();
+  if (trace) trace->finish();
+  if (video) video->commit();
+  if (trace) trace->commit();
 
   const double steps_per_s = wall_s > 0.0 ? static_cast<double>(steps) / wall_s : 0.0;
   const std::uint64_t events = state.events - events_before;

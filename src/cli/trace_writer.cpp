@@ -1,6 +1,8 @@
 #include "trace_writer.h"
 
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <stdexcept>
 
 namespace pinball::cli {
@@ -32,8 +34,9 @@ std::string describe_events(const table::Board& board, const sim::StepEvents& e)
   return out;
 }
 
-TraceWriter::TraceWriter(const std::string& path) : path_(path), file_(std::fopen(path.c_str(), "w")) {
-  if (!file_) throw std::runtime_error("cannot write trace file '" + path + "'");
+TraceWriter::TraceWriter(const std::string& path)
+    : staged_(path), path_(path), file_(std::fopen(staged_.writing_path().c_str(), "w")) {
+  if (!file_) throw std::runtime_error("cannot write trace file '" + path + "' (" + std::strerror(errno) + ")");
   std::fputs("t,x,y,vx,vy,event\n", file_);
 }
 
@@ -45,23 +48,32 @@ void TraceWriter::write(const table::Board& board, const sim::GameState& state, 
   char line[256];
   char* p = line;
   char* const end = line + sizeof(line);
-  const double values[] = {state.time_s, state.ball.position_m.x(), state.ball.position_m.y(),
-                           state.ball.velocity_mps.x(), state.ball.velocity_mps.y()};
+  // A lost ball's row is where it was lost: the state after that step holds it in the launcher.
+  const bool lost = events.has(sim::StepEvents::kBallLost);
+  const Vec2& position_m = lost ? events.lost_position_m : state.ball.position_m;
+  const Vec2& velocity_mps = lost ? events.lost_velocity_mps : state.ball.velocity_mps;
+  const double values[] = {state.time_s, position_m.x(), position_m.y(), velocity_mps.x(), velocity_mps.y()};
   for (const double v : values) {
     p = std::to_chars(p, end, v).ptr;  // shortest round-trip form
     *p++ = ',';
   }
-  std::fwrite(line, 1, static_cast<std::size_t>(p - line), file_);
-  if (events.flags != 0) std::fputs(describe_events(board, events).c_str(), file_);
-  std::fputc('\n', file_);
+  const std::size_t bytes = static_cast<std::size_t>(p - line);
+  bool written = std::fwrite(line, 1, bytes, file_) == bytes;
+  if (events.flags != 0) written = std::fputs(describe_events(board, events).c_str(), file_) >= 0 && written;
+  written = std::fputc('\n', file_) != EOF && written;
+  if (!written && write_errno_ == 0) write_errno_ = errno != 0 ? errno : EIO;
 }
 
-void TraceWriter::close() {
+void TraceWriter::finish() {
   if (!file_) return;
-  const bool failed = std::ferror(file_) != 0;
+  if (std::fflush(file_) != 0 && write_errno_ == 0) write_errno_ = errno;
+  if (std::ferror(file_) != 0 && write_errno_ == 0) write_errno_ = EIO;
   const bool close_failed = std::fclose(file_) != 0;
+  if (close_failed && write_errno_ == 0) write_errno_ = errno;
   file_ = nullptr;
-  if (failed || close_failed) throw std::runtime_error("error writing trace file '" + path_ + "'");
+  if (write_errno_ != 0) {
+    throw std::runtime_error("error writing trace file '" + path_ + "' (" + std::strerror(write_errno_) + ")");
+  }
 }
 
 }  // namespace pinball::cli

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "pinball/core/staged_file.h"
 #include "pinball/table/board.h"
 #include "pinball/sim/game_state.h"
 #include "pinball/sim/thesis_stepper.h"
@@ -15,7 +16,9 @@ namespace pinball::cli {
 /// or an empty string for plain flight.
 std::string describe_events(const table::Board& board, const sim::StepEvents& events);
 
-/// A CSV trace file.
+/// A CSV trace file, written under a temporary name beside its path and put
+/// in place by commit() (core/staged_file.h); a pipe or a device is written
+/// as the run goes.
 class TraceWriter {
  public:
   /// Creates the file and writes the header. Throws std::runtime_error naming the path.
@@ -27,12 +30,20 @@ class TraceWriter {
   /// Appends one row for the state after a step.
   void write(const table::Board& board, const sim::GameState& state, const sim::StepEvents& events);
 
-  /// Flushes and closes; throws std::runtime_error if the data could not be written.
-  void close();
+  /// True once a row could not be written (a full disk, /dev/full): the run may stop there.
+  bool failed() const { return write_errno_ != 0; }
+
+  /// Flushes and closes; throws std::runtime_error naming the path and the
+  /// reason if the data could not be written.
+  void finish();
+  /// Puts the finished file in place (throws naming it when it cannot).
+  void commit() { staged_.commit(); }
 
  private:
+  StagedFile staged_;
   std::string path_;
   std::FILE* file_ = nullptr;
+  int write_errno_ = 0;  // the first failed write's errno
 };
 
 }  // namespace pinball::cli

@@ -10,6 +10,8 @@ namespace pinball::sim::rules {
 
 void lose_ball(const table::Board& board, GameState& state, StepEvents& events) {
   events.flags |= StepEvents::kBallLost;
+  events.lost_position_m = state.ball.position_m;
+  events.lost_velocity_mps = state.ball.velocity_mps;
   state.ball_in_play = false;
   state.balls_left = std::max(0, state.balls_left - 1);
   state.ball.position_m = board.launcher.position;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -17,6 +18,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "common/command_test.h"
+#include "common/temp_path.h"
 #include "pinball/core/geometry.h"
 
 namespace {
@@ -25,6 +27,7 @@ namespace fs = std::filesystem;
 
 using pinball::testing::CommandResult;
 using pinball::testing::count_lines;
+using pinball::testing::entries;
 using pinball::testing::slurp;
 
 class Cli : public pinball::testing::CommandTest {};
@@ -263,6 +266,61 @@ TEST_F(Cli, SameSeedGivesTheSameTraceAndScores) {
   EXPECT_EQ(ja, jb);
   const CommandResult rc = run("sim boards/mit1993.board --policy spastic --balls 3 --seed 10 --json");
   EXPECT_NE(nlohmann::json::parse(rc.out).at("state_hash"), ja.at("state_hash"));
+}
+
+// The row of a lost ball had held the launcher's position and no speed: the state after that step,
+// already reset. It is where the ball was lost, one step on from the row before.
+TEST_F(Cli, TheTraceRowOfALostBallIsWhereItWasLost) {
+  const std::string trace = (dir_ / "lost.csv").string();
+  const CommandResult r = run("sim boards/mit1993.board --balls 3 --seed 4 --trace " + trace);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream rows(slurp(trace));
+  std::string row;
+  std::getline(rows, row);  // the header
+  double previous[5] = {};
+  int lost = 0;
+  while (std::getline(rows, row)) {
+    double v[5];
+    std::istringstream cells(row);
+    std::string cell;
+    for (double& x : v) {
+      std::getline(cells, cell, ',');
+      x = std::stod(cell);
+    }
+    std::getline(cells, cell);
+    if (cell.find("lost") != std::string::npos) {
+      ++lost;
+      const double dt = v[0] - previous[0];
+      EXPECT_GT(std::hypot(v[3], v[4]), 0.0) << row;
+      EXPECT_LT(std::hypot(v[1] - previous[1], v[2] - previous[2]), std::hypot(v[3], v[4]) * dt * 2 + 1e-3) << row;
+    }
+    std::copy(v, v + 5, previous);
+  }
+  EXPECT_EQ(lost, 3);
+}
+
+// A run that fails late (here its video meets a file size limit, as on a full disk) had left a cut
+// video and had already replaced the old trace: both stay as they were, and no temporary is left.
+TEST_F(Cli, ARunThatFailsLeavesItsOldOutputsAsTheyWere) {
+  const fs::path dir = dir_ / "late";
+  fs::create_directories(dir);
+  std::ofstream(dir / "t.csv") << "the old trace\n";
+  std::ofstream(dir / "v.avi") << "the old video\n";
+  const CommandResult r = run_shell("cd " PINBALL_SOURCE_DIR " && trap '' XFSZ && ulimit -f 1024 && " PINBALL_EXE
+                                    " sim boards/mit1993.board --balls 1 --seed 2 --max-ball-time 1 --trace " +
+                                    (dir / "t.csv").string() + " --video " + (dir / "v.avi").string());
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find((dir / "v.avi").string() + ": the video was not written whole"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("Unexpected element"), std::string::npos) << "OpenCV's reader is quiet: " << r.err;
+  EXPECT_EQ(slurp((dir / "t.csv").string()), "the old trace\n");
+  EXPECT_EQ(slurp((dir / "v.avi").string()), "the old video\n");
+  EXPECT_EQ(entries(dir), 2u);
+  // A device is written as the run goes, and one that takes nothing stops the run after its first ball.
+  const CommandResult full = run("sim boards/mit1993.board --balls 50 --trace /dev/full --progress");
+  EXPECT_EQ(full.exit_code, 1);
+  EXPECT_NE(full.err.find("error writing trace file '/dev/full' (No space left on device)"), std::string::npos)
+      << full.err;
+  EXPECT_EQ(full.err.find("50/50 balls"), std::string::npos) << full.err;
 }
 
 TEST_F(Cli, FlipsCanGoThroughTheCanPath) {

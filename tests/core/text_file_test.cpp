@@ -9,24 +9,15 @@
 #include <filesystem>
 #include <string>
 
+#include "common/temp_path.h"
+
 namespace pinball {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path fresh_folder(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) / (name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-// Nothing but the files named: no temporary left beside them.
-std::size_t entries(const fs::path& dir) {
-  std::size_t n = 0;
-  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++n;
-  return n;
-}
+using testing::entries;
+using testing::fresh_folder;
 
 TEST(TextFile, WritesWholeAndReadsBack) {
   const fs::path dir = fresh_folder("text_file_write");

@@ -141,7 +141,8 @@ TEST_F(VideoRecorderTest, RecordsRenderedBoardFrames) {
       state.time_s = i / 30.0;
       rec.write(render_board(b, &state, o));
     }
-  }  // the destructor finishes the file
+    rec.close();
+  }
   cv::VideoCapture cap(file);
   ASSERT_TRUE(cap.isOpened());
   cv::Mat frame;
@@ -151,6 +152,29 @@ TEST_F(VideoRecorderTest, RecordsRenderedBoardFrames) {
     ++read;
   }
   EXPECT_EQ(read, 5);
+}
+
+// A run that failed or was stopped had left a cut AVI in place of a good one: a recorder not closed
+// takes what it wrote with it.
+TEST_F(VideoRecorderTest, ARecorderNotClosedLeavesTheOldFileAsItWas) {
+  const cv::Size size{64, 48};
+  const std::string file = path("kept.avi");
+  {
+    VideoRecorder rec(file, 10.0, size);
+    for (int i = 0; i < 3; ++i) rec.write(test_frame(size, i));
+    rec.close();
+  }
+  const auto bytes = std::filesystem::file_size(file);
+  {
+    VideoRecorder rec(file, 10.0, size);
+    for (int i = 0; i < 7; ++i) rec.write(test_frame(size, i));
+    rec.finish();  // checked, never committed: the run failed elsewhere
+  }
+  EXPECT_EQ(std::filesystem::file_size(file), bytes);
+  EXPECT_EQ(avi_frame_count(file), 3);
+  for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(file).parent_path())) {
+    EXPECT_EQ(e.path().string().find(".partial"), std::string::npos) << e.path();
+  }
 }
 
 TEST_F(VideoRecorderTest, WrongFrameSizeOrTypeThrows) {

@@ -61,8 +61,8 @@ BallResult play_ball(World& world, GameState& state, const BallLimits& limits, P
     observer(static_cast<const GameState&>(state), events);
     if (events.has(StepEvents::kBallLost)) {
       result.left_table = events.has(StepEvents::kLeftTable);
-      result.end_position_m = state.ball.position_m;
-      result.end_velocity_mps = state.ball.velocity_mps;
+      result.end_position_m = events.lost_position_m;  // the state holds it in the launcher already
+      result.end_velocity_mps = events.lost_velocity_mps;
       break;
     }
     // Half a step of slack: time is a sum of steps and may fall just short.

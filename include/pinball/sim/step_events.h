@@ -4,6 +4,8 @@
 
 #include <cstdint>
 
+#include "pinball/core/geometry.h"
+
 namespace pinball::sim {
 
 /// What happened during one step (bit flags plus the first index of each kind).
@@ -24,6 +26,9 @@ struct StepEvents {
   std::int32_t flipper = -1;     ///< flipper hit or pushing (kHitFlipper, kFlipperPush, kFlipperStall)
   std::int32_t sensor = -1;      ///< first sensor entered (kSensor)
   double score_gained = 0.0;     ///< points scored this step
+  // Where the ball was lost (kBallLost): the state after the step already holds it in the launcher.
+  Vec2 lost_position_m = Vec2::Zero();
+  Vec2 lost_velocity_mps = Vec2::Zero();
 
   bool has(Flag f) const { return (flags & f) != 0; }
 };

@@ -6,6 +6,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "pinball/core/staged_file.h"
+
 namespace pinball::sim {
 
 /// Throws std::runtime_error "PATH: an MJPG AVI is written; give the file
@@ -17,7 +19,10 @@ void check_avi_name(const std::string& path);
 /// -1 when it cannot be opened as a video.
 int avi_frame_count(const std::string& path);
 
-/// An open AVI file receiving frames of one fixed size.
+/// An open AVI file receiving frames of one fixed size. It is written under
+/// a temporary name beside `path` (core/staged_file.h) and put in place by
+/// close(): a run that fails, or is stopped by a signal, leaves the file that
+/// was there as it was.
 class VideoRecorder {
  public:
   /// Opens `path` for frames of `frame_size` at `fps`. Throws
@@ -36,10 +41,20 @@ class VideoRecorder {
   /// Finishes the file and reads its index back: throws std::runtime_error
   /// naming the path when it does not hold every frame written (OpenCV's
   /// writer reports no write error: a full disk left a cut file and exit 0).
-  /// The destructor finishes the file without the check.
-  void close();
+  /// The file is not in place yet: commit() puts it there, so that several
+  /// outputs of one run are all checked before any replaces its old file.
+  void finish();
+  /// Renames the finished file over `path` (throws naming it when it cannot).
+  void commit();
+  /// finish() and commit(). The destructor of a recorder not committed
+  /// removes what it wrote.
+  void close() {
+    finish();
+    commit();
+  }
 
  private:
+  StagedFile file_;
   std::string path_;
   cv::Size size_;
   cv::VideoWriter writer_;
