@@ -136,7 +136,13 @@ void moving_flipper_impact(const StepContext& ctx, const table::Flipper& f, cons
     const double first = std::max(gap, 0.0) / b;
     const double slack = gap + tol;
     const double second = slack > 0.0 ? (rate + std::sqrt(rate * rate + 2.0 * c * slack)) / c : 0.0;
-    t += std::max({first, second, 1e-3 * ctx.t_tol});
+    // Separating, D' >= rate − C·δ stays >= 0 for rate / C: no approach can begin before. A ball
+    // leaving an overlap had crept forward by the least step and frozen there.
+    const double separating = rate > 0.0 ? rate / c : 0.0;
+    // The least step is length_tol at the flipper's closing speed b, never the ball's alone: a ball at
+    // rest (g = 0, a corner) has no speed of its own and the step had jumped the whole horizon, the
+    // blade passing through it.
+    t += std::max({first, second, separating, 1e-3 * tol / b});
     if (t >= next.t) return;
   }
   // Not settled within the iteration budget: come back from here.

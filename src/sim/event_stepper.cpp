@@ -16,6 +16,9 @@ namespace {
 // sequence (a pinch the stall rule missed, a carried ball): it rests for the
 // rest of the step (docs/physics.md, "The event stepper").
 constexpr int kMaxEventsPerStep = 256;
+// The same for searches that stop short of their horizon (a turning flipper's certified search out of
+// iterations): so many in one step is a search that no longer gets anywhere.
+constexpr int kMaxPartialHorizonsPerStep = 1024;
 
 // Turns the flippers with nothing else moving (no ball in play, or the guard):
 // one that reaches its stop stays there.
@@ -71,6 +74,7 @@ void run_events(event::StepContext& ctx, double horizon_s) {
   const table::Board& board = ctx.board;
   double t = 0.0;
   int count = 0;
+  int partial = 0;
   while (t < horizon_s) {
     if (!ctx.state.ball_in_play) {
       advance_flippers(ctx, horizon_s - t);
@@ -88,8 +92,17 @@ void run_events(event::StepContext& ctx, double horizon_s) {
     }
     if (!board.flippers.empty()) event::find_flipper_impact(ctx, next);
     advance(ctx, next.t);
-    t = (next.kind == Kind::kHorizon && h == horizon_s - t) ? horizon_s : t + next.t;
-    if (next.kind == Kind::kHorizon) continue;
+    // The whole rest of the step only when the search covered it: one that stopped short (the flipper's
+    // search) had been taken for the step's end, and the ball moved 1e-13 s per step.
+    const bool to_the_end = next.kind == Kind::kHorizon && next.t == h && h == horizon_s - t;
+    t = to_the_end ? horizon_s : t + next.t;
+    if (next.kind == Kind::kHorizon) {
+      if (next.t < h && ++partial > kMaxPartialHorizonsPerStep) {
+        give_up(ctx, horizon_s - t);
+        return;
+      }
+      continue;
+    }
     ++ctx.state.events;
     event::handle(ctx, next);
     if (++count > kMaxEventsPerStep) {

@@ -314,6 +314,37 @@ TEST(EventStepper, FlipperStrikesARestingBallWithTheThesisImpulse) {
   EXPECT_EQ(s.events, 1u);
 }
 
+// A ball at rest with no acceleration (g = 0; a corner) has no speed of its own: the certified
+// search's least step had come from the ball's speed alone, jumped the whole horizon and let the
+// blade's tip sweep 3.5 mm deep through the ball. Struck, the ball then overlapped the blade while it
+// separated and crept 1e-13 s per step, frozen with its 3 m/s until the ball was cut.
+TEST(EventStepper, ATurningBladeStrikesABallAtRestAndTheBallFliesOff) {
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  add_flipper(b, table::Side::kLeft, {0.3, 0.3}, 0.08, -0.5, 0.5, 35.0, 0.6, 1.6);
+  const table::Flipper& f = b.flippers[0];
+  const EventStepper stepper(b);
+  GameState s = make_game_state(b, 1);
+  s.ball_in_play = true;
+  s.ball.position_m = {0.39, 0.300001};  // the tip passes 10 mm from its centre, inside r = 13.5 mm
+  s.ball.velocity_mps = Vec2::Zero();
+  s.flippers[0].theta_rad = f.theta_min_rad;
+  s.flippers[0].energized = true;
+  bool struck = false;
+  for (int i = 0; i < 200 && s.ball_in_play; ++i) {
+    const Vec2 before = s.ball.position_m;
+    const StepEvents e = stepper.step(s);
+    ASSERT_LT(max_penetration_m(b, s), 1e-9) << "step " << i << ", blade at " << s.flippers[0].theta_rad;
+    struck = struck || e.has(StepEvents::kFlipperPush) || e.has(StepEvents::kHitFlipper);
+    if (struck && e.flags == 0) {  // free flight at g = 0: it moves as fast as it says
+      EXPECT_NEAR((s.ball.position_m - before).norm(), s.ball.velocity_mps.norm() * stepper.dt_s(), 1e-9)
+          << "step " << i;
+    }
+  }
+  EXPECT_TRUE(struck);
+  EXPECT_GT(s.ball.velocity_mps.norm(), 1.0);
+  EXPECT_GT((s.ball.position_m - Vec2(0.39, 0.300001)).norm(), 0.1) << "it left where it was struck";
+}
+
 TEST(EventStepper, EnergyNeverGrowsWithoutKickersOrFlippers) {
   table::Board b = box_board(0.9, 1.11, 5e-4);
   add_circle(b, {0.15, 0.70}, 0.03, 0.95);
