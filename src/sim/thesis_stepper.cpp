@@ -26,6 +26,34 @@ void clamp_speed(Vec2& v, double speed_max) {
 }
 
 /// The contacts of one step, kept for a wedged ball (no allocation).
+/// The first angle between `from` and `to` at which the tip of `f` comes
+/// within `r` of `p`: NaN when it never does. The tip's distance to p falls
+/// while the blade turns toward p's direction and rises after, so the first
+/// touch lies before the closest angle, which is found first (bisection on
+/// the side of p the blade is on), then the touch within it: the first angle
+/// at which the tip is inside the ball, by round-off.
+double tip_touch_angle(const table::Flipper& f, const Vec2& p, double r, double from, double to) {
+  const Vec2 rel = p - f.pivot;
+  const double front = to > from ? 1.0 : -1.0;
+  double lo = from;
+  double hi = to;
+  for (int i = 0; i < 60; ++i) {  // the angle pointing at p: the blade's line there
+    const double mid = 0.5 * (lo + hi);
+    (front * rel.dot(table::flipper_up_normal(f, mid)) >= 0.0 ? lo : hi) = mid;
+  }
+  const double closest = hi;
+  auto gap = [&](double theta) { return (p - table::flipper_tip(f, theta)).norm() - r; };
+  if (gap(closest) >= 0.0) return std::nan("");
+  if (gap(from) < 0.0) return from;
+  lo = from;
+  hi = closest;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (gap(mid) >= 0.0 ? lo : hi) = mid;
+  }
+  return hi;  // the first angle touching, within round-off of the ball's surface
+}
+
 struct StepContacts {
   Vec2 normal[kMaxContactsPerStep];
   Vec2 point[kMaxContactsPerStep];
@@ -129,9 +157,20 @@ void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const 
       contact = f.pivot + along * dir;
     } else {
       contact = f.pivot + f.length_m * dir;
-      const Vec2 away = p - contact;
-      const double dist = away.norm();
+      double dist = (p - contact).norm();
+      if (dist >= r && front * rel.dot(table::flipper_up_normal(f, theta_new)) < 0.0) {
+        // The blade swept past the ball's direction, the tip's arc through the ball between the two
+        // angles (the thesis's chord rule keeps the tip's chord, not its arc's depth, below 2r: a tip
+        // passing 3.5 mm deep into a resting ball had left it where it was). The blade stops where
+        // its tip first touches the ball, and strikes it there.
+        const double theta_touch = tip_touch_angle(f, p, r, theta_old, theta_new);
+        if (std::isnan(theta_touch)) continue;  // the arc stays a ball's radius away
+        fs.theta_rad = theta_touch;
+        contact = table::flipper_tip(f, theta_touch);
+        dist = (p - contact).norm();
+      }
       if (dist >= r) continue;
+      const Vec2 away = p - contact;
       normal = dist > 0.0 ? Vec2(away / dist) : n_face;
       pushed = contact + (r + options_.separation_m) * normal;
     }
@@ -143,7 +182,7 @@ void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const 
       continue;
     }
     p = pushed;
-    state.ball.velocity_mps = flipper_response(f, theta_new, omega, contact, normal, state.ball.velocity_mps);
+    state.ball.velocity_mps = flipper_response(f, fs.theta_rad, omega, contact, normal, state.ball.velocity_mps);
     events.flags |= StepEvents::kFlipperPush;
     events.flipper = static_cast<std::int32_t>(i);
   }

@@ -87,7 +87,8 @@ void check_overlay(const BoardOverlay& o, const YamlReadArchive& r) {
     }
     if (o.flippers[i].mu) check_value(*o.flippers[i].mu, kZero, {kMaxFlipperMu, false}, "", key + ".mu", r);
     if (o.flippers[i].omega_rad_s)
-      check_value(*o.flippers[i].omega_rad_s, kAboveZero, {200.0, false}, " rad/s", key + ".omega_rad_s", r);
+      check_value(*o.flippers[i].omega_rad_s, kAboveZero, {kMaxFlipperOmega_rad_s, false}, " rad/s",
+                  key + ".omega_rad_s", r);
     if (o.flippers[i].rise_delay_s)
       check_value(*o.flippers[i].rise_delay_s, kZero, {0.1, false}, " s", key + ".rise_delay_s", r);
   }

@@ -331,6 +331,10 @@ void flipper(LoadState& state, const Reader& r) {
   r.require(std::abs(v[3]) <= quarter_turn, "field THETA_MIN", "within +-" + quarter_text, v[3]);
   r.require(std::abs(v[4]) <= quarter_turn, "field THETA_MAX", "within +-" + quarter_text, v[4]);
   r.require(v[5] > 0, "field OMEGA", "> 0", v[5]);
+  r.require(v[5] * state.angle_scale <= kMaxFlipperOmega_rad_s, "field OMEGA",
+            "at most " + fmt(kMaxFlipperOmega_rad_s / state.angle_scale) +
+                (state.angle_scale == 1.0 ? " rad/s" : " deg/s"),
+            v[5]);
   f.pivot = position(state, r, v[0], v[1], "fields PX PY");
   f.length_m = v[2] * state.length_scale;
   f.theta_min_rad = v[3] * state.angle_scale;

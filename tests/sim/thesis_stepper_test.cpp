@@ -767,6 +767,35 @@ TEST(ThesisStepperFlippers, BallNearTipLaunchedFasterThanNearPivot) {
   EXPECT_GE(near_tip, 1.0 * 33.0 * 0.07 * 0.99);
 }
 
+// The thesis's chord rule (l·sin(ω·dt/2) < r) keeps the tip's chord between two steps below 2r, not
+// the depth its arc reaches: at dt 9.5 ms (the largest stable one is 9.69 ms) the tip stepped from
+// 17 mm one side of a resting ball to 17 mm the other, its arc 3.5 mm deep inside, and the ball was
+// never struck. The blade now stops where its tip first touches the ball, and strikes it.
+TEST(ThesisStepperFlippers, ATipWhoseArcCrossesTheBallBetweenStepsStrikesIt) {
+  const double dt = 0.0095;
+  table::Board b = empty_board(1.0, 1.5, 1.11, dt);
+  add_flipper(b, table::Side::kLeft, {0.3, 0.3}, 0.08, -0.5, 0.5, 35.0, 0.6, 1.6);
+  add_line(b, {0.385, 0.2865}, {0.45, 0.2865}, 0.6);  // a floor the ball rests on, under the tip's path
+  ASSERT_LT(dt, table::max_stable_dt_s(b));
+  const ThesisStepper stepper(b);
+  GameState s = state_with_ball(b, {0.39, 0.300001}, Vec2::Zero());  // 9 cm from the pivot: 1 cm beyond the tip
+  s.flippers[0].energized = true;
+  bool struck = false;
+  for (int i = 0; i < 10 && !struck; ++i) {
+    const StepEvents e = stepper.step(s);
+    ASSERT_LT(max_penetration_m(b, s), 1e-6) << "step " << i;
+    struck = e.has(StepEvents::kFlipperPush);
+    if (struck) {
+      const table::Flipper& f = b.flippers[0];
+      EXPECT_LT(s.flippers[0].theta_rad, 0.0) << "the blade stops short of the ball's direction, at the touch";
+      const Vec2 from_tip = s.ball.position_m - table::flipper_tip(f, s.flippers[0].theta_rad);
+      EXPECT_GT(from_tip.dot(s.ball.velocity_mps), 0.0) << "it flies off the tip (and has moved a step since)";
+      EXPECT_GT(s.ball.velocity_mps.norm(), 1.0) << "struck by a tip moving at 2.8 m/s";
+    }
+  }
+  EXPECT_TRUE(struck);
+}
+
 TEST(ThesisStepperFlippers, ContactSensorWhenBallRestsOnFlipper) {
   FlipperBoard fb(1.11, 0.0);  // horizontal at rest
   const table::Flipper& f = fb.board.flippers[0];

@@ -364,6 +364,17 @@ TEST(BoardLoaderErrors, FlipperAnglesAreElevationsWithinAQuarterTurn) {
   EXPECT_NO_THROW(parse("flipper left 0.15 0.16 0.076 -1.5 1.5 35\n"));
 }
 
+// A blade no longer than the ball's radius passes the chord rule at any speed: 1e5 rad/s, the whole
+// stroke inside one step, had been played (the event stepper's guard holding the ball in mid-air).
+TEST(BoardLoaderErrors, AFlipperTurnsNoFasterThanACoilCanTurnIt) {
+  expect_body_error("flipper left 0.15 0.16 0.01 -0.5 0.5 100000\n", 8,
+                    "flipper: field OMEGA must be at most 200 rad/s, got 1e+05");
+  expect_error("pinball-board 1\nangles deg\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\n"
+               "launcher 0.45 0.05\ndt 0.0005\nflipper left 0.15 0.16 0.01 -25 30 20000\n",
+               9, "field OMEGA must be at most 11459.2 deg/s, got 20000");
+  EXPECT_NO_THROW(parse("flipper left 0.15 0.16 0.076 -0.5 0.5 200\n"));
+}
+
 // Found by a helper: mu=1e300 overflowed the speed clamp to a stopped ball, and score=1e308
 // a game's sum to inf (the report's mean: nan).
 TEST(BoardLoaderErrors, FrictionAndPointsHaveUpperBounds) {
@@ -608,10 +619,10 @@ TEST(BoardLoaderErrors, FlipperThetaMinNotBelowThetaMax) {
 }
 
 TEST(BoardLoaderErrors, FlipperTooFastForTheTimeStep) {
-  // 0.076 m * sin(200 rad/s * 0.0005 s / 2) = 3.8 mm: fine; at 800 rad/s 0.076 * sin(0.2) = 15.1 mm > 13.5 mm.
+  // 0.076 m * sin(200 rad/s * 0.0005 s / 2) = 3.8 mm: fine; a 0.3 m blade: 0.3 * sin(0.05) = 15.0 mm > 13.5 mm.
   EXPECT_NO_THROW(parse("point 0.3 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 200\n"));
-  expect_body_error("point 0.3 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 800 name=lf\n", 9, "l*sin(omega*dt/2)");
-  expect_body_error("point 0.3 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 800 name=lf\n", 9, "flipper: flipper 'lf'");
+  expect_body_error("point 0.3 0.9\nflipper left 0.1 0.2 0.3 -0.5 0.5 200 name=lf\n", 9, "l*sin(omega*dt/2)");
+  expect_body_error("point 0.3 0.9\nflipper left 0.1 0.2 0.3 -0.5 0.5 200 name=lf\n", 9, "flipper: flipper 'lf'");
   // dt after the flipper still counts: the check runs on the whole file.
   expect_error(
       "pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\nlauncher 0.45 0.05\n"
@@ -620,8 +631,8 @@ TEST(BoardLoaderErrors, FlipperTooFastForTheTimeStep) {
       7, "l*sin(omega*dt/2)");
   // Said in the file's unit.
   expect_error("pinball-board 1\nunits mm\nsize 510 1070\nball 13.5 5000\ngravity 1110\nballs 3\nlauncher 450 50\n"
-               "dt 0.0005\nflipper left 100 200 76 -0.5 0.5 800 name=lf\n",
-               9, "l*sin(omega*dt/2) = 15.0989 mm is not below the ball radius 13.5 mm at dt = 0.0005 s");
+               "dt 0.0005\nflipper left 100 200 300 -0.5 0.5 200 name=lf\n",
+               9, "l*sin(omega*dt/2) = 14.9938 mm is not below the ball radius 13.5 mm at dt = 0.0005 s");
 }
 
 TEST(BoardLoaderErrors, BallAtTheLauncherOverlaps) {

@@ -58,6 +58,10 @@ inline constexpr double kMaxLaunchNoise = 0.5;
 /// The largest flipper friction coefficient a board or an overlay may give
 /// (rubber on a ball is about 1; 1e154 overflowed the clamp to a stopped ball).
 inline constexpr double kMaxFlipperMu = 10.0;
+/// The fastest flipper stroke a board or an overlay may give (rad/s): a real
+/// coil turns a blade at 30 to 60 rad/s; 1e5 rad/s, the whole stroke inside
+/// one step, had passed with a blade no longer than the ball's radius.
+inline constexpr double kMaxFlipperOmega_rad_s = 200.0;
 /// The most points one hit, one second of contact or one bank may give: a
 /// score summed over a long game stays far from overflow, and none is negative.
 inline constexpr double kMaxPoints = 1e6;
