@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 
 #include "common/thesis_board.h"
 #include "common/twin_params.h"
@@ -77,6 +79,49 @@ TEST(TwinModel, RefusesABoardItCannotRepresentNamingIt) {
   board = testing::thesis_board();
   board.flippers[0].length_m = 0.005;
   EXPECT_THROW(twin_model_text(board, testing::shipped_twin_params(), 0.0005, {}), std::invalid_argument);
+}
+
+std::string refusal(const table::Board& board) {
+  try {
+    check_board_fits_the_twin(board, testing::shipped_twin_params(), 0.0005);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Boards the model plays and the twin cannot, found by probing: each had played on with no warning.
+TEST(TwinModel, RefusesABallTheTwinsSolidsCannotHold) {
+  const table::Board thesis = testing::thesis_board();
+  EXPECT_EQ(refusal(thesis), "");
+  table::Board big = thesis;  // wedged between the playfield and the glass, creeping at 1e-5 m/s
+  big.ball.radius_m = 0.05;
+  EXPECT_NE(refusal(big).find("a ball 100 mm across does not fit under the twin's glass, 85 mm above the playfield"),
+            std::string::npos)
+      << refusal(big);
+  table::Board fast = thesis;  // 100 m/s: every ball left through a wall
+  fast.ball.speed_max_mps = 100.0;
+  EXPECT_NE(refusal(fast).find("at 100 m/s (SPEED_MAX, or a kickout) would pass through the twin's thinnest solid: "
+                               "it moves 50 mm a step"),
+            std::string::npos)
+      << refusal(fast);
+  table::Board small = thesis;  // 1 mm at 2.3 m/s: through a 2 mm bar, leaving faster than it came
+  small.ball.radius_m = 0.001;
+  small.ball.speed_max_mps = 2.3;
+  EXPECT_NE(refusal(small).find("sinks about 2.2 mm into a contact"), std::string::npos) << refusal(small);
+}
+
+// The loader clears a served ball of the board's lines; the twin's bars and rubbers are thicker, and a
+// ball served 1 µm from a wall had been shot off at 2 m/s.
+TEST(TwinModel, RefusesABallPutWhereItWouldOverlapASolid) {
+  table::Board board = testing::thesis_board();
+  const table::Flipper& f = board.flippers[0];
+  const Vec2 tip = table::flipper_tip(f, f.theta_min_rad);
+  board.start = table::BallStart{tip + (board.ball.radius_m + 1e-6) * table::flipper_up_normal(f, f.theta_min_rad),
+                                 Vec2::Zero()};
+  EXPECT_NE(refusal(board).find("the ball at the start would overlap flipper '" + f.name + "' at rest by 6 mm"),
+            std::string::npos)
+      << refusal(board);
 }
 
 }  // namespace

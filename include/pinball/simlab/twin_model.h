@@ -76,6 +76,13 @@ std::vector<std::vector<int>> twin_obstacle_groups(const table::Board& board);
 /// the table not below g).
 double twin_slope_rad(const table::Board& board, const TwinParams& params);
 
+/// Throws std::invalid_argument naming the board when the twin cannot play
+/// it as the model does: a ball too big for the glass, fast enough to pass
+/// through the twin's thinnest solid (its step or its sink into a soft
+/// contact), or put (chute, start, kickout) where it overlaps a solid the
+/// board draws as a line. twin_model_text calls it.
+void check_board_fits_the_twin(const table::Board& board, const TwinParams& params, double timestep_s);
+
 /// Builds the MJCF of `board`. Throws std::invalid_argument naming the board
 /// and the element for a board the twin cannot represent (see
 /// docs/worlds.md): a slope not below 45°, a flipper shorter than its rubber

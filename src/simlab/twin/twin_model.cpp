@@ -3,10 +3,14 @@
 #include <cmath>
 #include <iomanip>
 #include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
 #include <sstream>
 #include <stdexcept>
 
 #include "pinball/core/check.h"
+#include "pinball/core/format.h"
 
 namespace pinball::simlab {
 namespace {
@@ -96,9 +100,76 @@ double twin_slope_rad(const table::Board& board, const TwinParams& params) {
   return std::asin(s);
 }
 
+void check_board_fits_the_twin(const table::Board& board, const TwinParams& params, double timestep_s) {
+  const std::string context = "twin: " + board.source;
+  const double r = board.ball.radius_m;
+  auto mm = [](double m) { return format_number(m * 1e3) + " mm"; };
+  check_input(2.0 * r < params.glass_height_m.value, context,
+              "a ball " + mm(2.0 * r) + " across does not fit under the twin's glass, " +
+                  mm(params.glass_height_m.value) + " above the playfield (glass_height_m)");
+
+  // Its solids are thicker than the board's lines: a 2 mm bar, a 6 mm flipper rubber. A ball passes
+  // through one when its centre crosses the solid's middle in a step, or sinks that deep into the soft
+  // contact (about v·T/π in a bounce of T); half that depth is kept as margin.
+  double fastest_mps = board.ball.speed_max_mps;
+  for (const table::Sensor& sensor : board.sensors) {
+    if (sensor.has_kickout) fastest_mps = std::max(fastest_mps, sensor.kickout_mps.norm());
+  }
+  const double hold_m = r + std::min(params.pin_radius_m.value, params.flipper_radius_m.value);
+  const double step_m = fastest_mps * timestep_s;
+  const double sink_m = fastest_mps * params.contact_duration_s.value / std::numbers::pi;
+  check_input(step_m < hold_m && sink_m < 0.5 * hold_m, context,
+              "a ball of radius " + mm(r) + " at " + format_number(fastest_mps) +
+                  " m/s (SPEED_MAX, or a kickout) would pass through the twin's thinnest solid: it moves " +
+                  mm(step_m) + " a step and sinks about " + mm(sink_m) + " into a contact; the twin holds a ball " +
+                  "that moves less than " + mm(hold_m) + " a step (its radius and half the solid) and sinks less "
+                  "than " + mm(0.5 * hold_m));
+
+  // Where a ball is put (the chute, a start, a kickout) must be clear of those solids too: the loader
+  // measured it against the board's lines, and a ball served 1 µm from a wall had overlapped its bar
+  // and been shot off at 2 m/s.
+  std::vector<std::pair<std::string, Vec2>> places;
+  if (board.start) {
+    places.emplace_back("the start", board.start->position);
+  } else {
+    places.emplace_back("the launcher", board.launcher.position);
+  }
+  for (const table::Sensor& sensor : board.sensors) {
+    if (sensor.has_kickout) places.emplace_back("kickout '" + sensor.name + "'", sensor.shape.p0);
+  }
+  const double pin = params.pin_radius_m.value;
+  const double rf = params.flipper_radius_m.value;
+  for (const auto& [place, p] : places) {
+    auto refuse = [&](const std::string& solid, double gap_m) {
+      check_input(gap_m >= 0.0, context,
+                  "the ball at " + place + " would overlap " + solid + " by " + mm(-gap_m) +
+                      " (the twin's solids are thicker than the board's lines: bars " + mm(pin) +
+                      " about the line, pins and posts at least " + mm(pin) + " in radius, flipper rubbers " +
+                      mm(rf) + "); move it clear");
+    };
+    for (const std::vector<int>& members : twin_obstacle_groups(board)) {
+      const table::Shape& s = board.shapes[static_cast<std::size_t>(members.front())];
+      const std::string& name = board.obstacles[static_cast<std::size_t>(members.front())].name;
+      const bool bar = members.size() > 1 &&
+                       board.shapes[static_cast<std::size_t>(members[1])].kind == table::ShapeKind::kLine;
+      if (s.kind == table::ShapeKind::kLine && !bar) continue;  // its solid lies behind the line
+      if (s.kind == table::ShapeKind::kLine) {
+        refuse("the bar of wall '" + name + "'", distance_point_segment(p, s.p0, s.p1) - r - pin);
+      } else {
+        refuse("post '" + name + "'", (p - s.p0).norm() - r - std::max(s.radius_m, pin));
+      }
+    }
+    for (const table::Flipper& f : board.flippers) {
+      refuse("flipper '" + f.name + "' at rest",
+             distance_point_segment(p, f.pivot, table::flipper_tip(f, f.theta_min_rad)) - r - rf);
+    }
+  }
+}
+
 TwinModelText twin_model_text(const table::Board& board, const TwinParams& params, double timestep_s,
                               const TwinContacts& contacts) {
   check_twin_params(params);
+  check_board_fits_the_twin(board, params, timestep_s);
   TwinModelText model;
   model.slope_rad = twin_slope_rad(board, params);
   const double g = params.gravity_mps2.value;
