@@ -108,6 +108,9 @@ void handle(StepContext& ctx, const Next& next) {
     case Kind::kSensor:
       state.sensor_inside[next.index] = 1;
       rules::fire_sensor(board, state, next.index, ctx.events);
+      // A kickout faster than the clamp is clamped, as the thesis stepper's next step does: it had flown
+      // at 100 m/s under a 5 m/s clamp until its first collision.
+      if (state.ball_in_play) finish_response(ctx);
       return;
     case Kind::kObstacle: {
       const Vec2 accel = ctx.m.a;

@@ -345,6 +345,32 @@ TEST(EventStepper, ATurningBladeStrikesABallAtRestAndTheBallFliesOff) {
   EXPECT_GT((s.ball.position_m - Vec2(0.39, 0.300001)).norm(), 0.1) << "it left where it was struck";
 }
 
+// A kickout faster than the speed clamp is clamped, as the thesis stepper's next step clamps it: the
+// event stepper had flown it at 100 m/s under a 5 m/s clamp until its first collision.
+TEST(EventStepper, AKickoutFasterThanTheClampIsClamped) {
+  table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
+  b.ball.speed_max_mps = 5.0;
+  table::Sensor hole;
+  hole.kind = table::SensorKind::kHole;
+  hole.shape.kind = table::ShapeKind::kCircle;
+  hole.shape.p0 = {0.5, 0.5};
+  hole.shape.radius_m = 0.01;
+  hole.has_kickout = true;
+  hole.kickout_mps = {0.0, 100.0};
+  hole.kickout_spread_rad = 0.0;
+  hole.kickout_noise = 0.0;
+  b.sensors.push_back(hole);
+  const EventStepper stepper(b);
+  GameState s = state_with_ball(b, {0.3, 0.5}, {1.0, 0.0});
+  bool kicked = false;
+  for (int i = 0; i < 1000 && !kicked; ++i) {
+    kicked = stepper.step(s).has(StepEvents::kSensor);
+    ASSERT_LE(s.ball.velocity_mps.norm(), 5.0 + 1e-12) << "step " << i;
+  }
+  ASSERT_TRUE(kicked);
+  EXPECT_NEAR(s.ball.velocity_mps.y(), 5.0, 1e-12);
+}
+
 TEST(EventStepper, EnergyNeverGrowsWithoutKickersOrFlippers) {
   table::Board b = box_board(0.9, 1.11, 5e-4);
   add_circle(b, {0.15, 0.70}, 0.03, 0.95);
