@@ -61,14 +61,12 @@ inline void check_output_folder(const std::string& path, const char* option, boo
 /// Outputs of one command that name the same file would overwrite each
 /// other: refused, naming both options.
 inline void check_distinct_outputs(const std::vector<std::pair<const char*, std::string>>& outputs) {
-  namespace fs = std::filesystem;
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     for (std::size_t k = i + 1; k < outputs.size(); ++k) {
       const std::string& a = outputs[i].second;
       const std::string& b = outputs[k].second;
       if (a.empty() || b.empty()) continue;
-      // Absolute first: weakly_canonical leaves "y.json" relative and makes "./y.json" absolute.
-      if (fs::weakly_canonical(fs::absolute(a)) == fs::weakly_canonical(fs::absolute(b))) {
+      if (same_written_file(a, b)) {  // the path, a link (made or not yet) or a hard link
         throw std::runtime_error(std::string(outputs[i].first) + " and " + outputs[k].first + " both name " + a +
                                  ": each would overwrite the other");
       }

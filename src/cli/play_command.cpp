@@ -17,6 +17,7 @@
 
 #include "commands.h"
 #include "data_file.h"
+#include "display_check.h"
 #include "pinball/core/data_path.h"
 #include "pinball/core/format.h"
 #include "pinball/core/json_text.h"
@@ -159,12 +160,9 @@ int run_play(const PlayArgs& a, std::ostream& out, std::ostream& err) {
   std::vector<simlab::KeyEvent> script;
   if (!a.keys.empty()) script = simlab::parse_key_script(key_script_text(a.keys));
   if (a.headless && script.empty()) throw std::invalid_argument("play: --headless needs --keys SCRIPT (nobody is at the keyboard)");
-  if (!a.headless) {
-    const char* display = std::getenv("DISPLAY");
-    if (display == nullptr || *display == '\0') {
-      throw std::runtime_error(
-          "pinball play needs a display (DISPLAY is not set); use --headless with --keys to play a script");
-    }
+  if (const std::string problem = a.headless ? "" : display_problem(); !problem.empty()) {
+    throw std::runtime_error("pinball play needs a display (" + problem +
+                             "); use --headless with --keys to play a script");
   }
   simlab::PlayConfig config;
   config.seed = a.seed;

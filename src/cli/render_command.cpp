@@ -29,6 +29,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& a) {
 
 int run_render(const RenderArgs& a, std::ostream& out, std::ostream&) {
   check_png_output(a.out, "--out");
+  check_outputs_replace_no_input({{"--out", a.out}}, {{"board", a.board}});  // a board named x.png became a picture
   const table::Board board = table::load_board(a.board);
   sim::RenderOptions options;
   options.px_per_m = a.px_per_m;

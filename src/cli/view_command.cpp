@@ -19,6 +19,7 @@
 
 #include "commands.h"
 #include "data_file.h"
+#include "display_check.h"
 #include "pinball/bus/channels.h"
 #include "pinball/bus/lcm_bus.h"
 #include "pinball/bus/lcm_log_format.h"
@@ -41,12 +42,6 @@ constexpr double kFramePeriod_s = 1.0 / 60.0;
 
 double steady_s() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-bool has_display() {
-  const char* x = std::getenv("DISPLAY");
-  const char* wayland = std::getenv("WAYLAND_DISPLAY");
-  return (x != nullptr && *x != '\0') || (wayland != nullptr && *wayland != '\0');
 }
 
 // The board, calibration and controller the daemon runs with: --config's,
@@ -134,13 +129,22 @@ void write_snapshot(const ViewArgs& a, const cv::Mat& picture) {
 // The window's keys, for the help line and the docs.
 constexpr const char* kKeys = "space pause | . , frame +/- | l j 1 s +/- | L J 10 s +/- | + - speed | s snapshot | q quit";
 
+// A time past the log's end (--at, --quit-at) is refused: --quit-at had played on for ever, the view
+// held at the end and never reaching it.
+void check_within_log(const char* option, double t_s, const ViewArgs& a, const view::LogPlayer& player) {
+  const double end_s = player.duration_s();
+  if (t_s <= end_s + 1e-9) return;
+  // Exact only where rounding would hide the difference: "--at 35.9000001" had been refused as
+  // "--at 35.9 ... ends at 35.9 s", and a plain end had read 20.851499999999998 s.
+  const bool close = t_s - end_s < 1e-3;
+  auto shown = [close](double x) { return close ? format_exact(x) : format_number(x, 6); };
+  throw std::runtime_error(std::string(option) + " " + shown(t_s) + ": the log " + a.log + " ends at " +
+                           shown(end_s) + " s");
+}
+
 int view_log_snapshot(const ViewArgs& a, const view::ViewScene& scene, view::LogPlayer& player, std::ostream& out) {
   const double t_s = a.at_s < 0.0 ? player.duration_s() : a.at_s;
-  if (t_s > player.duration_s() + 1e-9) {
-    // Exact: rounded, "--at 35.9000001" was refused as "--at 35.9 ... ends at 35.9 s".
-    throw std::runtime_error("--at " + format_exact(t_s) + ": the log " + a.log + " ends at " +
-                             format_exact(player.duration_s()) + " s");
-  }
+  check_within_log("--at", t_s, a, player);
   player.seek(t_s);
   const cv::Mat picture = view::render_view(scene, player.state(), {a.log, "log " + format_number(t_s) + " s"});
   write_snapshot(a, picture);
@@ -149,6 +153,7 @@ int view_log_snapshot(const ViewArgs& a, const view::ViewScene& scene, view::Log
 }
 
 int view_log_window(const ViewArgs& a, const view::ViewScene& scene, view::LogPlayer& player, std::ostream& out) {
+  if (a.quit_at_s >= 0.0) check_within_log("--quit-at", a.quit_at_s, a, player);
   cv::namedWindow(kWindow, cv::WINDOW_AUTOSIZE);
   Session s;
   bool paused = false;
@@ -296,11 +301,16 @@ CLI::App* add_view_command(CLI::App& app, ViewArgs& a) {
 
 int run_view(const ViewArgs& a, std::ostream& out, std::ostream& err) {
   check_png_output(a.snapshot, "--snapshot");
+  // A snapshot named as the log or a file the scene reads had replaced it with a picture, exit 0.
+  check_outputs_replace_no_input({{"--snapshot", a.snapshot}}, {{"log", a.log},
+                                                               {"--config", a.config},
+                                                               {"--board", a.board},
+                                                               {"--calibration", a.calibration},
+                                                               {"--controller", a.controller}});
   const bool window = a.snapshot.empty() || a.quit_at_s >= 0.0;
-  if (window && !has_display()) {
-    throw std::runtime_error(
-        "pinball view needs a display for its window (DISPLAY is not set); "
-        "write a picture without one with --snapshot FILE.png --at SECONDS");
+  if (const std::string problem = window ? display_problem() : ""; !problem.empty()) {
+    throw std::runtime_error("pinball view needs a display for its window (" + problem +
+                             "); write a picture without one with --snapshot FILE.png --at SECONDS");
   }
   const view::ViewScene scene = scene_for(a);
   if (!a.log.empty()) {

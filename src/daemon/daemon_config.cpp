@@ -397,12 +397,9 @@ void check_written_paths(const DaemonConfig& c, const std::string& source_name) 
   if (lcm_log) check("lcm_url", lcm_log->path);
   // A recording must not replace what the run reads, nor the other recording (found: --can-log
   // naming the controller file replaced it with the log, exit 0).
-  namespace fs = std::filesystem;
-  // By path, not core's same_file: a recording is often a file not made yet, which equivalent() cannot compare.
-  const auto same_path = [](const std::string& a, const std::string& b) {
-    std::error_code ec;
-    return !a.empty() && !b.empty() && fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
-  };
+  // The file, not the name: a hard link of the board had become a CAN log, and a link to a log not made
+  // yet had been taken for another process's (same_written_file).
+  const auto same_path = same_written_file;
   DaemonConfig inputs = c;
   const std::vector<std::pair<const char*, std::string>> written = {
       {"can.log", c.can.log}, {"lcm_url", lcm_log ? lcm_log->path : std::string()}};

@@ -639,7 +639,7 @@ TEST_F(Cli, AnEmptyOutputPathIsRefusedNotTakenAsNone) {
 
 // A flipper ten times as fast as the thesis's: 5 ms, within --dt's range, is too long for them.
 TEST_F(Cli, TimeStepThatBreaksTheFlipperConditionIsRefused) {
-  const fs::path fast = variant_board(dir_, "-25 30 2000 ", "-25 30 20000 ");  // the left flipper
+  const fs::path fast = variant_board(dir_, "-25 30 2000 ", "-25 30 10000 ");  // the left flipper, 175 rad/s
   const CommandResult r = run("sim " + fast.string() + " --dt 0.005");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("l*sin(omega*dt/2)"), std::string::npos) << r.err;
@@ -688,6 +688,13 @@ TEST_F(Cli, RenderWritesAPng) {
   EXPECT_GT(j.at("width_px").get<int>(), 100);
   ASSERT_TRUE(fs::exists(png));
   EXPECT_EQ(slurp(png).substr(1, 3), "PNG");
+  // A board under a picture's name, drawn onto itself, had become its own picture, exit 0.
+  const fs::path board = dir_ / "board_as.png";
+  fs::copy_file(fs::path(PINBALL_SOURCE_DIR) / "boards/mit1993.board", board);
+  const CommandResult self = run("render " + board.string() + " --out " + board.string());
+  EXPECT_EQ(self.exit_code, 1);
+  EXPECT_NE(self.err.find("--out " + board.string() + " is the input board"), std::string::npos) << self.err;
+  EXPECT_EQ(slurp(board), slurp(PINBALL_SOURCE_DIR "/boards/mit1993.board"));
 }
 
 TEST_F(Cli, VideoRecordsFrames) {

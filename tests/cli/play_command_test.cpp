@@ -82,6 +82,14 @@ TEST_F(Play, WithoutADisplayItSaysSoAndWritesNothing) {
             std::string::npos) << r.err;
   EXPECT_EQ(count_lines(r.err), 1);
   EXPECT_FALSE(fs::exists(csv()));
+  // A display that does not answer (a stale SSH forwarding) had aborted in Qt: SIGABRT, exit 134.
+  const CommandResult stale = run_shell("cd " PINBALL_SOURCE_DIR " && env -u WAYLAND_DISPLAY -u QT_QPA_PLATFORM "
+                                        "DISPLAY=:987 " PINBALL_EXE " play boards/mit1993.board --csv " + csv());
+  EXPECT_EQ(stale.exit_code, 1);
+  EXPECT_NE(stale.err.find("needs a display (DISPLAY :987: no X server answers at /tmp/.X11-unix/X987)"),
+            std::string::npos)
+      << stale.err;
+  EXPECT_FALSE(fs::exists(csv()));
 }
 
 // A report that did not reach stdout (a full disk) is not a success for a script.

@@ -67,6 +67,20 @@ TEST(TextFile, AWriteOverSomethingThatIsNoFileIsRefused) {
   fs::remove_all(dir);
 }
 
+// What a write reaches: a hard link, or a link to a file not made yet, is the file it names.
+TEST(TextFile, TheFileAWriteReachesIsFoundThroughLinks) {
+  const fs::path dir = fresh_folder("text_file_links");
+  write_text_file((dir / "a.txt").string(), "a");
+  fs::create_hard_link(dir / "a.txt", dir / "hard.txt");
+  fs::create_symlink("later.txt", dir / "dangling.txt");
+  EXPECT_TRUE(same_written_file((dir / "a.txt").string(), (dir / "hard.txt").string()));
+  EXPECT_TRUE(same_written_file((dir / "dangling.txt").string(), (dir / "later.txt").string()));
+  EXPECT_TRUE(same_written_file((dir / "a.txt").string(), (dir / "." / "a.txt").string()));
+  EXPECT_FALSE(same_written_file((dir / "a.txt").string(), (dir / "later.txt").string()));
+  EXPECT_FALSE(same_written_file("", ""));
+  EXPECT_EQ(write_target((dir / "dangling.txt").string()), dir / "later.txt");
+}
+
 TEST(TextFile, ReadingAMissingFileNamesIt) {
   try {
     read_text_file("/nonexistent/pinball.yaml");

@@ -390,6 +390,37 @@ TEST(DaemonConfig, ARecordingReplacesNoInputAndNotTheOtherRecording) {
   EXPECT_THROW(check_written_paths(c, "x.yaml"), ConfigError) << "an LCM log over the controller";
 }
 
+// Compared by name, a hard link of the board became a CAN log (exit 0), and a log through a link whose
+// target was not made yet was taken for another pinballd's and left an empty file behind.
+TEST(DaemonConfig, ARecordingIsComparedAsTheFileItWritesNotByName) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fresh_dir("config_links");
+  const std::string controller = (dir / "c.json").string();
+  write_file(controller, "{}");
+  fs::create_hard_link(controller, dir / "c.can");
+  DaemonConfig c;
+  c.controller = controller;
+  c.can.log = (dir / "c.can").string();
+  try {
+    check_written_paths(c, "x.yaml");
+    ADD_FAILURE() << "a CAN log onto a hard link of the controller was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), "x.yaml: can.log: '" + c.can.log +
+                                         "' is the file controller names: it would be replaced by the recording");
+  }
+  c.controller.clear();
+  fs::create_symlink("target.log", dir / "link.log");  // dangling: the write would create target.log
+  c.can.log = (dir / "target.log").string();
+  c.lcm_url = "file://" + (dir / "link.log").string() + "?mode=w";
+  try {
+    check_written_paths(c, "x.yaml");
+    ADD_FAILURE() << "two recordings into one file through a link";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("is the lcm_url's log too"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "target.log"));
+}
+
 // --lcm-url file://CONFIG?mode=w made the configuration file an LCM log, exit 0 (--check said ok).
 TEST(DaemonConfig, ARecordingReplacesNotItsOwnConfigurationFile) {
   const std::string file = ::testing::TempDir() + "/config_self.yaml";

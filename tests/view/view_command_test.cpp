@@ -191,6 +191,25 @@ TEST_F(ViewCommand, ATimePastTheEndOfTheLogIsRefused) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("ends at 1 s"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(png));
+  // --quit-at past the end had played on for ever: the view holds at the end and never reaches it.
+  const CommandResult q = run_shell("env -u DISPLAY -u WAYLAND_DISPLAY QT_QPA_PLATFORM=offscreen timeout 60 " PINBALL_EXE
+                                    " view " + log_ + " --snapshot " + png + " --quit-at 100");
+  EXPECT_EQ(q.exit_code, 1);
+  EXPECT_NE(q.err.find("--quit-at 100: the log " + log_ + " ends at 1 s"), std::string::npos) << q.err;
+  EXPECT_FALSE(std::filesystem::exists(png));
+}
+
+// A snapshot named as the log (or the board) had replaced it with a picture, exit 0.
+TEST_F(ViewCommand, ASnapshotOverItsOwnInputIsRefused) {
+  const std::string log = (dir_ / "log.png").string();  // a log under a picture's name
+  std::filesystem::copy_file(log_, log);
+  const std::uintmax_t bytes = std::filesystem::file_size(log);
+  const CommandResult r = view(log + " --snapshot " + log + " --at 0.5");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--snapshot " + log + " is the input log " + log + "; it would be replaced"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(std::filesystem::file_size(log), bytes);
 }
 
 TEST_F(ViewCommand, ASnapshotIntoAMissingFolderIsRefusedFirst) {

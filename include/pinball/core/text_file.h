@@ -45,6 +45,28 @@ inline bool same_file(const std::string& a, const std::string& b) {
   return std::filesystem::equivalent(a, b, ec) && !ec;
 }
 
+/// The file a write to `path` would reach: absolute, without . and .., a
+/// symbolic link followed even when its target is not made yet (a write
+/// through it creates the target).
+inline std::filesystem::path write_target(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec);
+  for (int hops = 0; hops < 40 && fs::is_symlink(fs::symlink_status(p, ec)); ++hops) {
+    const fs::path to = fs::read_symlink(p, ec);
+    if (ec) break;
+    p = to.is_absolute() ? to : p.parent_path() / to;
+  }
+  const fs::path canonical = fs::weakly_canonical(p, ec);
+  return ec ? p.lexically_normal() : canonical;
+}
+
+/// Whether writing `a` would write `b` (or read it): one file now (a link or
+/// a hard link, same_file), or, for files not made yet, one write_target.
+inline bool same_written_file(const std::string& a, const std::string& b) {
+  return !a.empty() && !b.empty() && (same_file(a, b) || write_target(a) == write_target(b));
+}
+
 /// Whether two files hold the same bytes (a copy); false when either cannot be read.
 inline bool same_contents(const std::string& a, const std::string& b) {
   std::error_code ec_a, ec_b;

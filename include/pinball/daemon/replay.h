@@ -30,12 +30,25 @@ struct ReplayReport {
   bool reproduced = false;              ///< every recorded decision was reproduced, in order
 };
 
+/// How far a replay has come.
+struct ReplayProgress {
+  std::uint64_t bytes_read = 0;   ///< of the log
+  std::uint64_t bytes_total = 0;  ///< the log's size
+  std::uint64_t observations = 0;  ///< replayed so far
+};
+
 /// Replays `log_path` with the board and controller of `config` (looked up
-/// as pinballd does, find_data_files). Throws std::runtime_error naming the
-/// file when it cannot be read. `progress` (may be empty) gets a line every
-/// `progress_every` observations (about half a second of replay at 20000).
+/// as pinballd does, find_data_files). Decisions are compared by the camera
+/// frame behind them (the log's PINBALL_PROJECTION messages map a recorded
+/// decision's projection to its frame), so an observation the log lost (a
+/// udpm drop) shifts nothing after it; a log without projections is compared
+/// by projection number, one per observation. Throws std::runtime_error
+/// naming the file when it cannot be read, or holds nothing to compare: no
+/// PINBALL_OBSERVATION decoded, or no PINBALL_FLIPPER_CMD at all. `progress`
+/// (may be empty) is called every `progress_every` observations (about half
+/// a second of replay at 20000) and at the end.
 ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
-                        const std::function<void(const std::string&)>& progress = {},
+                        const std::function<void(const ReplayProgress&)>& progress = {},
                         std::uint64_t progress_every = 20000);
 
 }  // namespace pinball::daemon
