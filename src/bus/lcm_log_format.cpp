@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <cstring>
 #include <array>
+#include <filesystem>
 #include <fstream>
+#include <system_error>
 #include <stdexcept>
 
 namespace pinball::bus {
@@ -99,6 +101,15 @@ LcmLogCheck check_lcm_log(const std::string& path) {
 }
 
 void require_lcm_log(const std::string& path) {
+  // A log is read more than once (checked here, then played): a pipe would be emptied by the check, and
+  // one with no writer had held the reader for ever.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    throw std::runtime_error(path + ": is " +
+                             (std::filesystem::is_fifo(status) ? "a pipe" : std::string("not a regular file")) +
+                             ": an LCM log is read twice (checked, then played); give the file itself");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot read the LCM log");
   std::array<unsigned char, 4> word{};

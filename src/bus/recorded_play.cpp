@@ -33,24 +33,33 @@ bool decode(const LcmLogEvent& e, Message& m) {
 
 }  // namespace
 
-void check_one_run(const std::string& path, double& latest_s, double t_s, std::int64_t seq) {
+void check_one_run(const std::string& path, RunClock& clock, double t_s, std::int64_t seq) {
   // More than any interleaving of the daemon's threads, less than any run.
   constexpr double kAppendedRunGap_s = 1.0;
-  if (t_s < latest_s - kAppendedRunGap_s) {
-    throw std::runtime_error(path + ": its clock goes back " + format_number(latest_s - t_s) +
+  if (t_s < clock.latest_s - kAppendedRunGap_s) {
+    if (t_s >= clock.before_latest_s - kAppendedRunGap_s) {  // back in step: the one frame before leapt alone
+      throw std::runtime_error(path + ": the PINBALL_OBSERVATION of frame " + std::to_string(clock.latest_seq) +
+                               " is stamped " + format_number(clock.latest_s - t_s) +
+                               " s ahead of the frames around it: a damaged timestamp");
+    }
+    throw std::runtime_error(path + ": its clock goes back " + format_number(clock.latest_s - t_s) +
                              " s at the PINBALL_OBSERVATION of frame " + std::to_string(seq) +
                              ": several runs appended to one log (mode=a)? Record each run to a file of its own");
   }
-  latest_s = std::max(latest_s, t_s);
+  if (t_s > clock.latest_s) {
+    clock.before_latest_s = clock.latest_s;
+    clock.latest_s = t_s;
+    clock.latest_seq = seq;
+  }
 }
 
 void check_log_holds_one_run(const std::string& path, const std::vector<LcmLogEvent>& events) {
-  double latest_s = -1e300;
+  RunClock clock;
   for (const LcmLogEvent& e : events) {
     if (e.channel != kObservationChannel) continue;
     pinball_lcm::lcmt_pinball_observation m;
     if (decode_observation(e.data.data(), e.data.size(), m) == ObservationLayout::kMalformed || m.utime < 0) continue;
-    check_one_run(path, latest_s, from_utime(m.utime), m.seq);
+    check_one_run(path, clock, from_utime(m.utime), m.seq);
   }
 }
 
@@ -68,7 +77,7 @@ RecordedPlay read_recorded_play(const std::string& path) {
           channel + " message " + std::to_string(nth) + " (log event " + std::to_string(event + 1) + "): " + why;
     }
   };
-  double latest_frame_s = -1e300;
+  RunClock frame_clock;
   for (std::size_t i = 0; i < events.size(); ++i) {
     const LcmLogEvent& e = events[i];
     ++channel_counts[e.channel];
@@ -87,7 +96,7 @@ RecordedPlay read_recorded_play(const std::string& path) {
         left_out(e.channel, observation_messages, i, observation_fault(m));
         continue;
       }
-      check_one_run(path, latest_frame_s, o.t_s, m.seq);
+      check_one_run(path, frame_clock, o.t_s, m.seq);
       play.frames.push_back({o.t_s, m.seq, found, o.p_board, contacts.left, contacts.right});
       sightings += found ? 1 : 0;
     } else if (e.channel == kFlipperCommandChannel) {

@@ -1,7 +1,9 @@
 #include "pinball/daemon/config_check.h"
 
+#include <filesystem>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -105,6 +107,14 @@ ConfigCheck check_daemon_config(DaemonConfig config) {
   ConfigCheck out;
   out.mode = config.mode;
   out.warnings = config_warnings(config);  // as the start prints them
+  // The start opens a pipe for writing and refuses one nobody reads; the check opens nothing (a reader
+  // would see the end of its input when it closed), so it says what the start will need.
+  std::error_code ec;
+  if (!config.can.log.empty() && std::filesystem::is_fifo(config.can.log, ec)) {
+    out.warnings.push_back("can.log " + config.can.log +
+                           " is a named pipe: its reader must be running when pinballd starts (the start refuses a "
+                           "pipe nobody reads)");
+  }
   for (const std::string& why : realtime_refusals(config.threads)) {
     if (config.threads.enforce) {
       throw ConfigError(config.origin + ": threads.enforce: true, and the system refuses: " + why);

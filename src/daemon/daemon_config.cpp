@@ -148,6 +148,13 @@ void check_mode(const DaemonConfig& c, const std::string& s) {
     require(!c.board.empty(), s, "board", "is required in mode lab");
     require(c.can.interface != "sim" && !c.can.interface.empty(), s, "can.interface",
             "must name a SocketCAN interface (can0) in mode lab");
+    // A kernel interface name: at most 15 bytes, none of them a blank or a '/'. Anything else had gone
+    // unquoted into the `ip link` command the bring-up check suggests ("can0; rm").
+    const bool name_ok = c.can.interface.size() <= 15 && c.can.interface != "." && c.can.interface != ".." &&
+                         c.can.interface.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                           "0123456789_.-@") == std::string::npos;
+    require(name_ok, s, "can.interface",
+            "'" + c.can.interface + "' is no interface name (at most 15 letters, digits, '_', '.', '-' or '@')");
   }
 }
 

@@ -84,7 +84,7 @@ ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
   ControllerStage stage(*controller, bus, controller_stage_options_for(config, board));
 
   ReplayReport r;
-  double latest_observation_s = -1e300;
+  bus::RunClock observation_clock;
   std::vector<Decision> recorded, replayed;
   std::vector<std::int64_t> replayed_frames;            // the frame behind each replayed decision
   std::map<std::int64_t, std::int64_t> live_frames;      // live projection number -> its frame
@@ -118,7 +118,7 @@ ReplayReport replay_log(const std::string& log_path, DaemonConfig config,
         ++r.malformed;
         continue;
       }
-      bus::check_one_run(log_path, latest_observation_s, o.t_s, m.seq);
+      bus::check_one_run(log_path, observation_clock, o.t_s, m.seq);
       ++r.observations;
       if (layout == bus::ObservationLayout::kBeforeDelivery) ++r.observations_without_latency;
       camera.track(found, o, from_utime(m.delivered_utime), c, 0.0, record);

@@ -93,9 +93,18 @@ void ViewState::on_observation(const void* data, std::size_t size, double t_s, b
   ok = bus::decode_observation(data, size, m) != bus::ObservationLayout::kMalformed &&
        bus::from_lcm_observation(m, found, o, contacts);
   if (!ok) return;
+  // A frame number further on than even a 10 kHz camera gets in the time between is a damaged number,
+  // not lost frames: one such message had shown 999999999999470 frames dropped.
+  constexpr double kFastestCamera_hz = 1e4;
+  if (last_seq_ >= 0 && m.seq > last_seq_ + 1 &&
+      static_cast<double>(m.seq - last_seq_ - 1) > (t_s - last_seq_t_s_) * kFastestCamera_hz + 1.0) {
+    ok = false;
+    return;
+  }
   ++observations_;
   if (last_seq_ >= 0 && m.seq > last_seq_ + 1) seq_gaps_ += m.seq - last_seq_ - 1;
   last_seq_ = m.seq;
+  last_seq_t_s_ = t_s;
   last_found_ = found;
   frame_times_s_.push_back(t_s);
   if (found) trail_.push_back({t_s, o.p_board, m.seq});

@@ -1,6 +1,7 @@
 #include "pinball/bus/lcm_log_format.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <lcm/lcm-cpp.hpp>
 #include <unistd.h>
 
@@ -48,6 +49,21 @@ TEST(LcmLogFormat, LiblcmReadsWhatIsWrittenHere) {
   EXPECT_TRUE(c.ok) << c.problem;
   EXPECT_EQ(c.events, 2u);
   std::remove(path.c_str());
+}
+
+// `pinball replay FIFO` with no writer had waited for ever, and with one failed on "Illegal seek".
+TEST(LcmLogFormat, APipeIsRefusedBeforeItIsOpened) {
+  const std::string fifo = testing::temp_path("lcm_log_format", "log.fifo");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    require_lcm_log(fifo);
+    ADD_FAILURE() << "a pipe was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              fifo + ": is a pipe: an LCM log is read twice (checked, then played); give the file itself");
+  }
+  std::remove(fifo.c_str());
 }
 
 TEST(LcmLogFormat, HeaderFieldsAreBigEndian) {

@@ -69,6 +69,34 @@ TEST(RecordedPlay, ReadsBackWhatItWrites) {
   EXPECT_NEAR(read.duration_s(), 0.095, 1e-6);
 }
 
+// One frame stamped 1e6 s ahead had been blamed on the frame after it, as "several runs appended".
+TEST(RecordedPlay, ALoneTimestampThatLeapsAheadIsNamedNotTakenForASecondRun) {
+  RunClock clock;
+  for (int k = 0; k < 1030; ++k) check_one_run("a.lcm", clock, 0.005 * k, k);
+  check_one_run("a.lcm", clock, 0.005 * 1030 + 1e6, 1030);
+  try {
+    check_one_run("a.lcm", clock, 0.005 * 1031, 1031);
+    ADD_FAILURE() << "a leap was passed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("a.lcm: the PINBALL_OBSERVATION of frame 1030 is stamped 1000000 s ahead of "
+                                          "the frames around it: a damaged timestamp",
+                                          0),
+              0u)
+        << e.what();
+  }
+  RunClock appended;  // a second run: its clock starts again near 0
+  for (int k = 0; k < 1000; ++k) check_one_run("b.lcm", appended, 0.005 * k, k);
+  try {
+    check_one_run("b.lcm", appended, 0.0, 0);
+    ADD_FAILURE() << "two runs were passed";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("b.lcm: its clock goes back 5 s at the PINBALL_OBSERVATION of frame 0: "
+                                         "several runs appended"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RecordedPlay, RefusesAnEmptyOrDamagedOrForeignFile) {
   EXPECT_NE(error_for("empty.lcm", "").find("empty"), std::string::npos) << error_for("empty.lcm", "");
   const std::string log = recorded_play_log(small_play());

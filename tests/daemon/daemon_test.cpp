@@ -706,6 +706,16 @@ TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
   const std::string twin_params = std::string(kSource) + "/config/twin.yaml";
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --twin-params " + twin_params + " 2>&1", unread), 1);
   EXPECT_NE(unread.find("--twin-params: only the twin reads it"), std::string::npos) << unread;
+  // A pipe for the CAN log: the start refuses one nobody reads, so the check says the reader must be up.
+  const std::string fifo = ::testing::TempDir() + "/pinballd_check_" + std::to_string(getpid()) + ".fifo";
+  std::remove(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string piped;
+  EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --can-log " + fifo + " --json 2>/dev/null", piped), 0)
+      << piped;
+  EXPECT_NE(piped.find("is a named pipe: its reader must be running when pinballd starts"), std::string::npos)
+      << piped;
+  std::remove(fifo.c_str());
   std::string empty;  // an unset variable in a lab script: no log written, and nobody told
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --config " + config + " --can-log '' 2>&1", empty), 2);
   EXPECT_NE(empty.find("--can-log: an empty path names no file to write"), std::string::npos) << empty;

@@ -74,6 +74,17 @@ TEST(ViewState, SequenceGapsCountAsDroppedFramesAndStatsCanRaiseThem) {
   EXPECT_DOUBLE_EQ(f.frame_to_can_p99_us, 700.0);
 }
 
+// One damaged frame number had shown 999999999999470 frames dropped, exit 0: a jump no camera makes in
+// the time between is a malformed message, counted and not drawn.
+TEST(ViewState, AFrameNumberNoCameraCouldReachIsMalformedNotDrops) {
+  ViewState s;
+  ASSERT_TRUE(apply(s, bus::kObservationChannel, seen(0, 0.2, 0.5), 0.0));
+  EXPECT_FALSE(apply(s, bus::kObservationChannel, seen(1000000000000000, 0.2, 0.5), 0.005));
+  ASSERT_TRUE(apply(s, bus::kObservationChannel, seen(2, 0.2, 0.5), 0.010));
+  EXPECT_EQ(s.figures().frames_dropped, 1);
+  EXPECT_EQ(s.observations(), 2u);
+}
+
 TEST(ViewState, CommandsAreListedAndFlashOnTheirFlipperForAMoment) {
   ViewState s;
   pinball_lcm::lcmt_pinball_flipper_command c{};

@@ -52,11 +52,21 @@ struct RecordedPlay {
 /// lcm_url mode=a, which sorting by time would shuffle together).
 RecordedPlay read_recorded_play(const std::string& path);
 
+/// The observations' clock as check_one_run has seen it so far.
+struct RunClock {
+  double latest_s = -1e300;         ///< the latest time seen
+  double before_latest_s = -1e300;  ///< the latest before the frame that set it
+  std::int64_t latest_seq = -1;     ///< that frame
+};
+
 /// The readers' check that a log holds one run: an observation at `t_s` more
-/// than a second before `latest_s` (the latest so far, updated here) is a
-/// clock that started again, a second run appended (lcm_url mode=a). Throws
-/// std::runtime_error "path: its clock goes back ..." naming the frame.
-void check_one_run(const std::string& path, double& latest_s, double t_s, std::int64_t seq);
+/// than a second before the latest so far (`clock`, updated here) is a clock
+/// that started again, a second run appended (lcm_url mode=a), unless it is
+/// back in step with the frames before the latest: then that one frame's
+/// time jumped ahead alone (a damaged timestamp). Throws std::runtime_error
+/// "path: its clock goes back ..." or "path: ... frame N jumps ... ahead",
+/// naming the frame.
+void check_one_run(const std::string& path, RunClock& clock, double t_s, std::int64_t seq);
 
 /// check_one_run over every PINBALL_OBSERVATION of `events` (the log at
 /// `path`) that decodes; for a reader that plays the whole log on one

@@ -109,6 +109,7 @@ class ViewState {
   std::deque<double> frame_times_s_;  // observation times within the rate window
   bool last_found_ = false;
   std::int64_t last_seq_ = -1;
+  double last_seq_t_s_ = 0.0;  // the time of the frame last_seq_ numbers
   std::int64_t seq_gaps_ = 0;
   std::optional<pinball_lcm::lcmt_pinball_projection> projection_;
   int no_projection_reason_ = 0;
