@@ -350,16 +350,7 @@ TEST(EventStepper, ATurningBladeStrikesABallAtRestAndTheBallFliesOff) {
 TEST(EventStepper, AKickoutFasterThanTheClampIsClamped) {
   table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
   b.ball.speed_max_mps = 5.0;
-  table::Sensor hole;
-  hole.kind = table::SensorKind::kHole;
-  hole.shape.kind = table::ShapeKind::kCircle;
-  hole.shape.p0 = {0.5, 0.5};
-  hole.shape.radius_m = 0.01;
-  hole.has_kickout = true;
-  hole.kickout_mps = {0.0, 100.0};
-  hole.kickout_spread_rad = 0.0;
-  hole.kickout_noise = 0.0;
-  b.sensors.push_back(hole);
+  b.sensors.push_back(exact_kickout_hole({0.5, 0.5}, 0.01, {0.0, 100.0}));
   const EventStepper stepper(b);
   GameState s = state_with_ball(b, {0.3, 0.5}, {1.0, 0.0});
   bool kicked = false;

@@ -87,6 +87,19 @@ inline int add_flipper(table::Board& board, table::Side side, const Vec2& pivot,
   return static_cast<int>(board.flippers.size()) - 1;
 }
 
+/// A hole of `radius_m` at `centre` that kicks the ball out at exactly
+/// `kickout_mps` (no spread, no noise).
+inline table::Sensor exact_kickout_hole(const Vec2& centre, double radius_m, const Vec2& kickout_mps) {
+  table::Sensor hole;
+  hole.kind = table::SensorKind::kHole;
+  hole.shape = table::make_circle_shape(centre, radius_m);
+  hole.has_kickout = true;
+  hole.kickout_mps = kickout_mps;
+  hole.kickout_spread_rad = 0.0;
+  hole.kickout_noise = 0.0;
+  return hole;
+}
+
 /// An empty table of the given size: ball radius 13.5 mm, the given gravity
 /// and dt, a large speed clamp (so that it does not interfere unless a test
 /// lowers it), launcher in the lower right.

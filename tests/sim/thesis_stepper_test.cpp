@@ -534,16 +534,8 @@ TEST(ThesisStepperSensors, FastBallCannotSkipALineSensor) {
 
 TEST(ThesisStepperSensors, HoleWithKickoutPlacesBallAtCentre) {
   table::Board b = empty_board(1.0, 1.0, 0.0, 5e-4);
-  table::Sensor hole;
-  hole.kind = table::SensorKind::kHole;
-  hole.shape.kind = table::ShapeKind::kCircle;
-  hole.shape.p0 = {0.5, 0.5};
-  hole.shape.radius_m = 0.01;
+  table::Sensor hole = exact_kickout_hole({0.5, 0.5}, 0.01, {-0.8, 1.5});  // the spread has its own test below
   hole.action.score = 100.0;
-  hole.has_kickout = true;
-  hole.kickout_mps = {-0.8, 1.5};
-  hole.kickout_spread_rad = 0.0;  // the exact kickout; the spread has its own test below
-  hole.kickout_noise = 0.0;
   b.sensors.push_back(hole);
   const ThesisStepper stepper(b);
   GameState s = state_with_ball(b, {0.3, 0.505}, {1.0, 0.0});
