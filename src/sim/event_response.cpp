@@ -35,13 +35,22 @@ void finish_response(StepContext& ctx) {
   if (ctx.options.speed_clamp) clamp_speed(ctx.state.ball.velocity_mps, ctx.board.ball.speed_max_mps);
 }
 
-// A ball jammed between a moving flipper and a surface facing it.
-bool pinched(const StepContext& ctx, const Vec2& n) {
+// A ball jammed between moving flipper `pusher` and a surface facing it: an obstacle, or another
+// flipper's blade (two flippers whose sweeps overlap had held the ball by the event guard alone).
+bool pinched(const StepContext& ctx, std::int32_t pusher, const Vec2& n) {
   const table::Board& board = ctx.board;
   const Vec2& p = ctx.state.ball.position_m;
   const double r = ctx.r;
   const double near = ctx.options.contact_tolerance_m;
   bool found = false;
+  for (std::size_t j = 0; j < board.flippers.size() && !found; ++j) {
+    if (static_cast<std::int32_t>(j) == pusher) continue;
+    const table::Flipper& f = board.flippers[j];
+    const Vec2 tip = table::flipper_tip(f, ctx.state.flippers[j].theta_rad);
+    const Vec2 d = p - (f.pivot + closest_param_on_segment(p, f.pivot, tip) * (tip - f.pivot));
+    const double dist = d.norm();
+    if (dist > 0.0 && dist - r <= near) found = (d / dist).dot(n) < kPinchCosine;
+  }
   ctx.obstacles.for_each([&](std::int32_t i) {
     if (found || ctx.state.visible[i] != kVisible) return;
     const table::Shape& s = board.shapes[i];
@@ -69,7 +78,12 @@ void hit_flipper(StepContext& ctx, const Next& next) {
   Vec2& v = ctx.state.ball.velocity_mps;
   StepEvents& events = ctx.events;
   events.flipper = next.index;
-  if (fs.omega_rad_s != 0.0 && pinched(ctx, next.normal)) {
+  // Only a face that moves into the ball can pinch it: at the pivot it stands still (a ball resting in
+  // the corner of a floor and the pivot had stalled the flipper for as long as it was held).
+  const bool closing =
+      fs.omega_rad_s != 0.0 &&
+      flipper_point_velocity(f, fs.theta_rad, fs.omega_rad_s, next.point).dot(next.normal) > 0.0;
+  if (closing && pinched(ctx, next.index, next.normal)) {
     fs.omega_rad_s = 0.0;  // stalled until the next step's command
     events.flags |= StepEvents::kFlipperStall;
   }

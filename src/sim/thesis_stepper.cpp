@@ -174,7 +174,7 @@ void ThesisStepper::update_flippers(GameState& state, StepEvents& events) const 
       normal = dist > 0.0 ? Vec2(away / dist) : n_face;
       pushed = contact + (r + options_.separation_m) * normal;
     }
-    if (obstacle_penetration_m(board_, state, obstacle_candidates(pushed), pushed) > kStallDepth_m) {
+    if (push_is_blocked(state, i, p, pushed)) {
       fs.theta_rad = theta_old;  // jammed against a wall: the flipper stalls
       fs.omega_rad_s = 0.0;
       events.flags |= StepEvents::kFlipperStall;
@@ -305,6 +305,28 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
     events.flags |= StepEvents::kLeftTable;
     lose_ball(state, events);
   }
+}
+
+bool ThesisStepper::push_is_blocked(const GameState& state, std::size_t pusher, const Vec2& from,
+                                    const Vec2& to) const {
+  if (obstacle_penetration_m(board_, state, obstacle_candidates(to), to) > kStallDepth_m) return true;
+  // The way there too: a push longer than the ball's radius (a long blade, a fast stroke, a long step)
+  // had carried its centre past a one-sided line or through a polygon, where no overlap is counted.
+  const double r = board_.ball.radius_m;
+  Contact c;
+  for (const Vec2& at : {from, to}) {
+    for (const std::int32_t k : obstacle_candidates(at)) {
+      if (state.visible[k] == kVisible && shape_time_of_impact(board_.shapes[k], from, to - from, r, 1.0, c)) return true;
+    }
+  }
+  // And the other flippers: one whose blade lay in the way had been pushed through.
+  for (std::size_t j = 0; j < board_.flippers.size(); ++j) {
+    if (j == pusher) continue;
+    const table::Flipper& f = board_.flippers[j];
+    const double d = distance_point_segment(to, f.pivot, table::flipper_tip(f, state.flippers[j].theta_rad));
+    if (r - d > kStallDepth_m) return true;
+  }
+  return false;
 }
 
 void ThesisStepper::apply_obstacle_hit(GameState& state, std::int32_t index, const Vec2& normal,

@@ -172,6 +172,15 @@ double flipper_step_chord_m(const Flipper& flipper, double dt_s) {
   return half_sweep >= M_PI / 2.0 ? flipper.length_m : flipper.length_m * std::sin(half_sweep);
 }
 
+std::string flipper_tip_speed_problem(const Board& board, const Flipper& f) {
+  const double tip_mps = f.omega_rad_s * f.length_m;
+  if (tip_mps < board.ball.speed_max_mps) return "";
+  return "flipper '" + f.name + "': its tip moves at " + format_number(tip_mps, 4) +
+         " m/s (OMEGA x LENGTH), not below the ball's speed clamp SPEED_MAX " +
+         format_number(board.ball.speed_max_mps, 4) +
+         " m/s: a struck ball, held to the clamp, could never leave the blade";
+}
+
 void check_flipper_time_step(const Board& board, double dt_s) {
   for (const Flipper& f : board.flippers) {
     const double chord = flipper_step_chord_m(f, dt_s);

@@ -159,6 +159,9 @@ void check_whole_file(const LoadState& state) {
     }
   }
   for (const Flipper& f : board.flippers) {
+    if (const std::string problem = flipper_tip_speed_problem(board, f); !problem.empty()) {
+      throw BoardError(state.file, f.source_line, "flipper: " + problem);
+    }
     // check_flipper_time_step's rule, said in the file's unit.
     const double chord = flipper_step_chord_m(f, board.dt_s);
     if (!(chord < board.ball.radius_m)) {

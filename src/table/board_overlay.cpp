@@ -183,6 +183,9 @@ void apply_board_overlay(const BoardOverlay& overlay, const std::string& name, B
         Board one = b;
         one.flippers = {*target};
         check_flipper_time_step(one, b.dt_s);
+        if (const std::string problem = flipper_tip_speed_problem(b, *target); !problem.empty()) {
+          throw std::invalid_argument(problem);
+        }
       } catch (const std::invalid_argument& e) {
         throw KeyError(name, "flippers[" + std::to_string(i) + "].omega_rad_s",
                        std::string(e.what()) + " on the board " + board.source);

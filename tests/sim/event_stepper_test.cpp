@@ -345,6 +345,49 @@ TEST(EventStepper, ATurningBladeStrikesABallAtRestAndTheBallFliesOff) {
   EXPECT_GT((s.ball.position_m - Vec2(0.39, 0.300001)).norm(), 0.1) << "it left where it was struck";
 }
 
+// A ball pushed by one flipper into another's blade, and a ball resting against a pivot: the pinch rule
+// had ignored other flippers (the guard alone held the ball, 177597 events) and taken a pivot, which
+// never moves, for a closing face (the flipper stalled for as long as it was held).
+TEST(EventStepper, AnotherFlipperPinchesAndAPivotDoesNot) {
+  const table::Board two = table::parse_board(R"(pinball-board 1
+size 1 1.5
+ball 0.0135 5
+gravity 1.11
+dt 0.0005
+balls 1
+launcher 0.9 1.4 noise=0
+start 0.390872753573 0.283081920028 0 0
+flipper right 0.45 0.3 0.1 -0.5 0.5 35.0 rho=0.6 mu=1.6 name=rf
+flipper left 0.330872754 0.304584423 0.1 -0.05 0.5 35.0 rho=0.6 mu=1.6 name=lf
+)", "two.board");
+  const EventStepper with_two(two);
+  GameState s = state_with_ball(two, two.start->position, Vec2::Zero());
+  s.flippers[0].energized = true;
+  for (int i = 0; i < 400; ++i) {
+    const std::uint64_t before = s.events;
+    with_two.step(s);
+    ASSERT_LT(s.events - before, 64u) << "step " << i;
+    ASSERT_LT(max_penetration_m(two, s), 1e-9) << "step " << i;
+  }
+  const table::Board pivot = table::parse_board(R"(pinball-board 1
+size 1 1
+ball 0.0135 5
+gravity 1.11
+dt 0.0005
+balls 1
+launcher 0.9 0.9 noise=0
+start 0.5105 0.4915 0 0
+flipper right 0.5 0.5 0.08 -0.5 0.5 35 rho=0.6 mu=1.6 name=rf
+line 0.49 0.4775 0.7 0.4800 name=floor
+wall 0.7 0.48 0.7 0.6 name=back
+)", "pivot.board");  // the ball rests in the corner of the floor and the pivot, behind the blade
+  const EventStepper at_pivot(pivot);
+  s = state_with_ball(pivot, pivot.start->position, Vec2::Zero());
+  s.flippers[0].energized = true;
+  for (int i = 0; i < 200; ++i) at_pivot.step(s);
+  EXPECT_EQ(s.flippers[0].theta_rad, pivot.flippers[0].theta_max_rad) << "the stroke is 29 ms";
+}
+
 // A kickout faster than the speed clamp is clamped, as the thesis stepper's next step clamps it: the
 // event stepper had flown it at 100 m/s under a 5 m/s clamp until its first collision.
 TEST(EventStepper, AKickoutFasterThanTheClampIsClamped) {

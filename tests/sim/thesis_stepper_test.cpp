@@ -788,6 +788,54 @@ TEST(ThesisStepperFlippers, ATipWhoseArcCrossesTheBallBetweenStepsStrikesIt) {
   EXPECT_TRUE(struck);
 }
 
+// A ball served at rest where the board's `start` puts it, then flipper 0 held energised.
+GameState served(const table::Board& b) {
+  GameState s = state_with_ball(b, b.start->position, b.start->velocity_mps);
+  s.flippers[0].energized = true;
+  return s;
+}
+
+// The sweep's push was checked for overlap at its end only: a long fast blade carried the ball's centre
+// past a one-sided roof in one push (y 0.220 -> 0.266 through the roof at 0.236), where no overlap is
+// counted, and pushed it through another flipper's blade. The flipper now stalls there.
+TEST(ThesisStepperFlippers, ASweepPushesTheBallThroughNothing) {
+  const table::Board roof = table::parse_board(R"(pinball-board 1
+size 1 1.5
+ball 0.0135 100
+gravity 1.11
+dt 0.0005
+balls 1
+launcher 0.9 1.4 noise=0
+start 0.276787020527 0.220756600009 0 0
+flipper right 0.45 0.3 0.2 -0.5 0.5 200.0 rho=0.6 mu=1.6 name=rf
+line 0.326787021 0.236256600 0.226787021 0.236256600 name=roof
+)", "roof.board");
+  const ThesisStepper on_roof(roof);
+  GameState s = served(roof);
+  for (int i = 0; i < 200; ++i) {
+    on_roof.step(s);
+    const bool under = s.ball.position_m.x() > 0.2268 && s.ball.position_m.x() < 0.3268;
+    ASSERT_FALSE(under && s.ball.position_m.y() > 0.2362566 - kR + 1e-6) << "step " << i << " crossed the roof";
+  }
+  const table::Board two = table::parse_board(R"(pinball-board 1
+size 1 1.5
+ball 0.0135 5
+gravity 1.11
+dt 0.0005
+balls 1
+launcher 0.9 1.4 noise=0
+start 0.390872753573 0.283081920028 0 0
+flipper right 0.45 0.3 0.1 -0.5 0.5 35.0 rho=0.6 mu=1.6 name=rf
+flipper left 0.330872754 0.304584423 0.1 -0.05 0.5 35.0 rho=0.6 mu=1.6 name=lf
+)", "two.board");  // the ball rests on rf, 5 mm under lf's blade
+  const ThesisStepper with_two(two);
+  s = served(two);
+  for (int i = 0; i < 400; ++i) {
+    with_two.step(s);
+    ASSERT_LT(flipper_penetration_m(two, s, s.ball.position_m), 1e-6) << "step " << i;
+  }
+}
+
 TEST(ThesisStepperFlippers, ContactSensorWhenBallRestsOnFlipper) {
   FlipperBoard fb(1.11, 0.0);  // horizontal at rest
   const table::Flipper& f = fb.board.flippers[0];

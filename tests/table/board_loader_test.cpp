@@ -372,7 +372,13 @@ TEST(BoardLoaderErrors, AFlipperTurnsNoFasterThanACoilCanTurnIt) {
   expect_error("pinball-board 1\nangles deg\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\n"
                "launcher 0.45 0.05\ndt 0.0005\nflipper left 0.15 0.16 0.01 -25 30 20000\n",
                9, "field OMEGA must be at most 11459.2 deg/s, got 20000");
-  EXPECT_NO_THROW(parse("flipper left 0.15 0.16 0.076 -0.5 0.5 200\n"));
+  EXPECT_NO_THROW(parse("flipper left 0.15 0.16 0.02 -0.5 0.5 200\n"));
+  // A tip at or above the ball's speed clamp: the event stepper struck the ball again and again, frozen
+  // mid-stroke, until its guard held it; mit1993's tips move at 2.65 m/s under a 5 m/s clamp.
+  expect_body_error("flipper left 0.15 0.16 0.076 -0.5 0.5 70 name=lf\n", 8,
+                    "flipper: flipper 'lf': its tip moves at 5.32 m/s (OMEGA x LENGTH), not below the ball's speed "
+                    "clamp SPEED_MAX 5 m/s: a struck ball, held to the clamp, could never leave the blade");
+  EXPECT_NO_THROW(parse("flipper left 0.15 0.16 0.076 -0.5 0.5 60\n"));
 }
 
 // Found by a helper: mu=1e300 overflowed the speed clamp to a stopped ball, and score=1e308
@@ -619,20 +625,18 @@ TEST(BoardLoaderErrors, FlipperThetaMinNotBelowThetaMax) {
 }
 
 TEST(BoardLoaderErrors, FlipperTooFastForTheTimeStep) {
-  // 0.076 m * sin(200 rad/s * 0.0005 s / 2) = 3.8 mm: fine; a 0.3 m blade: 0.3 * sin(0.05) = 15.0 mm > 13.5 mm.
-  EXPECT_NO_THROW(parse("point 0.3 0.9\nflipper left 0.1 0.2 0.076 -0.5 0.5 200\n"));
-  expect_body_error("point 0.3 0.9\nflipper left 0.1 0.2 0.3 -0.5 0.5 200 name=lf\n", 9, "l*sin(omega*dt/2)");
-  expect_body_error("point 0.3 0.9\nflipper left 0.1 0.2 0.3 -0.5 0.5 200 name=lf\n", 9, "flipper: flipper 'lf'");
+  // A 0.1 m blade at 45 rad/s (tip 4.5 m/s, under the clamp): 0.1 * sin(45 * 0.0005 / 2) = 1.1 mm at
+  // dt 0.5 ms, fine; 0.1 * sin(45 * 0.008 / 2) = 17.9 mm > 13.5 mm at dt 8 ms.
+  const std::string head = "pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\nlauncher 0.45 0.05\n";
+  EXPECT_NO_THROW(parse("point 0.3 0.9\nflipper left 0.1 0.2 0.1 -0.5 0.5 45\n"));
+  expect_error(head + "dt 0.008\nflipper left 0.1 0.2 0.1 -0.5 0.5 45 name=lf\n", 8, "l*sin(omega*dt/2)");
+  expect_error(head + "dt 0.008\nflipper left 0.1 0.2 0.1 -0.5 0.5 45 name=lf\n", 8, "flipper: flipper 'lf'");
   // dt after the flipper still counts: the check runs on the whole file.
-  expect_error(
-      "pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\nlauncher 0.45 0.05\n"
-      "flipper left 0.1 0.2 0.076 -0.5 0.5 200\n"
-      "dt 0.002\n",
-      7, "l*sin(omega*dt/2)");
+  expect_error(head + "flipper left 0.1 0.2 0.1 -0.5 0.5 45\ndt 0.008\n", 7, "l*sin(omega*dt/2)");
   // Said in the file's unit.
   expect_error("pinball-board 1\nunits mm\nsize 510 1070\nball 13.5 5000\ngravity 1110\nballs 3\nlauncher 450 50\n"
-               "dt 0.0005\nflipper left 100 200 300 -0.5 0.5 200 name=lf\n",
-               9, "l*sin(omega*dt/2) = 14.9938 mm is not below the ball radius 13.5 mm at dt = 0.0005 s");
+               "dt 0.008\nflipper left 100 200 100 -0.5 0.5 45 name=lf\n",
+               9, "l*sin(omega*dt/2) = 17.903 mm is not below the ball radius 13.5 mm at dt = 0.008 s");
 }
 
 TEST(BoardLoaderErrors, BallAtTheLauncherOverlaps) {

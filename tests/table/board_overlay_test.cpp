@@ -474,6 +474,19 @@ TEST(BoardOverlay, AStrokeTooFastForTheBoardsStepIsRefusedAtItsKey) {
   EXPECT_EQ(b.flippers[0].omega_rad_s, file.flippers[0].omega_rad_s);  // all or nothing
   o.flippers[0].omega_rad_s->value = 20.0;
   EXPECT_NO_THROW(apply_board_overlay(o, "over.yaml", b));
+  // At the board's own step, a tip faster than the speed clamp (70 rad/s x 76 mm > 5 m/s) is refused too.
+  b = file;
+  b.dt_s = 0.0005;
+  o.flippers[0].omega_rad_s->value = 70.0;
+  try {
+    apply_board_overlay(o, "over.yaml", b);
+    FAIL() << "no error";
+  } catch (const KeyError& e) {
+    EXPECT_EQ(e.key(), "flippers[0].omega_rad_s");
+    EXPECT_NE(e.message().find("its tip moves at 5.32 m/s (OMEGA x LENGTH), not below the ball's speed clamp"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(BoardOverlay, ALaunchThatCannotLeaveTheLauncherIsRefused) {

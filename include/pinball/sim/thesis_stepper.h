@@ -52,6 +52,10 @@ class ThesisStepper {
   void update_sensors(GameState& state, const Vec2& from, StepEvents& events) const;
   void update_contacts(GameState& state, std::span<const std::int32_t> candidates, StepEvents& events) const;
   void lose_ball(GameState& state, StepEvents& events) const;
+  /// Whether a flipper's sweep may not push the ball from `from` to `to`: an
+  /// obstacle overlaps it there or lies across the way, or another flipper's
+  /// blade overlaps it there. Then the flipper stalls.
+  bool push_is_blocked(const GameState& state, std::size_t pusher, const Vec2& from, const Vec2& to) const;
   void raise_flags(GameState& state) const;
 
   const table::Board& board_;

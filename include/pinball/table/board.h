@@ -283,4 +283,9 @@ double flipper_step_chord_m(const Flipper& flipper, double dt_s);
 /// l·sin(θ̇₀·dt/2) < r for any flipper.
 void check_flipper_time_step(const Board& board, double dt_s);
 
+/// Why flipper `f`'s tip is too fast for `board`'s ball, or "": a tip at or
+/// above the speed clamp overtakes every ball it strikes (the event stepper
+/// struck one again and again, frozen mid-stroke, until its guard held it).
+std::string flipper_tip_speed_problem(const Board& board, const Flipper& f);
+
 }  // namespace pinball::table
