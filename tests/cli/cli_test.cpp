@@ -639,8 +639,8 @@ TEST_F(Cli, AnEmptyOutputPathIsRefusedNotTakenAsNone) {
 
 // A flipper ten times as fast as the thesis's: 5 ms, within --dt's range, is too long for them.
 TEST_F(Cli, TimeStepThatBreaksTheFlipperConditionIsRefused) {
-  const fs::path fast = variant_board(dir_, "-25 30 2000 ", "-25 30 10000 ");  // the left flipper, 175 rad/s
-  const CommandResult r = run("sim " + fast.string() + " --dt 0.005");
+  const fs::path fast = variant_board(dir_, "-25 30 2000 ", "-25 30 3700 ");  // the left flipper, 65 rad/s
+  const CommandResult r = run("sim " + fast.string() + " --dt 0.008");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("l*sin(omega*dt/2)"), std::string::npos) << r.err;
 }
