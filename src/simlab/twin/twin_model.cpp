@@ -139,7 +139,9 @@ void check_board_fits_the_twin(const table::Board& board, const TwinParams& para
   }
   const double pin = params.pin_radius_m.value;
   const double rf = params.flipper_radius_m.value;
-  for (const auto& [place, p] : places) {
+  for (const auto& served : places) {
+    const std::string& place = served.first;  // named, not bound: clang's lambdas take no structured binding
+    const Vec2& p = served.second;
     auto refuse = [&](const std::string& solid, double gap_m) {
       check_input(gap_m >= 0.0, context,
                   "the ball at " + place + " would overlap " + solid + " by " + mm(-gap_m) +
