@@ -289,7 +289,8 @@ void ThesisStepper::move_ball(GameState& state, StepEvents& events) const {
         surface_m = table::distance_to_shape(board_.shapes[contacts.obstacle[k]], p);
       } else {
         const table::Flipper& f = board_.flippers[contacts.flipper[k]];
-        surface_m = distance_point_segment(p, f.pivot, table::flipper_tip(f, state.flippers[contacts.flipper[k]].theta_rad));
+        const double theta = state.flippers[contacts.flipper[k]].theta_rad;
+        surface_m = distance_point_segment(p, f.pivot, table::flipper_tip(f, theta));
       }
       if (std::max(plane_gap_m, surface_m - r) <= options_.contact_tolerance_m) touching[n++] = contacts.normal[k];
     }
@@ -316,7 +317,8 @@ bool ThesisStepper::push_is_blocked(const GameState& state, std::size_t pusher, 
   Contact c;
   for (const Vec2& at : {from, to}) {
     for (const std::int32_t k : obstacle_candidates(at)) {
-      if (state.visible[k] == kVisible && shape_time_of_impact(board_.shapes[k], from, to - from, r, 1.0, c)) return true;
+      if (state.visible[k] != kVisible) continue;
+      if (shape_time_of_impact(board_.shapes[k], from, to - from, r, 1.0, c)) return true;
     }
   }
   // And the other flippers: one whose blade lay in the way had been pushed through.

@@ -209,7 +209,8 @@ TEST(DaemonConfig, LabModeNeedsItsHardware) {
   // Pasted unquoted into the bring-up check's `sudo ip link add dev ...` hint, "can0; rm" read as two commands.
   EXPECT_EQ(error_of("mode: lab\nboard: b\ncamera: {source: v4l2, device: /dev/video0}\n"
                      "can: {interface: 'can0; rm'}"),
-            "t.yaml: can.interface: 'can0; rm' is no interface name (at most 15 letters, digits, '_', '.', '-' or '@')");
+            "t.yaml: can.interface: 'can0; rm' is no interface name (at most 15 letters, digits, '_', '.', '-' "
+            "or '@')");
 }
 
 TEST(DaemonConfig, TheLabExampleLoads) {

@@ -627,7 +627,8 @@ TEST(BoardLoaderErrors, FlipperThetaMinNotBelowThetaMax) {
 TEST(BoardLoaderErrors, FlipperTooFastForTheTimeStep) {
   // A 0.1 m blade at 45 rad/s (tip 4.5 m/s, under the clamp): 0.1 * sin(45 * 0.0005 / 2) = 1.1 mm at
   // dt 0.5 ms, fine; 0.1 * sin(45 * 0.008 / 2) = 17.9 mm > 13.5 mm at dt 8 ms.
-  const std::string head = "pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\nlauncher 0.45 0.05\n";
+  const std::string head =
+      "pinball-board 1\nsize 0.51 1.07\nball 0.0135 5\ngravity 1.11\nballs 3\nlauncher 0.45 0.05\n";
   EXPECT_NO_THROW(parse("point 0.3 0.9\nflipper left 0.1 0.2 0.1 -0.5 0.5 45\n"));
   expect_error(head + "dt 0.008\nflipper left 0.1 0.2 0.1 -0.5 0.5 45 name=lf\n", 8, "l*sin(omega*dt/2)");
   expect_error(head + "dt 0.008\nflipper left 0.1 0.2 0.1 -0.5 0.5 45 name=lf\n", 8, "flipper: flipper 'lf'");

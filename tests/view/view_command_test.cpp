@@ -192,8 +192,8 @@ TEST_F(ViewCommand, ATimePastTheEndOfTheLogIsRefused) {
   EXPECT_NE(r.err.find("ends at 1 s"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(png));
   // --quit-at past the end had played on for ever: the view holds at the end and never reaches it.
-  const CommandResult q = run_shell("env -u DISPLAY -u WAYLAND_DISPLAY QT_QPA_PLATFORM=offscreen timeout 60 " PINBALL_EXE
-                                    " view " + log_ + " --snapshot " + png + " --quit-at 100");
+  const CommandResult q = run_shell("env -u DISPLAY -u WAYLAND_DISPLAY QT_QPA_PLATFORM=offscreen timeout 60 "
+                                    PINBALL_EXE " view " + log_ + " --snapshot " + png + " --quit-at 100");
   EXPECT_EQ(q.exit_code, 1);
   EXPECT_NE(q.err.find("--quit-at 100: the log " + log_ + " ends at 1 s"), std::string::npos) << q.err;
   EXPECT_FALSE(std::filesystem::exists(png));
