@@ -70,6 +70,21 @@ TEST(LogPlayer, ThePlayedLogCarriesTheCommandsCoilsAndStats) {
   EXPECT_EQ(player.state().messages(), player.events());
 }
 
+// lcm-logger stamps each event on receipt: an NTP step 30 s back halfway through had put the game's
+// end before its start ("ends at 10.54 s", the last ball at -9.15 s). The daemon's own message times
+// are the clock, as the live view reads them.
+TEST(LogPlayer, PlaysOnTheDaemonsClockNotTheLoggersStamps) {
+  const std::string path = pinball::testing::temp_path("log_player_ntp", "game.lcmlog");
+  pinball::testing::write_view_log(path);
+  std::vector<bus::LcmLogEvent> events = bus::read_lcm_log(path);
+  for (std::size_t i = events.size() / 2; i < events.size(); ++i) events[i].utime -= 30'000'000;
+  LogPlayer player(std::move(events));
+  EXPECT_NEAR(player.duration_s(), 1.0, 1e-9);
+  player.seek(0.9001);  // frame 180
+  ASSERT_TRUE(player.state().ball().has_value());
+  EXPECT_NEAR((player.state().ball()->p_board - pinball::testing::view_log_ball(0.9)).norm(), 0.0, 1e-12);
+}
+
 TEST(LogPlayer, RefusesALogWithoutEvents) { EXPECT_THROW(LogPlayer({}), std::invalid_argument); }
 
 }  // namespace

@@ -14,11 +14,14 @@
 
 namespace pinball::view {
 
-/// Plays a log into a view. Times are seconds from the log's first event.
+/// Plays a log into a view. Times are seconds from the log's first event, on
+/// the daemon's own clock: each of its messages' utime (as the live view
+/// reads them), not the log's event headers, which lcm-logger stamps on
+/// receipt (an NTP step under it had put the end of a game before its
+/// start). Another program's event takes the time of the event before it.
 class LogPlayer {
  public:
-  /// Takes the events of a log (file order; their timestamps never go back
-  /// in a log pinballd or lcm-logger wrote; an event out of order is played
+  /// Takes the events of a log (file order; an event out of order is played
   /// at its place in the file). Throws std::invalid_argument for no events.
   explicit LogPlayer(std::vector<bus::LcmLogEvent> events, ViewStateOptions options = {});
 
@@ -43,6 +46,7 @@ class LogPlayer {
   double time_of(std::size_t i) const;
 
   std::vector<bus::LcmLogEvent> events_;
+  std::vector<double> times_s_;  // each event's time, from the first
   ViewStateOptions options_;
   ViewState state_;
   std::size_t next_ = 0;  // first event not applied
