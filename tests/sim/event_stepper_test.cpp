@@ -349,17 +349,7 @@ TEST(EventStepper, ATurningBladeStrikesABallAtRestAndTheBallFliesOff) {
 // had ignored other flippers (the guard alone held the ball, 177597 events) and taken a pivot, which
 // never moves, for a closing face (the flipper stalled for as long as it was held).
 TEST(EventStepper, AnotherFlipperPinchesAndAPivotDoesNot) {
-  const table::Board two = table::parse_board(R"(pinball-board 1
-size 1 1.5
-ball 0.0135 5
-gravity 1.11
-dt 0.0005
-balls 1
-launcher 0.9 1.4 noise=0
-start 0.390872753573 0.283081920028 0 0
-flipper right 0.45 0.3 0.1 -0.5 0.5 35.0 rho=0.6 mu=1.6 name=rf
-flipper left 0.330872754 0.304584423 0.1 -0.05 0.5 35.0 rho=0.6 mu=1.6 name=lf
-)", "two.board");
+  const table::Board two = ball_between_two_flippers();
   const EventStepper with_two(two);
   GameState s = state_with_ball(two, two.start->position, Vec2::Zero());
   s.flippers[0].energized = true;

@@ -10,6 +10,7 @@
 #include "pinball/core/geometry.h"
 #include "pinball/core/rng.h"
 #include "pinball/table/board.h"
+#include "pinball/table/board_loader.h"
 #include "pinball/sim/game_state.h"
 
 namespace pinball::sim::testing {
@@ -98,6 +99,22 @@ inline table::Sensor exact_kickout_hole(const Vec2& centre, double radius_m, con
   hole.kickout_spread_rad = 0.0;
   hole.kickout_noise = 0.0;
   return hole;
+}
+
+/// Two flippers whose sweeps overlap, the ball served at rest on the right
+/// one 5 mm under the left one's blade: raising the right pinches it there.
+inline table::Board ball_between_two_flippers() {
+  return table::parse_board(R"(pinball-board 1
+size 1 1.5
+ball 0.0135 5
+gravity 1.11
+dt 0.0005
+balls 1
+launcher 0.9 1.4 noise=0
+start 0.390872753573 0.283081920028 0 0
+flipper right 0.45 0.3 0.1 -0.5 0.5 35.0 rho=0.6 mu=1.6 name=rf
+flipper left 0.330872754 0.304584423 0.1 -0.05 0.5 35.0 rho=0.6 mu=1.6 name=lf
+)", "two_flippers.board");
 }
 
 /// An empty table of the given size: ball radius 13.5 mm, the given gravity

@@ -817,17 +817,7 @@ line 0.326787021 0.236256600 0.226787021 0.236256600 name=roof
     const bool under = s.ball.position_m.x() > 0.2268 && s.ball.position_m.x() < 0.3268;
     ASSERT_FALSE(under && s.ball.position_m.y() > 0.2362566 - kR + 1e-6) << "step " << i << " crossed the roof";
   }
-  const table::Board two = table::parse_board(R"(pinball-board 1
-size 1 1.5
-ball 0.0135 5
-gravity 1.11
-dt 0.0005
-balls 1
-launcher 0.9 1.4 noise=0
-start 0.390872753573 0.283081920028 0 0
-flipper right 0.45 0.3 0.1 -0.5 0.5 35.0 rho=0.6 mu=1.6 name=rf
-flipper left 0.330872754 0.304584423 0.1 -0.05 0.5 35.0 rho=0.6 mu=1.6 name=lf
-)", "two.board");  // the ball rests on rf, 5 mm under lf's blade
+  const table::Board two = ball_between_two_flippers();  // the ball rests on rf, 5 mm under lf's blade
   const ThesisStepper with_two(two);
   s = served(two);
   for (int i = 0; i < 400; ++i) {
