@@ -614,7 +614,7 @@ DaemonReport Daemon::run() {
       });
     });
   }
-  LiveStatus live = LiveStatus::for_stderr(d.sim_mode ? d.config.sim.balls : 0, d.lockstep);
+  LiveStatus live = LiveStatus::for_stderr(d.sim_mode ? d.config.sim.balls : 0, d.lockstep, d.config.progress);
   while (!d.h.stop.load(std::memory_order_acquire) && !d.h.controller_done.load(std::memory_order_acquire)) {
     d.h.main_bell.wait(0.1);
     d.report_faults();
@@ -628,7 +628,7 @@ DaemonReport Daemon::run() {
   controller.join();
   driver.join();
   d.shutdown();
-  live.finish();  // after the coils are off: it writes to stderr
+  live.finish([&d] { return d.report(); });  // after the coils are off: it writes to stderr
   d.report_faults();
   // The CAN log's last frame is the shutdown's ReleaseAll: closed (what the sink takes within its
   // grace, the rest counted) before the LCM thread's last PINBALL_STATS, which carries its counters.

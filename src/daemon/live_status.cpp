@@ -60,8 +60,13 @@ void LiveStatus::tick_at(const std::function<DaemonReport()>& report, double ela
   shown_ = true;
 }
 
-void LiveStatus::finish() {
-  if (out_ && rewrite_ && shown_) std::fputs("\n", out_);
+void LiveStatus::finish(const std::function<DaemonReport()>& report) {
+  if (out_ && shown_) {
+    last_s_ = -1.0;  // shown whatever the interval: a script's log had ended at "0/3 balls"
+    tick_at(report, now_s() - start_s_);
+    if (rewrite_) std::fputs("\n", out_);
+    std::fflush(out_);
+  }
   shown_ = false;
 }
 

@@ -29,8 +29,9 @@ class LiveStatus {
   void tick(const std::function<DaemonReport()>& report);
   /// The same at a given elapsed time (tests).
   void tick_at(const std::function<DaemonReport()>& report, double elapsed_s);
-  /// Ends the rewritten line, so that the report starts on its own.
-  void finish();
+  /// The last line (the run's end: 100 % in simulation), when any line was
+  /// shown, then ends a rewritten line, so that the report starts on its own.
+  void finish(const std::function<DaemonReport()>& report);
 
  private:
   std::FILE* out_;

@@ -91,7 +91,7 @@ static int run_pinballd(int argc, char** argv) {
       sim_camera, identified;
   int balls = -1;
   long long seed = -1;
-  bool realtime = false, json = false, threads = false, check = false;
+  bool realtime = false, json = false, threads = false, check = false, progress = false;
   const DaemonConfig defaults;  // what --help shows as each option's default (no --config)
   app.add_option("--config", config_path, "YAML configuration (config/lab.example.yaml); none: embedded simulation")
       ->transform(pinball::data_file());
@@ -136,6 +136,9 @@ static int run_pinballd(int argc, char** argv) {
       ->check(pinball::output_file());
   app.add_flag("--realtime", realtime, "simulation paced to the wall clock (default: lockstep virtual clock)");
   app.add_flag("--json", json, "print the report as one JSON object on stdout");
+  app.add_flag("--progress", progress,
+               "the live status line (balls with percent and ETA in simulation) on stderr even when it is not a "
+               "terminal (a terminal always gets it)");
   app.add_flag("--threads", threads, "print the thread table and exit");
   app.add_flag("--check", check,
                "load and check the configuration and every file it names, as at start, then exit: 0 when all is "
@@ -185,6 +188,7 @@ static int run_pinballd(int argc, char** argv) {
     if (seed >= 0) config.sim.seed = static_cast<std::uint64_t>(seed);
     if (!lcm_url.empty()) config.lcm_url = lcm_url;
     if (realtime) config.sim.realtime = true;
+    config.progress = progress;
     if (!can_log.empty()) config.can.log = can_log;
     // Given on the command line and then read by no world: said, not ignored (a file lists every key).
     const bool twin = config.sim.world == pinball::simlab::WorldKind::kTwin;

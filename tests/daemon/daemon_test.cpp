@@ -671,6 +671,18 @@ TEST(Daemon, AStartThatFailsLeavesTheLastRunsCanLogAsItWas) {
 
 // --check loads what a run would and stops: 0 and the summary, or 1 naming
 // the problem; it opens no camera, no CAN and no LCM, and plays nothing.
+// Under systemd or in a script's pipe stderr is no terminal: --progress still shows the balls, and the
+// end (the status line had stopped at "0/2 balls").
+TEST(Pinballd, ProgressIntoAPipeShowsTheBallsToTheEnd) {
+  std::string text;
+  ASSERT_EQ(run_shell(std::string(PINBALLD_EXE) + " --balls 2 --seed 4 --progress 2>&1 >/dev/null", text), 0) << text;
+  EXPECT_NE(text.find("pinballd: 0/2 balls (0 %)"), std::string::npos) << text;
+  EXPECT_NE(text.find("pinballd: 2/2 balls (100 %)"), std::string::npos) << text;
+  std::string quiet;
+  ASSERT_EQ(run_shell(std::string(PINBALLD_EXE) + " --balls 1 --seed 4 2>&1 >/dev/null", quiet), 0) << quiet;
+  EXPECT_EQ(quiet.find("balls ("), std::string::npos) << "no terminal, not asked: " << quiet;
+}
+
 TEST(Pinballd, CheckSaysWhatWouldRunOrWhatIsMissing) {
   std::string text;
   EXPECT_EQ(run_shell(std::string(PINBALLD_EXE) + " --check --controller controllers/spastic.json --json 2>&1", text),

@@ -52,12 +52,28 @@ TEST(LiveStatus, RewritesOneLineAtMostOncePerInterval) {
   s.tick_at(report, 1.0);
   s.tick_at(report, 1.5);  // too soon: the report is not even taken
   s.tick_at(report, 2.0);
-  s.finish();
+  s.finish([] { return report_after(10); });  // the end, shown whatever the interval
   std::fclose(f);
   EXPECT_EQ(reports, 2);
   const std::string out = buf;
   EXPECT_EQ(out.rfind("\rpinballd: 1/10 balls (10 %)", 0), 0u) << out;
   EXPECT_NE(out.find("\x1b[K\rpinballd: 2/10 balls (20 %)"), std::string::npos) << out;
+  EXPECT_NE(out.find("\x1b[K\rpinballd: 10/10 balls (100 %)"), std::string::npos) << out;
+  EXPECT_EQ(out.back(), '\n');
+}
+
+// --progress into a file or a pipe: one line per interval and the end, which had been left out.
+TEST(LiveStatus, APipeGetsALinePerIntervalAndTheEnd) {
+  char buf[1024] = {};
+  std::FILE* f = fmemopen(buf, sizeof buf - 1, "w");
+  ASSERT_NE(f, nullptr);
+  LiveStatus s(f, 3, true, false, 1.0);
+  s.tick_at([] { return report_after(0); }, 0.0);
+  s.finish([] { return report_after(3); });
+  std::fclose(f);
+  const std::string out = buf;
+  EXPECT_EQ(out.rfind("pinballd: 0/3 balls (0 %)", 0), 0u) << out;
+  EXPECT_NE(out.find("\npinballd: 3/3 balls (100 %)"), std::string::npos) << out;
   EXPECT_EQ(out.back(), '\n');
 }
 

@@ -186,6 +186,9 @@ struct DaemonConfig {
   std::string origin = "the command line";
   /// The configuration file it was loaded from ("" for none): no recording may replace it. Not a key.
   std::string file;
+  /// The live status line on stderr even when it is not a terminal (--progress: a log file, a lab
+  /// script's pipe). Not a key.
+  bool progress = false;
 
   template <class Archive>
   void Serialize(Archive* a) {
