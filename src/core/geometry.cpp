@@ -46,15 +46,36 @@ bool point_in_polygon(const Vec2& p, const std::vector<Vec2>& vertices) {
 }
 
 std::pair<int, int> polygon_self_crossing(const std::vector<Vec2>& vertices) {
+  // Sort and sweep along x: only edges whose x extents overlap can cross, so an outline of
+  // thousands of vertices (an arc from CAD) is checked in about n log n, not n².
   const std::size_t n = vertices.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t k = i + 2; k < n; ++k) {
-      if (i == 0 && k == n - 1) continue;  // the last edge ends where the first begins
-      const double d = distance_segment_segment(vertices[i], vertices[(i + 1) % n], vertices[k], vertices[(k + 1) % n]);
-      if (d == 0.0) return {static_cast<int>(i), static_cast<int>(k)};
+  const auto x_lo = [&](std::size_t e) { return std::min(vertices[e].x(), vertices[(e + 1) % n].x()); };
+  const auto x_hi = [&](std::size_t e) { return std::max(vertices[e].x(), vertices[(e + 1) % n].x()); };
+  const auto y_lo = [&](std::size_t e) { return std::min(vertices[e].y(), vertices[(e + 1) % n].y()); };
+  const auto y_hi = [&](std::size_t e) { return std::max(vertices[e].y(), vertices[(e + 1) % n].y()); };
+  std::vector<std::size_t> by_x_lo(n);
+  for (std::size_t e = 0; e < n; ++e) by_x_lo[e] = e;
+  std::sort(by_x_lo.begin(), by_x_lo.end(), [&](std::size_t a, std::size_t b) { return x_lo(a) < x_lo(b); });
+  std::pair<int, int> first{-1, -1};
+  std::vector<std::size_t> open;  // edges whose x extent reaches the sweep line
+  for (const std::size_t e : by_x_lo) {
+    const double x = x_lo(e);
+    std::erase_if(open, [&](std::size_t o) { return x_hi(o) < x; });
+    for (const std::size_t o : open) {
+      const std::size_t i = std::min(e, o);
+      const std::size_t k = std::max(e, o);
+      if (k == i + 1 || (i == 0 && k == n - 1)) continue;  // neighbours share a vertex
+      if (y_hi(i) < y_lo(k) || y_hi(k) < y_lo(i)) continue;
+      // The same pair as the pairwise scan reports: the first in (i, k) order.
+      const std::pair<int, int> pair{static_cast<int>(i), static_cast<int>(k)};
+      if (first.first >= 0 && pair >= first) continue;
+      if (distance_segment_segment(vertices[i], vertices[(i + 1) % n], vertices[k], vertices[(k + 1) % n]) == 0.0) {
+        first = pair;
+      }
     }
+    open.push_back(e);
   }
-  return {-1, -1};
+  return first;
 }
 
 double distance_point_box(const Vec2& p, const Vec2& lo, const Vec2& hi) {

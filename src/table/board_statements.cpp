@@ -284,7 +284,7 @@ void polyline(LoadState& state, const Reader& r) {
 }
 
 void polygon(LoadState& state, const Reader& r) {
-  // Its edges are checked pairwise for crossings: a longer outline is a polyline.
+  // The crossing check is n² at worst (a comb of long edges side by side): a longer outline is a polyline.
   constexpr std::size_t kMaxPolygonVertices = 10000;
   std::vector<Vec2> v = path(state, r, 3, true);
   if (v.size() > kMaxPolygonVertices) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
 #include <utility>
 #include <vector>
 
@@ -157,6 +158,51 @@ TEST(PolygonSelfCrossing, ABowTieCrossesASquareDoesNot) {
   EXPECT_EQ(polygon_self_crossing({{0, 0}, {1, 1}, {1, 0}, {0, 1}}), std::make_pair(0, 2));
   // Two lobes that touch at one point are no simple outline either.
   EXPECT_NE(polygon_self_crossing({{0, 0}, {1, 1}, {2, 0}, {2, 2}, {1, 1}, {0, 2}}).first, -1);
+}
+
+// The pairwise scan the sweep replaced: every non-adjacent pair, the first crossing in (i, k) order.
+std::pair<int, int> self_crossing_pairwise(const std::vector<Vec2>& v) {
+  const std::size_t n = v.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = i + 2; k < n; ++k) {
+      if (i == 0 && k == n - 1) continue;
+      if (distance_segment_segment(v[i], v[(i + 1) % n], v[k], v[(k + 1) % n]) == 0.0) {
+        return {static_cast<int>(i), static_cast<int>(k)};
+      }
+    }
+  }
+  return {-1, -1};
+}
+
+TEST(PolygonSelfCrossing, TheSweepReportsThePairwiseScansFirstPairOnRandomOutlines) {
+  // Random outlines on a coarse grid cross, touch at vertices and run along each other often.
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> coordinate(0, 6);
+  std::uniform_int_distribution<int> size(3, 12);
+  int crossing = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::vector<Vec2> v(static_cast<std::size_t>(size(rng)));
+    for (Vec2& p : v) p = Vec2(coordinate(rng), coordinate(rng));
+    const std::pair<int, int> expected = self_crossing_pairwise(v);
+    ASSERT_EQ(polygon_self_crossing(v), expected) << "trial " << trial;
+    crossing += expected.first >= 0;
+  }
+  EXPECT_GT(crossing, 1000);
+  EXPECT_LT(crossing, 3000);
+}
+
+TEST(PolygonSelfCrossing, AFineCircleIsSimpleAndOneDentedVertexIsFound) {
+  constexpr int kVertices = 20000;  // past the loader's bound: the pairwise scan took seconds here
+  std::vector<Vec2> circle;
+  for (int i = 0; i < kVertices; ++i) {
+    const double a = 2.0 * M_PI * i / kVertices;
+    circle.emplace_back(std::cos(a), std::sin(a));
+  }
+  EXPECT_EQ(polygon_self_crossing(circle), std::make_pair(-1, -1));
+  circle[5000] = Vec2(0.0, -1.5);  // pulled across the far side: its two edges cross the outline there
+  const std::pair<int, int> crossing = polygon_self_crossing(circle);
+  EXPECT_EQ(crossing.first, 4999);  // its first edge, across the bottom of the circle
+  EXPECT_NEAR(crossing.second, 15000, 2);
 }
 
 }  // namespace
