@@ -1,8 +1,11 @@
 #include "pinball/bus/recorded_play.h"
 
 #include <algorithm>
+#include <bit>
 #include <map>
+#include <set>
 #include <stdexcept>
+#include <tuple>
 
 #include "pinball/bus/channels.h"
 #include "pinball/bus/lcm_log_format.h"
@@ -137,6 +140,37 @@ RecordedPlay read_recorded_play(const std::string& path) {
   std::stable_sort(play.commands.begin(), play.commands.end(),
                    [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
   return play;
+}
+
+SharedSightings shared_sightings(const RecordedPlay& a, const RecordedPlay& b) {
+  // Exact doubles are the point: a copy keeps them bit for bit, another run never does.
+  using Key = std::tuple<std::int64_t, std::uint64_t, std::uint64_t, std::uint64_t>;
+  const auto key = [](const RecordedFrame& f) {
+    return Key{f.seq, std::bit_cast<std::uint64_t>(f.t_s), std::bit_cast<std::uint64_t>(f.p_board.x()),
+               std::bit_cast<std::uint64_t>(f.p_board.y())};
+  };
+  const auto for_each_moving = [](const RecordedPlay& play, const auto& visit) {
+    std::size_t count = 0;
+    for (std::size_t i = 1; i < play.frames.size(); ++i) {
+      const RecordedFrame& f = play.frames[i];
+      const RecordedFrame& before = play.frames[i - 1];
+      if (!f.found || !before.found || f.p_board == before.p_board) continue;
+      ++count;
+      visit(f);
+    }
+    return count;
+  };
+  SharedSightings s;
+  std::set<Key> in_b;
+  s.moving_b = for_each_moving(b, [&](const RecordedFrame& f) { in_b.insert(key(f)); });
+  s.moving_a = for_each_moving(a, [&](const RecordedFrame& f) {
+    if (!in_b.contains(key(f))) return;
+    if (s.shared++ == 0) {
+      s.first_seq = f.seq;
+      s.first_t_s = f.t_s;
+    }
+  });
+  return s;
 }
 
 std::string recorded_play_log(const RecordedPlay& play) {

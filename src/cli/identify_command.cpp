@@ -63,6 +63,33 @@ void check_distinct_files(const IdentifyArgs& a) {
   check_outputs_replace_no_input({{"identify: --out", a.out}}, inputs);
 }
 
+// Copies of one recording whose bytes differ (a channel dropped, a log re-logged) pass
+// check_distinct_files; they still share every frame, and would count twice, or test on fitted play.
+void check_no_recording_twice(const std::vector<bus::RecordedPlay>& plays, const std::vector<bus::RecordedPlay>& held) {
+  const auto check = [](const bus::RecordedPlay& a, const bus::RecordedPlay& b, const std::string& what_b,
+                        const char* why) {
+    const bus::SharedSightings s = bus::shared_sightings(a, b);
+    if (!s.same_recording()) return;
+    throw std::runtime_error("identify: " + what_b + " and " + a.source + " share " + std::to_string(s.shared) +
+                             " sightings of the moving ball (of " + std::to_string(s.moving_b) + " and " +
+                             std::to_string(s.moving_a) + "; the first at frame " + std::to_string(s.first_seq) +
+                             ", t = " + format_number(s.first_t_s) + " s): one recording twice; " + why);
+  };
+  for (std::size_t i = 0; i < plays.size(); ++i) {
+    for (std::size_t k = i + 1; k < plays.size(); ++k) {
+      check(plays[i], plays[k], "log " + plays[k].source, "its events would count twice");
+    }
+    for (const bus::RecordedPlay& h : held) {
+      check(plays[i], h, "--held-out " + h.source, "a held-out log must be one never fitted");
+    }
+  }
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    for (std::size_t k = i + 1; k < held.size(); ++k) {
+      check(held[i], held[k], "--held-out " + held[k].source, "its moments would count twice");
+    }
+  }
+}
+
 // The standard uncertainty of the flippers' mean rise delay (the actuation
 // delay the model worlds play): independent flippers, sqrt(sum s^2) / n.
 double actuation_delay_stderr_s(const table::BoardOverlay& overlay) {
@@ -364,6 +391,7 @@ int run_identify(const IdentifyArgs& a, std::ostream& out, std::ostream& err) {
   std::ostream* shown = progress_wanted(a.progress) ? &err : nullptr;
   const std::vector<bus::RecordedPlay> plays = read_all(a.logs, shown, "reading logs");
   const std::vector<bus::RecordedPlay> held = read_all(a.held_out, shown, "reading held-out logs");
+  check_no_recording_twice(plays, held);
   for (const std::vector<bus::RecordedPlay>* logs : {&plays, &held}) {
     for (const bus::RecordedPlay& play : *logs) learn::check_recording_fits_board(play, board);
   }

@@ -69,6 +69,37 @@ TEST(RecordedPlay, ReadsBackWhatItWrites) {
   EXPECT_NEAR(read.duration_s(), 0.095, 1e-6);
 }
 
+TEST(SharedSightings, ACopyWhoseBytesDifferIsOneRecordingAnotherRunIsNot) {
+  const RecordedPlay play = small_play();  // 19 frames after the first, 3 of them next to frame 7 (no ball)
+  RecordedPlay cut = play;
+  cut.frames.resize(12);  // a copy cut short, its bytes unlike the whole
+  cut.commands.clear();
+  const SharedSightings copy = shared_sightings(cut, play);
+  EXPECT_EQ(copy.moving_a, 9u);  // frames 1-11 but 7, which saw no ball, and 8, which follows it
+  EXPECT_EQ(copy.moving_b, 17u);
+  EXPECT_EQ(copy.shared, 9u);
+  EXPECT_EQ(copy.first_seq, 1);
+  EXPECT_DOUBLE_EQ(copy.first_t_s, 0.005);
+  EXPECT_TRUE(copy.same_recording());
+  EXPECT_TRUE(shared_sightings(play, cut).same_recording());
+
+  RecordedPlay other = play;  // another run: its ball 1 nm elsewhere in every frame
+  for (RecordedFrame& f : other.frames) f.p_board.x() += 1e-9;
+  EXPECT_EQ(shared_sightings(other, play).shared, 0u);
+  EXPECT_FALSE(shared_sightings(other, play).same_recording());
+
+  RecordedPlay same_launch = other;  // another game of one simulated seed: the same launch, then its own
+  for (std::size_t i = 0; i < 5; ++i) same_launch.frames[i] = play.frames[i];
+  const SharedSightings launch = shared_sightings(same_launch, play);
+  EXPECT_EQ(launch.shared, 4u);
+  EXPECT_FALSE(launch.same_recording());
+
+  RecordedPlay at_rest = play;  // a ball that never moves looks the same in every run
+  for (RecordedFrame& f : at_rest.frames) f.p_board = Vec2(0.1, 0.5);
+  EXPECT_EQ(shared_sightings(at_rest, at_rest).moving_a, 0u);
+  EXPECT_FALSE(shared_sightings(at_rest, at_rest).same_recording());
+}
+
 // One frame stamped 1e6 s ahead had been blamed on the frame after it, as "several runs appended".
 TEST(RecordedPlay, ALoneTimestampThatLeapsAheadIsNamedNotTakenForASecondRun) {
   RunClock clock;

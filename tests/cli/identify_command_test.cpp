@@ -209,6 +209,20 @@ TEST_F(IdentifyCommand, RefusesRepeatedInputsAndAnOutThatIsNoNewFile) {
   EXPECT_NE(held_copy.err.find("identify: --held-out " + copy + " is also a fitted log (a copy of " + log + ")"),
             std::string::npos)
       << held_copy.err;
+  // A copy whose bytes differ (its last quarter cut) is the same recording: fitted twice, or fitted and held out.
+  bus::RecordedPlay cut_play = bus::read_recorded_play(log);
+  cut_play.frames.resize(cut_play.frames.size() * 3 / 4);
+  const std::string cut = write("cut_copy.lcm", bus::recorded_play_log(cut_play));
+  const pinball::testing::CommandResult fitted_cut = run("identify " + log + " " + cut);
+  EXPECT_EQ(fitted_cut.exit_code, 1);
+  EXPECT_NE(fitted_cut.err.find("identify: log " + cut + " and " + log + " share "), std::string::npos)
+      << fitted_cut.err;
+  EXPECT_NE(fitted_cut.err.find("one recording twice; its events would count twice"), std::string::npos)
+      << fitted_cut.err;
+  const pinball::testing::CommandResult held_cut = run("identify " + log + " --held-out " + cut);
+  EXPECT_EQ(held_cut.exit_code, 1);
+  EXPECT_NE(held_cut.err.find("one recording twice; a held-out log must be one never fitted"), std::string::npos)
+      << held_cut.err;
   const pinball::testing::CommandResult over = run("identify " + log + " --out " + log);
   EXPECT_EQ(over.exit_code, 1);
   EXPECT_NE(over.err.find("--out " + log + " is the input"), std::string::npos) << over.err;

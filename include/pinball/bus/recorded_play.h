@@ -4,6 +4,8 @@
 // ball sighting with the flipper contact switches (PINBALL_OBSERVATION) and
 // every coil command (PINBALL_FLIPPER_CMD). Other channels are skipped.
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -72,6 +74,24 @@ void check_one_run(const std::string& path, RunClock& clock, double t_s, std::in
 /// `path`) that decodes; for a reader that plays the whole log on one
 /// timeline (`pinball view`), where two runs would play interleaved.
 void check_log_holds_one_run(const std::string& path, const std::vector<LcmLogEvent>& events);
+
+/// The sightings of a moving ball that two recordings share.
+struct SharedSightings {
+  std::size_t shared = 0;    ///< in both: same frame number, time and position to the last bit
+  std::size_t moving_a = 0;  ///< of `a`'s sightings where the ball had moved since the frame before
+  std::size_t moving_b = 0;  ///< the same of `b`
+  std::int64_t first_seq = -1;  ///< the first shared one (by time in `a`), or -1
+  double first_t_s = 0.0;
+  /// Copies of one recording share every sighting, even when their bytes
+  /// differ (a channel dropped, a log cut or logged again). Two runs share
+  /// none, but for a deterministic simulation's launch, which two games of one
+  /// seed both start with: hence half of the shorter one, not one sighting.
+  bool same_recording() const { return shared > 0 && 2 * shared >= std::min(moving_a, moving_b); }
+};
+
+/// Compares the moving sightings of `a` and `b` (a ball at rest, or no ball,
+/// looks the same in any run).
+SharedSightings shared_sightings(const RecordedPlay& a, const RecordedPlay& b);
 
 /// `play` as the bytes of an LCM log (frames and commands interleaved in time
 /// order, stamped with their own times), which read_recorded_play reads back:
