@@ -224,7 +224,8 @@ TargetDetection detect_target(const cv::Mat& gray, const TargetSpec& target, con
 }
 
 IntrinsicsFit calibrate_intrinsics(std::span<const TargetImage> images, const TargetSpec& target,
-                                   const IntrinsicsFitConfig& config) {
+                                   const IntrinsicsFitConfig& config,
+                                   const std::function<void(std::size_t searched)>& searched) {
   check_input(check_target(target), "target");
   check_input(check_intrinsics_fit_config(config), "intrinsics fit");
   if (images.empty()) throw std::runtime_error("intrinsics: no images");
@@ -262,6 +263,7 @@ IntrinsicsFit calibrate_intrinsics(std::span<const TargetImage> images, const Ta
       views.push_back(std::move(v));
     }
     fit.images.push_back(std::move(r));
+    if (searched) searched(i + 1);
   }
   const auto too_few = [&](const char* what) {
     throw std::runtime_error("intrinsics: only " + std::to_string(views.size()) + " of " +

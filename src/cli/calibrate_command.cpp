@@ -23,6 +23,7 @@
 #include "commands.h"
 #include "data_file.h"
 #include "flag_uses.h"
+#include "progress_option.h"
 #include "pinball/calibration/calibration_figure.h"
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/calibration/camera_calibration.h"
@@ -36,6 +37,7 @@
 #include "pinball/core/json_text.h"
 #include "pinball/core/json_write_archive.h"
 #include "pinball/core/number_option.h"
+#include "pinball/core/progress.h"
 #include "pinball/core/rng.h"
 #include "pinball/core/text_file.h"
 #include "pinball/firmware/can_link.h"
@@ -182,6 +184,7 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->check(finite_range(0.0, 100000.0))
       ->default_str("");  // -1: the simulated camera's
   cmd->add_option("--fps", a.fps, "latency: the frame rate asked of the camera")->check(finite_range(1.0, 2000.0));
+  add_progress_flag(*cmd, a.progress);
   cmd->add_flag("--json", a.json, "print one JSON object instead of text");
   // Printing the target is all a run with --print-target does: images to fit, or a file to write, would be ignored.
   for (const char* measured : {"--images", "--out", "--png"}) print_target->excludes(cmd->get_option(measured));
@@ -204,6 +207,7 @@ const std::vector<FlagUse>& calibrate_flag_uses() {
       {{"--roll", "--sim-rolls", "--sigma"}, {"gravity"}},
       {{"--calibration"}, {"flippers", "latency"}},
       {{"--png"}, {"intrinsics", "camera", "flippers", "gravity"}},
+      {{"--progress"}, {"intrinsics"}},
       {{"--device", "--can", "--flipper", "--events", "--sim-latency-ms", "--sim-actuation-delay-ms",
         "--actuation-delay-ms", "--row-time-us", "--exposure-us", "--fps"},
        {"latency"}},
@@ -978,7 +982,12 @@ int run_intrinsics(const CalibrateArgs& a, std::ostream& out, std::ostream& err)
     for (const std::string& path : paths) images.push_back({path, plot::read_gray_image(path)});
   }
   err << "calibrate intrinsics: " << images.size() << " images of the " << target.describe() << "\n";
-  const calibration::IntrinsicsFit fit = calibration::calibrate_intrinsics(images, target);
+  // Searching a large image that lacks the target takes seconds: 25 of them, minutes.
+  ProgressMeter meter(progress_wanted(a.progress) ? &err : nullptr, "calibrate intrinsics: searching for the target",
+                      static_cast<double>(images.size()), "images", !a.progress && progress_wanted(false));
+  meter.update(0);
+  const calibration::IntrinsicsFit fit = calibration::calibrate_intrinsics(
+      images, target, {}, [&](std::size_t searched) { meter.update(static_cast<double>(searched)); });
   const calibration::IntrinsicsCalibration& in = fit.calibration;
   const vision::CameraIntrinsics& lens = in.lens;
 

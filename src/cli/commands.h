@@ -178,6 +178,7 @@ struct CalibrateArgs {
   double row_time_us = -1.0;         ///< latency: rolling shutter row time (µs); < 0: the camera's (--sim) or the file's
   double exposure_us = -1.0;         ///< latency: the camera's exposure time (µs); < 0: the simulated camera's, or 0 in the lab
   double fps = 200.0;                ///< latency: the frame rate asked of the camera
+  bool progress = false;             ///< intrinsics: images searched, with ETA, even when stderr is no terminal
   bool json = false;                 ///< one JSON object on stdout
   std::vector<std::string> flags_given;  ///< the long flags on the command line ("--sim-rolls"), set by the parser
 };

@@ -198,6 +198,10 @@ TEST_F(Calibrate, AFlagTheKindDoesNotReadIsRefused) {
   const Result fps = run("calibrate gravity --sim boards/mit1993.board --fps 60");
   EXPECT_EQ(fps.exit_code, 1);
   EXPECT_NE(fps.err.find("calibrate gravity: --fps applies to latency only"), std::string::npos) << fps.err;
+  const Result progress = run("calibrate gravity --sim boards/mit1993.board --progress");
+  EXPECT_EQ(progress.exit_code, 1);
+  EXPECT_NE(progress.err.find("calibrate gravity: --progress applies to intrinsics only"), std::string::npos)
+      << progress.err;
   const Result png = run("calibrate latency --sim boards/mit1993.board --png " + (dir_ / "x.png").string());
   EXPECT_NE(png.err.find("--png applies to intrinsics, camera, flippers and gravity only"), std::string::npos)
       << png.err;
@@ -490,8 +494,12 @@ TEST_F(Calibrate, IntrinsicsSimulatedWritesTheLensAndKeepsTheOtherSections) {
   EXPECT_EQ(c.gravity->g_mps2, 1.1);
 
   // The text report: the lens, every image, the truth.
-  const Result text = run("calibrate intrinsics --sim boards/mit1993.board --sim-views 6");
+  const Result text = run("calibrate intrinsics --sim boards/mit1993.board --sim-views 6 --progress");
   ASSERT_EQ(text.exit_code, 0) << text.err;
+  // The search for the target, the long part, shows its progress when asked (stderr is no terminal here).
+  EXPECT_NE(text.err.find("calibrate intrinsics: searching for the target: 6/6 images (100 %)"), std::string::npos)
+      << text.err;
+  EXPECT_EQ(r.err.find("searching for the target"), std::string::npos) << r.err;
   EXPECT_NE(text.out.find("lens (640x480): fx "), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("sim_view_06.png  used"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("against the simulated lens: fx "), std::string::npos) << text.out;

@@ -7,6 +7,7 @@
 // p2 k3), images where the target is not found or whose own reprojection error
 // is poor are left out by name, and the fit is repeated without them.
 
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -71,8 +72,11 @@ TargetDetection detect_target(const cv::Mat& gray, const TargetSpec& target, con
 /// needed (rejected: a.png target not found, ...)" (or "... fit within
 /// max_image_rms_px ..." after the rejections), and "intrinsics: ..." for a
 /// fit whose lens is out of range (vision::check_intrinsics).
+/// `searched(n)`, when given, is called after the n-th image's search: the
+/// search is the long part (seconds for a large image without the target).
 IntrinsicsFit calibrate_intrinsics(std::span<const TargetImage> images, const TargetSpec& target,
-                                   const IntrinsicsFitConfig& config = {});
+                                   const IntrinsicsFitConfig& config = {},
+                                   const std::function<void(std::size_t searched)>& searched = {});
 
 /// A fitted lens against another (the truth in simulation, or the previous calibration).
 struct LensComparison {
