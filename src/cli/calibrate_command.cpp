@@ -584,6 +584,18 @@ void report_latency(Context& c, const calibration::LatencyEstimate& e, const cal
   c.text = s.str();
 }
 
+// The text report of a kind without one of its own: the section it wrote, as the file now holds it.
+// The whole file repeated every other section a lab had calibrated before (a lens, the flippers).
+calibration::Calibration written_section(const calibration::Calibration& file, const std::string& kind) {
+  calibration::Calibration part;
+  part.date = file.date;
+  part.board = file.board;
+  if (kind == "camera") part.camera = file.camera;
+  if (kind == "flippers") part.flippers = file.flippers;
+  if (kind == "gravity") part.gravity = file.gravity;
+  return part;
+}
+
 // A rolling shutter reads its rows out within one frame: a line time that makes the read-out longer
 // (1000 us x 480 rows = 480 ms at 200 frames/s) is a unit or a digit wrong, and skews every event.
 void check_row_time(double row_time_s, int rows, double fps) {
@@ -1116,7 +1128,7 @@ int run_calibrate(const CalibrateArgs& a, std::ostream& out, std::ostream& err) 
   } else if (!c.text.empty()) {
     out << c.text;
   } else {
-    out << calibration::calibration_to_yaml(c.cal);
+    out << calibration::calibration_to_yaml(written_section(c.cal, a.kind));
   }
   return 0;
 }

@@ -461,6 +461,18 @@ pinball::calibration::Calibration lab_file(int width_px, int height_px) {
   return c;
 }
 
+// The text report of gravity (or camera, or flippers) is the section written, not the whole file again.
+TEST_F(Calibrate, TheTextReportIsTheSectionWrittenNotTheWholeFile) {
+  const std::string file = (dir_ / "lab.yaml").string();
+  pinball::calibration::write_calibration(lab_file(640, 480), file);
+  const Result r = run("calibrate gravity --sim boards/mit1993.board --sim-rolls 3 --out " + file);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\ngravity:\n  g_mps2: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("board: boards/mit1993.board"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("camera:"), std::string::npos) << r.out;
+  EXPECT_NE(pinball::testing::slurp(file).find("\ncamera:\n"), std::string::npos) << "the file keeps it";
+}
+
 TEST_F(Calibrate, IntrinsicsSimulatedWritesTheLensAndKeepsTheOtherSections) {
   const std::string file = (dir_ / "lab.yaml").string();
   const std::string png = (dir_ / "intrinsics.png").string();
