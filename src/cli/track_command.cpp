@@ -89,17 +89,18 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
     } else {
       char line[256];
       if (p.valid) {
-        std::snprintf(line, sizeof line, "%.9g,1,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", row.observation.t_s,
+        // t to the microsecond at any clock (a clock since the epoch printed 1.7e+09 on every row).
+        std::snprintf(line, sizeof line, "%.6f,1,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", row.observation.t_s,
                       side_name(p.flipper), p.speed_mps, p.angle_rad, p.h, p.d_m, p.t_impact_s, p.rolling ? 1 : 0);
       } else {
-        std::snprintf(line, sizeof line, "%.9g,0,,,,,,,0\n", row.observation.t_s);
+        std::snprintf(line, sizeof line, "%.6f,0,,,,,,,0\n", row.observation.t_s);
       }
       out << line;
     }
   }
   err << "track: " << rows.size() << " observations, " << valid << " projections, " << launches << " launches, "
       << losses << " losses, " << tracker.flushes() << " collision flushes, " << tracker.pushes()
-      << " pushed fits\n";
+      << " pushed fits, " << tracker.gap_restarts() << " new paths after a gap\n";
   if (a.json) {
     const nlohmann::json summary{{"board", a.board},
                                  {"observations_file", a.observations},
@@ -111,7 +112,9 @@ int run_track(const TrackArgs& a, std::ostream& out, std::ostream& err) {
                                  {"launches", launches},
                                  {"losses", losses},
                                  {"collision_flushes", tracker.flushes()},
-                                 {"pushed_fits", tracker.pushes()}};
+                                 {"pushed_fits", tracker.pushes()},
+                                 {"gap_restarts", tracker.gap_restarts()},
+                                 {"max_gap_s", config.max_gap_s}};
     const std::string counts = json_text(summary, 2);
     out << "\n  ],\n" << counts.substr(2) << "\n";  // the counts' keys after the array, in the one object
   }

@@ -21,6 +21,7 @@ TrackerConfig default_tracker_config(const table::Board& board, const CameraMode
   }
   c.sigma_m = observation_sigma_m(camera);
   c.critical_y_m = pivot_y + 0.35;
+  if (camera.fps > 0.0) c.max_gap_s = std::max(c.max_gap_s, 3.0 / camera.fps);  // a slow camera's lost frame or two
   return c;
 }
 
@@ -29,9 +30,9 @@ Tracker::Tracker(const FlipperGeometry& geometry, const TrackerConfig& config)
   if (!(config.window_distance_m > 0.0) || !(config.rolling_epsilon_m > 0.0) || !(config.sigma_m > 0.0) ||
       config.max_window < 3 || config.max_window > static_cast<int>(kHistory) || config.min_window < 0 ||
       config.min_window > config.max_window || !std::isfinite(config.g_mps2) || !(config.max_push_mps2 >= 0.0) ||
-      !std::isfinite(config.max_push_mps2)) {
+      !std::isfinite(config.max_push_mps2) || !(config.max_gap_s > 0.0)) {
     throw std::invalid_argument(
-        "tracker: window distance, rolling epsilon and sigma must be > 0, max_window in [3, 512], "
+        "tracker: window distance, rolling epsilon, sigma and max gap must be > 0, max_window in [3, 512], "
         "min_window in [0, max_window], g finite, max push finite and >= 0");
   }
 }
@@ -41,6 +42,7 @@ void Tracker::reset() {
   head_ = 0;
   size_ = 0;
   was_rolling_ = false;
+  behind_in_a_row_ = 0;
   launch_.reset();
   out_ = TrackerOutput{};
 }
@@ -91,10 +93,23 @@ double Tracker::sigma_m() const {
 }
 
 const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensors& contacts) {
-  if (size_ > 0 && !(obs.t_s > back(0).t_s)) {
-    // Out of order or repeated frame: ignore it, keep the last answer.
+  const double since_s = size_ > 0 ? obs.t_s - back(0).t_s : 0.0;
+  // A frame far behind the newest is a stale one, unless frames keep coming from there: then the clock
+  // jumped back, or the newest was stamped far ahead, and waiting would ignore every frame from now on.
+  const bool clock_jumped_back = since_s < -config_.max_gap_s && ++behind_in_a_row_ >= kFramesBehindForNewClock;
+  if (!std::isfinite(obs.t_s) || !obs.p_board.allFinite() || (!(since_s > 0.0) && size_ > 0 && !clock_jumped_back)) {
+    // No sighting, or an out of order or repeated frame: ignore it, keep the last answer.
+    ++ignored_;
     out_.launch = LaunchEvent{};
     return out_;
+  }
+  behind_in_a_row_ = 0;
+  if (since_s > config_.max_gap_s || clock_jumped_back) {
+    // The old points are another path: a fit across the gap bends to join the two, and names the wrong flipper.
+    keep_newest(0);
+    noise_.restart_track();
+    was_rolling_ = false;
+    ++gap_restarts_;
   }
   if (size_ == kHistory) keep_newest(kHistory - 1);
   history_[(head_ + size_) % kHistory] = obs;

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -856,6 +857,32 @@ TEST_F(Cli, TrackKeepsASkiddingBallsPathAsOnePushedFit) {
   EXPECT_GT(report.at("pushed_fits").get<int>(), 10);
   EXPECT_TRUE(report.at("projections").at(39).at("pushed").get<bool>());
   EXPECT_NE(j.err.find(" pushed fits"), std::string::npos) << j.err;
+}
+
+// Two paths 2 s apart: the second is tracked alone (one parabola across the gap named the wrong flipper),
+// and a clock since the epoch keeps its microseconds in the CSV.
+TEST_F(Cli, TrackStartsANewPathAfterAGap) {
+  const fs::path obs = dir_ / "gap.csv";
+  {
+    std::ofstream f(obs);
+    f << std::fixed << std::setprecision(6) << "t,x,y\n";
+    const double t0 = 1.7e9;
+    for (int i = 0; i < 40; ++i) f << t0 + i * 0.005 << "," << 0.30 - 0.2 * i * 0.005 << "," << 0.45 << "\n";
+    for (int i = 0; i < 6; ++i) {
+      const double t = 2.2 + i * 0.005;
+      f << t0 + t << "," << 0.20 + 0.1 * (t - 2.2) << "," << 0.45 - 0.5 * (t - 2.2) - 0.555 * (t - 2.2) * (t - 2.2)
+        << "\n";
+    }
+  }
+  const CommandResult j = run("track --board boards/mit1993.board --json --observations " + obs.string());
+  ASSERT_EQ(j.exit_code, 0) << j.err;
+  const auto report = nlohmann::json::parse(j.out);
+  EXPECT_EQ(report.at("gap_restarts"), 1);
+  EXPECT_EQ(report.at("projections").at(41).at("window"), 2) << "the new path's own points only";
+  EXPECT_NE(j.err.find(", 1 new paths after a gap"), std::string::npos) << j.err;
+  const CommandResult csv = run("track --board boards/mit1993.board --observations " + obs.string());
+  ASSERT_EQ(csv.exit_code, 0) << csv.err;
+  EXPECT_NE(csv.out.find("\n1700000000.005000,"), std::string::npos) << csv.out.substr(0, 300);
 }
 
 TEST_F(Cli, TrackRejectsABadObservationFileNamingTheLine) {

@@ -112,6 +112,9 @@ TEST(DefaultTrackerConfig, FromBoardAndCamera) {
   EXPECT_NEAR(c.rolling_epsilon_m, 0.0076, 1e-12);  // a tenth of it
   EXPECT_EQ(c.sigma_m, observation_sigma_m(cam));
   EXPECT_NEAR(c.critical_y_m, 0.16 + 0.35, 1e-12);
+  EXPECT_EQ(c.max_gap_s, 0.05);  // ten frames at 200 fps
+  cam.fps = 30.0;
+  EXPECT_NEAR(default_tracker_config(thesis_board(), cam).max_gap_s, 0.1, 1e-12);  // three at 30
 }
 
 TEST(Tracker, BadConfigThrows) {
@@ -135,6 +138,9 @@ TEST(Tracker, BadConfigThrows) {
   c.max_push_mps2 = -1.0;
   EXPECT_THROW(Tracker(g, c), std::invalid_argument);
   c.max_push_mps2 = NAN;
+  EXPECT_THROW(Tracker(g, c), std::invalid_argument);
+  c = config();
+  c.max_gap_s = 0.0;
   EXPECT_THROW(Tracker(g, c), std::invalid_argument);
 }
 
@@ -520,6 +526,64 @@ TEST(Tracker, OutOfOrderAndRepeatedFramesAreIgnored) {
   const TrackerOutput& next = tracker.update(obs(7 * kFrame_s, f.at(7 * kFrame_s)), kNoContact);
   EXPECT_EQ(tracker.history_size(), 8u);
   EXPECT_NEAR(next.projection.h, before.projection.h, 1e-9);  // the wild point left no trace
+}
+
+// One parabola pushed across a gap had fitted the old path and the new one together, and
+// named the wrong flipper (a camera that stalled, then saw the ball again, in pinballd).
+TEST(Tracker, AfterAGapTheNewPathIsTrackedAsAFreshTrackerTracksIt) {
+  const TrackerConfig c = config();
+  const Flight before{0.0, {0.30, 0.45}, {-0.2, -0.3}, c.g_mps2};
+  const Flight after{2.2, {0.20, 0.45}, {0.1, -0.5}, c.g_mps2};
+  Tracker tracker(geometry(), c);
+  Tracker fresh(geometry(), c);
+  for (int k = 0; k < 40; ++k) tracker.update(obs(k * kFrame_s, before.at(k * kFrame_s)), kNoContact);
+  ASSERT_EQ(tracker.history_size(), 40u);
+  for (int k = 0; k < 6; ++k) {
+    const double t = 2.2 + k * kFrame_s;
+    const TrackerOutput& out = tracker.update(obs(t, after.at(t)), kNoContact);
+    const TrackerOutput& alone = fresh.update(obs(t, after.at(t)), kNoContact);
+    EXPECT_EQ(tracker.history_size(), static_cast<std::size_t>(k + 1));
+    EXPECT_EQ(out.projection.valid, alone.projection.valid) << k;
+    EXPECT_EQ(out.projection.flipper, alone.projection.flipper) << k;
+    EXPECT_EQ(out.projection.h, alone.projection.h) << k;
+    EXPECT_FALSE(out.pushed) << k;
+  }
+  EXPECT_EQ(tracker.gap_restarts(), 1u);
+  // Within the gap allowed, one trajectory: 8 frames missed at 200 fps (45 ms between two seen) are no new path.
+  Tracker dropped(geometry(), c);
+  for (int k = 0; k < 40; ++k) {
+    if (k < 20 || k >= 28) dropped.update(obs(k * kFrame_s, before.at(k * kFrame_s)), kNoContact);
+  }
+  EXPECT_EQ(dropped.gap_restarts(), 0u);
+  EXPECT_EQ(dropped.history_size(), 32u);
+}
+
+// A frame stamped far ahead had made every later frame "out of order": the tracker stopped for good.
+TEST(Tracker, AClockThatJumpsIsFollowedAndBadTimesAndPlacesAreIgnored) {
+  const TrackerConfig c = config();
+  const Flight f{10.0, {0.30, 0.45}, {-0.2, -0.3}, c.g_mps2};
+  Tracker tracker(geometry(), c);
+  for (int k = 0; k < 10; ++k) tracker.update(obs(10.0 + k * kFrame_s, f.at(10.0 + k * kFrame_s)), kNoContact);
+  tracker.update(obs(1e6, f.at(10.05)), kNoContact);  // one damaged stamp, far ahead: a gap, a fresh path
+  EXPECT_EQ(tracker.history_size(), 1u);
+  EXPECT_EQ(tracker.gap_restarts(), 1u);
+  for (int k = 11; k < 13; ++k) {  // the true clock again: stale, at first
+    tracker.update(obs(10.0 + k * kFrame_s, f.at(10.0 + k * kFrame_s)), kNoContact);
+    EXPECT_EQ(tracker.history_size(), 1u) << k;
+  }
+  for (int k = 13; k < 20; ++k) tracker.update(obs(10.0 + k * kFrame_s, f.at(10.0 + k * kFrame_s)), kNoContact);
+  EXPECT_EQ(tracker.gap_restarts(), 2u);
+  EXPECT_EQ(tracker.history_size(), 7u) << "tracking on the true clock from its third frame";
+  EXPECT_EQ(tracker.ignored(), 2u);
+
+  Tracker nan_first(geometry(), c);
+  nan_first.update(obs(NAN, {0.3, 0.4}), kNoContact);
+  nan_first.update(obs(1.0, {NAN, 0.4}), kNoContact);
+  nan_first.update(obs(1.0 + kFrame_s, {0.3, INFINITY}), kNoContact);
+  EXPECT_EQ(nan_first.history_size(), 0u);
+  EXPECT_EQ(nan_first.ignored(), 3u);
+  for (int k = 0; k < 5; ++k) nan_first.update(obs(10.0 + k * kFrame_s, f.at(10.0 + k * kFrame_s)), kNoContact);
+  EXPECT_EQ(nan_first.history_size(), 5u);
 }
 
 TEST(Tracker, ResetForgetsTheBall) {

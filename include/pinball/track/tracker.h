@@ -43,6 +43,12 @@ struct TrackerConfig {
   /// sigma_m: a camera noisier than its calibration says then no longer fails
   /// every χ² test. false: sigma_m always (the thesis).
   bool estimate_noise = true;
+  /// Observations further apart than this (a camera that stalled, a ball
+  /// out of sight, a clock that jumped either way) start a new trajectory:
+  /// one parabola pushed across a gap had fitted the old path and the new
+  /// one together and named the wrong flipper (s, > 0; ten frames at 200 fps;
+  /// default_tracker_config makes it at least three frames of a slower camera).
+  double max_gap_s = 0.05;
   LaunchDetectorConfig launch;        ///< launch detection
 };
 
@@ -94,6 +100,12 @@ class Tracker {
   std::size_t flushes() const { return flushes_; }
   /// Updates whose fit was a pushed ball's (TrackerOutput::pushed) since construction.
   std::size_t pushes() const { return pushes_; }
+  /// Trajectories started afresh since construction: after a gap over TrackerConfig::max_gap_s, or
+  /// where kFramesBehindForNewClock frames in a row came from that far behind the newest (a clock that
+  /// jumped back, or a newest frame stamped far ahead).
+  std::size_t gap_restarts() const { return gap_restarts_; }
+  /// Observations ignored since construction: out of order, repeated, or with a time or position not finite.
+  std::size_t ignored() const { return ignored_; }
   /// The σ per coordinate the fits use now (m): the calibrated one, or the
   /// measured one where it is more than kNoiseOverCalibration times that.
   double sigma_m() const;
@@ -102,6 +114,7 @@ class Tracker {
 
  private:
   static constexpr std::size_t kHistory = 512;
+  static constexpr int kFramesBehindForNewClock = 3;  // frames in a row over max_gap_s behind the newest
 
   const Observation& back(std::size_t i) const { return history_[(head_ + size_ - 1 - i) % kHistory]; }
   void keep_newest(std::size_t n);
@@ -120,6 +133,9 @@ class Tracker {
   bool was_rolling_ = false;
   std::size_t flushes_ = 0;
   std::size_t pushes_ = 0;
+  std::size_t gap_restarts_ = 0;
+  std::size_t ignored_ = 0;
+  int behind_in_a_row_ = 0;
   TrackerOutput out_;
 };
 
