@@ -175,8 +175,15 @@ BoardView DriverBus::board() const {
   return v;
 }
 
-bool DriverBus::send(const Payload& p, double now_s) {
-  // What the host wants is decided here, whether or not the frame leaves.
+DriverBus::Sent DriverBus::send(const Payload& p, double now_s, WhenFull when_full) {
+  const bool may_wait = when_full == WhenFull::kBackOff;
+  const CanFrame frame = encode(options_.board_id, p);
+  const TxStatus s = may_wait ? transport_.send(frame) : transport_.send_without_waiting(frame);
+  if (s == TxStatus::kBufferFull && !may_wait) {
+    bump(&DriverBusCounters::sends_left_queued);
+    return Sent::kLeftQueued;  // the caller leaves the command queued; the bus thread sends it, backing off
+  }
+  // What the host wants is decided here, whether or not the frame left.
   if (const auto* fire = std::get_if<Fire>(&p)) {
     Intent& i = intent_[fire->driver];
     i.on = true;
@@ -193,12 +200,10 @@ bool DriverBus::send(const Payload& p, double now_s) {
       i.off_sent_s = now_s;
     }
   }
-  const CanFrame frame = encode(options_.board_id, p);
-  const TxStatus s = transport_.send(frame);
   if (options_.log != nullptr) options_.log->record(frame);
   if (s == TxStatus::kOk) {
     bump(&DriverBusCounters::frames_sent);
-    return true;
+    return Sent::kOk;
   }
   bump(&DriverBusCounters::tx_failures);
   if (s == TxStatus::kDown) {
@@ -206,31 +211,34 @@ bool DriverBus::send(const Payload& p, double now_s) {
     set_state(BusState::kBusOff);
     bus_off_s_ = now_s;
     note_fault(BusFaultKind::kBusOff, now_s);
-    return false;
+    return Sent::kFailed;
   }
   note_fault(BusFaultKind::kTxFailure, now_s, kBoardDriver, static_cast<std::uint16_t>(s));
   // Safe first: whatever failed, try to switch every coil off (once).
   if (!std::holds_alternative<ReleaseAll>(p)) {
     const std::uint16_t off_seq = ++seq_;
+    const bool any_on = std::any_of(intent_.begin(), intent_.end(), [](const Intent& i) { return i.on; });
     for (Intent& i : intent_) {
       i.on = false;
       i.off_seq = off_seq;
       i.off_sent_s = now_s;
     }
+    // A coil the controller holds goes off behind its back: it must know to fire again.
+    if (any_on) bump(&DriverBusCounters::coils_dropped);
     const CanFrame off = encode(options_.board_id, ReleaseAll{off_seq});
-    if (transport_.send(off) == TxStatus::kOk) {
+    if ((may_wait ? transport_.send(off) : transport_.send_without_waiting(off)) == TxStatus::kOk) {
       bump(&DriverBusCounters::frames_sent);
     } else {
       bump(&DriverBusCounters::tx_failures);
       release_all_pending_.store(true, std::memory_order_release);  // try again next iteration
     }
   }
-  return false;
+  return Sent::kFailed;
 }
 
-void DriverBus::make_safe(double now_s) {
-  if (state() == BusState::kBusOff) return;  // nothing reaches the bus; the board's watchdog acts
-  send(ReleaseAll{++seq_}, now_s);
+DriverBus::Sent DriverBus::make_safe(double now_s, WhenFull when_full) {
+  if (state() == BusState::kBusOff) return Sent::kFailed;  // nothing reaches the bus; the board's watchdog acts
+  return send(ReleaseAll{++seq_}, now_s, when_full);
 }
 
 void DriverBus::begin_session(double now_s) {
@@ -465,7 +473,7 @@ void DriverBus::poll_once(double now_s) {
   }
 
   // 3. Commands.
-  send_commands(now_s);
+  send_commands(now_s, WhenFull::kBackOff);
 
   // 4. The heartbeat, while the chain it vouches for makes progress.
   // Checked on every poll, so that a stall releases the coils at once.
@@ -484,20 +492,29 @@ void DriverBus::poll_once(double now_s) {
   }
 }
 
-bool DriverBus::send_queued(double now_s) {
+bool DriverBus::send_queued(double now_s, WhenFull when_full) {
   const std::unique_lock<std::mutex> lock(io_mutex_, std::try_to_lock);
   if (!lock.owns_lock()) return false;  // poll_once is sending: it takes the queue
-  send_commands(now_s);
+  send_commands(now_s, when_full);
   return true;
 }
 
 // ReleaseAll first, and it discards what was queued before it. Called with io_mutex_ held.
-void DriverBus::send_commands(double now_s) {
+void DriverBus::send_commands(double now_s, WhenFull when_full) {
+  // The request before the tail: a fire() then release_all() landing between the two loads had left
+  // that Fire behind the old tail, sent on the next pass, after its ReleaseAll (a coil on after
+  // "all off"). The request's acquire makes every command queued before it visible to the tail's load.
+  const bool release_all = release_all_pending_.exchange(false, std::memory_order_acq_rel);
   const std::uint32_t tail = tail_.load(std::memory_order_acquire);
   std::uint32_t head = head_.load(std::memory_order_relaxed);
-  if (release_all_pending_.exchange(false, std::memory_order_acq_rel)) {
+  if (release_all) {
     head = tail;
-    make_safe(now_s);
+    if (make_safe(now_s, when_full) == Sent::kLeftQueued) {
+      release_all_pending_.store(true, std::memory_order_release);  // the bus thread sends it, first
+      head_.store(head, std::memory_order_release);
+      wake();
+      return;
+    }
   }
   for (; head != tail; ++head) {
     const Command c = queue_[head % kQueueSize];
@@ -505,10 +522,11 @@ void DriverBus::send_commands(double now_s) {
       bump(&DriverBusCounters::dropped_not_running);
       continue;
     }
-    if (c.op == Op::kFire) {
-      send(Fire{c.driver, FireMode::kPulseHold, 0, ++seq_}, now_s);
-    } else {
-      send(Release{c.driver, ++seq_}, now_s);
+    const Payload p = c.op == Op::kFire ? Payload{Fire{c.driver, FireMode::kPulseHold, 0, ++seq_}}
+                                        : Payload{Release{c.driver, ++seq_}};
+    if (send(p, now_s, when_full) == Sent::kLeftQueued) {
+      wake();  // this command and those after it stay queued, in order
+      break;
     }
   }
   head_.store(head, std::memory_order_release);

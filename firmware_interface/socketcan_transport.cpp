@@ -92,6 +92,10 @@ TxStatus SocketCanTransport::send(const CanFrame& frame) {
   return detail::send_frame(fd_, frame, options_.retry, counters_);
 }
 
+TxStatus SocketCanTransport::send_without_waiting(const CanFrame& frame) {
+  return detail::send_frame(fd_, frame, TxRetryPolicy{0, 0}, counters_);
+}
+
 RxStatus SocketCanTransport::receive(CanFrame& frame, int timeout_ms) {
   return detail::receive_frame(fd_, frame, timeout_ms, counters_);
 }

@@ -51,6 +51,10 @@ std::pair<std::unique_ptr<StreamTransport>, std::unique_ptr<StreamTransport>> St
 
 TxStatus StreamTransport::send(const CanFrame& frame) { return detail::send_frame(fd_, frame, retry_, counters_); }
 
+TxStatus StreamTransport::send_without_waiting(const CanFrame& frame) {
+  return detail::send_frame(fd_, frame, TxRetryPolicy{0, 0}, counters_);
+}
+
 RxStatus StreamTransport::receive(CanFrame& frame, int timeout_ms) {
   return detail::receive_frame(fd_, frame, timeout_ms, counters_);
 }

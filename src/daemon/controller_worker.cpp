@@ -9,7 +9,7 @@ namespace pinball::daemon {
 // Writes the commands' CAN frames on the controller thread, saving the wake-up
 // of the driver thread; when the driver thread is busy sending, it takes them.
 void ControllerWorker::send_now(ControllerStage::Commands& cmds, int n, double now_s) {
-  if (n == 0 || !bus_.send_queued(now_s)) return;
+  if (n == 0 || !bus_.send_queued(now_s, firmware::DriverBus::WhenFull::kLeaveQueued)) return;
   const double written = steady_now_s();
   for (int i = 0; i < n; ++i) cmds[static_cast<std::size_t>(i)].written_wall_s = written;
 }

@@ -333,5 +333,89 @@ TEST_F(DriverBusTest, SendQueuedNeverWaitsForABusyPoll) {
   EXPECT_EQ(board_.counters().fires_accepted, 1u);
 }
 
+// A link whose kernel queue can be full: send() would back off until it drains (here: at once).
+class FullQueueLink : public CanTransport {
+ public:
+  explicit FullQueueLink(CanTransport& inner) : inner_(inner) {}
+  TxStatus send(const CanFrame& frame) override { return inner_.send(frame); }
+  TxStatus send_without_waiting(const CanFrame& frame) override {
+    return full_ ? TxStatus::kBufferFull : inner_.send(frame);
+  }
+  RxStatus receive(CanFrame& frame, int timeout_ms) override { return inner_.receive(frame, timeout_ms); }
+  int poll_fd() const override { return inner_.poll_fd(); }
+  TransportCounters counters() const override { return inner_.counters(); }
+  bool full_ = false;
+
+ private:
+  CanTransport& inner_;
+};
+
+// The controller's thread must not sleep in SocketCAN's back-off (up to 750 us a frame, 4 ms
+// measured for two Fires): on a full queue it leaves the commands, in order, to the bus thread.
+TEST_F(DriverBusTest, OnAFullKernelQueueTheRealTimeCallerLeavesTheCommandsToTheBusThread) {
+  FullQueueLink link(*host_);
+  DriverBus bus(link, bus_options());
+  run(bus, 0.05);
+  ASSERT_EQ(bus.state(), BusState::kRunning);
+  link.full_ = true;
+  bus.fire(0);
+  bus.release(0);
+  bus.fire(1);
+  EXPECT_TRUE(bus.send_queued(t_, DriverBus::WhenFull::kLeaveQueued));
+  board_.service(*link_, t_ += 0.0005);
+  EXPECT_EQ(board_.counters().fires_accepted, 0u) << "nothing left on the caller's thread";
+  EXPECT_EQ(bus.counters().sends_left_queued, 1u) << "the first command found the queue full; the rest waited";
+  EXPECT_EQ(bus.counters().tx_failures, 0u) << "a full queue is no failure: no ReleaseAll follows";
+  bus.poll_once(t_ += 0.0005);  // the bus thread's turn: it sends all three, in order
+  board_.service(*link_, t_ += 0.0005);
+  EXPECT_EQ(board_.counters().fires_accepted, 2u);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  EXPECT_EQ(board_.coil(1).state, CoilState::kPulse);
+  // A ReleaseAll left by a full queue goes first on the bus thread, and discards what it discarded.
+  bus.fire(0);
+  bus.release_all();
+  EXPECT_TRUE(bus.send_queued(t_, DriverBus::WhenFull::kLeaveQueued));
+  EXPECT_EQ(bus.counters().sends_left_queued, 2u);
+  bus.poll_once(t_ += 0.0005);
+  board_.service(*link_, t_ += 0.0005);
+  EXPECT_EQ(board_.coil(0).state, CoilState::kOff);
+  EXPECT_EQ(board_.coil(1).state, CoilState::kOff);
+  EXPECT_EQ(board_.counters().fires_accepted, 2u);
+}
+
+// A link that fails one send (an error, not a full queue).
+class FailOnceLink : public CanTransport {
+ public:
+  explicit FailOnceLink(CanTransport& inner) : inner_(inner) {}
+  TxStatus send(const CanFrame& frame) override {
+    return fail_next_ ? (fail_next_ = false, TxStatus::kError) : inner_.send(frame);
+  }
+  RxStatus receive(CanFrame& frame, int timeout_ms) override { return inner_.receive(frame, timeout_ms); }
+  int poll_fd() const override { return inner_.poll_fd(); }
+  TransportCounters counters() const override { return inner_.counters(); }
+  bool fail_next_ = false;
+
+ private:
+  CanTransport& inner_;
+};
+
+// After a failed send the bus switches every coil off: a flipper the controller holds up went down
+// behind its back, and it must be told (coils_dropped) to fire again.
+TEST_F(DriverBusTest, ASendFailureThatSwitchesAHeldCoilOffTellsTheController) {
+  FailOnceLink link(*host_);
+  DriverBus bus(link, bus_options());
+  run(bus, 0.05);
+  bus.fire(1);
+  run(bus, 0.05);
+  ASSERT_EQ(board_.coil(1).state, CoilState::kHold);
+  const std::uint64_t dropped = bus.counters().coils_dropped;
+  link.fail_next_ = true;
+  bus.fire(0);
+  run(bus, 0.002);
+  EXPECT_EQ(board_.coil(1).state, CoilState::kOff);
+  EXPECT_EQ(bus.counters().tx_failures, 1u);
+  EXPECT_EQ(bus.counters().coils_dropped, dropped + 1);
+}
+
 }  // namespace
 }  // namespace pinball::firmware

@@ -67,6 +67,10 @@ class CanTransport {
 
   /// Sends one frame without blocking beyond the retry policy's back-off.
   virtual TxStatus send(const CanFrame& frame) = 0;
+  /// Sends one frame, or reports kBufferFull at once where send() would back
+  /// off and retry: for a real-time thread, which must not sleep. A transport
+  /// that never waits need not override it.
+  virtual TxStatus send_without_waiting(const CanFrame& frame) { return send(frame); }
   /// Receives one frame (data or error), waiting at most `timeout_ms` (0: poll only).
   virtual RxStatus receive(CanFrame& frame, int timeout_ms) = 0;
   /// A file descriptor that becomes readable when a frame may be waiting (-1: none).

@@ -77,6 +77,9 @@ struct DriverBusCounters {
   std::uint64_t dropped_not_running = 0;  ///< commands discarded because the session was not running
   std::uint64_t frames_sent = 0;       ///< frames sent successfully
   std::uint64_t tx_failures = 0;       ///< sends that failed (each followed by a ReleaseAll attempt)
+  /// Commands send_queued left for the bus thread because the kernel's queue
+  /// was full (WhenFull::kLeaveQueued: the caller must not sleep in a back-off).
+  std::uint64_t sends_left_queued = 0;
   std::uint64_t heartbeats = 0;        ///< heartbeats sent
   std::uint64_t hellos = 0;            ///< Hello frames sent
   std::uint64_t sessions = 0;          ///< times the session reached kRunning
@@ -168,12 +171,19 @@ class DriverBus {
   /// session, send commands and the heartbeat. For use without start().
   void poll_once(double now_s);
 
+  /// What a send does when the kernel's queue is full: back off and retry
+  /// (the transport's policy, up to 750 us a frame on SocketCAN), or leave
+  /// the command and those after it queued for the bus thread.
+  enum class WhenFull : std::uint8_t { kBackOff, kLeaveQueued };
+
   /// Sends what is queued (ReleaseAll first) on the calling thread, unless
   /// poll_once is running elsewhere at this moment: never blocks on another
   /// thread. True when the queue was sent (or discarded because the session
-  /// is not running); false when the bus was busy, and the next poll_once
-  /// sends it. At most one caller besides the bus's own thread.
-  bool send_queued(double now_s);
+  /// is not running, or left for the bus thread on a full kernel queue with
+  /// kLeaveQueued, which a real-time caller passes); false when the bus was
+  /// busy, and the next poll_once sends it. At most one caller besides the
+  /// bus's own thread.
+  bool send_queued(double now_s, WhenFull when_full = WhenFull::kBackOff);
 
   /// Session state.
   BusState state() const { return state_.load(std::memory_order_acquire); }
@@ -214,14 +224,15 @@ class DriverBus {
   void run();
   void loop();
   void wake();
-  bool send(const Payload& p, double now_s);
+  enum class Sent : std::uint8_t { kOk, kFailed, kLeftQueued };
+  Sent send(const Payload& p, double now_s, WhenFull when_full = WhenFull::kBackOff);
   void bump(std::uint64_t DriverBusCounters::*field, std::uint64_t n = 1);
-  void make_safe(double now_s);
+  Sent make_safe(double now_s, WhenFull when_full = WhenFull::kBackOff);
   void begin_session(double now_s);
   void on_message(const Message& m, double now_s);
   void on_error_frame(const CanFrame& f, double now_s);
   void set_state(BusState s) { state_.store(s, std::memory_order_release); }
-  void send_commands(double now_s);
+  void send_commands(double now_s, WhenFull when_full);
 
   CanTransport& transport_;
   DriverBusOptions options_;

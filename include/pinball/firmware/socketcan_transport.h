@@ -32,6 +32,7 @@ class SocketCanTransport final : public CanTransport {
   static std::string unavailable_reason(const std::string& interface);
 
   TxStatus send(const CanFrame& frame) override;
+  TxStatus send_without_waiting(const CanFrame& frame) override;
   RxStatus receive(CanFrame& frame, int timeout_ms) override;
   int poll_fd() const override { return fd_; }
   /// Closes and opens the socket again (after bus-off, once the kernel restarted the controller).

@@ -26,6 +26,7 @@ class StreamTransport final : public CanTransport {
       TxRetryPolicy retry = {});
 
   TxStatus send(const CanFrame& frame) override;
+  TxStatus send_without_waiting(const CanFrame& frame) override;
   RxStatus receive(CanFrame& frame, int timeout_ms) override;
   int poll_fd() const override { return fd_; }
   TransportCounters counters() const override { return counters_.snapshot(); }
