@@ -10,7 +10,8 @@
 #   --max-flash / --max-ram
 #                 fail (exit 1) when the board image needs more
 # Environment: FIRMWARE_JOBS (default 1), FIRMWARE_OPT (-O2 or -Os; default
-# the project's, -O2), CMAKE (default cmake).
+# the project's, -O2), FIRMWARE_BENCH_STEPPING=1 (a halt freezes the IWDG, for
+# single-stepping with coil power off; FIRMWARE.md), CMAKE (default cmake).
 #
 # Flash = every section placed in flash plus .data's initial values; RAM =
 # .data + .bss + .noinit + the stack the linker script reserves (4 KiB).
@@ -53,6 +54,12 @@ generator=()
 if [ ! -f "$dir/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 options=(-DCMAKE_TOOLCHAIN_FILE="$root/cmake/arm-none-eabi.cmake")
 if [ -n "${FIRMWARE_OPT:-}" ]; then options+=(-DPINBALL_FW_OPT="$FIRMWARE_OPT"); fi
+# Said every time: the cache would keep a bench build's setting for the next, lab build.
+if [ "${FIRMWARE_BENCH_STEPPING:-0}" = 1 ]; then
+  options+=(-DPINBALL_FW_IWDG_MAY_STOP_UNDER_HALT=ON)
+else
+  options+=(-DPINBALL_FW_IWDG_MAY_STOP_UNDER_HALT=OFF)
+fi
 
 # In --json mode stdout carries the JSON object alone.
 if [ "$json" = 1 ]; then exec 3>&1 1>&2; else exec 3>&1; fi

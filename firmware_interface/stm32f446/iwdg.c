@@ -17,9 +17,15 @@
  * with 16 frames to handle (docs/results.md), so even the shortest 6.8 ms
  * leaves a margin of 7x at worst.
  *
- * It keeps running while a debugger halts the core (DBGMCU_APB1_FZ's
- * DBG_IWDG_STOP is left clear): a halted board resets within 19 ms with its
- * coils off, rather than holding a coil on under a breakpoint. */
+ * It keeps running while a debugger halts the core: a halted board resets
+ * within 19 ms with its coils off, rather than holding a coil on under a
+ * breakpoint. openocd's stm32f4x.cfg sets DBGMCU_APB1_FZ's DBG_IWDG_STOP
+ * (and DBG_WWDG_STOP) when it attaches, which would freeze the IWDG under a
+ * halt while the PWM timers run on (a coil at its pulse or hold duty until
+ * someone resumes). So every refresh clears it again: microseconds after an
+ * attach, long before anyone types `halt`. A bench build for single-stepping
+ * with coil power off defines PBFW_IWDG_MAY_STOP_UNDER_HALT and keeps
+ * whatever the debugger set. */
 
 #include "drivers.h"
 #include "registers.h"
@@ -55,4 +61,9 @@ void iwdg_start(void) {
   IWDG->KR = IWDG_KR_REFRESH;
 }
 
-void iwdg_refresh(void) { IWDG->KR = IWDG_KR_REFRESH; }
+void iwdg_refresh(void) {
+  IWDG->KR = IWDG_KR_REFRESH;
+#ifndef PBFW_IWDG_MAY_STOP_UNDER_HALT
+  DBGMCU->APB1_FZ &= ~DBGMCU_APB1_FZ_DBG_IWDG_STOP;
+#endif
+}

@@ -203,6 +203,19 @@ typedef struct iwdg_regs {
 #define IWDG_SR_PVU (1u << 0)
 #define IWDG_SR_RVU (1u << 1)
 
+/* ---- DBGMCU: the debug support's freeze bits (RM0390, DBG registers) ---- */
+typedef struct dbgmcu_regs {
+  reg32 IDCODE;  /* 0x00 */
+  reg32 CR;      /* 0x04 */
+  reg32 APB1_FZ; /* 0x08 */
+  reg32 APB2_FZ; /* 0x0C */
+} dbgmcu_regs;
+REG_CHECK(dbgmcu_regs, APB1_FZ, 0x08);
+#define DBGMCU ((dbgmcu_regs*)0xE0042000u)
+
+#define DBGMCU_APB1_FZ_DBG_WWDG_STOP (1u << 11)
+#define DBGMCU_APB1_FZ_DBG_IWDG_STOP (1u << 12)
+
 /* ---- bxCAN1 (RM0390, bxCAN registers) ---- */
 typedef struct can_tx_mailbox {
   reg32 TIR;  /* STID [31:21], IDE 2, RTR 1, TXRQ 0 */
