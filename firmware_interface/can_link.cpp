@@ -60,6 +60,8 @@ CanLinkStatus read_can_link(const std::string& interface) {
   } else if (s.read_error.empty()) {
     s.read_error = "libsocketcan could not read the bit timing";
   }
+  __u32 restart_ms = 0;
+  if (::can_get_restart_ms(interface.c_str(), &restart_ms) == 0) s.restart_ms = restart_ms;
   return s;
 }
 
@@ -102,6 +104,10 @@ CanLinkVerdict judge_can_link(const CanLinkStatus& s, const std::string& interfa
   if (s.bitrate_bps != bitrate_bps) {
     return refuse(interface + " runs at " + std::to_string(s.bitrate_bps) + " bit/s, the bus at " +
                   std::to_string(bitrate_bps) + fix);
+  }
+  if (s.restart_ms == 0) {
+    return refuse(interface + " has no automatic restart after bus-off: one bus-off would silence it until "
+                              "someone runs `ip link set " + interface + " type can restart`" + fix);
   }
   if (s.state == CanControllerState::kErrorPassive || s.state == CanControllerState::kErrorWarning) {
     return {true, interface + " is error-" + (s.state == CanControllerState::kErrorPassive ? "passive" : "warning") +

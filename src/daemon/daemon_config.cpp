@@ -73,9 +73,11 @@ void check_camera(const CameraSettings& c, const std::string& s) {
 }
 
 void check_can(const CanSettings& c, const std::string& s) {
-  // ISO 11898's classic CAN rates run from 10 kbit/s to 1 Mbit/s.
-  require(c.bitrate_bps >= 10'000 && c.bitrate_bps <= 1'000'000, s, "can.bitrate_bps",
-          "must be in [10000, 1000000] bit/s (PROTOCOL.md: " + std::to_string(firmware::kBitrate_bps) + ")");
+  // The driver board's firmware runs its bxCAN at this rate only (stm32f446/can.c): at any other the
+  // interface would pass the bring-up check and every frame on the wire would be destroyed.
+  require(c.bitrate_bps == firmware::kBitrate_bps, s, "can.bitrate_bps",
+          "must be " + std::to_string(firmware::kBitrate_bps) +
+              " bit/s: the driver board's firmware runs at no other rate (PROTOCOL.md)");
   require(c.board_id >= 0 && c.board_id < firmware::kMaxBoards, s, "can.board_id", "must be in [0, 15]");
   // The board accepts a watchdog of 10..1000 ms in Hello (firmware/protocol.h).
   require(std::isfinite(c.watchdog_timeout_s) && c.watchdog_timeout_s * 1e3 >= firmware::kMinWatchdogMs &&

@@ -57,6 +57,20 @@ TEST(CanLink, DownStoppedAsleepOrBusOffIsRefused) {
   EXPECT_NE(judge_can_link(off, "can0", 500000).message.find("bus-off"), std::string::npos);
 }
 
+// Reopening a socket restarts no controller: without restart-ms one bus-off silenced the board for good.
+TEST(CanLink, NoAutomaticRestartAfterBusOffIsRefused) {
+  CanLinkStatus s = healthy();
+  s.restart_ms = 0;
+  const CanLinkVerdict v = judge_can_link(s, "can0", 500000);
+  EXPECT_FALSE(v.ok);
+  EXPECT_EQ(v.message.rfind("can0 has no automatic restart after bus-off", 0), 0u) << v.message;
+  EXPECT_NE(v.message.find("restart-ms 100"), std::string::npos) << v.message;
+  s.restart_ms = 100;
+  EXPECT_TRUE(judge_can_link(s, "can0", 500000).ok);
+  s.restart_ms = -1;  // not read (an old kernel): the bit rate and state checks stand alone
+  EXPECT_TRUE(judge_can_link(s, "can0", 500000).ok);
+}
+
 TEST(CanLink, ErrorPassiveStartsWithAWarning) {
   CanLinkStatus s = healthy();
   s.state = CanControllerState::kErrorPassive;

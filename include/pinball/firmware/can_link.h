@@ -30,6 +30,9 @@ struct CanLinkStatus {
   bool is_virtual = false;  ///< vcan, vxcan: no controller, no bit rate
   CanControllerState state = CanControllerState::kUnknown;  ///< the controller's state
   std::uint32_t bitrate_bps = 0;  ///< the configured bit rate (bit/s); 0: unknown or not set
+  /// The automatic restart after bus-off (ms; 0: none, the controller stays
+  /// off until `ip link ... restart`); -1: not read.
+  std::int64_t restart_ms = -1;
   std::string read_error;   ///< why state or bit rate could not be read (empty: read, or virtual)
 };
 
@@ -40,12 +43,14 @@ struct CanLinkVerdict {
 };
 
 /// Reads `interface`'s flags (SIOCGIFFLAGS), its link type (SIOCGIFHWADDR), whether it is virtual
-/// (/sys/devices/virtual/net) and, for a real controller, its state and bit
-/// rate (libsocketcan: can_get_state, can_get_bittiming). Never throws.
+/// (/sys/devices/virtual/net) and, for a real controller, its state, bit
+/// rate and restart (libsocketcan: can_get_state, can_get_bittiming,
+/// can_get_restart_ms). Never throws.
 CanLinkStatus read_can_link(const std::string& interface);
 
 /// The rules: refuse an interface that is missing, not CAN, down, stopped, asleep,
-/// bus-off, of unknown state, or at a bit rate other than `bitrate_bps`; a
+/// bus-off, of unknown state, at a bit rate other than `bitrate_bps`, or with no
+/// automatic restart after bus-off (reopening the socket restarts no controller); a
 /// virtual interface has no bit rate and is accepted with a note. Messages
 /// name the interface and say the command that fixes it.
 CanLinkVerdict judge_can_link(const CanLinkStatus& status, const std::string& interface, std::uint32_t bitrate_bps);
