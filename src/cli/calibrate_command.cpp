@@ -40,6 +40,8 @@
 #include "pinball/core/progress.h"
 #include "pinball/core/rng.h"
 #include "pinball/core/text_file.h"
+#include "pinball/daemon/daemon_config.h"
+#include "pinball/daemon/pipeline.h"
 #include "pinball/firmware/can_link.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/socketcan_transport.h"
@@ -157,6 +159,10 @@ CLI::App* add_calibrate_command(CLI::App& app, CalibrateArgs& a) {
       ->needs(sim);
   cmd->add_option("--device", a.device, "latency: the camera, /dev/videoN")->excludes(sim);
   cmd->add_option("--can", a.can, "latency: the driver board's SocketCAN interface, e.g. can0")->excludes(sim);
+  cmd->add_option("--config", a.config,
+                  "latency: pinballd's configuration (YAML), to fire the board as pinballd does: its can.board_id, "
+                  "coils and watchdog, and its can.interface when --can is not given")
+      ->excludes(sim);
   cmd->add_option("--flipper", a.flipper, "latency: the flipper to fire, by the board's name (default: the first)");
   cmd->add_option("--events", a.events, "latency: times the flipper is fired")->check(finite_range(3, 1000));
   cmd->add_option("--sim-latency-ms", a.sim_latency_ms,
@@ -208,7 +214,7 @@ const std::vector<FlagUse>& calibrate_flag_uses() {
       {{"--calibration"}, {"flippers", "latency"}},
       {{"--png"}, {"intrinsics", "camera", "flippers", "gravity"}},
       {{"--progress"}, {"intrinsics"}},
-      {{"--device", "--can", "--flipper", "--events", "--sim-latency-ms", "--sim-actuation-delay-ms",
+      {{"--device", "--can", "--config", "--flipper", "--events", "--sim-latency-ms", "--sim-actuation-delay-ms",
         "--actuation-delay-ms", "--row-time-us", "--exposure-us", "--fps"},
        {"latency"}},
   };
@@ -694,8 +700,17 @@ double send_now(firmware::DriverBus& bus) {
 
 void run_latency_lab(Context& c) {
   const CalibrateArgs& a = c.a;
-  if (a.device.empty() || a.can.empty()) {
-    throw std::runtime_error("calibrate latency: give --device /dev/videoN and --can IFACE (or --sim BOARD)");
+  // pinballd's own settings, when given: a board strapped to another id than 0 never answered the
+  // defaults, and the coil fired with timings the game does not use.
+  const std::optional<daemon::DaemonConfig> lab =
+      a.config.empty() ? std::nullopt : std::optional<daemon::DaemonConfig>(daemon::load_daemon_config(a.config));
+  std::string can = a.can;
+  if (can.empty() && lab && lab->can.interface != "sim") can = lab->can.interface;
+  std::string device = a.device;
+  if (device.empty() && lab && lab->camera.source == "v4l2") device = lab->camera.device;
+  if (device.empty() || can.empty()) {
+    throw std::runtime_error("calibrate latency: give --device /dev/videoN and --can IFACE (or --config with "
+                             "pinballd's lab camera.device and can.interface; or --sim BOARD)");
   }
   const std::string from = a.calibration.empty() ? a.out : a.calibration;
   if (from.empty()) {
@@ -743,33 +758,35 @@ void run_latency_lab(Context& c) {
 
   // The hardware: say everything that is missing at once, before opening anything.
   std::string missing;
-  if (!vision::is_device_source(a.device)) {
-    missing = a.device + ": not a camera device (a video file cannot watch a flipper being fired)";
+  if (!vision::is_device_source(device)) {
+    missing = device + ": not a camera device (a video file cannot watch a flipper being fired)";
   } else {
-    missing = vision::missing_camera_device(a.device);
+    missing = vision::missing_camera_device(device);
   }
   const firmware::CanLinkVerdict link =
-      firmware::judge_can_link(firmware::read_can_link(a.can), a.can, firmware::kBitrate_bps);
+      firmware::judge_can_link(firmware::read_can_link(can), can, firmware::kBitrate_bps);
   if (!link.ok) missing += (missing.empty() ? "" : "; ") + std::string("--can ") + link.message;
   if (!missing.empty()) throw std::runtime_error("calibrate latency: " + missing + "; nothing was fired or written");
 
   vision::CaptureConfig cc;
-  cc.source = a.device;
+  cc.source = device;
   cc.width_px = size.width;
   cc.height_px = size.height;
   cc.fps = a.fps;
   if (a.exposure_us > 0.0) cc.exposure_s = a.exposure_us * 1e-6;  // fixed, as pinballd's camera.exposure_s fixes it
   vision::CaptureSource camera(cc);
   if (camera.frame_size() != size) {
-    throw std::runtime_error("calibrate latency: " + a.device + " gives " + std::to_string(camera.frame_size().width) +
+    throw std::runtime_error("calibrate latency: " + device + " gives " + std::to_string(camera.frame_size().width) +
                              "x" + std::to_string(camera.frame_size().height) + " frames, the calibration is for " +
                              std::to_string(size.width) + "x" + std::to_string(size.height));
   }
   firmware::SocketCanOptions so;
-  so.interface = a.can;
+  so.interface = can;
   firmware::SocketCanTransport transport(so);
+  const int drivers = static_cast<int>(c.board.flippers.size());
   firmware::DriverBusOptions bo;
-  bo.driver_count = static_cast<int>(c.board.flippers.size());
+  bo.driver_count = drivers;
+  if (lab) bo = daemon::driver_bus_options_for(*lab, drivers);
   firmware::DriverBus bus(transport, bo);  // its destructor stops the thread with every coil off
   InterruptGuard interrupts;
   bus.start();  // from here the bus's destructor stops it with every coil off
@@ -778,7 +795,9 @@ void run_latency_lab(Context& c) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (bus.state() != firmware::BusState::kRunning) {
-    throw std::runtime_error("calibrate latency: the driver board did not answer on " + a.can + " within 2 s");
+    throw std::runtime_error("calibrate latency: the driver board " + std::to_string(bo.board_id) +
+                             " did not answer on " + can + " within 2 s" +
+                             (lab ? "" : " (board id 0 and the protocol's coil timings: --config takes pinballd's)"));
   }
 
   // The camera's thread keeps the region of every frame; this one fires.
@@ -842,7 +861,7 @@ void run_latency_lab(Context& c) {
   stop.store(true);
   reader.join();
   if (g_latency_interrupted.load()) throw std::runtime_error("calibrate latency: interrupted; every coil released, nothing written");
-  if (!camera_error.empty()) throw std::runtime_error("calibrate latency: " + a.device + ": " + camera_error);
+  if (!camera_error.empty()) throw std::runtime_error("calibrate latency: " + device + ": " + camera_error);
   if (bus.counters().coils_dropped > 0 || bus.state() != firmware::BusState::kRunning) {
     throw std::runtime_error("calibrate latency: the driver board dropped the coils or the session during the run");
   }

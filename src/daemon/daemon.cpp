@@ -73,16 +73,6 @@ static_assert(simlab::GameEvent::kBallLost == GameEventMessage::KIND_BALL_LOST);
 static_assert(simlab::GameEvent::kScore == GameEventMessage::KIND_SCORE);
 static_assert(simlab::GameEvent::kBallCut == GameEventMessage::KIND_BALL_CUT);
 
-firmware::DriverBusOptions bus_options(const DaemonConfig& c, int drivers) {
-  firmware::DriverBusOptions o;
-  o.board_id = static_cast<std::uint8_t>(c.can.board_id);
-  o.driver_count = drivers;
-  for (auto& d : o.drivers) d = c.coils;
-  o.heartbeat_period_s = c.can.heartbeat_period_s;
-  o.watchdog_timeout_s = c.can.watchdog_timeout_s;
-  return o;
-}
-
 }  // namespace
 
 struct Daemon::Impl {
@@ -226,7 +216,7 @@ void Daemon::Impl::build() {
     o.interface = config.can.interface;
     host_link = std::make_unique<firmware::SocketCanTransport>(o);
   }
-  firmware::DriverBusOptions bo = bus_options(config, drivers);
+  firmware::DriverBusOptions bo = driver_bus_options_for(config, drivers);
   // The heartbeat vouches for the chain: it flows only while the camera and
   // the controller threads progress. A beat every frame is expected; three
   // frame periods (at least one heartbeat period) without one is a stall.

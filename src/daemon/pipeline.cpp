@@ -263,6 +263,16 @@ ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, 
   return o;
 }
 
+firmware::DriverBusOptions driver_bus_options_for(const DaemonConfig& c, int drivers) {
+  firmware::DriverBusOptions o;
+  o.board_id = static_cast<std::uint8_t>(c.can.board_id);
+  o.driver_count = drivers;
+  for (auto& d : o.drivers) d = c.coils;
+  o.heartbeat_period_s = c.can.heartbeat_period_s;
+  o.watchdog_timeout_s = c.can.watchdog_timeout_s;
+  return o;
+}
+
 double lost_after_s_for(const DaemonConfig& config) {
   // A ball unseen for the stall timeout plus 4 frame periods is gone.
   return config.camera.stall_timeout_s + 4.0 / config.camera.fps;

@@ -438,6 +438,16 @@ TEST_F(Calibrate, LatencyInTheLabWithoutHardwareFailsClearlyAndWritesNothing) {
   r = run("calibrate latency --board boards/mit1993.board --calibration " + file);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("give --device"), std::string::npos) << r.err;
+  // pinballd's configuration gives the camera, the interface and the board id it fires.
+  const std::string pinballd = (dir_ / "pinballd.yaml").string();
+  std::ofstream(pinballd) << "version: 1\nmode: lab\nboard: " PINBALL_SOURCE_DIR "/boards/mit1993.board\n"
+                          << "camera: {source: v4l2, device: /dev/video96}\ncan: {interface: pinballcan8, board_id: 3}\n";
+  r = run("calibrate latency --board boards/mit1993.board --calibration " + file + " --config " + pinballd +
+          " --row-time-us 10");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("/dev/video96: no such camera device"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--can no interface pinballcan8"), std::string::npos) << r.err;
+  EXPECT_EQ(run("calibrate gravity --sim boards/mit1993.board --config " + pinballd).exit_code, 2) << "latency only";
   const std::string before = pinball::testing::slurp(file);
   r = run("calibrate latency --board boards/mit1993.board --calibration " + file +
           " --device /dev/video97 --can pinballcan7 --row-time-us 10 --out " + file);

@@ -237,5 +237,9 @@ TrackingSetup tracking_setup_for(const DaemonConfig& config, const table::Board&
 ControllerStageOptions controller_stage_options_for(const DaemonConfig& config, const table::Board& board);
 /// How long the camera stage keeps an unseen ball before forgetting it (s).
 double lost_after_s_for(const DaemonConfig& config);
+/// The driver bus's settings for `config` with `drivers` coils: its board id,
+/// the coils' timings, the heartbeat and the board's watchdog (pinballd's,
+/// and `calibrate latency --config`'s, so that both fire the same board alike).
+firmware::DriverBusOptions driver_bus_options_for(const DaemonConfig& config, int drivers);
 
 }  // namespace pinball::daemon
