@@ -1,10 +1,12 @@
 #include "pinball/daemon/pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "pinball/calibration/calibration_file.h"
 #include "pinball/core/utime.h"
 #include "pinball/core/clock.h"
+#include "pinball/core/format.h"
 #include "pinball/plot/png_file.h"
 #include "pinball/table/board_overlay.h"
 
@@ -225,6 +227,7 @@ vision::CaptureConfig capture_config_for(const CameraSettings& camera) {
   cc.fps = camera.fps;
   cc.fourcc = camera.fourcc;
   cc.exposure_s = camera.exposure_s;
+  cc.pace_file = true;  // a recorded video plays as the camera delivered it
   return cc;
 }
 
@@ -236,6 +239,13 @@ std::unique_ptr<vision::CaptureSource> open_lab_camera(const CameraSettings& cam
                              std::to_string(wanted.height) +
                              " px of camera.width_px x camera.height_px; the detector, the mask and the "
                              "calibration take frames of that size");
+  }
+  // The frame clock's correction runs on 1/camera.fps: a camera that grants another rate than asked
+  // (120 for 200) dated every frame 0.2 s early, and the controller led by as much.
+  if (std::abs(capture->fps() - camera.fps) > 0.01 * camera.fps) {
+    throw std::runtime_error(capture->describe() + ": not the " + format_number(camera.fps) +
+                             " frames/s of camera.fps; set camera.fps to the rate it gives (a camera: "
+                             "v4l2-ctl --list-formats-ext lists its rates at each size)");
   }
   return capture;
 }

@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <opencv2/imgproc.hpp>
 
@@ -134,6 +135,18 @@ bool CaptureSource::read(Frame& out) {
   const bool have_driver = std::isfinite(pos_ms) && (pos_ms > 0.0 || (!is_device_ && counters_.frames == 0));
   out.driver_t_s = have_driver ? pos_ms * 1e-3 : std::numeric_limits<double>::quiet_NaN();
   out.t_s = now_s;
+  if (!is_device_ && have_driver) {
+    // A file's frames on its own clock: stamped at decoding, 60 frames of 200 fps had spanned 25 ms,
+    // and the tracker saw the ball 12 times too fast.
+    if (file_start_steady_s_ < 0.0) {
+      file_start_steady_s_ = now_s;
+      file_start_pos_s_ = out.driver_t_s;
+    }
+    out.t_s = file_start_steady_s_ + (out.driver_t_s - file_start_pos_s_);
+    if (config_.pace_file && out.t_s > now_s) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(out.t_s - now_s));
+    }
+  }
   // Dropped frames: from the driver's clock when it has one, else (devices only) from the steady clock.
   const bool use_driver = have_driver;
   const double stamp_s = use_driver ? out.driver_t_s : now_s;

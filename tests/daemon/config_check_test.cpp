@@ -136,6 +136,29 @@ TEST(ConfigCheck, ARecordedCameraOfAnotherFrameSizeFailsTheCheck) {
   fs::remove(c.camera.device);
 }
 
+// A recording (or a camera) at another rate than camera.fps: the frame clock's correction runs on
+// 1/camera.fps, and 120 frames/s taken for 200 had dated every frame 0.2 s early.
+TEST(ConfigCheck, ARecordedCameraOfAnotherFrameRateFailsTheCheck) {
+  DaemonConfig c = lab_without_hardware();
+  c.camera.source = "file";
+  c.camera.device = ::testing::TempDir() + "/config_check_30fps_" + std::to_string(::getpid()) + ".avi";
+  {
+    cv::VideoWriter writer(c.camera.device, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30.0, cv::Size(640, 480));
+    ASSERT_TRUE(writer.isOpened());
+    const cv::Mat grey(480, 640, CV_8UC3, cv::Scalar(40, 40, 40));
+    for (int i = 0; i < 3; ++i) writer.write(grey);
+  }
+  ASSERT_EQ(c.camera.fps, 200.0);
+  const std::string what = check_error(c);
+  EXPECT_NE(what.find("camera.device: video file " + c.camera.device + " 640x480 at 30 fps: not the 200 frames/s of "
+                      "camera.fps"),
+            std::string::npos)
+      << what;
+  c.camera.fps = 30.0;
+  EXPECT_EQ(check_error(c).find("frames/s"), std::string::npos) << check_error(c);
+  fs::remove(c.camera.device);
+}
+
 // The command line's CAN log is checked as the file's would be, and a failed
 // check is still one JSON object.
 TEST(ConfigCheck, ACanLogThatCannotBeWrittenFailsTheCheck) {

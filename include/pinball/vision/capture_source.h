@@ -25,6 +25,11 @@ struct CaptureConfig {
   std::string fourcc;          ///< requested pixel format, e.g. "GREY", "YUYV", "MJPG" (devices; empty: the driver's)
   double exposure_s = -1.0;    ///< fixed exposure (s), set with auto-exposure off (devices); < 0 leaves the driver's
   int buffers = 2;             ///< driver buffer count (devices; fewer: less latency, more drops); 0 leaves it
+  /// A video file's frames are stamped on the steady clock at their recorded
+  /// times after the first (Frame::t_s), never at their decoding. true: read()
+  /// also waits until that time, so the file plays as a camera delivers
+  /// (pinballd); false: as fast as it decodes (calibration's sweep videos).
+  bool pace_file = false;
 };
 
 /// An exposure time in V4L2's exposure_time_absolute units of 100 µs,
@@ -76,6 +81,8 @@ class CaptureSource final : public FrameSource {
   bool at_end_ = false;
   bool have_last_ = false;
   double last_stamp_s_ = 0.0;
+  double file_start_steady_s_ = -1.0;  // a file: the steady time of its first frame (< 0: none read yet)
+  double file_start_pos_s_ = 0.0;      // and that frame's own time in the file
   std::uint64_t sequence_ = 0;
   FrameSourceCounters counters_;
 };
