@@ -1,5 +1,6 @@
 #include "pinball/vision/camera_homography.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -17,6 +18,29 @@ bool finite(const cv::Matx33d& m) {
   return true;
 }
 
+// Twice the area of the triangle a, b, c over the square of its longest side: 0 when the three lie on
+// a line, about 1 for a well-shaped one; scale-free, so metres and pixels are judged alike.
+double triangle_shape(const cv::Point2d& a, const cv::Point2d& b, const cv::Point2d& c) {
+  const double twice_area = std::abs((b - a).cross(c - a));
+  const double longest = std::max({cv::norm(b - a), cv::norm(c - b), cv::norm(a - c)});
+  return longest > 0.0 ? twice_area / (longest * longest) : 0.0;
+}
+
+// The four correspondences a homography can be fitted to: no three on a line on either side.
+void check_four_points(const std::array<cv::Point2d, 4>& p, const char* side) {
+  constexpr double kLeastShape = 1e-6;  // a corner 1 um off the line through two 1 m apart
+  for (int skip = 0; skip < 4; ++skip) {
+    std::array<cv::Point2d, 3> t;
+    for (int i = 0, k = 0; i < 4; ++i) {
+      if (i != skip) t[static_cast<std::size_t>(k++)] = p[static_cast<std::size_t>(i)];
+    }
+    if (!(triangle_shape(t[0], t[1], t[2]) > kLeastShape)) {
+      throw std::invalid_argument(std::string("camera homography: three of the four ") + side +
+                                  " points lie on a line (or two coincide): no homography maps them");
+    }
+  }
+}
+
 }  // namespace
 
 CameraHomography::CameraHomography(const cv::Matx33d& image_from_board) : h_(image_from_board) {
@@ -29,6 +53,12 @@ CameraHomography::CameraHomography(const cv::Matx33d& image_from_board) : h_(ima
 
 CameraHomography CameraHomography::from_points(const std::array<Vec2, 4>& p_board,
                                                const std::array<cv::Point2d, 4>& uv_px) {
+  // A degenerate set had been accepted: three board points on a line gave a matrix that mapped
+  // (0, 0) 73 px from where it was told to, and (0.4, 0) to 1.8e16 px.
+  std::array<cv::Point2d, 4> board_points;
+  for (std::size_t i = 0; i < 4; ++i) board_points[i] = cv::Point2d(p_board[i].x(), p_board[i].y());
+  check_four_points(board_points, "board");
+  check_four_points(uv_px, "image");
   std::vector<cv::Point2f> src(4);
   std::vector<cv::Point2f> dst(4);
   for (std::size_t i = 0; i < 4; ++i) {
@@ -63,6 +93,21 @@ CameraHomography CameraHomography::from_points(const std::array<Vec2, 4>& p_boar
   cv::Matx<double, 8, 1> sol;
   if (cv::solve(a, b, sol, cv::DECOMP_LU)) {
     h = cv::Matx33d(sol(0), sol(1), sol(2), sol(3), sol(4), sol(5), sol(6), sol(7), 1.0);
+  }
+  // The points on one side of the horizon, and each mapped where it was told to: a crossed corner
+  // order (a bow tie) puts one behind the camera.
+  double image_scale = 0.0;
+  for (const cv::Point2d& q : uv_px) image_scale = std::max(image_scale, cv::norm(q - uv_px[0]));
+  double first_w = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const cv::Vec3d q = h * cv::Vec3d(p_board[i].x(), p_board[i].y(), 1.0);
+    if (i == 0) first_w = q[2];
+    const bool same_side = q[2] * first_w > 0.0;
+    const cv::Point2d mapped(q[0] / q[2], q[1] / q[2]);
+    if (!same_side || !(cv::norm(mapped - uv_px[i]) <= 1e-6 * std::max(image_scale, 1.0))) {
+      throw std::invalid_argument("camera homography: the four points are in an order no view of a plane gives "
+                                  "(corners crossed, or the horizon between them)");
+    }
   }
   return CameraHomography(h);
 }

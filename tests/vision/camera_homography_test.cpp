@@ -40,6 +40,34 @@ TEST(CameraHomography, FromPointsMapsThePointsExactly) {
   for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(cv::norm(h.image_from_board(board[i]) - image[i]), 0.0, 1e-9);
 }
 
+// Degenerate correspondences had been accepted with a matrix that did not map them.
+TEST(CameraHomography, FromPointsRefusesPointsNoViewOfAPlaneGives) {
+  const std::array<Vec2, 4> board{Vec2{0.0, 0.0}, Vec2{0.5, 0.0}, Vec2{0.5, 1.0}, Vec2{0.0, 1.0}};
+  const std::array<cv::Point2d, 4> image{cv::Point2d{10.3, 20.1}, cv::Point2d{15.0, 300.7},
+                                         cv::Point2d{600.2, 280.0}, cv::Point2d{590.9, 40.4}};
+  const auto error = [](const std::array<Vec2, 4>& b, const std::array<cv::Point2d, 4>& i) {
+    try {
+      (void)CameraHomography::from_points(b, i);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::array<Vec2, 4> on_a_line = board;
+  on_a_line[1] = Vec2{0.25, 0.5};  // between corners 0 and 2
+  EXPECT_NE(error(on_a_line, image).find("three of the four board points lie on a line"), std::string::npos);
+  std::array<cv::Point2d, 4> flat = image;
+  for (cv::Point2d& p : flat) p.y = 20.0;  // the board squashed onto one image row
+  EXPECT_NE(error(board, flat).find("three of the four image points lie on a line"), std::string::npos);
+  std::array<Vec2, 4> twice = board;
+  twice[3] = twice[0];
+  EXPECT_NE(error(twice, image).find("board points lie on a line (or two coincide)"), std::string::npos);
+  std::array<cv::Point2d, 4> crossed = image;
+  std::swap(crossed[2], crossed[3]);  // a bow tie
+  EXPECT_NE(error(board, crossed).find("an order no view of a plane gives"), std::string::npos) << error(board, crossed);
+  EXPECT_EQ(error(board, image), "");
+}
+
 TEST(CameraHomography, LocalScaleIsTheSquareRootOfTheAreaMagnification) {
   const CameraHomography h = CameraHomography::default_view(table(), {1280, 1024});
   const Vec2 p{0.3, 0.9};

@@ -34,7 +34,9 @@ class CameraHomography {
   explicit CameraHomography(const cv::Matx33d& image_from_board);
 
   /// The homography that maps the four board points to the four image points
-  /// (cv::getPerspectiveTransform). Throws std::invalid_argument when degenerate.
+  /// (cv::getPerspectiveTransform). Throws std::invalid_argument when
+  /// degenerate: three points of either side on a line (or two coincide), or
+  /// an order no view of a plane gives (a bow tie: one point behind the camera).
   static CameraHomography from_points(const std::array<Vec2, 4>& p_board, const std::array<cv::Point2d, 4>& uv_px);
 
   /// The simulator's default camera over `board` for an image of `image_size`.
