@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -110,6 +111,18 @@ BallDetector::BallDetector(const CameraHomography& homography, cv::Size frame_si
     undistorter_.emplace(*c.lens);
   }
   if (c.dejitter_frames > 0) dejitter_.emplace(c.frame_period_s, c.dejitter_frames);
+  // The smallest ball the image holds, over a grid (half its area: the scale varies smoothly between
+  // grid points). A blob under min_area_ratio of it is a speck anywhere, found without the ball's
+  // expected size at its centre: through a lens that costs an undistortion, and 2 % salt noise took
+  // 3.3 ms a frame instead of 0.4.
+  double least_ball_px2 = std::numeric_limits<double>::infinity();
+  for (int gv = 0; gv <= 12; ++gv) {
+    for (int gu = 0; gu <= 16; ++gu) {
+      const double r = expected_radius_px({(size_.width - 1) * gu / 16.0, (size_.height - 1) * gv / 12.0});
+      if (std::isfinite(r) && r > 0.0) least_ball_px2 = std::min(least_ball_px2, std::numbers::pi * r * r);
+    }
+  }
+  speck_area_px2_ = std::isfinite(least_ball_px2) ? 0.5 * c.min_area_ratio * least_ball_px2 : 0.0;
   split_label_ = cv::Mat::zeros(size_, CV_8U);
   split_core_ = cv::Mat::zeros(size_, CV_8U);
   split_run_ = cv::Mat::zeros(size_, CV_16S);
@@ -338,6 +351,7 @@ void BallDetector::scan(const cv::Rect& region, const cv::Rect& box, bool region
       fill_blob(u, v, region, blob);
       ++u;
       ++out.blobs;
+      if (blob.area < 3.0 && blob.area < speck_area_px2_) continue;  // a speck anywhere in the image
       const cv::Point2d centre{blob.su / blob.area, blob.sv / blob.area};
       const double r_px = expected_radius_px(centre);
       const double expected = std::numbers::pi * r_px * r_px;

@@ -176,6 +176,7 @@ class BallDetector {
 
   CameraHomography homography_;
   std::optional<PointUndistorter> undistorter_;  // with a lens
+  double speck_area_px2_ = 0.0;  // a blob smaller is noise wherever it lies (set at construction)
   std::optional<FrameDejitter> dejitter_;        // with dejitter_frames > 0
   cv::Size size_;
   BallDetectorConfig config_;
