@@ -1,5 +1,6 @@
 #include "pinball/vision/lens_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -60,6 +61,27 @@ TEST(LensModel, UndistortionInvertsDistortionEverywhereInTheImage) {
     }
   }
   EXPECT_LT(worst, 1e-4);
+}
+
+// OpenCV's fixed-point undistortion wandered off on a short, strongly barrelled lens whose inverse
+// exists everywhere (its radial map rises monotonically): 7 % of the image came back up to 292 px wrong.
+TEST(LensModel, UndistortionInvertsAShortStronglyBarrelledLensToo) {
+  CameraIntrinsics lens = typical_wide_lens();
+  lens.fx_px = lens.fy_px = 373.0;  // a 2.8 mm lens
+  lens.k1 = -0.4;
+  lens.k2 = 0.08;
+  ASSERT_FALSE(check_intrinsics(lens));
+  const PointUndistorter undistorter(lens);
+  double worst_px = 0.0;
+  for (double v = 0.0; v < 480.0; v += 8.0) {
+    for (double u = 0.0; u < 640.0; u += 8.0) {
+      const cv::Point2d p(u, v);
+      worst_px = std::max(worst_px, cv::norm(distort_pixel(lens, undistorter.ideal_from_distorted(p)) - p));
+    }
+  }
+  EXPECT_LT(worst_px, 1e-3);
+  const cv::Point2d corner(600.0, 440.0);  // where the fixed point had returned (826.7, 604.3)
+  EXPECT_LT(cv::norm(undistorter.ideal_from_distorted(corner) - ideal_from_distorted_newton(lens, corner)), 1e-3);
 }
 
 TEST(LensModel, TheSimulatorsNewtonInverseAgreesWithOpenCvs) {
