@@ -52,10 +52,15 @@ class CradlePlayer {
       last_return_s_ = s.time_s;
     } else if (pending_) {
       ++ball_.duds;
+      if (bat != last_dropped_) {  // rolled or hopped across to the other bat: a pass
+        ++ball_.passes;
+        last_pass_s_ = s.time_s;
+      }
     }
     last_cradle_s_ = s.time_s;
     last_cradle_score_ = s.score;
     dropped_ = bat;
+    last_dropped_ = bat;
     raise_at_s_ = s.time_s + drop_s_;
     pending_ = true;
     left_bats_ = false;
@@ -67,6 +72,7 @@ class CradlePlayer {
     ball_.score = r.score;
     ball_.cut = r.cut;
     ball_.cycling_at_cut = r.cut && ball_.returns > 0 && r.duration_s - (last_return_s_ - start_s_) <= o_.cycling_gap_s;
+    ball_.passing_at_cut = r.cut && ball_.passes > 0 && r.duration_s - (last_pass_s_ - start_s_) <= o_.cycling_gap_s;
     if (!r.cut && pending_) {  // lost after a drop: the cycle broke
       ball_.lost_after_drop = true;
       ball_.drain = drain;
@@ -94,11 +100,13 @@ class CradlePlayer {
   double left_y_m_;
   CradleBall ball_;
   int dropped_ = -1;
+  int last_dropped_ = -1;  // the bat of the latest drop, still known once it is raised
   double raise_at_s_ = 0.0;
   double still_since_s_ = -1.0;
   double last_cradle_s_ = 0.0;
   double last_cradle_score_ = 0.0;
   double last_return_s_ = 0.0;
+  double last_pass_s_ = 0.0;
   double start_s_ = 0.0;
   bool left_bats_ = false;
   bool pending_ = false;  // a drop whose outcome is not known yet
@@ -192,9 +200,11 @@ CradleReport run_cradle_bench(const sim::World& world, const CradleBenchOptions&
       r.shots += ball.shots;
       r.returns += ball.returns;
       r.duds += ball.duds;
+      r.passes += ball.passes;
       if (ball.lost_after_drop) r.drains.add(ball.drain, false);
       r.cut += ball.cut ? 1 : 0;
       r.cut_cycling += ball.cycling_at_cut ? 1 : 0;
+      r.cut_passing += ball.passing_at_cut ? 1 : 0;
       time_sum_s += ball.ball_time_s;
       cycle_time_s += ball.cycle_time_s;
       cycle_points += ball.cycle_points;
@@ -229,6 +239,7 @@ nlohmann::json to_json(const CradleReport& report) {
                      {"shots", r.shots},
                      {"returns", r.returns},
                      {"duds", r.duds},
+                     {"passes", r.passes},
                      {"return_share", r.return_share()},
                      {"return_ci95_low", r.return_interval.low},
                      {"return_ci95_high", r.return_interval.high},
@@ -243,6 +254,7 @@ nlohmann::json to_json(const CradleReport& report) {
                        {"other", r.drains.other}}},
                      {"balls_cut_at_time_limit", r.cut},
                      {"balls_cut_cycling", r.cut_cycling},
+                     {"balls_cut_passing", r.cut_passing},
                      {"mean_ball_time_s", r.mean_ball_time_s},
                      {"mean_score_per_ball", r.mean_score},
                      {"score_ci95_half_width", r.score_ci95}});
@@ -284,7 +296,8 @@ std::string to_text(const CradleReport& report) {
     }
     out << "; lost after a drop: outlane "
         << r.drains.left_outlane + r.drains.right_outlane << ", centre " << r.drains.centre << "; cut "
-        << r.cut << " (" << r.cut_cycling << " cycling); mean ball " << format_number(r.mean_ball_time_s)
+        << r.cut << " (" << r.cut_cycling << " cycling, " << r.cut_passing << " passing); duds " << r.duds << " ("
+        << r.passes << " passes); mean ball " << format_number(r.mean_ball_time_s)
         << " s, " << format_mean_ci(r.mean_score, r.score_ci95) << " points\n";
   }
   if (!report.drops.empty() && !report.best) {

@@ -55,12 +55,14 @@ struct CradleBall {
   int shots = 0;               ///< drops whose outcome is known: returns, and the drop the ball was lost after
   int returns = 0;             ///< drops after which the ball left the bats and came back to a cradle
   int duds = 0;                ///< drops after which the ball settled again without leaving the bats (no cycle, no loss)
+  int passes = 0;              ///< duds after which it settled on the other bat (rolled or hopped across)
   double cycle_time_s = 0.0;   ///< cradle to cradle, summed over the returns
   double cycle_points = 0.0;   ///< points scored over the returns
   bool lost_after_drop = false; ///< the cycle broke: lost after a drop, whether it left the bats or not
   DrainCause drain = DrainCause::kOther;  ///< when lost_after_drop
   bool cut = false;            ///< alive at the cap
   bool cycling_at_cut = false; ///< cut, with a return within cycling_gap_s of the cap
+  bool passing_at_cut = false; ///< cut, with a pass within cycling_gap_s of the cap
   double ball_time_s = 0.0;
   double score = 0.0;
 };
@@ -73,6 +75,7 @@ struct CradleDropResult {
   int shots = 0;               ///< returns + losses after a drop
   int returns = 0;
   int duds = 0;
+  int passes = 0;
   DrainCounts drains;          ///< balls lost after a drop, by route
   Interval return_interval;  ///< Wilson 95 % of returns / shots
   double mean_period_s = 0.0;  ///< cradle to cradle over the returns (NaN without a return)
@@ -80,6 +83,7 @@ struct CradleDropResult {
   double mean_ball_time_s = 0.0;
   int cut = 0;
   int cut_cycling = 0;
+  int cut_passing = 0;
   double mean_score = 0.0;
   double score_ci95 = 0.0;     ///< half-width of mean_score's 95 % interval (Student's t)
 

@@ -201,6 +201,15 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
     refuse(r, "spastic", check_spastic_config(spastic));
     s.spastic = spastic;
   }
+  if (j.contains("cradle")) {
+    if (s.shot_table || s.planner || s.spastic) {
+      r.fail("cradle", "a cradle controller file holds no imitation, planner or spastic object");
+    }
+    CradleConfig cradle;
+    r.read(&j["cradle"], "cradle", &cradle);
+    refuse(r, "cradle", check_cradle_config(cradle));
+    s.cradle = cradle;
+  }
   if (j.contains("actuator")) {
     r.read(&j["actuator"], "actuator", &s.actuator);
     refuse(r, "actuator", check_actuator_config(s.actuator));
@@ -219,7 +228,7 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
   }
   // Last: a required key misspelt is reported as missing, which says more.
   refuse_unknown_keys(r, j, "", {"format", "version", "note", "partition", "minicontrollers", "actuator", "launcher",
-                                 "planner", "spastic", "imitation"});
+                                 "planner", "spastic", "cradle", "imitation"});
   return s;
 }
 
@@ -228,7 +237,10 @@ ControllerSpec spec_from_json(const json& j, JsonReadArchive& r) {
 std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec) {
   check_input(!spec.spastic || (!spec.shot_table && !spec.planner), "controller",
               "spastic settings beside a shot table or a planner");
+  check_input(!spec.cradle || (!spec.shot_table && !spec.planner && !spec.spastic), "controller",
+              "cradle settings beside another player");
   if (spec.spastic) return std::make_unique<SpasticController>(*spec.spastic);
+  if (spec.cradle) return std::make_unique<CradleController>(*spec.cradle);
   if (spec.planner) {
     throw std::invalid_argument("controller: the planner needs the belief board (learn::make_controller)");
   }
@@ -258,6 +270,7 @@ std::string controller_to_json(const ControllerSpec& s) {
   };
   if (s.planner) j["planner"] = to_json_value(*s.planner);
   if (s.spastic) j["spastic"] = to_json_value(*s.spastic);
+  if (s.cradle) j["cradle"] = to_json_value(*s.cradle);
   if (!s.shot_table) return json_text(j, 2) + "\n";
   // One line per shot: the table stays readable (and diffable) at thousands of shots.
   json table = shot_table_json(*s.shot_table);

@@ -25,6 +25,7 @@ namespace {
 
 std::string controller_kind(const control::ControllerSpec& spec) {
   if (spec.spastic) return "spastic";
+  if (spec.cradle) return "cradle";
   if (spec.planner) return "planner";
   if (spec.shot_table) return "imitation";
   return "action function";

@@ -127,7 +127,7 @@ std::array<bool, 2> PlanningController::energized_by_side() const {
 
 std::unique_ptr<control::FlipperController> make_controller(const control::ControllerSpec& spec,
                                                             const table::Board& belief) {
-  if (spec.planner && !spec.spastic) return std::make_unique<PlanningController>(belief, *spec.planner);
+  if (spec.planner && !spec.spastic && !spec.cradle) return std::make_unique<PlanningController>(belief, *spec.planner);
   return control::make_flipper_controller(spec);
 }
 

@@ -118,6 +118,7 @@ const TrackerOutput& Tracker::update(const Observation& obs, const ContactSensor
   const double sigma = sigma_m();
 
   out_ = TrackerOutput{};
+  out_.ball_m = obs.p_board;
   const bool rolling = contacts.left || contacts.right;
   if (!rolling && was_rolling_) keep_newest(1);  // rolling points are no parabola
   was_rolling_ = rolling;

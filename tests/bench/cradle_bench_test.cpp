@@ -47,6 +47,8 @@ TEST(CradleBench, ABriefDropOnlyRocksTheBallInTheCrookAndIsNoCycle) {
   EXPECT_EQ(b.shots, 0) << "a dud neither returns nor loses the ball";
   EXPECT_TRUE(b.cut);
   EXPECT_FALSE(b.cycling_at_cut) << "a ball rocking in the crook is not a cycle";
+  EXPECT_EQ(b.passes, 0) << "it rocks back onto the bat it lay on";
+  EXPECT_FALSE(b.passing_at_cut);
   EXPECT_FALSE(b.lost_after_drop);
 }
 

@@ -287,6 +287,27 @@ TEST(ControllerFile, ASpasticFileIsRefusedOutOfRangeOrBesideAnotherController) {
   EXPECT_THROW(make_flipper_controller(both), std::invalid_argument);
 }
 
+TEST(ControllerFile, ACradleFileRoundTripsAndIsRefusedBesideAnotherPlayer) {
+  ControllerSpec s;
+  s.cradle = CradleConfig{0.092, 0.4, 0.002, 3.0};
+  const ControllerSpec r = controller_from_json(controller_to_json(s), "cradle.json");
+  ASSERT_TRUE(r.cradle);
+  EXPECT_EQ(r.cradle->drop_s, 0.092);
+  EXPECT_EQ(r.cradle->rest_s, 0.4);
+  EXPECT_EQ(r.cradle->still_band_m, 0.002);
+  EXPECT_EQ(r.cradle->max_hold_s, 3.0);
+  EXPECT_EQ(controller_to_json(r), controller_to_json(s));
+  EXPECT_NE(dynamic_cast<CradleController*>(make_flipper_controller(r).get()), nullptr);
+  const std::string good = controller_to_json(s);
+  expect_error(with(good, "\"drop_s\": 0.092", "\"drop_s\": 2"), "bad.json: cradle.drop_s: must be in (0, 1] s");
+  ControllerSpec both = s;
+  both.spastic = SpasticConfig{};
+  expect_error(controller_to_json(both),
+               "bad.json: cradle: a cradle controller file holds no imitation, planner or spastic object");
+  EXPECT_THROW(make_flipper_controller(both), std::invalid_argument);
+  EXPECT_TRUE(load_controller(PINBALL_SOURCE_DIR "/controllers/cradle.json").cradle);
+}
+
 // docs/results.md quotes every file under controllers/: each must load as shipped.
 TEST(ControllerFile, EveryShippedControllerLoads) {
   int loaded = 0;

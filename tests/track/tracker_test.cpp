@@ -586,6 +586,14 @@ TEST(Tracker, AClockThatJumpsIsFollowedAndBadTimesAndPlacesAreIgnored) {
   EXPECT_EQ(nan_first.history_size(), 5u);
 }
 
+// A controller that waits for a ball at rest (the cradle cycle) reads where it lies from the output.
+TEST(Tracker, TheOutputSaysWhereTheNewestObservationPutTheBall) {
+  Tracker tracker(geometry(), config());
+  EXPECT_EQ(tracker.update(obs(1.0, {0.3, 0.7}), kNoContact).ball_m, Vec2(0.3, 0.7));  // outside the critical area
+  EXPECT_EQ(tracker.update(obs(1.005, {0.31, 0.18}), {false, true}).ball_m, Vec2(0.31, 0.18));  // rolling on a bat
+  EXPECT_EQ(tracker.update(obs(1.01, {0.31, 0.4}), kNoContact).ball_m, Vec2(0.31, 0.4));
+}
+
 TEST(Tracker, ResetForgetsTheBall) {
   Tracker tracker(geometry(), config());
   const Flight f{100.0, {0.22, 0.40}, {0.05, -0.3}, 1.11};

@@ -10,6 +10,7 @@
 
 #include "pinball/control/action_function.h"
 #include "pinball/control/actuator_controller.h"
+#include "pinball/control/cradle_controller.h"
 #include "pinball/control/imitation_controller.h"
 #include "pinball/control/planner_settings.h"
 #include "pinball/control/spastic_controller.h"
@@ -39,6 +40,10 @@ struct ControllerSpec {
   /// (`controllers/spastic.json`); a file may not also hold a shot table or a
   /// planner.
   std::optional<SpasticConfig> spastic;
+  /// The cradle cycle (issue 20's ball alive for 10 minutes): when set, it
+  /// drives the flippers and nothing else in the file is used
+  /// (`controllers/cradle.json`); a file may hold no other player beside it.
+  std::optional<CradleConfig> cradle;
   double launcher_pull = -1.0;    ///< launcher pull fraction; negative: the board's
   bool randomise_launch = false;  ///< draw the pull per ball from [launch_pull_min, launch_pull_max] (thesis 7.1)
   double launch_pull_min = 0.5;   ///< lower end of a randomised pull
@@ -47,11 +52,12 @@ struct ControllerSpec {
 };
 
 /// The flipper controller a spec describes: the spastic flipper when it holds
-/// spastic settings, the imitation controller when it holds a shot table, the
+/// spastic settings, the cradle cycle when it holds cradle settings, the
+/// imitation controller when it holds a shot table, the
 /// action function's actuator controller otherwise. Throws
 /// std::invalid_argument for a planner spec, which needs the belief board
-/// (learn::make_controller builds every kind), and for spastic settings beside
-/// a shot table or a planner.
+/// (learn::make_controller builds every kind), and for spastic or cradle
+/// settings beside another player.
 std::unique_ptr<FlipperController> make_flipper_controller(const ControllerSpec& spec);
 
 /// Bad controller input; what() is "file: field: message".

@@ -77,6 +77,7 @@ struct TrackerOutput {
   int window = 0;                   ///< observations in the fit
   bool flushed = false;             ///< the χ² test dropped points from before a collision
   bool pushed = false;              ///< the fit is the window's own acceleration's (TrackerConfig::max_push_mps2)
+  Vec2 ball_m = Vec2::Zero();       ///< the newest observation's ball (m, board frame): where a resting ball lies
 };
 
 /// Stateful tracker for one ball at a time.
