@@ -456,6 +456,7 @@ DaemonReport Daemon::Impl::report() const {
   r.bus_fault_releases = kc.bus_faults;
   r.fires_deferred = kc.deferred;
   r.frames_dropped = h.frames_dropped.load() + (capture ? capture->counters().dropped : 0);
+  r.camera_reopens = capture ? capture->counters().reopens : 0;
   r.ring_overflows = h.ring_overflows.load();
   r.lcm = lcm->counters();
   if (frame_log) r.can_log = frame_log->counters();
@@ -742,6 +743,7 @@ nlohmann::json report_to_json(const DaemonReport& r) {
   j["latency"] = lat;
   j["frames"] = r.frames;
   j["frames_dropped"] = r.frames_dropped;
+  j["camera_reopens"] = r.camera_reopens;
   j["detections"] = r.detections;
   j["projections"] = r.projections;
   j["camera_noise"] = {{"calibrated_m", r.camera_noise_calibrated_m},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <sstream>
@@ -46,21 +47,22 @@ CaptureSource::CaptureSource(const CaptureConfig& config) : config_(config) {
   if (is_device_ && !all_digits(src) && !std::filesystem::exists(src)) {
     throw std::runtime_error("capture: cannot open camera device '" + src + "': no such device");
   }
+  if (is_device_) {
+    // OpenCV's V4L2 backend waits 10 s for a frame by default: a camera that hangs would hold the
+    // camera thread, and pinballd's exit, that long. A lab that set its own wait keeps it.
+    ::setenv("OPENCV_VIDEOIO_V4L_SELECT_TIMEOUT", "1000", 0);
+  }
   bool opened = false;
   try {
-    if (all_digits(src)) {
-      opened = capture_.open(std::stoi(src), cv::CAP_V4L2);
+    if (is_device_) {
+      opened = open_device();
     } else {
-      if (is_device_) {
-        opened = capture_.open(src, cv::CAP_V4L2);
-      } else {
-        // Files: the decoders that read files, not every backend (CAP_ANY also
-        // probes camera plugins, which log noise and leak in libusb).
-        for (const int api : {cv::CAP_FFMPEG, cv::CAP_OPENCV_MJPEG}) {
-          if (capture_.open(src, api)) {
-            opened = true;
-            break;
-          }
+      // Files: the decoders that read files, not every backend (CAP_ANY also
+      // probes camera plugins, which log noise and leak in libusb).
+      for (const int api : {cv::CAP_FFMPEG, cv::CAP_OPENCV_MJPEG}) {
+        if (capture_.open(src, api)) {
+          opened = true;
+          break;
         }
       }
     }
@@ -73,20 +75,6 @@ CaptureSource::CaptureSource(const CaptureConfig& config) : config_(config) {
                              std::string(is_device_ ? "camera device '" + src + "' (V4L2)"
                                                     : "video file '" + src + "': not a video OpenCV can decode"));
   }
-  if (is_device_) {
-    if (config_.fourcc.size() == 4) {
-      capture_.set(cv::CAP_PROP_FOURCC, cv::VideoWriter::fourcc(config_.fourcc[0], config_.fourcc[1],
-                                                                config_.fourcc[2], config_.fourcc[3]));
-    }
-    if (config_.width_px > 0) capture_.set(cv::CAP_PROP_FRAME_WIDTH, config_.width_px);
-    if (config_.height_px > 0) capture_.set(cv::CAP_PROP_FRAME_HEIGHT, config_.height_px);
-    if (config_.fps > 0.0) capture_.set(cv::CAP_PROP_FPS, config_.fps);
-    if (config_.buffers > 0) capture_.set(cv::CAP_PROP_BUFFERSIZE, config_.buffers);
-    if (config_.exposure_s >= 0.0) {
-      capture_.set(cv::CAP_PROP_AUTO_EXPOSURE, 1);  // V4L2: 1 = manual
-      capture_.set(cv::CAP_PROP_EXPOSURE, v4l2_exposure_units(config_.exposure_s));
-    }
-  }
   size_ = cv::Size(static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH)),
                    static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_HEIGHT)));
   fps_ = capture_.get(cv::CAP_PROP_FPS);
@@ -94,6 +82,45 @@ CaptureSource::CaptureSource(const CaptureConfig& config) : config_(config) {
   if (size_.width <= 0 || size_.height <= 0) {
     throw std::runtime_error("capture: '" + src + "' reports no frame size");
   }
+}
+
+bool CaptureSource::open_device() {
+  const std::string& src = config_.source;
+  const bool opened = all_digits(src) ? capture_.open(std::stoi(src), cv::CAP_V4L2) : capture_.open(src, cv::CAP_V4L2);
+  if (!opened || !capture_.isOpened()) return false;
+  if (config_.fourcc.size() == 4) {
+    capture_.set(cv::CAP_PROP_FOURCC, cv::VideoWriter::fourcc(config_.fourcc[0], config_.fourcc[1],
+                                                              config_.fourcc[2], config_.fourcc[3]));
+  }
+  if (config_.width_px > 0) capture_.set(cv::CAP_PROP_FRAME_WIDTH, config_.width_px);
+  if (config_.height_px > 0) capture_.set(cv::CAP_PROP_FRAME_HEIGHT, config_.height_px);
+  if (config_.fps > 0.0) capture_.set(cv::CAP_PROP_FPS, config_.fps);
+  if (config_.buffers > 0) capture_.set(cv::CAP_PROP_BUFFERSIZE, config_.buffers);
+  if (config_.exposure_s >= 0.0) {
+    capture_.set(cv::CAP_PROP_AUTO_EXPOSURE, 1);  // V4L2: 1 = manual
+    capture_.set(cv::CAP_PROP_EXPOSURE, v4l2_exposure_units(config_.exposure_s));
+  }
+  return true;
+}
+
+void CaptureSource::reopen_device() {
+  // An unplugged camera fails every read on its dead handle; plugged back, it is a new device node
+  // behind the same path, and only a new open sees it.
+  capture_.release();
+  try {
+    if (!open_device()) return;
+  } catch (const cv::Exception&) {
+    capture_.release();
+    return;
+  }
+  const cv::Size size(static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_WIDTH)),
+                      static_cast<int>(capture_.get(cv::CAP_PROP_FRAME_HEIGHT)));
+  if (size != size_) {  // another camera, or another mode: its frames would not fit the detector
+    capture_.release();
+    return;
+  }
+  ++counters_.reopens;
+  have_last_ = false;  // the gap while it was away is no count of dropped frames
 }
 
 std::string CaptureSource::describe() const {
@@ -115,11 +142,16 @@ bool CaptureSource::read(Frame& out) {
   if (!ok || raw_.empty()) {
     if (is_device_) {
       ++counters_.read_failures;
+      if (++failures_in_a_row_ >= kReopenAfterFailures) {
+        failures_in_a_row_ = 0;
+        reopen_device();
+      }
     } else {
       at_end_ = true;
     }
     return false;
   }
+  failures_in_a_row_ = 0;
   if (raw_.channels() == 3) {
     cv::cvtColor(raw_, out.gray, cv::COLOR_BGR2GRAY);
   } else if (raw_.channels() == 4) {

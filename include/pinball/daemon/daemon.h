@@ -63,6 +63,7 @@ struct DaemonReport {
   std::array<LatencySummary, kStageCount> latency{};  ///< per stage
   std::uint64_t frames = 0;                  ///< frames processed by the camera thread
   std::uint64_t frames_dropped = 0;          ///< frames lost before the camera thread
+  std::uint64_t camera_reopens = 0;          ///< a lab camera opened again after failing reads in a row (replugged)
   std::uint64_t detections = 0;              ///< frames with a ball
   std::uint64_t projections = 0;             ///< valid projections
   /// The camera's noise per coordinate (m): the calibration's, which the

@@ -71,8 +71,18 @@ class CaptureSource final : public FrameSource {
   FrameSourceCounters counters() const override { return counters_; }
   std::string describe() const override;
 
+ public:
+  /// Reads failed in a row after which a camera is opened again (an unplugged
+  /// and replugged camera is seen only by a new open): about 5 s of pinballd's
+  /// retries, whose wait grows to 0.1 s.
+  static constexpr int kReopenAfterFailures = 50;
+
  private:
+  bool open_device();    // opens config_.source with V4L2 and asks for the configured format
+  void reopen_device();  // after kReopenAfterFailures: release, open again if it is back at the same size
+
   CaptureConfig config_;
+  int failures_in_a_row_ = 0;
   bool is_device_ = false;
   cv::VideoCapture capture_;
   cv::Mat raw_;

@@ -17,6 +17,7 @@ struct FrameSourceCounters {
   std::uint64_t frames = 0;         ///< frames delivered by read()
   std::uint64_t dropped = 0;        ///< frames the source knows it lost (timestamp gaps)
   std::uint64_t read_failures = 0;  ///< reads that failed while the source was still open
+  std::uint64_t reopens = 0;        ///< a camera opened again after failing kReopenAfterFailures reads in a row
 };
 
 /// A stream of grayscale frames.
