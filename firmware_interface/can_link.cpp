@@ -65,6 +65,20 @@ CanLinkStatus read_can_link(const std::string& interface) {
   return s;
 }
 
+std::string driver_board_lock_path(const std::string& interface, int board_id) {
+  std::error_code ec;
+  const std::filesystem::path folder =
+      ::access("/run/lock", W_OK) == 0 ? std::filesystem::path("/run/lock") : std::filesystem::temp_directory_path(ec);
+  return (folder / ("pinball-" + interface + "-board" + std::to_string(board_id) + ".lock")).string();
+}
+
+WriterLock lock_driver_board(const std::string& interface, int board_id) {
+  const std::string path = driver_board_lock_path(interface, board_id);
+  return WriterLock(path, interface + " board " + std::to_string(board_id) +
+                              " is driven by another process (a pinballd service, or a calibrate latency: `fuser " +
+                              path + "` names it): two hosts would each switch off the other's coils");
+}
+
 std::string can_bring_up_command(const std::string& interface, std::uint32_t bitrate_bps) {
   return "sudo ip link set " + interface + " down; sudo ip link set " + interface + " up type can bitrate " +
          std::to_string(bitrate_bps) + " restart-ms 100";

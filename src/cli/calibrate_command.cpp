@@ -780,13 +780,14 @@ void run_latency_lab(Context& c) {
                              "x" + std::to_string(camera.frame_size().height) + " frames, the calibration is for " +
                              std::to_string(size.width) + "x" + std::to_string(size.height));
   }
-  firmware::SocketCanOptions so;
-  so.interface = can;
-  firmware::SocketCanTransport transport(so);
   const int drivers = static_cast<int>(c.board.flippers.size());
   firmware::DriverBusOptions bo;
   bo.driver_count = drivers;
   if (lab) bo = daemon::driver_bus_options_for(*lab, drivers);
+  const WriterLock board_lock = firmware::lock_driver_board(can, bo.board_id);  // not beside a running pinballd
+  firmware::SocketCanOptions so;
+  so.interface = can;
+  firmware::SocketCanTransport transport(so);
   firmware::DriverBus bus(transport, bo);  // its destructor stops the thread with every coil off
   InterruptGuard interrupts;
   bus.start();  // from here the bus's destructor stops it with every coil off

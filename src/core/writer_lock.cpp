@@ -12,7 +12,7 @@
 
 namespace pinball {
 
-WriterLock::WriterLock(const std::string& path) {
+WriterLock::WriterLock(const std::string& path, const std::string& held_elsewhere) {
   if (path.empty()) return;
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) return;  // a pipe or a device: its reader's
@@ -24,6 +24,7 @@ WriterLock::WriterLock(const std::string& path) {
     ::close(fd_);
     fd_ = -1;
     if (why == EWOULDBLOCK) {
+      if (!held_elsewhere.empty()) throw std::runtime_error(held_elsewhere);
       throw std::runtime_error(path + " is being written by another process (another pinballd?): two writers "
                                       "would interleave their records into one damaged file");
     }

@@ -28,6 +28,7 @@
 #include "pinball/daemon/doorbell.h"
 #include "pinball/daemon/pipeline.h"
 #include "pinball/daemon/thread_table.h"
+#include "pinball/firmware/can_link.h"
 #include "pinball/firmware/frame_log.h"
 #include "pinball/firmware/socketcan_transport.h"
 #include "pinball/firmware/stream_transport.h"
@@ -78,6 +79,7 @@ static_assert(simlab::GameEvent::kBallCut == GameEventMessage::KIND_BALL_CUT);
 struct Daemon::Impl {
   DaemonConfig config;
   std::vector<WriterLock> recording_locks;  // the LCM and CAN logs: no second pinballd writes into them
+  WriterLock board_lock{""};                // the lab's driver board: no second host drives it
   CpuPlan cpus;  // threads.chain_cpu
   bool fifo_allowed = true;  // false once the probe was refused: warned once, not once per thread
   bool sim_mode = true;
@@ -212,6 +214,7 @@ void Daemon::Impl::build() {
   } else {
     // In the lab the camera is looked for too, so that a start names all that is missing at once.
     for (std::string& note : check_lab_hardware(config)) warnings.push_back(std::move(note));
+    board_lock = firmware::lock_driver_board(config.can.interface, config.can.board_id);
     firmware::SocketCanOptions o;
     o.interface = config.can.interface;
     host_link = std::make_unique<firmware::SocketCanTransport>(o);

@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <stdexcept>
 #include <string>
+
+#include <unistd.h>
 
 namespace pinball::firmware {
 namespace {
@@ -69,6 +73,27 @@ TEST(CanLink, NoAutomaticRestartAfterBusOffIsRefused) {
   EXPECT_TRUE(judge_can_link(s, "can0", 500000).ok);
   s.restart_ms = -1;  // not read (an old kernel): the bit rate and state checks stand alone
   EXPECT_TRUE(judge_can_link(s, "can0", 500000).ok);
+}
+
+// Two hosts on one board each switched off the other's coils (pinballd's service and a calibrate latency).
+TEST(CanLink, OneHostAtATimeDrivesABoard) {
+  const std::string iface = "pbtest" + std::to_string(::getpid() % 100000);
+  const std::string path = driver_board_lock_path(iface, 3);
+  EXPECT_NE(path.find("pinball-" + iface + "-board3.lock"), std::string::npos) << path;
+  {
+    const WriterLock first = lock_driver_board(iface, 3);
+    try {
+      (void)lock_driver_board(iface, 3);
+      ADD_FAILURE() << "a second host took the board";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(iface + " board 3 is driven by another process", 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find("`fuser " + path + "`"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW((void)lock_driver_board(iface, 4)) << "another board on the same bus is free";
+  }
+  EXPECT_NO_THROW((void)lock_driver_board(iface, 3)) << "released with its holder";
+  std::remove(path.c_str());
+  std::remove(driver_board_lock_path(iface, 4).c_str());
 }
 
 TEST(CanLink, ErrorPassiveStartsWithAWarning) {

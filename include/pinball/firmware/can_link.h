@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <string>
 
+#include "pinball/core/writer_lock.h"
+
 namespace pinball::firmware {
 
 /// The controller's state, as linux/can/netlink.h numbers it (CAN_STATE_*).
@@ -54,6 +56,16 @@ CanLinkStatus read_can_link(const std::string& interface);
 /// virtual interface has no bit rate and is accepted with a note. Messages
 /// name the interface and say the command that fixes it.
 CanLinkVerdict judge_can_link(const CanLinkStatus& status, const std::string& interface, std::uint32_t bitrate_bps);
+
+/// The lock file of driver board `board_id` on `interface`, which the one
+/// host that drives it holds (pinballd in the lab, `calibrate latency`):
+/// under /run/lock, or the temporary folder where there is none. Two hosts on
+/// one board each switched off the other's coils, both reporting "running".
+std::string driver_board_lock_path(const std::string& interface, int board_id);
+
+/// Takes that lock, or throws std::runtime_error naming the interface, the
+/// board, the lock file and what to do (another process holds it).
+WriterLock lock_driver_board(const std::string& interface, int board_id);
 
 /// The `ip link` command that brings `interface` up at `bitrate_bps`, with
 /// the automatic restart after bus-off that PROTOCOL.md asks for.
