@@ -117,18 +117,22 @@ TEST(ConfigCheck, AnLcmServerThatIsNotListeningFailsTheCheck) {
   EXPECT_FALSE(fs::exists(log)) << "the check wrote the log";
 }
 
+// Three grey frames as an MJPG video of this rate and size: a recording to stand in for the lab's camera.
+std::string grey_video(const std::string& name, double fps, cv::Size size) {
+  const std::string path = ::testing::TempDir() + "/config_check_" + name + "_" + std::to_string(::getpid()) + ".avi";
+  cv::VideoWriter writer(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, size);
+  EXPECT_TRUE(writer.isOpened()) << path;
+  const cv::Mat grey(size, CV_8UC3, cv::Scalar(40, 40, 40));
+  for (int i = 0; i < 3; ++i) writer.write(grey);
+  return path;
+}
+
 // A recording of another frame size than the configuration's: the check says
 // so, as the start does (it was found only at the start).
 TEST(ConfigCheck, ARecordedCameraOfAnotherFrameSizeFailsTheCheck) {
   DaemonConfig c = lab_without_hardware();
   c.camera.source = "file";
-  c.camera.device = ::testing::TempDir() + "/config_check_320x240_" + std::to_string(::getpid()) + ".avi";
-  {
-    cv::VideoWriter writer(c.camera.device, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30.0, cv::Size(320, 240));
-    ASSERT_TRUE(writer.isOpened());
-    const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(40, 40, 40));
-    for (int i = 0; i < 3; ++i) writer.write(grey);
-  }
+  c.camera.device = grey_video("320x240", 30.0, cv::Size(320, 240));
   const std::string what = check_error(c);
   EXPECT_NE(what.find("camera.device: video file " + c.camera.device + " 320x240 at 30 fps"), std::string::npos)
       << what;
@@ -141,13 +145,7 @@ TEST(ConfigCheck, ARecordedCameraOfAnotherFrameSizeFailsTheCheck) {
 TEST(ConfigCheck, ARecordedCameraOfAnotherFrameRateFailsTheCheck) {
   DaemonConfig c = lab_without_hardware();
   c.camera.source = "file";
-  c.camera.device = ::testing::TempDir() + "/config_check_30fps_" + std::to_string(::getpid()) + ".avi";
-  {
-    cv::VideoWriter writer(c.camera.device, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30.0, cv::Size(640, 480));
-    ASSERT_TRUE(writer.isOpened());
-    const cv::Mat grey(480, 640, CV_8UC3, cv::Scalar(40, 40, 40));
-    for (int i = 0; i < 3; ++i) writer.write(grey);
-  }
+  c.camera.device = grey_video("30fps", 30.0, cv::Size(640, 480));
   ASSERT_EQ(c.camera.fps, 200.0);
   const std::string what = check_error(c);
   EXPECT_NE(what.find("camera.device: video file " + c.camera.device + " 640x480 at 30 fps: not the 200 frames/s of "

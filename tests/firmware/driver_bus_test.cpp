@@ -333,18 +333,22 @@ TEST_F(DriverBusTest, SendQueuedNeverWaitsForABusyPoll) {
   EXPECT_EQ(board_.counters().fires_accepted, 1u);
 }
 
-// A link whose kernel queue can be full: send() would back off until it drains (here: at once).
-class FullQueueLink : public CanTransport {
+// A link whose kernel queue can be full (send() would back off until it drains: here, at once), or
+// whose next send fails outright.
+class ScriptedLink : public CanTransport {
  public:
-  explicit FullQueueLink(CanTransport& inner) : inner_(inner) {}
-  TxStatus send(const CanFrame& frame) override { return inner_.send(frame); }
+  explicit ScriptedLink(CanTransport& inner) : inner_(inner) {}
+  TxStatus send(const CanFrame& frame) override {
+    return fail_next_ ? (fail_next_ = false, TxStatus::kError) : inner_.send(frame);
+  }
   TxStatus send_without_waiting(const CanFrame& frame) override {
-    return full_ ? TxStatus::kBufferFull : inner_.send(frame);
+    return full_ ? TxStatus::kBufferFull : send(frame);
   }
   RxStatus receive(CanFrame& frame, int timeout_ms) override { return inner_.receive(frame, timeout_ms); }
   int poll_fd() const override { return inner_.poll_fd(); }
   TransportCounters counters() const override { return inner_.counters(); }
   bool full_ = false;
+  bool fail_next_ = false;
 
  private:
   CanTransport& inner_;
@@ -353,7 +357,7 @@ class FullQueueLink : public CanTransport {
 // The controller's thread must not sleep in SocketCAN's back-off (up to 750 us a frame, 4 ms
 // measured for two Fires): on a full queue it leaves the commands, in order, to the bus thread.
 TEST_F(DriverBusTest, OnAFullKernelQueueTheRealTimeCallerLeavesTheCommandsToTheBusThread) {
-  FullQueueLink link(*host_);
+  ScriptedLink link(*host_);
   DriverBus bus(link, bus_options());
   run(bus, 0.05);
   ASSERT_EQ(bus.state(), BusState::kRunning);
@@ -383,26 +387,10 @@ TEST_F(DriverBusTest, OnAFullKernelQueueTheRealTimeCallerLeavesTheCommandsToTheB
   EXPECT_EQ(board_.counters().fires_accepted, 2u);
 }
 
-// A link that fails one send (an error, not a full queue).
-class FailOnceLink : public CanTransport {
- public:
-  explicit FailOnceLink(CanTransport& inner) : inner_(inner) {}
-  TxStatus send(const CanFrame& frame) override {
-    return fail_next_ ? (fail_next_ = false, TxStatus::kError) : inner_.send(frame);
-  }
-  RxStatus receive(CanFrame& frame, int timeout_ms) override { return inner_.receive(frame, timeout_ms); }
-  int poll_fd() const override { return inner_.poll_fd(); }
-  TransportCounters counters() const override { return inner_.counters(); }
-  bool fail_next_ = false;
-
- private:
-  CanTransport& inner_;
-};
-
 // After a failed send the bus switches every coil off: a flipper the controller holds up went down
 // behind its back, and it must be told (coils_dropped) to fire again.
 TEST_F(DriverBusTest, ASendFailureThatSwitchesAHeldCoilOffTellsTheController) {
-  FailOnceLink link(*host_);
+  ScriptedLink link(*host_);
   DriverBus bus(link, bus_options());
   run(bus, 0.05);
   bus.fire(1);
