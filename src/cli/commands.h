@@ -170,7 +170,7 @@ struct CalibrateArgs {
   std::string sim_camera = "ideal";  ///< --sim: the simulated camera, ideal or typical (lens, rolling shutter, ...)
   std::string device;                ///< latency: the camera, /dev/videoN
   std::string can;                   ///< latency: the driver board's SocketCAN interface (can0)
-  std::string config;                ///< latency: pinballd's configuration: board id, coils, watchdog (and can.interface)
+  std::string config;                ///< latency: pinballd's configuration (board id, coils, watchdog, devices)
   std::string flipper;               ///< latency: the flipper fired (board name); empty: the board's first
   int events = 20;                   ///< latency: times the flipper is fired
   double sim_latency_ms = -1.0;      ///< latency --sim: the camera's minimum latency (ms); < 0: the typical camera's

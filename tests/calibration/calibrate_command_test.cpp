@@ -441,7 +441,8 @@ TEST_F(Calibrate, LatencyInTheLabWithoutHardwareFailsClearlyAndWritesNothing) {
   // pinballd's configuration gives the camera, the interface and the board id it fires.
   const std::string pinballd = (dir_ / "pinballd.yaml").string();
   std::ofstream(pinballd) << "version: 1\nmode: lab\nboard: " PINBALL_SOURCE_DIR "/boards/mit1993.board\n"
-                          << "camera: {source: v4l2, device: /dev/video96}\ncan: {interface: pinballcan8, board_id: 3}\n";
+                          << "camera: {source: v4l2, device: /dev/video96}\n"
+                          << "can: {interface: pinballcan8, board_id: 3}\n";
   r = run("calibrate latency --board boards/mit1993.board --calibration " + file + " --config " + pinballd +
           " --row-time-us 10");
   EXPECT_EQ(r.exit_code, 1);

@@ -64,7 +64,8 @@ TEST(CameraHomography, FromPointsRefusesPointsNoViewOfAPlaneGives) {
   EXPECT_NE(error(twice, image).find("board points lie on a line (or two coincide)"), std::string::npos);
   std::array<cv::Point2d, 4> crossed = image;
   std::swap(crossed[2], crossed[3]);  // a bow tie
-  EXPECT_NE(error(board, crossed).find("an order no view of a plane gives"), std::string::npos) << error(board, crossed);
+  EXPECT_NE(error(board, crossed).find("an order no view of a plane gives"), std::string::npos)
+      << error(board, crossed);
   EXPECT_EQ(error(board, image), "");
 }
 
