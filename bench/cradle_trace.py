@@ -16,21 +16,12 @@ last rested. Standard library only; `--json` prints one object.
 """
 import argparse
 import collections
-import csv
 import json
 import math
 import statistics
 import sys
 
-
-def read_trace(path):
-    rows = []
-    with open(path, newline="") as f:
-        for r in csv.DictReader(f):
-            rows.append((float(r["t"]), float(r["x"]), float(r["y"]), float(r["vx"]), float(r["vy"]), r["event"]))
-    if not rows:
-        sys.exit(f"{path}: no rows")
-    return rows
+import sim_trace
 
 
 def rests(rows, still_mps, rest_s):
@@ -59,10 +50,19 @@ def main():
     p.add_argument("--rock-m", type=float, default=0.02)
     p.add_argument("--json", action="store_true")
     a = p.parse_args()
-    rows = read_trace(a.trace)
+    try:
+        rows = list(sim_trace.steps(a.trace))
+    except sim_trace.TraceError as e:
+        print(f"cradle_trace: {e}; nothing printed", file=sys.stderr)
+        return 1
+    if not rows:
+        print(f"cradle_trace: {a.trace}: no steps", file=sys.stderr)
+        return 1
     found = rests(rows, a.still_mps, a.rest_s)
     if not found:
-        sys.exit(f"{a.trace}: the ball never rested {a.rest_s} s below {a.still_mps} m/s: no cradle")
+        print(f"cradle_trace: {a.trace}: the ball never rested {a.rest_s} s below {a.still_mps} m/s: no cradle",
+              file=sys.stderr)
+        return 1
     floor_y = min(r[3] for r in found)
     index = {t: i for i, (t, *_rest) in enumerate(rows)}
     trips, rocks = [], 0
@@ -103,7 +103,7 @@ def main():
     }
     if a.json:
         print(json.dumps(report, indent=2))
-        return
+        return 0
     print(f"{a.trace}: {report['ball_time_s']:.1f} s of ball time, {'lost' if report['lost'] else 'not lost'}, "
           f"last rest at {report['last_rest_s']:.1f} s")
     print(f"rests {report['rests']} ({100 * report['share_of_time_at_rest']:.0f} % of the time), at:")
@@ -117,7 +117,8 @@ def main():
               "y {:.3f} / {:.3f} / {:.3f} m".format(*q["trip_away_s_min_median_max"], *q["trip_top_x_m_min_median_max"],
                                                    *q["trip_top_y_m_min_median_max"]))
         print("  hits per trip: " + ", ".join(f"{k} {v:.2f}" for k, v in list(q["hits_per_trip"].items())[:8]))
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

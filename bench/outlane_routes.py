@@ -18,11 +18,12 @@ chute). Standard library only; `--json` prints one object.
 """
 import argparse
 import collections
-import csv
 import json
 import math
 import statistics
 import sys
+
+import sim_trace
 
 
 def main() -> int:
@@ -39,14 +40,13 @@ def main() -> int:
     a = p.parse_args()
 
     try:
-        f = open(a.trace, newline="")
-    except OSError as e:
-        print(f"outlane_routes: {a.trace}: {e.strerror}", file=sys.stderr)
+        return report(a, sim_trace.steps(a.trace))
+    except sim_trace.TraceError as e:
+        print(f"outlane_routes: {e}; nothing printed", file=sys.stderr)
         return 1
-    rows = csv.reader(f)
-    if next(rows, None) != ["t", "x", "y", "vx", "vy", "event"]:
-        print(f"outlane_routes: {a.trace}: not a pinball sim --trace CSV (header t,x,y,vx,vy,event)", file=sys.stderr)
-        return 1
+
+
+def report(a, rows) -> int:
 
     steps = collections.deque()  # (t, x, y, vy) of the last window
     prev = None
@@ -68,15 +68,7 @@ def main() -> int:
         shot_outcomes[flipper][b][outcome] += 1
         shot_seconds[flipper][b] += t_end - t0
 
-    for r in rows:
-        try:
-            if len(r) != 6:
-                raise ValueError(f"{len(r)} fields, not 6")
-            t, x, y, vx, vy, event = float(r[0]), float(r[1]), float(r[2]), float(r[3]), float(r[4]), r[5]
-        except ValueError as e:
-            print(f"outlane_routes: {a.trace}:{rows.line_num}: not a trace row ({e}); nothing printed",
-                  file=sys.stderr)
-            return 1
+    for t, x, y, vx, vy, event in rows:
         if event == "launch":
             crossing_x, touched_s, contacts, prev = None, None, 0, None
             steps.clear()
