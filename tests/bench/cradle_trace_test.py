@@ -1,13 +1,12 @@
 #!/usr/bin/env python3
 """bench/cradle_trace.py on a hand-made trace: a ball at rest in one crook
 four times, between the rests a trip up the lane, a rock in the crook and a
-shot up the table; and the refusals of a missing file and of a file that is
-no trace."""
+shot up the table; and the refusals of a missing file, of a file that is no
+trace and of a row cut short."""
 import json
-import os
 import tempfile
 
-from script_test import check, run
+from script_test import check, check_refuses_what_is_no_trace, run, write_trace
 
 REST = (0.342, 0.184)
 rows = [
@@ -28,11 +27,7 @@ rows = [
     (4.7, *REST, 0, 0, ""),  # rest 4: cut here
 ]
 with tempfile.TemporaryDirectory() as d:
-    trace = os.path.join(d, "trace.csv")
-    with open(trace, "w") as f:
-        f.write("t,x,y,vx,vy,event\n")
-        for r in rows:
-            f.write(",".join(str(v) for v in r) + "\n")
+    trace = write_trace(d, rows)
     r = run(trace, "--json")
     check(r.returncode == 0, "exit 0 on a trace: " + r.stderr)
     j = json.loads(r.stdout)
@@ -45,11 +40,5 @@ with tempfile.TemporaryDirectory() as d:
     check(text.returncode == 0 and "1 rocks in the crook" in text.stdout and "2 trips away, 1 of them" in text.stdout,
           text.stdout)
 
-    missing = run(os.path.join(d, "no_such.csv"))
-    check(missing.returncode == 1 and "no_such.csv" in missing.stderr and not missing.stdout, "a missing file")
-    other = os.path.join(d, "other.csv")
-    with open(other, "w") as f:
-        f.write("a,b\n1,2\n")
-    wrong = run(other)
-    check(wrong.returncode == 1 and "other.csv" in wrong.stderr and "header" in wrong.stderr, "not a trace")
+    check_refuses_what_is_no_trace(d)
 print("cradle_trace: all checks passed")

@@ -5,10 +5,9 @@ the shots by direction (one from the left bat that drains down the left
 outlane, one from the right bat that comes back, one too slow to count);
 and the refusals of a missing file and of a file that is no trace."""
 import json
-import os
 import tempfile
 
-from script_test import check, run
+from script_test import check, check_refuses_what_is_no_trace, run, write_trace
 
 rows = [
     # ball 1: pushed at 1.0 s, two obstacles, down the passage, past the pivot line at x 0.02 at 3.5 s
@@ -33,11 +32,7 @@ rows = [
     (6.2, 0.25, 0.02, 0, -1, "hit:drain|lost"),
 ]
 with tempfile.TemporaryDirectory() as d:
-    trace = os.path.join(d, "trace.csv")
-    with open(trace, "w") as f:
-        f.write("t,x,y,vx,vy,event\n")
-        for r in rows:
-            f.write(",".join(str(v) for v in r) + "\n")
+    trace = write_trace(d, rows)
     r = run(trace, "--json")
     check(r.returncode == 0, "exit 0 on a trace: " + r.stderr)
     j = json.loads(r.stdout)
@@ -54,16 +49,5 @@ with tempfile.TemporaryDirectory() as d:
     text = run(trace)
     check(text.returncode == 0 and "1 left outlane (1 down the left passage" in text.stdout, text.stdout)
 
-    missing = run(os.path.join(d, "no_such.csv"))
-    check(missing.returncode == 1 and "no_such.csv" in missing.stderr and not missing.stdout, "a missing file")
-    other = os.path.join(d, "other.csv")
-    with open(other, "w") as f:
-        f.write("a,b\n1,2\n")
-    wrong = run(other)
-    check(wrong.returncode == 1 and "other.csv" in wrong.stderr and "header" in wrong.stderr, "not a trace")
-    truncated = os.path.join(d, "truncated.csv")
-    with open(truncated, "w") as f:
-        f.write("t,x,y,vx,vy,event\n0,0.49,0.054,0,4.6,launch\n0.5,0.4\n")
-    cut = run(truncated, "--json")
-    check(cut.returncode == 1 and "truncated.csv:3" in cut.stderr and not cut.stdout, "a truncated row: " + cut.stderr)
+    check_refuses_what_is_no_trace(d)
 print("outlane_routes: all checks passed")
