@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "../firmware/board_harness.h"
+#include "common/forwarding_link.h"
 #include "pinball/firmware/driver_bus.h"
 #include "pinball/firmware/frame_log.h"
 #include "pinball/firmware/liveness.h"
@@ -26,24 +27,20 @@ constexpr double kTick_s = 0.001;
 constexpr double kStatusPeriod_s = 0.01;  // VirtualDriverBoardOptions' default
 
 // The host's end of the link, dropping the frames a test picks.
-class DroppingLink final : public CanTransport {
+class DroppingLink final : public pinball::testing::ForwardingLink {
  public:
-  DroppingLink(CanTransport& inner, std::function<bool(const CanFrame&)> drop) : inner_(inner), drop_(std::move(drop)) {}
+  DroppingLink(CanTransport& inner, std::function<bool(const CanFrame&)> drop)
+      : ForwardingLink(inner), drop_(std::move(drop)) {}
   TxStatus send(const CanFrame& f) override {
     if (drop_(f)) {
       ++dropped;
       return TxStatus::kOk;  // lost on the wire: the sender cannot know
     }
-    return inner_.send(f);
+    return ForwardingLink::send(f);
   }
-  RxStatus receive(CanFrame& f, int timeout_ms) override { return inner_.receive(f, timeout_ms); }
-  int poll_fd() const override { return inner_.poll_fd(); }
-  bool reopen() override { return inner_.reopen(); }
-  TransportCounters counters() const override { return inner_.counters(); }
   int dropped = 0;
 
  private:
-  CanTransport& inner_;
   std::function<bool(const CanFrame&)> drop_;
 };
 

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "board_harness.h"
+#include "common/forwarding_link.h"
 #include "pinball/firmware/frame_log.h"
 #include "pinball/simlab/faulty_link.h"
 
@@ -294,23 +295,17 @@ TEST_F(DriverBusTest, SendQueuedSendsReleaseAllFirstAndDropsWhenNotRunning) {
 }
 
 // A link whose receive() can be held, to catch poll_once in the middle of its work.
-class GatedLink : public CanTransport {
+class GatedLink : public pinball::testing::ForwardingLink {
  public:
-  explicit GatedLink(CanTransport& inner) : inner_(inner) {}
-  TxStatus send(const CanFrame& frame) override { return inner_.send(frame); }
+  using ForwardingLink::ForwardingLink;
   RxStatus receive(CanFrame& frame, int timeout_ms) override {
     if (armed_.exchange(false)) {
       inside_ = true;
       while (!open_.load()) std::this_thread::yield();
     }
-    return inner_.receive(frame, timeout_ms);
+    return ForwardingLink::receive(frame, timeout_ms);
   }
-  int poll_fd() const override { return inner_.poll_fd(); }
-  TransportCounters counters() const override { return inner_.counters(); }
   std::atomic<bool> armed_{false}, inside_{false}, open_{false};
-
- private:
-  CanTransport& inner_;
 };
 
 TEST_F(DriverBusTest, SendQueuedNeverWaitsForABusyPoll) {
@@ -335,23 +330,17 @@ TEST_F(DriverBusTest, SendQueuedNeverWaitsForABusyPoll) {
 
 // A link whose kernel queue can be full (send() would back off until it drains: here, at once), or
 // whose next send fails outright.
-class ScriptedLink : public CanTransport {
+class ScriptedLink : public pinball::testing::ForwardingLink {
  public:
-  explicit ScriptedLink(CanTransport& inner) : inner_(inner) {}
+  using ForwardingLink::ForwardingLink;
   TxStatus send(const CanFrame& frame) override {
-    return fail_next_ ? (fail_next_ = false, TxStatus::kError) : inner_.send(frame);
+    return fail_next_ ? (fail_next_ = false, TxStatus::kError) : ForwardingLink::send(frame);
   }
   TxStatus send_without_waiting(const CanFrame& frame) override {
     return full_ ? TxStatus::kBufferFull : send(frame);
   }
-  RxStatus receive(CanFrame& frame, int timeout_ms) override { return inner_.receive(frame, timeout_ms); }
-  int poll_fd() const override { return inner_.poll_fd(); }
-  TransportCounters counters() const override { return inner_.counters(); }
   bool full_ = false;
   bool fail_next_ = false;
-
- private:
-  CanTransport& inner_;
 };
 
 // The controller's thread must not sleep in SocketCAN's back-off (up to 750 us a frame, 4 ms
